@@ -1,0 +1,1 @@
+"""nanoimpact calibration layer: MD results -> continuum parameters, pipelines and the command line."""

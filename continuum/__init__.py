@@ -1,0 +1,2 @@
+"""nanoimpact continuum layer: contact laws, closed-form references and the impact driver (SI units)."""
+__version__ = "0.1.0"

@@ -1,0 +1,1 @@
+"""Contact laws usable by the impact driver."""

@@ -1,0 +1,1 @@
+"""Closed-form reference solutions (Hertz, JKR) used to validate the numerical laws."""

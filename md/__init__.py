@@ -1,0 +1,1 @@
+"""nanoimpact molecular layer: LAMMPS loading, structure builders, MD workflows and analysis (SI at the edges)."""
