@@ -1,0 +1,67 @@
+"""What a contact law provides to the impact driver.
+
+Following ASE's calculator idea, a law declares what it provides and the driver never cares
+which law it has. Coordinates: `gap` h (m) is the height of the body's lowest point above the
+contact datum; approach delta = -h. Forces are upward forces on the body (N, positive pushes the
+body away from the surface). Energies are in J.
+
+A law owns its own losses: dissipation is booked from the law's loss terms (e.g. the closed-form
+area of a JKR hysteresis loop at each detachment), never taken as the leftover of an energy
+balance, so the driver's energy audit can fail.
+"""
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+
+class ContactLaw(ABC):
+    """A rate-independent contact law with optional history.
+
+    Attributes
+    ----------
+    name : str
+        Short identifier recorded in results.
+    touch_gap : float
+        Gap (m) at which contact begins on approach.
+    bound_is_final : bool
+        True if, once the body turns back towards the surface while still in contact, it can
+        never leave (the law is elastic while attached, so the motion is a lossless oscillation).
+    """
+
+    name: str = "law"
+    touch_gap: float = 0.0
+    bound_is_final: bool = True
+
+    def reset(self) -> None:
+        """Start a new contact (history cleared)."""
+
+    @abstractmethod
+    def force(self, gap: float) -> float:
+        """Upward contact force (N) at `gap` (m) on the current branch."""
+
+    @abstractmethod
+    def stiffness(self, gap: float) -> float:
+        """Contact stiffness -dF/dgap = dP/d(delta) (N/m)."""
+
+    @abstractmethod
+    def stored_energy(self, gap: float) -> float:
+        """Energy (J) stored in the contact relative to the state at touch."""
+
+    @abstractmethod
+    def release_gap(self) -> float:
+        """Gap (m) at which the contact ends while the body moves away."""
+
+    def on_release(self) -> float:
+        """Book the loss of one release, from the law's own loss term (J)."""
+        return 0.0
+
+    def accept(self, gap: float) -> None:
+        """Update history after an accepted integration step (stateless laws ignore it)."""
+
+    @abstractmethod
+    def length_scale(self, mass: float, speed: float) -> float:
+        """A typical approach (m) for an impact of `mass` (kg) at `speed` (m/s): scales tolerances."""
+
+    @abstractmethod
+    def describe(self) -> dict:
+        """JSON-ready description: name, equations' source, parameters (SI)."""

@@ -1,0 +1,54 @@
+"""Figures of an impact run. Functions take `ax=None`, return the axes and never call plt.show().
+
+Plot units (nm, ns, ms, uN) are converted here, at the edge; data stay in SI.
+"""
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def height_vs_time(trace: dict, ax=None, label: str | None = None):
+    """Gap of the body's lowest point (nm) against time (ms)."""
+    ax = ax or plt.figure(figsize=(7, 3.5)).gca()
+    ax.plot(np.asarray(trace["t"]) * 1e3, np.asarray(trace["gap"]) * 1e9, lw=1.0, label=label)
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("height above datum (nm)")
+    ax.grid(alpha=0.3)
+    return ax
+
+
+def force_vs_time(trace: dict, bounces: list[dict], ax=None, max_impacts: int = 12):
+    """Contact force (uN) against time since touch (ns), one line per impact."""
+    ax = ax or plt.figure(figsize=(7, 3.5)).gca()
+    t = np.asarray(trace["t"])
+    force = np.asarray(trace["force"])
+    phase = np.asarray(trace["phase"])
+    cmap = plt.get_cmap("viridis")
+    shown = bounces[:max_impacts]
+    for k, b in enumerate(shown):
+        sel = phase == b["index"]
+        if not np.any(sel):
+            continue
+        ax.plot((t[sel] - b["t_contact"]) * 1e9, force[sel] * 1e6, lw=1.0,
+                color=cmap(k / max(len(shown) - 1, 1)), label=f"impact {b['index'] + 1}")
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("time since touch (ns)")
+    ax.set_ylabel("contact force (uN)")
+    ax.grid(alpha=0.3)
+    if shown:
+        ax.legend(fontsize=7, ncol=2)
+    return ax
+
+
+def save(ax, path, title: str | None = None) -> None:
+    """Save the figure of `ax` to `path` (PNG) and close it."""
+    fig = ax.figure
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -1,0 +1,345 @@
+"""Scene files: read, merge with a parameter set, validate at the edge, build frozen dataclasses.
+
+Resolution order for every key: schema default < parameter set (`params = "NAME"` reads
+`inputs/params/NAME.toml`, or `--params NAME|FILE` replaces it) < the scene file itself. The
+resolved scene records each value and where it came from. Validation rejects unknown keys and
+checks every value's type, sign and range; the first problem raises `SceneError` naming the key,
+the value and what is allowed. Nothing here writes files.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from .reference.hertz import effective_modulus
+from .schema import FIDELITY, FIELD_BY_PATH, FIELDS, REQUIRED, Field, is_section, to_internal
+
+#: Default folder of parameter sets, relative to the project root (inputs/params).
+PARAMS_DIR = Path(__file__).resolve().parent.parent / "inputs" / "params"
+
+
+class SceneError(ValueError):
+    """An invalid scene: names the key, the value and what is allowed."""
+
+    def __init__(self, key: str, value, allowed: str, origin: str = ""):
+        self.key, self.value, self.allowed, self.origin = key, value, allowed, origin
+        where = f"{origin}: " if origin else ""
+        super().__init__(f"{where}{key} = {value!r}: {allowed}")
+
+
+# ----------------------------------------------------------------------------- dataclasses
+@dataclass(frozen=True)
+class Body:
+    """The impacting body. Lengths in m, mass in kg."""
+
+    shape: str
+    radius: float
+    length: float | None
+    mass: float
+
+
+@dataclass(frozen=True)
+class Material:
+    """Elastic constants (Pa, 1) and water contact angle (rad, or None if not given) of one surface."""
+
+    youngs_modulus: float
+    poisson_ratio: float
+    contact_angle: float | None
+
+
+@dataclass(frozen=True)
+class Surfaces:
+    """The pair of surfaces: work of adhesion (J/m^2) and each side's material."""
+
+    work_of_adhesion: float
+    body: Material
+    substrate: Material
+
+    @property
+    def e_star(self) -> float:
+        """Effective (contact) modulus E* in Pa, 1/E* = sum (1 - nu^2)/E (Johnson's convention)."""
+        return float(effective_modulus(self.body.youngs_modulus, self.body.poisson_ratio,
+                                       self.substrate.youngs_modulus, self.substrate.poisson_ratio))
+
+
+@dataclass(frozen=True)
+class Environment:
+    """Gravity (m/s^2), relative humidity (fraction) and temperature (K)."""
+
+    gravity: float
+    relative_humidity: float
+    temperature: float
+
+
+@dataclass(frozen=True)
+class Physics:
+    """Model choices."""
+
+    adhesion_law: str
+    detachment: str
+    line_stiffness: str
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """Numerical settings; `rtol` is resolved from the fidelity preset unless given."""
+
+    fidelity: str
+    rtol: float
+    max_bounces: int
+    max_time: float
+    rest_fraction: float
+    samples_per_flight: int
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene in SI units (angles in radians)."""
+
+    name: str
+    description: str
+    contact: str
+    release_height: float | None
+    impact_velocity: float | None
+    body: Body
+    surfaces: Surfaces
+    environment: Environment
+    physics: Physics
+    numerics: Numerics
+
+
+@dataclass(frozen=True)
+class ResolvedScene:
+    """A scene together with the file-unit values it was built from and where each came from."""
+
+    scene: Scene
+    values: dict
+    sources: dict
+    scene_file: str | None
+    params_file: str | None
+
+    def to_json(self) -> dict:
+        """JSON-ready record: nested values in file units (as written), sources, files, SI dataclass."""
+        return {
+            "file": self.scene_file,
+            "params_file": self.params_file,
+            "values": _nest(self.values),
+            "sources": self.sources,
+            "si": asdict(self.scene),
+        }
+
+    @property
+    def input_hash(self) -> str:
+        """SHA-256 of the canonical resolved values: identical physics inputs give identical hashes."""
+        blob = json.dumps(self.values, sort_keys=True, default=repr).encode()
+        return hashlib.sha256(blob).hexdigest()
+
+
+# ----------------------------------------------------------------------------- reading
+def read_toml(path: Path, what: str = "scene") -> dict:
+    """Parse a TOML file, turning I/O and syntax problems into SceneError."""
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(what, str(path), "file not found")
+    try:
+        with path.open("rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(what, str(path), f"is not valid TOML ({exc})") from None
+
+
+def flatten(table: dict, origin: str, prefix: str = "", skip: tuple[str, ...] = ()) -> dict:
+    """Flatten nested tables to dotted keys, rejecting any key the schema does not know."""
+    flat = {}
+    for key, value in table.items():
+        path = f"{prefix}{key}"
+        if path in skip:
+            continue
+        if isinstance(value, dict):
+            if not is_section(path):
+                raise SceneError(path, "{...}", _unknown(path), origin)
+            flat.update(flatten(value, origin, path + ".", skip))
+        elif path in FIELD_BY_PATH:
+            flat[path] = value
+        else:
+            raise SceneError(path, value, _unknown(path), origin)
+    return flat
+
+
+def _unknown(path: str) -> str:
+    parent = path.rsplit(".", 1)[0] if "." in path else ""
+    known = sorted(f.path.rsplit(".", 1)[-1] for f in FIELDS
+                   if (f.path.rsplit(".", 1)[0] if "." in f.path else "") == parent)
+    return f"unknown key; keys allowed here: {', '.join(known)}"
+
+
+def find_params(spec: str, params_dir: Path | None = None) -> Path:
+    """A parameter-set name (inputs/params/NAME.toml) or a path to a TOML file."""
+    candidate = Path(spec)
+    if candidate.suffix == ".toml" or candidate.is_file():
+        if not candidate.is_file():
+            raise SceneError("params", spec, "parameter file not found")
+        return candidate
+    folder = Path(params_dir) if params_dir else PARAMS_DIR
+    path = folder / f"{spec}.toml"
+    if not path.is_file():
+        names = sorted(p.stem for p in folder.glob("*.toml")) if folder.is_dir() else []
+        raise SceneError("params", spec, f"no parameter set of that name; available: {', '.join(names) or 'none'}")
+    return path
+
+
+# ----------------------------------------------------------------------------- validation
+def check_value(f: Field, value, origin: str):
+    """Type and range check of one value in file units; returns it (ints widened to float)."""
+    if f.kind is str:
+        if not isinstance(value, str):
+            raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
+        if f.choices and value not in f.choices:
+            raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
+        return value
+    if f.kind is bool:
+        if not isinstance(value, bool):
+            raise SceneError(f.path, value, "must be true or false", origin)
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
+    if f.kind is int and not isinstance(value, int):
+        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
+    if not math.isfinite(value):
+        raise SceneError(f.path, value, f"must be finite: {f.allowed()}", origin)
+    if f.low is not None and (value < f.low or (f.low_open and value == f.low)):
+        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
+    if f.high is not None and (value > f.high or (f.high_open and value == f.high)):
+        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
+    return float(value) if f.kind is float else value
+
+
+def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = None,
+                  params: str | None = None, params_dir: Path | None = None) -> ResolvedScene:
+    """Read, merge and validate a scene (from a file or an in-memory table).
+
+    `params` (a name or a path) replaces the scene's own `params` entry, as `--params` does.
+    """
+    origin = str(scene_file) if scene_file is not None else "<scene>"
+    if table is None:
+        if scene_file is None:
+            raise ValueError("give a scene file or a table")
+        table = read_toml(Path(scene_file))
+    flat_scene = flatten(table, origin)
+    for path, value in flat_scene.items():
+        check_value(FIELD_BY_PATH[path], value, origin)
+
+    params_spec = params if params is not None else flat_scene.get("params")
+    params_file = None
+    flat_params: dict = {}
+    if params_spec is not None:
+        params_file = find_params(params_spec, params_dir)
+        raw = read_toml(params_file, "params")
+        flat_params = flatten(raw, str(params_file), skip=("meta",))
+        for forbidden in ("params", "name", "description"):
+            if forbidden in flat_params:
+                raise SceneError(forbidden, flat_params[forbidden], "cannot be set by a parameter set",
+                                 str(params_file))
+        for path, value in flat_params.items():
+            check_value(FIELD_BY_PATH[path], value, str(params_file))
+        flat_scene = {**flat_scene, "params": str(params_spec)}
+
+    values, sources = {}, {}
+    set_label = f"params:{Path(params_file).stem}" if params_file else None
+    for f in FIELDS:
+        if f.path in flat_scene:
+            values[f.path], sources[f.path] = flat_scene[f.path], "scene"
+        elif f.path in flat_params:
+            values[f.path], sources[f.path] = flat_params[f.path], set_label
+        elif f.default is REQUIRED:
+            continue
+        else:
+            values[f.path], sources[f.path] = f.default, "default"
+    if values.get("name") is None:
+        values["name"] = Path(scene_file).stem if scene_file is not None else "scene"
+        sources["name"] = "file name"
+    scene = _build(values, origin)
+    return ResolvedScene(scene, values, sources, str(scene_file) if scene_file else None,
+                         str(params_file) if params_file else None)
+
+
+def _require(values: dict, path: str, origin: str, why: str):
+    if values.get(path) is None:
+        raise SceneError(path, None, f"is required {why}", origin)
+    return values[path]
+
+
+def _build(v: dict, origin: str) -> Scene:
+    """Cross-field checks, then the dataclasses (SI; degrees -> radians)."""
+    for f in FIELDS:
+        if f.default is REQUIRED and f.path not in v:
+            raise SceneError(f.path, None, f"is required: {f.allowed()}", origin)
+    si = {path: to_internal(FIELD_BY_PATH[path], val) for path, val in v.items()}
+
+    if (si["release_height"] is None) == (si["impact_velocity"] is None):
+        raise SceneError("release_height", si["release_height"],
+                         "give exactly one of release_height and impact_velocity", origin)
+    if si["release_height"] is not None and si["environment.gravity"] == 0.0:
+        raise SceneError("environment.gravity", 0.0, "must be > 0 when the body is released from a height", origin)
+
+    shape = si["body.shape"]
+    if shape == "cylinder":
+        length = _require(si, "body.length", origin, "for a cylinder")
+    else:
+        if si["body.length"] is not None:
+            raise SceneError("body.length", v["body.length"], "is for cylinders only; remove it for a sphere", origin)
+        length = None
+    if (si["body.mass"] is None) == (si["body.density"] is None):
+        raise SceneError("body.mass", si["body.mass"], "give exactly one of body.mass and body.density", origin)
+    if si["body.mass"] is not None:
+        mass = si["body.mass"]
+    elif shape == "sphere":
+        mass = 4.0 / 3.0 * math.pi * si["body.radius"] ** 3 * si["body.density"]
+    else:
+        mass = math.pi * si["body.radius"] ** 2 * length * si["body.density"]
+
+    if si["physics.adhesion_law"] == "jkr":
+        if shape == "cylinder" and si["contact"] == "smooth":
+            raise SceneError("physics.adhesion_law", "jkr",
+                             "a smooth cylinder has no JKR law here (2-D JKR is not implemented); "
+                             "use body.shape = 'sphere' or contact = 'rough'", origin)
+        if si["surfaces.work_of_adhesion"] <= 0.0:
+            raise SceneError("surfaces.work_of_adhesion", si["surfaces.work_of_adhesion"],
+                             "must be > 0 J/m^2 when physics.adhesion_law = 'jkr'", origin)
+
+    rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else FIDELITY[si["numerics.fidelity"]]["rtol"]
+    return Scene(
+        name=si["name"],
+        description=si["description"],
+        contact=si["contact"],
+        release_height=si["release_height"],
+        impact_velocity=si["impact_velocity"],
+        body=Body(shape, si["body.radius"], length, mass),
+        surfaces=Surfaces(
+            si["surfaces.work_of_adhesion"],
+            Material(si["surfaces.body.youngs_modulus"], si["surfaces.body.poisson_ratio"],
+                     si["surfaces.body.contact_angle"]),
+            Material(si["surfaces.substrate.youngs_modulus"], si["surfaces.substrate.poisson_ratio"],
+                     si["surfaces.substrate.contact_angle"]),
+        ),
+        environment=Environment(si["environment.gravity"], si["environment.relative_humidity"],
+                                si["environment.temperature"]),
+        physics=Physics(si["physics.adhesion_law"], si["physics.detachment"], si["physics.line_stiffness"]),
+        numerics=Numerics(si["numerics.fidelity"], rtol, si["numerics.max_bounces"], si["numerics.max_time"],
+                          si["numerics.rest_fraction"], si["numerics.samples_per_flight"]),
+    )
+
+
+def _nest(flat: dict) -> dict:
+    out: dict = {}
+    for path, value in flat.items():
+        node = out
+        *parents, leaf = path.split(".")
+        for p in parents:
+            node = node.setdefault(p, {})
+        node[leaf] = value
+    return out

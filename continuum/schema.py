@@ -1,0 +1,164 @@
+"""The scene-file schema: one table of fields drives validation, defaults and `docs/scenes.md`.
+
+Scene files are TOML in SI units; angles are written in degrees and converted to radians
+here, at the edge (the only unit conversion a scene needs). Every field states its type, unit,
+allowed range and default. `REQUIRED` marks fields without a default; `None` as a default
+marks optional fields whose absence means "not given" (the model that needs them says so).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Field:
+    """One scene key.
+
+    `path` is the dotted key ("body.radius"); `kind` is float, int, str or bool; `low`/`high`
+    bound numbers (`low_open`/`high_open` make the bound strict); `choices` lists allowed
+    strings; `degrees` marks angles written in degrees and stored in radians.
+    """
+
+    path: str
+    kind: type
+    unit: str
+    doc: str
+    default: object = REQUIRED
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple[str, ...] = ()
+    degrees: bool = False
+
+    def allowed(self) -> str:
+        """Human-readable statement of what the field accepts."""
+        if self.kind is str:
+            return "one of " + ", ".join(repr(c) for c in self.choices) if self.choices else "a string"
+        if self.kind is bool:
+            return "true or false"
+        name = "an integer" if self.kind is int else "a number"
+        parts = []
+        if self.low is not None:
+            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
+        if self.high is not None:
+            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
+        rng = " and ".join(parts)
+        unit = f" {self.unit}" if self.unit and self.unit != "1" else ""
+        return f"{name} {rng}{unit}".rstrip() if rng else f"{name}{unit}"
+
+
+_LEN = dict(kind=float, unit="m")
+_MODULUS = dict(kind=float, unit="Pa", low=1e6, high=1e13)
+_POISSON = dict(kind=float, unit="1", low=0.0, high=0.5, high_open=True)
+_ANGLE = dict(kind=float, unit="deg", low=0.0, high=180.0, degrees=True)
+
+FIELDS: tuple[Field, ...] = (
+    # --- top level -----------------------------------------------------------------------
+    Field("name", str, "", "Scene name (defaults to the file name without extension).", None),
+    Field("description", str, "", "Free text shown in results.", ""),
+    Field("params", str, "", "Parameter set: reads inputs/params/NAME.toml; scene values override it.", None),
+    Field("contact", str, "", "Contact model: 'smooth' (Hertz/JKR of the body's own curvature) or 'rough' "
+          "(Greenwood-Williamson summits; later issue).", "smooth", choices=("smooth",)),
+    Field("release_height", float, "m", "Release height of the lowest point of the body above the contact "
+          "datum, from rest. Give exactly one of release_height and impact_velocity.", None,
+          low=0.0, high=1.0, low_open=True),
+    Field("impact_velocity", float, "m/s", "Normal speed at first touch (the body starts at the datum "
+          "moving down). Give exactly one of release_height and impact_velocity.", None,
+          low=0.0, high=100.0, low_open=True),
+    # --- body ----------------------------------------------------------------------------
+    Field("body.shape", str, "", "Body geometry.", REQUIRED, choices=("cylinder", "sphere")),
+    Field("body.radius", doc="Radius of the cylinder or sphere.", default=REQUIRED,
+          low=1e-9, high=1.0, **_LEN),
+    Field("body.length", doc="Cylinder (roller) length l; cylinders only.", default=None,
+          low=1e-9, high=10.0, **_LEN),
+    Field("body.mass", float, "kg", "Body mass. Give mass or density, not both.", None,
+          low=0.0, high=1e3, low_open=True),
+    Field("body.density", float, "kg/m^3", "Body density; mass follows from the shape.", None,
+          low=1.0, high=1e5),
+    # --- surfaces ------------------------------------------------------------------------
+    Field("surfaces.work_of_adhesion", float, "J/m^2", "Work of adhesion (Dupre): gamma1 + gamma2 - gamma12.",
+          0.0, low=0.0, high=10.0),
+    Field("surfaces.body.youngs_modulus", doc="Young's modulus of the body.", default=REQUIRED, **_MODULUS),
+    Field("surfaces.body.poisson_ratio", doc="Poisson's ratio of the body.", default=REQUIRED, **_POISSON),
+    Field("surfaces.body.contact_angle", doc="Water contact angle on the body (menisci; later issue).",
+          default=None, **_ANGLE),
+    Field("surfaces.substrate.youngs_modulus", doc="Young's modulus of the substrate.", default=REQUIRED,
+          **_MODULUS),
+    Field("surfaces.substrate.poisson_ratio", doc="Poisson's ratio of the substrate.", default=REQUIRED,
+          **_POISSON),
+    Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci; later issue).",
+          default=None, **_ANGLE),
+    # --- environment ---------------------------------------------------------------------
+    Field("environment.gravity", float, "m/s^2", "Gravitational acceleration (0 switches gravity off).",
+          9.80665, low=0.0, high=1e3),
+    Field("environment.relative_humidity", float, "1", "Relative humidity as a fraction (0-1).", 0.0,
+          low=0.0, high=1.0),
+    Field("environment.temperature", float, "K", "Temperature.", 298.15, low=0.0, high=2000.0, low_open=True),
+    # --- physics -------------------------------------------------------------------------
+    Field("physics.adhesion_law", str, "", "'none' (Hertz) or 'jkr' (JKR with Fuller-Tabor hysteresis).",
+          "none", choices=("none", "jkr")),
+    Field("physics.detachment", str, "", "JKR detachment criterion: 'displacement' (let go at -delta_c, as "
+          "the paper) or 'load' (let go at -P_c).", "displacement", choices=("displacement", "load")),
+    Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
+          "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",
+          "implicit", choices=("implicit", "constant")),
+    # --- numerics ------------------------------------------------------------------------
+    Field("numerics.fidelity", str, "", "Preset for tolerances (and later grid and table sizes).", "standard",
+          choices=("fast", "standard", "reference")),
+    Field("numerics.rtol", float, "1", "Relative tolerance of the contact integrator (overrides the preset).",
+          None, low=1e-14, high=1e-3),
+    Field("numerics.max_bounces", int, "1", "Stop after this many impacts.", 100, low=1, high=100000),
+    Field("numerics.max_time", float, "s", "Stop after this much simulated time.", 10.0, low=0.0, high=1e6,
+          low_open=True),
+    Field("numerics.rest_fraction", float, "1", "A rebound lower than this fraction of the release height "
+          "counts as coming to rest (the notes' 1e-3 h0).", 1e-3, low=0.0, high=1.0, low_open=True, high_open=True),
+    Field("numerics.samples_per_flight", int, "1", "Time-series samples written per free flight.", 64,
+          low=2, high=100000),
+)
+
+FIELD_BY_PATH = {f.path: f for f in FIELDS}
+SECTIONS = sorted({f.path.rsplit(".", 1)[0] for f in FIELDS if "." in f.path})
+
+#: Fidelity presets: integrator tolerances now; grid and table sizes join with the rough model.
+FIDELITY = {
+    "fast": {"rtol": 1e-7},
+    "standard": {"rtol": 1e-10},
+    "reference": {"rtol": 1e-12},
+}
+
+
+def is_section(path: str) -> bool:
+    """True if `path` names a table (section) of the schema rather than a value."""
+    return path in SECTIONS
+
+
+def to_internal(f: Field, value):
+    """Convert a validated file value to SI-internal form (degrees -> radians)."""
+    if value is None:
+        return None
+    if f.degrees:
+        return math.radians(value)
+    return value
+
+
+def schema_markdown() -> str:
+    """The schema as a markdown table, for docs/scenes.md (generated, so it cannot drift)."""
+    lines = ["| key | type | unit | allowed | default | meaning |", "|---|---|---|---|---|---|"]
+    for f in FIELDS:
+        if f.default is REQUIRED:
+            default = "required"
+        elif f.default is None:
+            default = "not set"
+        else:
+            default = f"`{f.default!r}`"
+        lines.append(f"| `{f.path}` | {f.kind.__name__} | {f.unit or ''} | {f.allowed()} | {default} | {f.doc} |")
+    return "\n".join(lines)
+
+
+
+if __name__ == "__main__":  # python -m continuum.schema  -> prints the table for docs/scenes.md
+    print(schema_markdown())
