@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parent.parent
 CASES = [
     ("hertz roller, implicit K, 20 bounces", "hertz_roller.toml"),
     ("hertz roller, constant K, 20 bounces", "hertz_roller_constant_k.toml"),
-    ("JKR sphere, 10 bounces", "jkr_sphere.toml"),
+    ("JKR sphere, to stiction (11 rebounds)", "jkr_sphere.toml"),
 ]
 
 

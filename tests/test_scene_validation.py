@@ -111,8 +111,8 @@ def test_unknown_section_is_refused():
 def test_good_scene_converts_degrees_and_derives_mass_from_density():
     table = _with("body", {"shape": "sphere", "radius": 1e-6, "density": 2000.0})
     scene = resolve_scene(table=table).scene
-    assert scene.surfaces.substrate.contact_angle == pytest.approx(math.pi / 6, rel=1e-15)
-    assert scene.body.mass == pytest.approx(4 / 3 * math.pi * 1e-18 * 2000.0, rel=1e-15)
+    assert scene.surfaces.substrate.contact_angle == pytest.approx(math.pi / 6, rel=1e-15, abs=0)
+    assert scene.body.mass == pytest.approx(4 / 3 * math.pi * 1e-18 * 2000.0, rel=1e-15, abs=0)
 
 
 def test_params_set_is_overridden_by_scene_values_and_sources_recorded(tmp_path):

@@ -1,8 +1,9 @@
 """Non-adhesive Hertz contact laws: sphere, and a roller (line contact) with log stiffness.
 
-Sources: Johnson, *Contact Mechanics* (1985) §3.9 / §4.2 (sphere, eqs 4.22-4.23) and §5.6
-eq 5.39 (approach of a cylinder of finite length l: W = pi l E* delta / (2 ln(2l/b) + 1), the
-paper's eq 1 with b = sqrt(4WR/(pi E* l)) in Johnson's E* convention; see docs/model.md).
+Sources: Johnson, *Contact Mechanics* (1985) §4.2 (sphere, eqs 4.22-4.23; line-contact
+half-width); the roller's approach W = pi l E* delta / (2 ln(2l/b) + 1) is the paper's eq 1 (its
+ref. [19]) with b = sqrt(4WR/(pi E* l)) in Johnson's E* convention. Johnson §5.6 explains why the
+approach of a finite cylinder needs such a length-dependent log term (see docs/model.md).
 """
 from __future__ import annotations
 
@@ -41,9 +42,9 @@ class HertzSphere(ContactLaw):
 
 
 class HertzLine(ContactLaw):
-    """Roller of radius R and length l, W(delta) from Johnson eq 5.39 solved exactly.
+    """Roller of radius R and length l, W(delta) from the paper's eq 1 solved exactly.
 
-    With D = pi l E* delta and the log factor q = 2 ln(2l/b) + 1, eq 5.39 reads W q = D with
+    With D = pi l E* delta and the log factor q = 2 ln(2l/b) + 1, eq 1 reads W q = D with
     q = C - ln W (C from `reference.hertz`), i.e. q - ln q = C - ln D. The reference module solves
     this through Lambert's W_{-1} for arrays; the driver calls the law one scalar at a time, so
     here the same root is found by Newton's method on g(q) = q - ln q - (C - ln D) (g convex,
@@ -97,7 +98,7 @@ class HertzLine(ContactLaw):
         return float(ref.line_impact_max_approach(mass, speed, self.radius, self.length, self.e_star))
 
     def describe(self):
-        return {"name": self.name, "source": "Johnson (1985) eq 5.39; paper eq 1 (E* convention fixed)",
+        return {"name": self.name, "source": "paper eq 1 (E* convention fixed, Johnson 1985 §4.2), b(W) solved exactly",
                 "radius": self.radius, "length": self.length, "e_star": self.e_star}
 
 

@@ -34,6 +34,14 @@ class JKRSphere(ContactLaw):
         else:
             self.detach_approach = float(ref.load_controlled_detach_approach(radius, work_of_adhesion, e_star))
         self.loop_energy = float(ref.loop_area(radius, work_of_adhesion, e_star, detachment=detachment))
+        # scalar fast path (the driver calls the law one value at a time); see _sqrt_radius
+        self._k = 4.0 * e_star / 3.0
+        self._adh = math.sqrt(8.0 * math.pi * work_of_adhesion * e_star)
+        self._c = math.sqrt(2.0 * math.pi * work_of_adhesion / e_star)
+        self._u_fold = (radius * self._c / 4.0) ** (1.0 / 3.0)
+        a_touch = float(ref.contact_radius_at_touch(radius, work_of_adhesion, e_star))
+        self._energy_at_touch = self._energy_of_radius(a_touch)
+        self._cache = (None, self._u_fold)
 
     def _delta(self, gap):
         # Trial steps of the integrator may overshoot the release event slightly; the stable
@@ -43,14 +51,58 @@ class JKRSphere(ContactLaw):
     def _p(self):
         return self.radius, self.work_of_adhesion, self.e_star
 
+    def _sqrt_radius(self, delta: float) -> float:
+        """u = sqrt(a) on the stable branch: largest root of u^4 - c beta u - beta delta = 0.
+
+        Newton's method on this convex quartic converges monotonically to the largest root from
+        any start right of the fold u_c (where d delta/da = 0), so it is warm-started from the
+        previous call. Within 1e-6 delta_c of the fold the root is double and Newton slows down:
+        there the reference's closed-form (Ferrari) solution is used instead.
+        """
+        if self._cache[0] == delta:
+            return self._cache[1]
+        if delta + self.delta_c < 1e-6 * self.delta_c:
+            u = math.sqrt(float(ref.radius_from_approach(delta, *self._p())))
+        else:
+            beta, cb = self.radius, self._c * self.radius
+            u = max(self._cache[1], self._u_fold * (1.0 + 1e-3), (2.0 * beta * max(delta, 0.0)) ** 0.25)
+            for _ in range(100):
+                f = ((u * u) * (u * u) - cb * u - beta * delta)
+                step = f / (4.0 * u * u * u - cb)
+                u -= step
+                if abs(step) <= 2e-16 * u:
+                    break
+        self._cache = (delta, u)
+        return u
+
     def force(self, gap):
-        return float(ref.force_from_approach(self._delta(gap), *self._p()))
+        u = self._sqrt_radius(self._delta(gap))
+        a = u * u
+        return self._k * a * a * a / self.radius - self._adh * a * u
 
     def stiffness(self, gap):
-        return float(ref.stiffness_from_approach(self._delta(gap), *self._p()))
+        delta = self._delta(gap)
+        if delta <= -self.delta_c:
+            return -math.inf  # the stable branch's dP/d(delta) diverges to -inf at the fold
+        a = self._sqrt_radius(delta) ** 2
+        dp_da = 3.0 * self._k * a * a / self.radius - 1.5 * self._adh * math.sqrt(a)
+        dd_da = 2.0 * a / self.radius - 0.5 * self._c / math.sqrt(a)
+        return dp_da / dd_da
 
     def stored_energy(self, gap):
-        return float(ref.energy_from_approach(self._delta(gap), *self._p()))
+        a = self._sqrt_radius(self._delta(gap)) ** 2
+        return self._energy_of_radius(a) - self._energy_at_touch
+
+    def _energy_of_radius(self, a: float) -> float:
+        """Antiderivative of P(a) d(delta)/da: 2Ka^5/(5 beta^2) - (2/7) c2 a^(7/2) + pi dgamma a^2 (J).
+
+        With K = 4E*/3 (Johnson's K), c = sqrt(2 pi dgamma/E*), c2 = K c/(2 beta) + 2 sqrt(8 pi
+        dgamma E*)/beta; the a^1 term of P d(delta)/da is sqrt(8 pi dg E*) c a / 2 = 2 pi dg a.
+        """
+        beta = self.radius
+        c2 = self._k * self._c / (2.0 * beta) + 2.0 * self._adh / beta
+        return (2.0 * self._k * a**5 / (5.0 * beta * beta) - 2.0 / 7.0 * c2 * a**3.5
+                + math.pi * self.work_of_adhesion * a * a)
 
     def release_gap(self):
         return -self.detach_approach
