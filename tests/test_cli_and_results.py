@@ -77,5 +77,6 @@ def test_every_subcommand_has_help(sub):
 
 
 def test_console_script_is_installed():
-    proc = subprocess.run(["nanoimpact", "--help"], capture_output=True, text=True)
+    script = Path(sys.executable).parent / "nanoimpact"   # the venv's bin/, whether or not it is on PATH
+    proc = subprocess.run([str(script), "--help"], capture_output=True, text=True)
     assert proc.returncode == 0 and "impact" in proc.stdout
