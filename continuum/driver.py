@@ -146,6 +146,7 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
         return 0.5 * mass * v_ * v_ + mass * gravity * gap_ + stored + booked + extra_booked
 
     def record(t_, gap_, v_, force_, phase_, stored, extra_booked=0.0):
+        """Add a sample; `extra_booked` is dissipation of the current contact not yet in `booked`."""
         nonlocal worst
         e = energy(gap_, v_, stored, extra_booked)
         trace.add(t_, gap_, v_, force_, phase_, e)
@@ -201,9 +202,10 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
 
 def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSettings, index, record):
     """Integrate one contact from touch; returns the bounce record, end state and booked loss."""
+    speed = abs(v0)
+    law.prepare(mass, speed, gravity)
     law.reset()
     release = law.release_gap()
-    speed = abs(v0)
     length = law.length_scale(mass, speed)
     atol = np.array([settings.rtol * length, settings.rtol * speed]) * 0.1
 
@@ -215,7 +217,11 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
     peak_force = law.force(gap0)
     max_pen = -gap0
     e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
-    record(t0, gap0, v0, law.force(gap0), index, law.stored_energy(gap0))
+
+    def sample(s, gap_, v_):
+        record(s, gap_, v_, law.force(gap_), index, law.stored_energy(gap_), law.dissipated(gap_))
+
+    sample(t0, gap0, v0)
 
     def finish(t_end, gap_end, v_end, end, booked):
         e_mech_out = 0.5 * mass * v_end * v_end + mass * gravity * gap_end
@@ -250,29 +256,29 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
             if events and s >= events[0][0]:
                 break
             y = dense(s)
-            record(s, y[0], y[1], law.force(y[0]), index, law.stored_energy(y[0]))
+            sample(s, y[0], y[1])
         for te, kind in events:
             ye = dense(te)
-            if kind == "max_approach":
-                law.accept(ye[0])
+            if kind in ("max_approach", "turn"):
+                # extrema of the gap: history must see them (paper notes on eq 11)
                 max_pen = max(max_pen, -ye[0])
                 peak_force = max(peak_force, law.force(ye[0]))
-                record(te, ye[0], ye[1], law.force(ye[0]), index, law.stored_energy(ye[0]))
-            elif kind == "turn" and law.bound_is_final:
-                record(te, ye[0], 0.0, law.force(ye[0]), index, law.stored_energy(ye[0]))
+                sample(te, ye[0], 0.0)
+                law.accept(ye[0])
+            if kind == "turn" and law.bound_is_final:
                 end = "stuck" if law.force(ye[0]) < mass * gravity or gravity == 0.0 else "rest"
-                return finish(te, ye[0], 0.0, end, 0.0)
-            elif kind == "release":
+                return finish(te, ye[0], 0.0, end, law.dissipated(ye[0]))
+            if kind == "release":
                 gap_r, v_r = release, ye[1]
-                record(te, gap_r, v_r, law.force(gap_r), index, law.stored_energy(gap_r))
+                sample(te, gap_r, v_r)
                 loss = law.on_release()
-                # the instant after: nothing stored, the law's loss term is booked as dissipated
+                # the instant after: nothing stored, the law's loss terms are booked as dissipated
                 record(te, gap_r, v_r, 0.0, -1, 0.0, extra_booked=loss)
                 return finish(te, gap_r, v_r, None, loss)
-        law.accept(y1[0])
         max_pen = max(max_pen, -y1[0])
         peak_force = max(peak_force, law.force(y1[0]))
-        record(t1, y1[0], y1[1], law.force(y1[0]), index, law.stored_energy(y1[0]))
+        sample(t1, y1[0], y1[1])
+        law.accept(y1[0])
         if solver.status == "finished":
             return finish(t1, y1[0], y1[1], "max_time", 0.0)
 

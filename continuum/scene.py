@@ -52,12 +52,30 @@ class Material:
 
 
 @dataclass(frozen=True)
+class Roughness:
+    """Summit statistics of the (composite) rough surface: sigma (m), density (1/m^2), tip radius (m)."""
+
+    sigma: float
+    summit_density: float
+    summit_radius: float
+    datum: str
+    mode: str
+    seed: int
+
+
+@dataclass(frozen=True)
 class Surfaces:
-    """The pair of surfaces: work of adhesion (J/m^2) and each side's material."""
+    """The pair of surfaces: work of adhesion (J/m^2), each side's material, roughness (or None).
+
+    `yield_strength` and `hardness` (Pa, optional) are the substrate's, for the plasticity warnings.
+    """
 
     work_of_adhesion: float
     body: Material
     substrate: Material
+    roughness: Roughness | None = None
+    yield_strength: float | None = None
+    hardness: float | None = None
 
     @property
     def e_star(self) -> float:
@@ -82,6 +100,7 @@ class Physics:
     adhesion_law: str
     detachment: str
     line_stiffness: str
+    half_space: str = "on"
 
 
 @dataclass(frozen=True)
@@ -94,6 +113,8 @@ class Numerics:
     max_time: float
     rest_fraction: float
     samples_per_flight: int
+    grid_points: int = 256
+    table: str = "standard"
 
 
 @dataclass(frozen=True)
@@ -302,6 +323,17 @@ def _build(v: dict, origin: str) -> Scene:
     else:
         mass = math.pi * si["body.radius"] ** 2 * length * si["body.density"]
 
+    roughness = None
+    if si["contact"] == "rough":
+        if shape != "cylinder":
+            raise SceneError("contact", "rough", "rough contact is modelled for a roller (body.shape = 'cylinder', "
+                             "plane-strain line contact) only", origin)
+        for key in ("sigma", "summit_density", "summit_radius"):
+            _require(si, f"surfaces.roughness.{key}", origin, "for contact = 'rough'")
+        roughness = Roughness(si["surfaces.roughness.sigma"], si["surfaces.roughness.summit_density"],
+                              si["surfaces.roughness.summit_radius"], si["surfaces.roughness.datum"],
+                              si["surfaces.roughness.mode"], si["surfaces.roughness.seed"])
+
     if si["physics.adhesion_law"] == "jkr":
         if shape == "cylinder" and si["contact"] == "smooth":
             raise SceneError("physics.adhesion_law", "jkr",
@@ -311,7 +343,9 @@ def _build(v: dict, origin: str) -> Scene:
             raise SceneError("surfaces.work_of_adhesion", si["surfaces.work_of_adhesion"],
                              "must be > 0 J/m^2 when physics.adhesion_law = 'jkr'", origin)
 
-    rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else FIDELITY[si["numerics.fidelity"]]["rtol"]
+    preset = FIDELITY[si["numerics.fidelity"]]
+    rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else preset["rtol"]
+    grid_points = si["numerics.grid_points"] if si["numerics.grid_points"] is not None else preset["grid_points"]
     return Scene(
         name=si["name"],
         description=si["description"],
@@ -325,12 +359,15 @@ def _build(v: dict, origin: str) -> Scene:
                      si["surfaces.body.contact_angle"]),
             Material(si["surfaces.substrate.youngs_modulus"], si["surfaces.substrate.poisson_ratio"],
                      si["surfaces.substrate.contact_angle"]),
+            roughness, si["surfaces.substrate.yield_strength"], si["surfaces.substrate.hardness"],
         ),
         environment=Environment(si["environment.gravity"], si["environment.relative_humidity"],
                                 si["environment.temperature"]),
-        physics=Physics(si["physics.adhesion_law"], si["physics.detachment"], si["physics.line_stiffness"]),
+        physics=Physics(si["physics.adhesion_law"], si["physics.detachment"], si["physics.line_stiffness"],
+                        si["physics.half_space"]),
         numerics=Numerics(si["numerics.fidelity"], rtol, si["numerics.max_bounces"], si["numerics.max_time"],
-                          si["numerics.rest_fraction"], si["numerics.samples_per_flight"]),
+                          si["numerics.rest_fraction"], si["numerics.samples_per_flight"], grid_points,
+                          preset["table"]),
     )
 
 

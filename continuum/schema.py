@@ -62,7 +62,7 @@ FIELDS: tuple[Field, ...] = (
     Field("description", str, "", "Free text shown in results.", ""),
     Field("params", str, "", "Parameter set: reads inputs/params/NAME.toml; scene values override it.", None),
     Field("contact", str, "", "Contact model: 'smooth' (Hertz/JKR of the body's own curvature) or 'rough' "
-          "(Greenwood-Williamson summits; later issue).", "smooth", choices=("smooth",)),
+          "(Greenwood-Williamson summits on the substrate under the body).", "smooth", choices=("smooth", "rough")),
     Field("release_height", float, "m", "Release height of the lowest point of the body above the contact "
           "datum, from rest. Give exactly one of release_height and impact_velocity.", None,
           low=0.0, high=1.0, low_open=True),
@@ -92,6 +92,25 @@ FIELDS: tuple[Field, ...] = (
           **_POISSON),
     Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci; later issue).",
           default=None, **_ANGLE),
+    Field("surfaces.substrate.yield_strength", float, "Pa", "Tensile yield strength of the substrate: warn "
+          "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
+    Field("surfaces.substrate.hardness", float, "Pa", "Indentation hardness of the summits: the plasticity index "
+          "uses it (optional).", None, low=1e6, high=1e12),
+    Field("surfaces.roughness.sigma", float, "m", "Standard deviation of summit heights (composite of both "
+          "surfaces; the paper's 'average asperity height'). Required for contact = 'rough'.", None,
+          low=1e-11, high=1e-5),
+    Field("surfaces.roughness.summit_density", float, "1/m^2", "Summits per unit nominal area (n).", None,
+          low=1e6, high=1e20),
+    Field("surfaces.roughness.summit_radius", float, "m", "Tip radius of every summit (beta).", None,
+          low=1e-10, high=1e-2),
+    Field("surfaces.roughness.datum", str, "", "Where release_height is measured from: the tallest summit "
+          "expected in the nominal footprint (default), or the summits' mean plane.", "tallest_summit",
+          choices=("tallest_summit", "mean_plane")),
+    Field("surfaces.roughness.mode", str, "", "'averaged' (GW statistics on a grid) or 'discrete' (a seeded "
+          "random realisation of individual summits along the footprint, same laws).", "averaged",
+          choices=("averaged", "discrete")),
+    Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation.", 0,
+          low=0, high=2**63 - 1),
     # --- environment ---------------------------------------------------------------------
     Field("environment.gravity", float, "m/s^2", "Gravitational acceleration (0 switches gravity off).",
           9.80665, low=0.0, high=1e3),
@@ -106,11 +125,16 @@ FIELDS: tuple[Field, ...] = (
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",
           "implicit", choices=("implicit", "constant")),
+    Field("physics.half_space", str, "", "Rough contact: couple the summits to the elastic half-space "
+          "under them (eqs 16-17, FFT influence coefficients) or treat the substrate below the summits as rigid.",
+          "on", choices=("on", "off")),
     # --- numerics ------------------------------------------------------------------------
     Field("numerics.fidelity", str, "", "Preset for tolerances (and later grid and table sizes).", "standard",
           choices=("fast", "standard", "reference")),
     Field("numerics.rtol", float, "1", "Relative tolerance of the contact integrator (overrides the preset).",
           None, low=1e-14, high=1e-3),
+    Field("numerics.grid_points", int, "1", "Rough contact: grid points across the footprint (overrides the "
+          "preset).", None, low=16, high=65536),
     Field("numerics.max_bounces", int, "1", "Stop after this many impacts.", 100, low=1, high=100000),
     Field("numerics.max_time", float, "s", "Stop after this much simulated time.", 10.0, low=0.0, high=1e6,
           low_open=True),
@@ -123,11 +147,11 @@ FIELDS: tuple[Field, ...] = (
 FIELD_BY_PATH = {f.path: f for f in FIELDS}
 SECTIONS = sorted({f.path.rsplit(".", 1)[0] for f in FIELDS if "." in f.path})
 
-#: Fidelity presets: integrator tolerances now; grid and table sizes join with the rough model.
+#: Fidelity presets: integrator tolerance, grid points across a rough footprint, GW table resolution.
 FIDELITY = {
-    "fast": {"rtol": 1e-7},
-    "standard": {"rtol": 1e-10},
-    "reference": {"rtol": 1e-12},
+    "fast": {"rtol": 1e-7, "grid_points": 64, "table": "fast"},
+    "standard": {"rtol": 1e-10, "grid_points": 256, "table": "standard"},
+    "reference": {"rtol": 1e-12, "grid_points": 1024, "table": "reference"},
 }
 
 

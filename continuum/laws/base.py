@@ -32,6 +32,12 @@ class ContactLaw(ABC):
     touch_gap: float = 0.0
     bound_is_final: bool = True
 
+    def prepare(self, mass: float, speed: float, gravity: float) -> None:
+        """Called before each contact with the impact's mass (kg), speed (m/s) and gravity (m/s^2).
+
+        Laws with a spatial grid size it here so that cost follows the impact; others ignore it.
+        """
+
     def reset(self) -> None:
         """Start a new contact (history cleared)."""
 
@@ -51,8 +57,17 @@ class ContactLaw(ABC):
     def release_gap(self) -> float:
         """Gap (m) at which the contact ends while the body moves away."""
 
+    def dissipated(self, gap: float) -> float:
+        """Energy (J) dissipated so far in this contact, as the law would book it at `gap`.
+
+        Laws whose losses accrue during a contact (summits letting go one by one) report them
+        here, including what a trial state at `gap` would release; laws that lose energy only at
+        the release return 0 until then.
+        """
+        return 0.0
+
     def on_release(self) -> float:
-        """Book the loss of one release, from the law's own loss term (J)."""
+        """The whole contact's loss, booked at release from the law's own loss terms (J)."""
         return 0.0
 
     def accept(self, gap: float) -> None:
