@@ -52,6 +52,7 @@ class Bounce:
     rebound_height: float | None
     energy_lost: float
     energy_booked: float
+    profiles: dict | None = None
 
 
 @dataclass
@@ -218,8 +219,17 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
     max_pen = -gap0
     e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
 
+    pull = {"force": math.inf, "after_max": False}
+    profiles: dict = {}
+
     def sample(s, gap_, v_):
-        record(s, gap_, v_, law.force(gap_), index, law.stored_energy(gap_), law.dissipated(gap_))
+        f = law.force(gap_)
+        record(s, gap_, v_, f, index, law.stored_energy(gap_), law.dissipated(gap_))
+        if pull["after_max"] and f < pull["force"]:
+            snap = law.snapshot(gap_)
+            if snap is not None:
+                pull["force"] = f
+                profiles["pull_off"] = {"t": s, "gap": gap_, "force": f, **snap}
 
     sample(t0, gap0, v0)
 
@@ -234,7 +244,8 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                    v_rebound=abs(v_end) if free else 0.0,
                    restitution=abs(v_end) / speed if free else 0.0,
                    peak_force=peak_force, max_penetration=max_pen, rebound_height=rebound,
-                   energy_lost=e_mech_in - e_mech_out if free else math.nan, energy_booked=booked)
+                   energy_lost=e_mech_in - e_mech_out if free else math.nan, energy_booked=booked,
+                   profiles=profiles or None)
         return {"bounce": b, "t": t_end, "gap": gap_end, "v": v_end, "end": end, "booked": booked}
 
     while True:
@@ -247,10 +258,16 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
         events = []
         if y_prev[1] < 0.0 <= y1[1]:
             events.append((_root(lambda s: dense(s)[1], t_prev, t1), "max_approach"))
+        t_turn = None
         if y_prev[1] > 0.0 >= y1[1]:
-            events.append((_root(lambda s: dense(s)[1], t_prev, t1), "turn"))
+            t_turn = _root(lambda s: dense(s)[1], t_prev, t1)
+            events.append((t_turn, "turn"))
         if y_prev[0] < release <= y1[0]:
             events.append((_root(lambda s: dense(s)[0] - release, t_prev, t1), "release"))
+        elif y_prev[0] < release and t_turn is not None and dense(t_turn)[0] >= release:
+            # the gap crossed the release point and came back within one step (slow release):
+            # the endpoints miss it, the turning point does not
+            events.append((_root(lambda s: dense(s)[0] - release, t_prev, t_turn), "release"))
         events.sort()
         for s in np.linspace(t_prev, t1, settings.samples_per_step + 2)[1:-1]:
             if events and s >= events[0][0]:
@@ -264,6 +281,11 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                 max_pen = max(max_pen, -ye[0])
                 peak_force = max(peak_force, law.force(ye[0]))
                 sample(te, ye[0], 0.0)
+                if kind == "max_approach" and "max_approach" not in profiles:
+                    snap = law.snapshot(ye[0])
+                    if snap is not None:
+                        profiles["max_approach"] = {"t": te, "gap": ye[0], "force": law.force(ye[0]), **snap}
+                    pull["after_max"] = True
                 law.accept(ye[0])
             if kind == "turn" and law.bound_is_final:
                 end = "stuck" if law.force(ye[0]) < mass * gravity or gravity == 0.0 else "rest"

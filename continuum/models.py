@@ -1,10 +1,43 @@
 """Choose the contact law a scene needs, and say why (recorded in result.json -> models)."""
 from __future__ import annotations
 
+import math
+
+from . import regimes
 from .laws.base import ContactLaw
 from .laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
 from .laws.jkr import JKRSphere
 from .scene import Scene
+
+
+def rough_law(scene: Scene) -> tuple[ContactLaw, dict]:
+    """GW/JKR rough roller for `scene`, and the record of its datum, regime numbers and choices."""
+    from .laws.rough_roller import RoughRoller
+    from .rough.datum import tallest_summit
+    from .rough.gw import GWJKRSurface, SummitStatistics
+
+    body, surf, phys = scene.body, scene.surfaces, scene.physics
+    rough = surf.roughness
+    w = surf.interface_work_of_adhesion if phys.adhesion_law == "jkr" else 0.0
+    datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
+    stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
+    surface = GWJKRSurface(stats, w, surf.e_star, z_max=datum["z_max"], detachment=phys.detachment,
+                           resolution=scene.numerics.table)
+    law = RoughRoller(surface, body.radius, body.length, surf.e_star, half_space=phys.half_space == "on",
+                      grid_points=scene.numerics.grid_points)
+    regime = {
+        "sigma_over_delta_c": rough.sigma / surface.delta_c if w > 0 else math.inf,
+        "fuller_tabor_theta": regimes.fuller_tabor_theta(rough.sigma, rough.summit_radius, w, surf.e_star),
+        "tabor_parameter": regimes.tabor_parameter(rough.summit_radius, w, surf.e_star) if w > 0 else 0.0,
+        "tabor_z0": regimes.Z0_DEFAULT,
+    }
+    if surf.hardness is not None:
+        regime["plasticity_index"] = regimes.plasticity_index(surf.e_star, surf.hardness, rough.sigma,
+                                                              rough.summit_radius)
+    record = {"datum": {**datum, "z_max_m": datum["z_max"] * rough.sigma, "release_from": rough.datum},
+              "regime": regime, "table": {"resolution": scene.numerics.table,
+                                          "build_seconds": getattr(surface, "build_seconds", None)}}
+    return law, record
 
 
 def select_law(scene: Scene, first_impact_speed: float) -> tuple[ContactLaw, dict]:
@@ -12,6 +45,25 @@ def select_law(scene: Scene, first_impact_speed: float) -> tuple[ContactLaw, dic
     body, surf, phys = scene.body, scene.surfaces, scene.physics
     e_star = surf.e_star
     models: dict = {}
+    if scene.contact == "rough":
+        law, record = rough_law(scene)
+        adhesive = phys.adhesion_law == "jkr"
+        models["contact_law"] = {**law.describe(), **record,
+                                 "why": "contact = 'rough': GW summits on a grid under the roller"}
+        models["adhesion"] = {"used": adhesive, "law": phys.adhesion_law,
+                              "work_of_adhesion": surf.interface_work_of_adhesion if adhesive else 0.0,
+                              "source": "SAM-SAM" if surf.sam is not None else "surfaces.work_of_adhesion",
+                              "why": f"adhesion_law = '{phys.adhesion_law}' set in the scene"}
+        models["half_space"] = {"used": phys.half_space == "on",
+                                "why": f"physics.half_space = '{phys.half_space}'"}
+        models["menisci"] = {"used": False, "why": "not modelled yet (wet contact is a later model)"}
+        models["sam"] = ({"used": True, "thickness": surf.sam.thickness,
+                          "why": "both surfaces covered: SAM-SAM work of adhesion; a uniform layer conforming "
+                                 "to the summits shifts all gaps equally, so its thickness does not enter the "
+                                 "mechanics (its compliance is a later model)"}
+                         if surf.sam is not None else {"used": False, "why": "surfaces.sam.coverage = 'none'"})
+        models["free_flight"] = {"used": True, "why": "closed form under gravity (no time steps spent in flight)"}
+        return law, models
     if phys.adhesion_law == "none":
         if body.shape == "sphere":
             law = HertzSphere(body.radius, e_star)
@@ -29,7 +81,7 @@ def select_law(scene: Scene, first_impact_speed: float) -> tuple[ContactLaw, dic
         else:
             models["adhesion"] = {"used": False, "why": "adhesion_law = 'none'"}
     else:  # jkr; scene validation admits only a sphere for smooth contact
-        law = JKRSphere(body.radius, surf.work_of_adhesion, e_star, phys.detachment)
+        law = JKRSphere(body.radius, surf.interface_work_of_adhesion, e_star, phys.detachment)
         why = f"smooth sphere, adhesion_law = 'jkr': JKR with Fuller-Tabor hysteresis, {phys.detachment}-controlled release"
         models["adhesion"] = {"used": True, "law": "jkr", "why": "adhesion_law = 'jkr' set in the scene"}
     models["contact_law"] = {**law.describe(), "why": why}

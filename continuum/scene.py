@@ -64,6 +64,16 @@ class Roughness:
 
 
 @dataclass(frozen=True)
+class SAM:
+    """A self-assembled monolayer on both surfaces: thickness (m), SAM-SAM work of adhesion (J/m^2),
+    water contact angle (rad or None)."""
+
+    thickness: float | None
+    work_of_adhesion: float
+    contact_angle: float | None
+
+
+@dataclass(frozen=True)
 class Surfaces:
     """The pair of surfaces: work of adhesion (J/m^2), each side's material, roughness (or None).
 
@@ -76,6 +86,12 @@ class Surfaces:
     roughness: Roughness | None = None
     yield_strength: float | None = None
     hardness: float | None = None
+    sam: SAM | None = None
+
+    @property
+    def interface_work_of_adhesion(self) -> float:
+        """Work of adhesion (J/m^2) of the contacting pair: the SAM's when both sides carry one."""
+        return self.sam.work_of_adhesion if self.sam is not None else self.work_of_adhesion
 
     @property
     def e_star(self) -> float:
@@ -334,14 +350,21 @@ def _build(v: dict, origin: str) -> Scene:
                               si["surfaces.roughness.summit_radius"], si["surfaces.roughness.datum"],
                               si["surfaces.roughness.mode"], si["surfaces.roughness.seed"])
 
+    sam = None
+    if si["surfaces.sam.coverage"] == "both":
+        sam = SAM(si["surfaces.sam.thickness"],
+                  _require(si, "surfaces.sam.work_of_adhesion", origin, "when surfaces.sam.coverage = 'both'"),
+                  si["surfaces.sam.contact_angle"])
+    adhesion = sam.work_of_adhesion if sam is not None else si["surfaces.work_of_adhesion"]
+
     if si["physics.adhesion_law"] == "jkr":
         if shape == "cylinder" and si["contact"] == "smooth":
             raise SceneError("physics.adhesion_law", "jkr",
                              "a smooth cylinder has no JKR law here (2-D JKR is not implemented); "
                              "use body.shape = 'sphere' or contact = 'rough'", origin)
-        if si["surfaces.work_of_adhesion"] <= 0.0:
-            raise SceneError("surfaces.work_of_adhesion", si["surfaces.work_of_adhesion"],
-                             "must be > 0 J/m^2 when physics.adhesion_law = 'jkr'", origin)
+        if adhesion <= 0.0:
+            key = "surfaces.sam.work_of_adhesion" if sam is not None else "surfaces.work_of_adhesion"
+            raise SceneError(key, adhesion, "must be > 0 J/m^2 when physics.adhesion_law = 'jkr'", origin)
 
     preset = FIDELITY[si["numerics.fidelity"]]
     rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else preset["rtol"]
@@ -359,7 +382,7 @@ def _build(v: dict, origin: str) -> Scene:
                      si["surfaces.body.contact_angle"]),
             Material(si["surfaces.substrate.youngs_modulus"], si["surfaces.substrate.poisson_ratio"],
                      si["surfaces.substrate.contact_angle"]),
-            roughness, si["surfaces.substrate.yield_strength"], si["surfaces.substrate.hardness"],
+            roughness, si["surfaces.substrate.yield_strength"], si["surfaces.substrate.hardness"], sam,
         ),
         environment=Environment(si["environment.gravity"], si["environment.relative_humidity"],
                                 si["environment.temperature"]),

@@ -96,6 +96,13 @@ FIELDS: tuple[Field, ...] = (
           "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
     Field("surfaces.substrate.hardness", float, "Pa", "Indentation hardness of the summits: the plasticity index "
           "uses it (optional).", None, low=1e6, high=1e12),
+    Field("surfaces.sam.coverage", str, "", "Self-assembled monolayer: 'none', or 'both' (both surfaces covered; "
+          "the SAM-SAM work of adhesion replaces surfaces.work_of_adhesion).", "none", choices=("none", "both")),
+    Field("surfaces.sam.thickness", float, "m", "SAM thickness (OTS ~2-2.5 nm). A uniform layer that conforms to "
+          "the summits shifts every gap equally; its compliance is a later model.", None, low=1e-10, high=1e-7),
+    Field("surfaces.sam.work_of_adhesion", float, "J/m^2", "Work of adhesion between the two SAM-covered "
+          "surfaces.", None, low=0.0, high=10.0),
+    Field("surfaces.sam.contact_angle", doc="Water contact angle on the SAM.", default=None, **_ANGLE),
     Field("surfaces.roughness.sigma", float, "m", "Standard deviation of summit heights (composite of both "
           "surfaces; the paper's 'average asperity height'). Required for contact = 'rough'.", None,
           low=1e-11, high=1e-5),

@@ -25,7 +25,7 @@ def test_energy_lost_per_impact_is_one_jkr_loop(detachment, coefficient):
 
 
 @pytest.mark.parametrize("detachment", ["displacement", "load"])
-@pytest.mark.parametrize("ratio", [1.02, 1.2, 2.0, 5.0, 20.0])
+@pytest.mark.parametrize("ratio", [1.001, 1.02, 1.2, 2.0, 5.0, 20.0])  # 1.001: slow release, turn and re-cross within one step
 def test_restitution_follows_escape_velocity_law(detachment, ratio):
     law = JKRSphere(RADIUS, W, E_STAR, detachment)
     v_s = law.escape_velocity(MASS)

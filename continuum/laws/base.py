@@ -73,6 +73,10 @@ class ContactLaw(ABC):
     def accept(self, gap: float) -> None:
         """Update history after an accepted integration step (stateless laws ignore it)."""
 
+    def snapshot(self, gap: float) -> dict | None:
+        """Spatial profiles at `gap` (pressure, deflection...) for laws that have them, else None."""
+        return None
+
     @abstractmethod
     def length_scale(self, mass: float, speed: float) -> float:
         """A typical approach (m) for an impact of `mass` (kg) at `speed` (m/s): scales tolerances."""

@@ -1,0 +1,49 @@
+"""Escape velocity: the smallest impact speed from which the body still rebounds (paper Fig 8).
+
+Bisection on the impact velocity (in log space) with single-impact runs: below the escape
+velocity the body turns back while still attached (stuck), above it it leaves the surface.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+from .driver import DriverSettings, ImpactRun, simulate
+from .laws.base import ContactLaw
+
+
+def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rtol: float = 1e-9) -> ImpactRun:
+    """One impact at `speed` (m/s) from the datum; the run ends at release or when stuck."""
+    return simulate(law, mass, gravity, impact_velocity=speed,
+                    settings=DriverSettings(rtol=rtol, max_bounces=1, max_time=1.0, samples_per_flight=2))
+
+
+def escape_velocity(law: ContactLaw, mass: float, gravity: float, v_low: float, v_high: float, *,
+                    rel_tol: float = 1e-3, rtol: float = 1e-9,
+                    on_run: Callable[[float, ImpactRun], None] | None = None) -> dict:
+    """Bisect [v_low, v_high] (m/s) for the escape velocity to `rel_tol`.
+
+    Returns dict(escape_velocity, lower, upper, runs) where `lower` sticks and `upper` rebounds;
+    raises ValueError if the bracket does not straddle the transition.
+    """
+    def escapes(v):
+        run = single_impact(law, mass, gravity, v, rtol)
+        if on_run:
+            on_run(v, run)
+        return not run.stuck
+
+    runs = 0
+    if escapes(v_low):
+        raise ValueError(f"escape velocity below the bracket: the body already rebounds at {v_low:.3e} m/s")
+    if not escapes(v_high):
+        raise ValueError(f"escape velocity above the bracket: the body still sticks at {v_high:.3e} m/s")
+    lo, hi = v_low, v_high
+    runs = 2
+    while hi / lo - 1.0 > rel_tol:
+        mid = math.sqrt(lo * hi)
+        runs += 1
+        if escapes(mid):
+            hi = mid
+        else:
+            lo = mid
+    return {"escape_velocity": math.sqrt(lo * hi), "lower": lo, "upper": hi, "runs": runs}
