@@ -21,18 +21,20 @@ def rough_law(scene: Scene) -> tuple[ContactLaw, dict]:
     w = surf.interface_work_of_adhesion if phys.adhesion_law == "jkr" else 0.0
     datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
-    surface = GWJKRSurface(stats, w, surf.e_star, z_max=datum["z_max"], detachment=phys.detachment,
+    summit_e_star = rough.summit_modulus if rough.summit_modulus is not None else surf.e_star
+    surface = GWJKRSurface(stats, w, summit_e_star, z_max=datum["z_max"], detachment=phys.detachment,
                            resolution=scene.numerics.table)
     law = RoughRoller(surface, body.radius, body.length, surf.e_star, half_space=phys.half_space == "on",
                       grid_points=scene.numerics.grid_points)
     regime = {
+        "summit_e_star": summit_e_star,
         "sigma_over_delta_c": rough.sigma / surface.delta_c if w > 0 else math.inf,
-        "fuller_tabor_theta": regimes.fuller_tabor_theta(rough.sigma, rough.summit_radius, w, surf.e_star),
-        "tabor_parameter": regimes.tabor_parameter(rough.summit_radius, w, surf.e_star) if w > 0 else 0.0,
+        "fuller_tabor_theta": regimes.fuller_tabor_theta(rough.sigma, rough.summit_radius, w, summit_e_star),
+        "tabor_parameter": regimes.tabor_parameter(rough.summit_radius, w, summit_e_star) if w > 0 else 0.0,
         "tabor_z0": regimes.Z0_DEFAULT,
     }
     if surf.hardness is not None:
-        regime["plasticity_index"] = regimes.plasticity_index(surf.e_star, surf.hardness, rough.sigma,
+        regime["plasticity_index"] = regimes.plasticity_index(summit_e_star, surf.hardness, rough.sigma,
                                                               rough.summit_radius)
     record = {"datum": {**datum, "z_max_m": datum["z_max"] * rough.sigma, "release_from": rough.datum},
               "regime": regime, "table": {"resolution": scene.numerics.table,

@@ -61,6 +61,7 @@ class Roughness:
     datum: str
     mode: str
     seed: int
+    summit_modulus: float | None = None
 
 
 @dataclass(frozen=True)
@@ -256,10 +257,13 @@ def check_value(f: Field, value, origin: str):
 
 
 def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = None,
-                  params: str | None = None, params_dir: Path | None = None) -> ResolvedScene:
+                  params: str | None = None, params_dir: Path | None = None,
+                  overrides: dict | None = None, override_label: str = "override") -> ResolvedScene:
     """Read, merge and validate a scene (from a file or an in-memory table).
 
     `params` (a name or a path) replaces the scene's own `params` entry, as `--params` does.
+    `overrides` ({dotted key: value}, file units) win over everything and are recorded with the
+    source `override_label` (sweeps and the paper's cases use them).
     """
     origin = str(scene_file) if scene_file is not None else "<scene>"
     if table is None:
@@ -269,6 +273,11 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
     flat_scene = flatten(table, origin)
     for path, value in flat_scene.items():
         check_value(FIELD_BY_PATH[path], value, origin)
+    overrides = dict(overrides or {})
+    for path, value in overrides.items():
+        if path not in FIELD_BY_PATH:
+            raise SceneError(path, value, _unknown(path), override_label)
+        check_value(FIELD_BY_PATH[path], value, override_label)
 
     params_spec = params if params is not None else flat_scene.get("params")
     params_file = None
@@ -288,7 +297,9 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
     values, sources = {}, {}
     set_label = f"params:{Path(params_file).stem}" if params_file else None
     for f in FIELDS:
-        if f.path in flat_scene:
+        if f.path in overrides:
+            values[f.path], sources[f.path] = overrides[f.path], override_label
+        elif f.path in flat_scene:
             values[f.path], sources[f.path] = flat_scene[f.path], "scene"
         elif f.path in flat_params:
             values[f.path], sources[f.path] = flat_params[f.path], set_label
@@ -348,7 +359,8 @@ def _build(v: dict, origin: str) -> Scene:
             _require(si, f"surfaces.roughness.{key}", origin, "for contact = 'rough'")
         roughness = Roughness(si["surfaces.roughness.sigma"], si["surfaces.roughness.summit_density"],
                               si["surfaces.roughness.summit_radius"], si["surfaces.roughness.datum"],
-                              si["surfaces.roughness.mode"], si["surfaces.roughness.seed"])
+                              si["surfaces.roughness.mode"], si["surfaces.roughness.seed"],
+                              si["surfaces.roughness.summit_modulus"])
 
     sam = None
     if si["surfaces.sam.coverage"] == "both":

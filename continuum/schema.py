@@ -110,6 +110,8 @@ FIELDS: tuple[Field, ...] = (
           low=1e6, high=1e20),
     Field("surfaces.roughness.summit_radius", float, "m", "Tip radius of every summit (beta).", None,
           low=1e-10, high=1e-2),
+    Field("surfaces.roughness.summit_modulus", float, "Pa", "Effective modulus E* of the summit contacts "
+          "(e.g. a compliant surface layer); default: E* of the two surfaces.", None, low=1e6, high=1e13),
     Field("surfaces.roughness.datum", str, "", "Where release_height is measured from: the tallest summit "
           "expected in the nominal footprint (default), or the summits' mean plane.", "tallest_summit",
           choices=("tallest_summit", "mean_plane")),

@@ -186,3 +186,15 @@ def test_every_shipped_scene_is_valid():
 def test_docs_scenes_md_carries_the_current_schema_table():
     text = (ROOT / "docs" / "scenes.md").read_text()
     assert schema_markdown() in text, "regenerate with: python -m continuum.schema"
+
+
+def test_overrides_win_and_are_recorded_and_validated():
+    scene_file = ROOT / "inputs" / "scenes" / "hertz_roller.toml"
+    resolved = resolve_scene(scene_file, overrides={"release_height": 50e-9}, override_label="case sigma3")
+    assert resolved.scene.release_height == 50e-9
+    assert resolved.sources["release_height"] == "case sigma3"
+    with pytest.raises(SceneError) as err:
+        resolve_scene(scene_file, overrides={"release_height": -1.0})
+    assert err.value.key == "release_height"
+    with pytest.raises(SceneError, match="unknown key"):
+        resolve_scene(scene_file, overrides={"body.colour": 1})

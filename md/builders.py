@@ -1,0 +1,948 @@
+"""Structure builders for the MD workflows: silica slabs and asperities, OTS monolayers, water.
+
+Every builder returns a :class:`md.topology.System` in LAMMPS ``real`` units (angstrom, e, g/mol) whose atoms
+carry force-field type names, whose bonds, angles and dihedrals are typed from the force field
+(:func:`md.topology.with_bonded_terms`), and whose ``info`` dict records what was built (counts, silanol
+density and SAM coverage achieved, the random seed, sources). All random choices take a ``seed``.
+
+Silica (INTERFACE FF types, ``inputs/forcefields/silica_interface.toml``)
+    Crystalline silica cut from an orthorhombic periodic supercell of the bulk crystal:
+
+    * ``polymorph="cristobalite"``: idealised beta-cristobalite, space group Fd-3m, a = 7.16 A, Si on the
+      diamond sites (8a), O midway between bonded Si (16c) -- Wyckoff, Z. Kristallogr. 62 (1925) 189;
+      AFLOW prototype A2B_cF24_227_c_a (Mehl et al., Comput. Mater. Sci. 136 (2017) S1). The ideal cell has
+      straight Si-O-Si (180 deg) and Si-O = a sqrt(3)/8 = 1.550 A; the IFF minimum (1.68 A, 149 deg) is reached
+      by energy minimisation in LAMMPS. ``face="001"`` exposes geminal (Q2) silanols at 2/(a^2/2) = 7.80 OH/nm^2,
+      reduced towards the requested density by condensing neighbouring silanol pairs (below); ``face="111"``
+      exposes single (Q3) silanols at 4/(sqrt(3) a^2) = 4.50 OH/nm^2, one per surface Si, all pointing along
+      the normal -- the face the OTS monolayer is grafted on.
+    * ``polymorph="quartz"``: alpha-quartz P3_221, a = 4.916 A, c = 5.4054 A, Si (0.4697, 0, 0),
+      O (0.4135, 0.2669, 0.1191) -- Levien, Prewitt, Weidner, Am. Mineral. 65 (1980) 920 -- shifted by
+      (0, 0, 2/3) to the International Tables origin (the one ``ase.spacegroup`` uses); ``face="0001"``.
+
+    Cutting rule (any polymorph and shape): keep the Si atoms inside the region; repeatedly drop kept Si with
+    fewer than two kept Si neighbours (Q0/Q1) and, for asperities, add back removed Si with three or more (so
+    the carved surface has no Q1 and few overhangs); keep every O bonded to a kept Si. An O with two kept Si
+    is bridging (OC23); an O with one is a silanol O (OC24) and gets an H (HOY) at 0.945 A with Si-O-H =
+    115 deg, tilted towards the local outward normal. Every Si is therefore 4-coordinated and every O is
+    bridging or silanol.
+
+    Condensation (lowers the silanol density): two silanol O on different Si that were bonded to the same
+    removed Si are replaced by one bridging O at their midpoint (Si-OH + HO-Si -> Si-O-Si + H2O). Each Si
+    takes part in at most one condensation (Q2 -> Q3, never Q4), pairs are drawn as a seeded random subset of a
+    maximum matching. On cristobalite (001) the condensed Si are 5.06 A apart, so the new Si-O bonds start
+    at ~2.7 A: minimise before dynamics.
+
+    Neutrality, algebraically: every Si-O bond moves 0.275 e from Si to O (SC4 +1.1 = 4 x 0.275; OC23
+    -0.55 = 2 x -0.275; OC24 + HOY = -0.675 + 0.4 = -0.275). With 4 N_Si = 2 N_OC23 + N_OH (bond count),
+    Q = 1.1 N_Si - 0.55 N_OC23 - 0.275 N_OH = 0.275 (4 N_Si - 2 N_OC23 - N_OH) = 0 for any cut.
+
+OTS (``ots_trappe_ua.toml``): C18 united-atom chains CH3-(CH2)17- on a head Si (SIH) bonded to one surface O
+(silanol O retyped OC24 -> OC23, its H deleted) and carrying two OH; no lateral cross-linking.
+
+Water (``water_spce.toml``): SPC/E molecules (geometry from the force field: O-H 1.0 A, H-O-H 109.47 deg) on a
+lattice at 0.997 g/cm^3 with random orientations.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from md.forcefield import ForceField, combine, load_forcefield
+from md.topology import (System, flip_upside_down, from_types, merge, minimum_image, remove_atoms, translate,
+                         with_bonded_terms)
+
+__all__ = ["silica_slab", "silica_asperity", "ots_sam", "water_slab", "water_cylinder", "place_on",
+           "flip_upside_down", "silica_forcefield", "sam_forcefield", "water_forcefield",
+           "CRISTOBALITE_A", "QUARTZ", "WATER_DENSITY", "AVOGADRO"]
+
+AVOGADRO = 6.02214076e23                  #: 1/mol (SI 2019, exact)
+CRISTOBALITE_A = 7.16                     #: A, idealised cubic beta-cristobalite (Wyckoff 1925)
+QUARTZ = {"a": 4.916, "c": 5.4054, "spacegroup": 154,     # P3_221
+          "si": (0.4697, 0.0, 2.0 / 3.0), "o": (0.4135, 0.2669, 0.1191 + 2.0 / 3.0)}  # Levien et al. 1980
+WATER_DENSITY = 0.997                     #: g/cm^3, liquid water at 298 K
+SIO_BOND_CUTOFF = 2.0                     #: A, Si-O bond search radius in the bulk crystals (bonds 1.55-1.61 A)
+SIOH_ANGLE = 115.0                        #: deg, IFF SC4-OC24-HOY theta0 (used to place H)
+
+SOURCES = {
+    "cristobalite": "idealised beta-cristobalite Fd-3m, a = 7.16 A: R. W. G. Wyckoff, Z. Kristallogr. 62 (1925) 189; "
+                    "AFLOW prototype A2B_cF24_227_c_a (M. J. Mehl et al., Comput. Mater. Sci. 136 (2017) S1)",
+    "quartz": "alpha-quartz P3_221: L. Levien, C. T. Prewitt, D. J. Weidner, Am. Mineral. 65 (1980) 920",
+    "silanol_density": "4.6-4.9 OH/nm^2 on fully hydroxylated amorphous silica: L. T. Zhuravlev, Colloids Surf. A "
+                       "173 (2000) 1",
+    "surface_models": "Q2/Q3 silica surface models: F. S. Emami et al., Chem. Mater. 26 (2014) 2647",
+    "ots": "OTS monolayer ~2.5 nm thick, ~4.5-4.7 chains/nm^2: S. R. Wasserman et al., Langmuir 5 (1989) 1074",
+}
+
+
+# ================================================================================================ force fields
+
+def silica_forcefield() -> ForceField:
+    return load_forcefield("silica_interface")
+
+
+def sam_forcefield() -> ForceField:
+    return combine("silica_interface", "ots_trappe_ua")
+
+
+def water_forcefield(model: str = "water_spce") -> ForceField:
+    return load_forcefield(model)
+
+
+def _bond_r0(ff: ForceField, a: str, b: str) -> float:
+    for t in ff.bond_types:
+        if tuple(t.types) in ((a, b), (b, a)):
+            return float(t.coeffs[-1] if t.style == "harmonic" else t.coeffs[1])
+    raise KeyError(f"no bond {a}-{b} in force field {ff.name!r}")
+
+
+def _angle_theta0(ff: ForceField, a: str, b: str, c: str) -> float:
+    for t in ff.angle_types:
+        if tuple(t.types) in ((a, b, c), (c, b, a)):
+            return float(t.coeffs[1])
+    raise KeyError(f"no angle {a}-{b}-{c} in force field {ff.name!r}")
+
+
+def _plain(obj: Any) -> Any:
+    """numpy scalars/arrays inside an info dict -> plain Python (JSON-friendly)."""
+    if isinstance(obj, Mapping):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return type(obj)(_plain(v) for v in obj)
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+# ================================================================================================ bulk crystals
+
+class _Bulk:
+    """A periodic orthorhombic supercell of a silica crystal, with its Si-O bond graph."""
+
+    def __init__(self, pos: np.ndarray, is_si: np.ndarray, cell: np.ndarray, period_z: float, unit_xy: tuple,
+                 polymorph: str, face: str, lattice_a: float):
+        self.pos, self.cell, self.period_z, self.unit_xy = pos, cell, period_z, unit_xy
+        self.polymorph, self.face, self.lattice_a = polymorph, face, lattice_a
+        self.si = np.flatnonzero(is_si)
+        self.o = np.flatnonzero(~is_si)
+        tree = cKDTree(pos, boxsize=cell)
+        pairs = tree.query_pairs(SIO_BOND_CUTOFF, output_type="ndarray")
+        local = np.full(len(pos), -1)
+        local[self.si] = np.arange(len(self.si))
+        local[self.o] = np.arange(len(self.o))
+        si_of_o = [[] for _ in self.o]
+        o_of_si = [[] for _ in self.si]
+        for i, j in pairs:
+            if is_si[i] == is_si[j]:
+                raise RuntimeError(f"unexpected {'Si-Si' if is_si[i] else 'O-O'} contact below {SIO_BOND_CUTOFF} A")
+            s, o = (i, j) if is_si[i] else (j, i)
+            si_of_o[local[o]].append(local[s])
+            o_of_si[local[s]].append(local[o])
+        if any(len(x) != 2 for x in si_of_o) or any(len(x) != 4 for x in o_of_si):
+            raise RuntimeError("bulk crystal is not a fully connected SiO4 network (check lattice and box)")
+        self.si_of_o = np.array(si_of_o, int)          # (n_o, 2) local Si indices
+        self.o_of_si = np.array(o_of_si, int)          # (n_si, 4) local O indices
+        other = np.where(self.si_of_o[self.o_of_si, 0] == np.arange(len(self.si))[:, None],
+                         self.si_of_o[self.o_of_si, 1], self.si_of_o[self.o_of_si, 0])
+        self.si_nb = other                             # (n_si, 4) Si neighbours through each O
+        self.si_pos = pos[self.si]
+        self.o_pos = pos[self.o]
+
+    def si_planes(self) -> np.ndarray:
+        return np.unique(np.round(self.si_pos[:, 2], 3))
+
+
+def _fill_box(lattice: np.ndarray, frac: np.ndarray, is_si: np.ndarray, rot: np.ndarray, box: np.ndarray):
+    """Atoms of the crystal (rows of ``lattice`` are the lattice vectors, crystal frame) rotated by ``rot`` (rows:
+    new axes in the crystal frame) that fall in [0, box). The box vectors must be lattice translations."""
+    corners = np.array([[x, y, z] for x in (0, box[0]) for y in (0, box[1]) for z in (0, box[2])])
+    f = (corners @ rot) @ np.linalg.inv(lattice)
+    lo, hi = np.floor(f.min(0)) - 1, np.ceil(f.max(0)) + 1
+    grid = np.stack(np.meshgrid(*[np.arange(lo[k], hi[k] + 1) for k in range(3)], indexing="ij"), -1).reshape(-1, 3)
+    cart = ((grid[:, None, :] + frac[None, :, :]).reshape(-1, 3)) @ lattice
+    r = cart @ rot.T + 0.05            # tiny shift: no atom sits exactly on a box face
+    sel = np.all((r >= 0) & (r < box), axis=1)
+    n_expect = abs(np.prod(box) / np.linalg.det(lattice)) * len(frac)
+    if abs(sel.sum() - n_expect) > 1e-6:
+        raise RuntimeError(f"supercell holds {sel.sum()} atoms, expected {n_expect:.3f}: box is not a lattice supercell")
+    return r[sel], np.tile(is_si, len(grid))[sel]
+
+
+def quartz_basis() -> tuple[np.ndarray, np.ndarray]:
+    """Fractional coordinates (9, 3) and Si mask of alpha-quartz, P3_221 (No. 154), from the Wyckoff positions
+    3a (x, 0, 2/3) and 6c (x, y, z) of :data:`QUARTZ` and the six symmetry operations of the group
+    (International Tables setting, the one ``ase.spacegroup`` uses; a test checks the two agree)."""
+    x = QUARTZ["si"][0]
+    si = [(x, 0.0, 2 / 3), (0.0, x, 1 / 3), (-x, -x, 0.0)]
+    X, Y, Z = QUARTZ["o"]
+    o = [(X, Y, Z), (-Y, X - Y, Z + 2 / 3), (-X + Y, -X, Z + 1 / 3), (Y, X, -Z), (X - Y, -Y, -Z + 1 / 3),
+         (-X, -X + Y, -Z + 2 / 3)]
+    return np.mod(np.array(si + o, float), 1.0), np.r_[np.ones(3, bool), np.zeros(6, bool)]
+
+
+def _bulk(polymorph: str, face: str, nx: int, ny: int, nz: int, lattice_a: float | None = None) -> _Bulk:
+    if polymorph == "cristobalite":
+        a = float(lattice_a or CRISTOBALITE_A)
+        fcc = np.array([[0, 0, 0], [0, .5, .5], [.5, 0, .5], [.5, .5, 0]])
+        si = np.concatenate([fcc, fcc + 0.25])
+        o = np.concatenate([fcc + np.array(d) / 8.0 for d in ((1, 1, 1), (1, -1, -1), (-1, 1, -1), (-1, -1, 1))])
+        frac = np.concatenate([si, o])
+        is_si = np.r_[np.ones(len(si), bool), np.zeros(len(o), bool)]
+        lattice = a * np.eye(3)
+        if face == "001":
+            rot, unit = np.eye(3), (a, a, a)
+        elif face == "111":
+            rot = np.array([_unit(np.array(v, float)) for v in ((1, -1, 0), (1, 1, -2), (1, 1, 1))])
+            unit = (a / math.sqrt(2), a * math.sqrt(6) / 2, a * math.sqrt(3))
+        else:
+            raise ValueError(f"cristobalite face must be '001' or '111', got {face!r}")
+    elif polymorph == "quartz":
+        if face != "0001":
+            raise ValueError(f"quartz face must be '0001', got {face!r}")
+        q = QUARTZ
+        a = float(lattice_a or q["a"])
+        frac, is_si = quartz_basis()
+        lattice = np.array([[a, 0.0, 0.0], [-0.5 * a, 0.5 * math.sqrt(3) * a, 0.0], [0.0, 0.0, q["c"]]])
+        rot, unit = np.eye(3), (a, a * math.sqrt(3), q["c"])
+    else:
+        raise ValueError(f"polymorph must be 'cristobalite' or 'quartz', got {polymorph!r}")
+    box = np.array([nx * unit[0], ny * unit[1], nz * unit[2]])
+    pos, si_mask = _fill_box(lattice, frac, is_si, rot, box)
+    return _Bulk(pos, si_mask, box, unit[2], (unit[0], unit[1]), polymorph, face, a)
+
+
+# ================================================================================================ cutting
+
+def _clean(bulk: _Bulk, keep: np.ndarray, fill: bool, max_iter: int = 100) -> np.ndarray:
+    """Drop kept Si with < 2 kept Si neighbours; with ``fill`` also add back removed Si with >= 3."""
+    keep = keep.copy()
+    for _ in range(max_iter):
+        n_kept = keep[bulk.si_nb].sum(axis=1)
+        changed = False
+        if fill:
+            add = ~keep & (n_kept >= 3)
+            if add.any():
+                keep |= add
+                changed = True
+                n_kept = keep[bulk.si_nb].sum(axis=1)
+        drop = keep & (n_kept <= 1)
+        if drop.any():
+            keep &= ~drop
+            changed = True
+        if not changed:
+            return keep
+    raise RuntimeError("cutting did not converge (add/drop oscillation)")
+
+
+def _choose_planes(bulk: _Bulk, thickness: float | None, layers: int | None) -> np.ndarray:
+    """Boolean Si mask for a slab of whole Si planes, starting one period above the bulk box bottom at a plane
+    whose Si have >= 2 neighbours above them (so the bottom face is Q2/Q3, not Q1)."""
+    planes = bulk.si_planes()
+    z = np.round(bulk.si_pos[:, 2], 3)
+    per_period = int(np.sum(planes < planes[0] + bulk.period_z - 1e-3))
+    p0 = None
+    for p in range(per_period, len(planes)):
+        members = np.flatnonzero(z == planes[p])
+        above = (bulk.si_pos[bulk.si_nb[members], 2] - bulk.si_pos[members, 2][:, None])
+        above = minimum_image(np.stack([np.zeros_like(above)] * 2 + [above], -1), bulk.cell, (0, 0, 1))[..., 2]
+        if np.all((above > 0.01).sum(axis=1) >= 2):
+            p0 = p
+            break
+    if p0 is None:
+        raise RuntimeError("no suitable bottom Si plane found")
+    if layers is not None:
+        n = int(layers) * per_period
+        if p0 + n > len(planes) - per_period:
+            raise RuntimeError("bulk box too short for the requested layers")
+        return np.isin(z, planes[p0:p0 + n])
+    for n in range(1, len(planes) - p0 - per_period + 1):
+        keep = _clean(bulk, np.isin(z, planes[p0:p0 + n]), fill=False)
+        if keep.any() and np.ptp(bulk.si_pos[keep, 2]) >= thickness - 1e-6:
+            return keep
+    raise RuntimeError("bulk box too short for the requested thickness")
+
+
+def _max_matching(edges: list[tuple[int, int]], rng: np.random.Generator) -> list[int]:
+    """Indices of a (near-)maximum matching of ``edges`` (Karp-Sipser: degree-1 vertices first, ties at random).
+    Exact on paths, cycles and trees -- the pair graphs met here have vertex degree <= 2 on flat faces."""
+    alive = set(range(len(edges)))
+    inc: dict[int, set[int]] = {}
+    for e, (u, v) in enumerate(edges):
+        inc.setdefault(u, set()).add(e)
+        inc.setdefault(v, set()).add(e)
+    chosen: list[int] = []
+    while alive:
+        leaves = sorted(e for e in alive if len(inc[edges[e][0]]) == 1 or len(inc[edges[e][1]]) == 1)
+        pool = leaves if leaves else sorted(alive)
+        e = pool[int(rng.integers(len(pool)))]
+        chosen.append(e)
+        for w in edges[e]:
+            for f in list(inc[w]):
+                alive.discard(f)
+                for x in edges[f]:
+                    inc[x].discard(f)
+    return chosen
+
+
+def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np.ndarray], np.ndarray],
+                         areas: Mapping[str, float], target_density: float, normal: Callable, rng: np.random.Generator,
+                         ff: ForceField, tolerance: float) -> tuple[System, dict[str, Any]]:
+    """Kept Si + their O + silanol H, condensed region by region to ``target_density`` (OH/nm^2).
+
+    ``regions(si_positions) -> region label per Si`` assigns each surface Si to a face ('top', 'bottom',
+    'dome', ...) whose area (A^2) is in ``areas``. Returns the System (no bonded types yet) and an info dict.
+    """
+    cell = bulk.cell
+    pbc3 = (True, True, True)
+    si_keep = np.flatnonzero(keep)
+    kept_of_o = keep[bulk.si_of_o]                           # (n_o, 2)
+    o_keep = np.flatnonzero(kept_of_o.any(axis=1))
+    silanol = o_keep[kept_of_o[o_keep].sum(axis=1) == 1]
+    # per silanol: its kept Si and the removed partner Si
+    first_kept = kept_of_o[silanol, 0]
+    s_own = np.where(first_kept, bulk.si_of_o[silanol, 0], bulk.si_of_o[silanol, 1])
+    s_gone = np.where(first_kept, bulk.si_of_o[silanol, 1], bulk.si_of_o[silanol, 0])
+    label_of_si = np.full(len(bulk.si), "", dtype=object)
+    label_of_si[si_keep] = regions(bulk.si_pos[si_keep])
+    n_sil_of_si = np.bincount(s_own, minlength=len(bulk.si))
+
+    # bridging Si pairs already present (to avoid creating two-membered rings)
+    bridged = {tuple(sorted(p)) for p in bulk.si_of_o[o_keep[kept_of_o[o_keep].all(axis=1)]].tolist()}
+
+    # candidate condensations: silanol pairs sharing a removed Si, on different Si, both Si with >= 2 silanols
+    by_gone: dict[int, list[int]] = {}
+    for k, g in enumerate(s_gone.tolist()):
+        by_gone.setdefault(g, []).append(k)
+    cand: dict[tuple[int, int], tuple[int, int]] = {}
+    for ks in by_gone.values():
+        for x in range(len(ks)):
+            for y in range(x + 1, len(ks)):
+                a, b = ks[x], ks[y]
+                sa, sb = int(s_own[a]), int(s_own[b])
+                key = tuple(sorted((sa, sb)))
+                if sa == sb or key in bridged or key in cand:
+                    continue
+                if n_sil_of_si[sa] < 2 or n_sil_of_si[sb] < 2:
+                    continue
+                cand[key] = (a, b)
+    # pairs straddling two regions are not condensed (keeps the per-region bookkeeping exact)
+    cand = {k: v for k, v in cand.items() if label_of_si[k[0]] == label_of_si[k[1]]}
+    info: dict[str, Any] = {}
+    used_si: set[int] = set()
+    cond_pairs: list[tuple[int, int]] = []          # (silanol index a, silanol index b)
+    per_region: dict[str, dict[str, Any]] = {}
+    for name, area in areas.items():
+        n_oh = int(np.sum(label_of_si[s_own] == name))
+        keys = [k for k in sorted(cand) if label_of_si[k[0]] == name and not (set(k) & used_si)]
+        match = [keys[e] for e in _max_matching(keys, rng)]
+        want = (n_oh - target_density * area / 100.0) / 2.0
+        k_needed = int(min(max(round(want), 0), len(match)))
+        pick = sorted(rng.choice(len(match), size=k_needed, replace=False).tolist()) if k_needed else []
+        for p in pick:
+            used_si.update(match[p])
+            cond_pairs.append(cand[match[p]])
+        n_after = n_oh - 2 * k_needed
+        per_region[name] = {"area_nm2": area / 100.0, "silanols_before": n_oh, "condensations": k_needed,
+                            "silanols": n_after, "density_nm2": n_after / (area / 100.0),
+                            "max_density_nm2": n_oh / (area / 100.0),
+                            "min_density_nm2": (n_oh - 2 * len(match)) / (area / 100.0)}
+    removed_sil = {x for pair in cond_pairs for x in pair}
+
+    # ---- assemble atoms
+    pos_si = bulk.si_pos[si_keep]
+    si_new = np.full(len(bulk.si), -1)
+    si_new[si_keep] = np.arange(len(si_keep))
+    bridging_o = o_keep[kept_of_o[o_keep].all(axis=1)]
+    positions = [pos_si]
+    types = ["SC4"] * len(si_keep)
+    bonds: list[tuple[int, int]] = []
+    n = len(si_keep)
+    # bridging O of the crystal
+    for o in bridging_o.tolist():
+        s1, s2 = bulk.si_of_o[o]
+        p = bulk.si_pos[s1] + minimum_image(bulk.o_pos[o] - bulk.si_pos[s1], cell, pbc3)
+        positions.append(p[None])
+        types.append("OC23")
+        bonds += [(si_new[s1], n), (si_new[s2], n)]
+        n += 1
+    # bridging O made by condensation
+    for a, b in cond_pairs:
+        sa, sb = s_own[a], s_own[b]
+        pa = bulk.si_pos[sa] + minimum_image(bulk.o_pos[silanol[a]] - bulk.si_pos[sa], cell, pbc3)
+        pb = pa + minimum_image(bulk.o_pos[silanol[b]] - pa, cell, pbc3)
+        positions.append((0.5 * (pa + pb))[None])
+        types.append("OC23")
+        bonds += [(si_new[sa], n), (si_new[sb], n)]
+        n += 1
+    n_condensed_o = len(cond_pairs)
+    # silanols
+    r_oh = _bond_r0(ff, "OC24", "HOY")
+    bend = math.radians(180.0 - _angle_theta0(ff, "SC4", "OC24", "HOY"))
+    sil_o_idx: dict[str, list[int]] = {}
+    sil_h_idx: dict[str, list[int]] = {}
+    for k in range(len(silanol)):
+        if k in removed_sil:
+            continue
+        s = s_own[k]
+        ps = bulk.si_pos[s]
+        po = ps + minimum_image(bulk.o_pos[silanol[k]] - ps, cell, pbc3)
+        u = _unit(po - ps)
+        nrm = normal(po, label_of_si[s])
+        perp = nrm - np.dot(nrm, u) * u
+        if np.linalg.norm(perp) < 1e-6:
+            perp = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
+            phi = rng.uniform(0, 2 * math.pi)
+            perp = _unit(perp)
+            perp = math.cos(phi) * perp + math.sin(phi) * np.cross(u, perp)
+        perp = _unit(perp)
+        ph = po + r_oh * (math.cos(bend) * u + math.sin(bend) * perp)
+        positions += [po[None], ph[None]]
+        types += ["OC24", "HOY"]
+        bonds += [(si_new[s], n), (n, n + 1)]
+        lab = str(label_of_si[s])
+        sil_o_idx.setdefault(lab, []).append(n)
+        sil_h_idx.setdefault(lab, []).append(n + 1)
+        n += 2
+    positions = np.concatenate(positions)
+    # Q-distribution of the kept Si
+    n_oh_of_si = np.zeros(len(si_keep), int)
+    for k in range(len(silanol)):
+        if k not in removed_sil:
+            n_oh_of_si[si_new[s_own[k]]] += 1
+    q_counts = {f"Q{4 - m}": int(np.sum(n_oh_of_si == m)) for m in range(0, 3)}
+    geminal = int(np.sum(n_oh_of_si == 2))
+    system = from_types(positions, types, ff, cell=cell, pbc=(True, True, False), bonds=bonds)
+    groups = {}
+    for lab, idx in sil_o_idx.items():
+        groups[f"silanol_O_{lab}"] = idx
+        groups[f"silanol_H_{lab}"] = sil_h_idx[lab]
+    system = replace(system, groups=groups)
+    for name, d in per_region.items():
+        achieved, lo, hi = d["density_nm2"], d["min_density_nm2"], d["max_density_nm2"]
+        if target_density > 0 and abs(achieved - target_density) > tolerance * target_density:
+            raise ValueError(
+                f"silanol density {target_density} OH/nm^2 is not reachable on the {name} face of "
+                f"{bulk.polymorph}({bulk.face}): achievable {lo:.2f}..{hi:.2f} OH/nm^2 in steps of "
+                f"{2 / d['area_nm2']:.3f} (condensation Q2->Q3 only); got {achieved:.2f}. "
+                + ("Use face='001' for 3.9-7.8 OH/nm^2." if bulk.face == "111" else
+                   "Use face='111' for 4.50 OH/nm^2 (Q3)." if bulk.face == "001" else ""))
+    info.update({"silanol_regions": per_region, "q_distribution": q_counts, "geminal_si": geminal,
+                 "condensed_bridges": n_condensed_o})
+    return system, info
+
+
+def _finish_silica(system: System, ff: ForceField, vacuum: float, frozen_depth: float) -> System:
+    """Wrap x, y; put the lowest atom ``vacuum`` above z = 0; box height = extent + 2 vacuum; type bonded terms."""
+    p = system.positions.copy()
+    p[:, 0] = np.mod(p[:, 0], system.cell[0])
+    p[:, 1] = np.mod(p[:, 1], system.cell[1])
+    p[:, 2] += vacuum - p[:, 2].min()
+    cell = np.array([system.cell[0], system.cell[1], np.ptp(p[:, 2]) + 2.0 * vacuum])
+    groups = dict(system.groups)
+    groups["silica"] = np.arange(system.n_atoms)
+    if frozen_depth > 0:
+        groups["frozen"] = np.flatnonzero(p[:, 2] <= p[:, 2].min() + frozen_depth)
+    out = replace(system, positions=p, cell=cell, groups=groups)
+    return with_bonded_terms(out, ff)
+
+
+def silica_slab(nx: int = 4, ny: int = 4, *, thickness: float | None = 25.0, layers: int | None = None,
+                silanol_density: float = 4.7, polymorph: str = "cristobalite", face: str | None = None,
+                seed: int = 0, vacuum: float = 10.0, frozen_depth: float = 5.0, density_tolerance: float = 0.10,
+                lattice_a: float | None = None, forcefield: ForceField | None = None) -> System:
+    """Hydroxylated crystalline silica slab, periodic in x and y, both faces hydroxylated.
+
+    ``nx``, ``ny``: repeats of the surface cell (cristobalite (001): a x a; (111): a/sqrt2 x a sqrt(3/2);
+    quartz (0001): a x a sqrt3). ``thickness`` (A): smallest distance between the outermost Si planes;
+    or ``layers``: number of crystal periods along z (overrides ``thickness``). ``silanol_density``
+    (OH/nm^2, per face): the cut face's natural density is lowered by condensation (module docstring); if the
+    achieved value is more than ``density_tolerance`` (relative) from the request, ValueError states the
+    achievable range. ``face`` defaults to '001' (cristobalite) / '0001' (quartz). ``vacuum`` (A) is added
+    below and above. ``frozen_depth`` (A): atoms this close to the bottom form the group 'frozen'.
+
+    Groups: 'silica', 'slab', 'silanol_O_top', 'silanol_H_top', 'silanol_O_bottom', 'silanol_H_bottom',
+    'frozen'. ``info``: counts, per-face silanol densities and achievable ranges, Q distribution, thicknesses.
+    """
+    ff = forcefield or silica_forcefield()
+    face = face or ("0001" if polymorph == "quartz" else "001")
+    rng = np.random.default_rng(seed)
+    probe = _bulk(polymorph, face, 1, 1, 1, lattice_a)
+    if layers is None and (thickness is None or thickness <= 0):
+        raise ValueError("give thickness (A, > 0) or layers")
+    nz = (int(layers) if layers is not None else int(math.ceil(thickness / probe.period_z))) + 3
+    bulk = _bulk(polymorph, face, nx, ny, nz, lattice_a)
+    keep = _clean(bulk, _choose_planes(bulk, thickness, layers), fill=False)
+    zc = 0.5 * (bulk.si_pos[keep, 2].min() + bulk.si_pos[keep, 2].max())
+    area = bulk.cell[0] * bulk.cell[1]
+    system, sinfo = _hydroxylated_silica(
+        bulk, keep, regions=lambda p: np.where(p[:, 2] > zc, "top", "bottom"),
+        areas={"top": area, "bottom": area}, target_density=silanol_density,
+        normal=lambda p, lab: np.array([0.0, 0.0, 1.0 if lab == "top" else -1.0]), rng=rng, ff=ff,
+        tolerance=density_tolerance)
+    system = _finish_silica(system, ff, vacuum, frozen_depth)
+    si = system.select("SC4")
+    reg = sinfo["silanol_regions"]
+    info = {
+        "builder": "silica_slab", "polymorph": polymorph, "face": face, "lattice_a_A": bulk.lattice_a,
+        "surface_cells": (nx, ny), "area_nm2": area / 100.0, "seed": seed,
+        "n_atoms": system.n_atoms, "counts": system.type_counts(),
+        "silanol_density_requested_nm2": silanol_density,
+        "silanol_density_top": reg["top"]["density_nm2"], "silanol_density_bottom": reg["bottom"]["density_nm2"],
+        "silanol_density_range_nm2": (reg["top"]["min_density_nm2"], reg["top"]["max_density_nm2"]),
+        "thickness_si_A": float(np.ptp(system.positions[si, 2])),
+        "thickness_A": float(np.ptp(system.positions[:, 2])),
+        "total_charge": system.total_charge(), "source": SOURCES[polymorph], **sinfo,
+        "omitted_zero_dihedrals": system.info.get("omitted_zero_dihedrals", 0),
+    }
+    groups = dict(system.groups)
+    groups["slab"] = np.arange(system.n_atoms)
+    return replace(system, groups=groups, info=_plain(info))
+
+
+def silica_asperity(radius: float = 15.0, holder_thickness: float = 10.0, *, nx: int | None = None,
+                    ny: int | None = None, margin: float = 10.0, silanol_density: float = 4.7,
+                    polymorph: str = "cristobalite", face: str | None = None, seed: int = 0, vacuum: float = 10.0,
+                    frozen_depth: float = 5.0, lattice_a: float | None = None,
+                    forcefield: ForceField | None = None) -> System:
+    """Hemispherical crystalline silica asperity of ``radius`` (A) on a holder slab, pointing up (+z).
+
+    Carved from the same crystal as :func:`silica_slab`: Si inside the hemisphere (centre on the holder's
+    top Si plane, middle of the box) or inside the holder are kept, then cleaned (no Q0/Q1 Si, removed Si
+    with >= 3 kept neighbours put back) and hydroxylated. Condensation lowers the silanol density separately
+    on the dome (nominal area 2 pi R^2), the flat top of the holder (Lx Ly - pi R^2) and its back (Lx Ly);
+    the dome value is nominal (the crystalline dome is stepped, its true area is larger) and is reported, not
+    enforced. Lateral size: ``nx``, ``ny`` surface cells, default the smallest with L >= 2 R + 2 ``margin``.
+    Use :func:`flip_upside_down` to point it down onto a flat.
+
+    Groups: 'silica', 'asperity' (dome Si and their O/H), 'holder' (the rest), 'frozen' (atoms within
+    ``frozen_depth`` of the holder's back), 'silanol_O_top'/'_dome'/'_bottom' and the matching H groups.
+    """
+    ff = forcefield or silica_forcefield()
+    face = face or ("0001" if polymorph == "quartz" else "001")
+    rng = np.random.default_rng(seed)
+    probe = _bulk(polymorph, face, 1, 1, 1, lattice_a)
+    ux, uy = probe.unit_xy
+    nx = nx or int(math.ceil((2 * radius + 2 * margin) / ux))
+    ny = ny or int(math.ceil((2 * radius + 2 * margin) / uy))
+    nz = int(math.ceil((holder_thickness + radius) / probe.period_z)) + 4
+    bulk = _bulk(polymorph, face, nx, ny, nz, lattice_a)
+    holder = _clean(bulk, _choose_planes(bulk, holder_thickness, None), fill=False)
+    z_top = bulk.si_pos[holder, 2].max()
+    centre = np.array([0.5 * bulk.cell[0], 0.5 * bulk.cell[1], z_top])
+    d = minimum_image(bulk.si_pos - centre, bulk.cell, (True, True, False))
+    dome = (bulk.si_pos[:, 2] > z_top + 0.01) & (np.linalg.norm(d, axis=1) <= radius)
+    keep = _clean(bulk, holder | dome, fill=True)
+    # nothing may grow below the holder's bottom plane
+    z_bot = bulk.si_pos[holder, 2].min()
+    keep &= bulk.si_pos[:, 2] >= z_bot - 0.01
+    keep = _clean(bulk, keep, fill=False)
+    zc = 0.5 * (z_bot + z_top)
+    area = bulk.cell[0] * bulk.cell[1]
+
+    def regions(p):
+        lab = np.where(p[:, 2] > zc, "top", "bottom").astype(object)
+        lab[p[:, 2] > z_top + 0.01] = "dome"
+        return lab
+
+    def normal(p, lab):
+        if lab == "dome":
+            return _unit(minimum_image(p - centre, bulk.cell, (True, True, False)))
+        return np.array([0.0, 0.0, 1.0 if lab == "top" else -1.0])
+
+    areas = {"dome": 2 * math.pi * radius ** 2, "top": area - math.pi * radius ** 2, "bottom": area}
+    system, sinfo = _hydroxylated_silica(bulk, keep, regions=regions, areas=areas, target_density=silanol_density,
+                                         normal=normal, rng=rng, ff=ff, tolerance=math.inf)
+    z_shift = vacuum - system.positions[:, 2].min()
+    system = _finish_silica(system, ff, vacuum, frozen_depth)
+    # asperity atoms: dome Si and every O/H bonded to them (O shared with the holder's top plane included)
+    si = system.select("SC4")
+    z_top_new = z_top + z_shift
+    dome_si = si[system.positions[si, 2] > z_top_new + 0.01]
+    nb = [[] for _ in range(system.n_atoms)]
+    for i, j in system.bonds.tolist():
+        nb[i].append(j)
+        nb[j].append(i)
+    asp = set(dome_si.tolist())
+    for s in dome_si.tolist():
+        for o in nb[s]:
+            asp.add(o)
+            asp.update(h for h in nb[o] if system.types[h] == "HOY")
+    asp_idx = np.array(sorted(asp), int)
+    holder_idx = np.setdiff1d(np.arange(system.n_atoms), asp_idx)
+    r_dome = np.linalg.norm(minimum_image(system.positions[dome_si] - (centre + [0, 0, z_shift]), system.cell,
+                                          system.pbc), axis=1)
+    reg = sinfo["silanol_regions"]
+    info = {
+        "builder": "silica_asperity", "polymorph": polymorph, "face": face, "lattice_a_A": bulk.lattice_a,
+        "radius_requested_A": radius, "radius_max_si_A": float(r_dome.max()) if len(r_dome) else 0.0,
+        "dome_height_si_A": float(system.positions[dome_si, 2].max() - z_top_new) if len(dome_si) else 0.0,
+        "centre_A": (centre + [0, 0, z_shift]).tolist(), "holder_top_si_z_A": float(z_top_new),
+        "holder_thickness_si_A": float(z_top - z_bot), "surface_cells": (nx, ny), "seed": seed,
+        "n_atoms": system.n_atoms, "counts": system.type_counts(), "n_asperity_atoms": int(len(asp_idx)),
+        "silanol_density_requested_nm2": silanol_density,
+        "silanol_density_dome": reg["dome"]["density_nm2"], "silanol_density_top": reg["top"]["density_nm2"],
+        "silanol_density_bottom": reg["bottom"]["density_nm2"],
+        "total_charge": system.total_charge(), "source": SOURCES[polymorph], **sinfo,
+        "omitted_zero_dihedrals": system.info.get("omitted_zero_dihedrals", 0),
+    }
+    groups = dict(system.groups)
+    groups["asperity"] = asp_idx
+    groups["holder"] = holder_idx
+    return replace(system, groups=groups, info=_plain(info))
+
+
+# ================================================================================================ OTS monolayer
+
+def _xy_spacing_ok(p: np.ndarray, accepted: list[np.ndarray], cell: np.ndarray, dmin: float) -> bool:
+    if not accepted:
+        return True
+    d = minimum_image(np.array(accepted)[:, :2] - p[:2], cell[:2], (True, True))
+    return bool(np.min(np.hypot(d[:, 0], d[:, 1])) >= dmin)
+
+
+def _chain_template(ff: ForceField, chain_length: int, tilt_deg: float, azimuth_deg: float):
+    """Positions (relative to the anchor O at the origin) and types of SIH, 2 x (OC24, HOY), CH2 x (n-1), CH3.
+
+    All-trans zigzag: anchor O, head Si and the carbons lie in one plane containing the chain axis, which is
+    tilted ``tilt_deg`` from +z towards azimuth ``azimuth_deg``; every backbone angle is the TraPPE C-C-C
+    theta0 (114 deg), bond lengths are the force field's r0. The two head OH take the remaining tetrahedral
+    directions at the head Si, with Si-O-H = IFF theta0 and H tilted upwards.
+    """
+    t, phi = math.radians(tilt_deg), math.radians(azimuth_deg)
+    axis = np.array([math.sin(t) * math.cos(phi), math.sin(t) * math.sin(phi), math.cos(t)])
+    up = np.array([0.0, 0.0, 1.0])
+    w = up - np.dot(up, axis) * axis
+    if np.linalg.norm(w) < 1e-9:  # untilted: any perpendicular in the azimuth plane
+        w = np.array([math.cos(phi), math.sin(phi), 0.0])
+    w = _unit(w)
+    half = math.radians(0.5 * (180.0 - _angle_theta0(ff, "CH2", "CH2", "CH2")))
+    r = {"O-S": _bond_r0(ff, "SIH", "OC23"), "S-C": _bond_r0(ff, "CH2", "SIH"), "C-C": _bond_r0(ff, "CH2", "CH2"),
+         "C-C3": _bond_r0(ff, "CH3", "CH2"), "S-OH": _bond_r0(ff, "SIH", "OC24"), "O-H": _bond_r0(ff, "OC24", "HOY")}
+    lengths = [r["O-S"], r["S-C"]] + [r["C-C"]] * (chain_length - 2) + [r["C-C3"]]
+    backbone = [np.zeros(3)]
+    for k, length in enumerate(lengths):
+        sign = 1.0 if k % 2 == 0 else -1.0
+        backbone.append(backbone[-1] + length * (math.cos(half) * axis + sign * math.sin(half) * w))
+    backbone = np.array(backbone)            # 0: anchor O, 1: SIH, 2..: carbons
+    s = backbone[1]
+    a, b = _unit(backbone[0] - s), _unit(backbone[2] - s)
+    m, nrm = _unit(a + b), _unit(np.cross(a, b))
+    half_tet = math.acos(-1.0 / 3.0) / 2.0
+    bend = math.radians(180.0 - _angle_theta0(ff, "SIH", "OC24", "HOY"))
+    head = []
+    for sign in (1.0, -1.0):
+        d = -math.cos(half_tet) * m + sign * math.sin(half_tet) * nrm
+        o = s + r["S-OH"] * d
+        p = up - np.dot(up, d) * d
+        p = _unit(p) if np.linalg.norm(p) > 1e-6 else _unit(np.cross(d, axis))
+        head.append((o, o + r["O-H"] * (math.cos(bend) * d + math.sin(bend) * p)))
+    pos = [backbone[1], head[0][0], head[0][1], head[1][0], head[1][1], *backbone[2:]]
+    types = ["SIH", "OC24", "HOY", "OC24", "HOY"] + ["CH2"] * (chain_length - 1) + ["CH3"]
+    # local bonds (indices into pos); the anchor bond O-SIH is added by the caller
+    bonds = [(0, 1), (1, 2), (0, 3), (3, 4), (0, 5)] + [(5 + k, 6 + k) for k in range(chain_length - 1)]
+    return np.array(pos), types, bonds
+
+
+def ots_sam(substrate: System, coverage: float = 4.5, *, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
+            chain_length: int = 18, seed: int = 0, min_spacing: float = 4.4, site_group: str = "silanol_O_top",
+            vacuum: float = 10.0, forcefield: ForceField | None = None) -> System:
+    """Graft an OTS monolayer (C``chain_length`` united-atom chains on Si(OH)2 heads) onto a flat silica slab.
+
+    Grafting sites are drawn (seeded, random order) from the substrate's top silanol O (group ``site_group``)
+    with a lateral minimum spacing ``min_spacing`` (A) until ``coverage`` chains/nm^2 (of the x-y area) is
+    reached; if the sites cannot hold it, ValueError says how many fit (cristobalite (111), one Q3 silanol per
+    4.50 nm^-2 on a 5.06 A hexagonal lattice, holds 4.50 chains/nm^2; the (001) face at most 3.9).
+
+    Each graft is the condensation Si-OH + HO-Si(OH)2R -> Si-O-Si(OH)2R: the surface silanol H is deleted and
+    its O retyped OC24 -> OC23 (charge -0.675 -> -0.55); the head Si (SIH, +0.825) is bonded to that O, to two
+    OH (OC24/HOY) and to the alpha-CH2. Charge per graft: substrate -0.4 + 0.125 = -0.275, chain
+    0.825 + 2 (-0.675 + 0.4) = +0.275, net 0 (inputs/forcefields/README.md). No lateral Si-O-Si cross-links
+    between heads (simplification).
+    Chains start all-trans with their axis tilted ``tilt_deg`` towards ``tilt_azimuth_deg``.
+
+    Groups added: 'sam' (all chain atoms incl. head OH), 'sam_head_si', 'sam_ch3', 'sam_anchor_O'.
+    ``info``: chains, coverage (nm^-2), thickness (mean CH3 height above the mean anchor-O plane, A), sites.
+    """
+    ff = forcefield or sam_forcefield()
+    rng = np.random.default_rng(seed)
+    if chain_length < 2:
+        raise ValueError("chain_length must be >= 2")
+    sites = np.asarray(substrate.group(site_group), int)
+    if not len(sites):
+        raise ValueError(f"substrate group {site_group!r} is empty: nothing to graft on")
+    area = float(substrate.cell[0] * substrate.cell[1])
+    target = int(round(coverage * area / 100.0))
+    pos = substrate.positions
+    accepted: list[int] = []
+    acc_pos: list[np.ndarray] = []
+    for k in rng.permutation(len(sites)).tolist():
+        i = int(sites[k])
+        if len(accepted) == target:
+            break
+        if _xy_spacing_ok(pos[i], acc_pos, substrate.cell, min_spacing):
+            accepted.append(i)
+            acc_pos.append(pos[i])
+    if len(accepted) < target:
+        raise ValueError(
+            f"only {len(accepted)} of {target} grafting sites fit at {min_spacing} A spacing on this substrate "
+            f"({len(accepted) / area * 100:.2f} chains/nm^2 < requested {coverage}); cristobalite face='111' "
+            f"offers 4.50 sites/nm^2 on a 5.06 A lattice")
+    accepted.sort()
+    # delete the silanol H of each anchor O, retype the O
+    nb = [[] for _ in range(substrate.n_atoms)]
+    for i, j in substrate.bonds.tolist():
+        nb[i].append(j)
+        nb[j].append(i)
+    h_del = []
+    for o in accepted:
+        hs = [h for h in nb[o] if substrate.types[h] == "HOY"]
+        if len(hs) != 1 or substrate.types[o] != "OC24":
+            raise ValueError(f"site atom {o} is not a silanol O (type {substrate.types[o]}, H neighbours {hs})")
+        h_del.append(hs[0])
+    types = substrate.types.copy().astype(object)
+    charges = substrate.charges.copy()
+    oc23 = ff.atom_type("OC23")
+    types[accepted] = "OC23"
+    charges[accepted] = oc23.charge
+    # the anchor O stays but is no longer a silanol; record it through a group so that remove_atoms re-indexes it
+    groups = {k: (np.setdiff1d(v, accepted) if k.startswith("silanol_O") else v) for k, v in substrate.groups.items()}
+    groups["sam_anchor_O"] = np.array(accepted, int)
+    base = replace(substrate, types=types, charges=charges, groups=groups)
+    base = remove_atoms(base, h_del)
+    anchors = np.asarray(base.group("sam_anchor_O"), int)
+    # chains
+    tpos, ttypes, tbonds = _chain_template(ff, chain_length, tilt_deg, tilt_azimuth_deg)
+    n0 = base.n_atoms
+    per = len(ttypes)
+    mol0 = int(base.mol_ids.max())
+    all_pos, all_types, all_mol, bonds = [], [], [], []
+    for c, o in enumerate(anchors.tolist()):
+        off = n0 + c * per
+        all_pos.append(base.positions[o] + tpos)
+        all_types += ttypes
+        all_mol += [mol0 + 1 + c] * per
+        bonds += [(off + i, off + j) for i, j in tbonds]
+        bonds.append((o, off))                        # anchor O - head Si
+    chain_pos = np.concatenate(all_pos)
+    chains = from_types(chain_pos, all_types, ff, mol_ids=all_mol, cell=base.cell, pbc=base.pbc)
+    merged = merge([base, chains], cell=base.cell)
+    merged = replace(merged, bonds=np.concatenate([merged.bonds, np.array(bonds, int)]), bond_types=[])
+    zmax = merged.positions[:, 2].max()
+    cell = np.array([base.cell[0], base.cell[1], zmax + vacuum])
+    sam_idx = np.arange(n0, n0 + len(anchors) * per)
+    head_si = n0 + np.arange(len(anchors)) * per
+    ch3 = n0 + np.arange(len(anchors)) * per + per - 1
+    groups = {k: v for k, v in merged.groups.items()}
+    groups.update(sam=sam_idx, sam_head_si=head_si, sam_ch3=ch3, sam_anchor_O=anchors)
+    merged = replace(merged, cell=cell, groups=groups, info={})
+    merged = with_bonded_terms(merged, ff)
+    p = merged.positions
+    thickness = float(p[ch3, 2].mean() - p[anchors, 2].mean())
+    top_sil = merged.groups.get("silanol_O_top", np.array([], int))
+    sub_info = dict(substrate.info)
+    info = {
+        "builder": "ots_sam", "chains": int(len(anchors)), "chain_length": chain_length,
+        "coverage_requested_nm2": coverage, "coverage_nm2": len(anchors) / (area / 100.0),
+        "area_nm2": area / 100.0, "tilt_deg": tilt_deg, "tilt_azimuth_deg": tilt_azimuth_deg,
+        "min_spacing_A": min_spacing, "seed": seed,
+        "thickness_A": thickness,
+        "thickness_definition": "mean CH3 height minus mean anchor-O height (initial all-trans geometry)",
+        "unreacted_top_silanols": int(len(top_sil)),
+        "unreacted_top_silanol_density_nm2": len(top_sil) / (area / 100.0),
+        "cross_linking": "none: each head keeps two Si-OH (simplification)",
+        "n_atoms": merged.n_atoms, "counts": merged.type_counts(), "total_charge": merged.total_charge(),
+        "source": SOURCES["ots"], "substrate": sub_info,
+        "omitted_zero_dihedrals": merged.info.get("omitted_zero_dihedrals", 0),
+    }
+    return replace(merged, info=_plain(info))
+
+
+# ================================================================================================ water
+
+def _water_geometry(ff: ForceField) -> tuple[str, str, np.ndarray]:
+    """(O type, H type, (3, 3) molecule-frame positions O, H1, H2) of the rigid 3-site model in ``ff``."""
+    o = next(t for t in ff.atom_types if t.element == "O" and t.name.startswith("OW"))
+    h = next(t for t in ff.atom_types if t.element == "H" and t.name.startswith("HW"))
+    r = _bond_r0(ff, o.name, h.name)
+    half = math.radians(_angle_theta0(ff, h.name, o.name, h.name)) / 2.0
+    frame = np.array([[0, 0, 0], [r * math.sin(half), 0, r * math.cos(half)],
+                      [-r * math.sin(half), 0, r * math.cos(half)]], float)
+    return o.name, h.name, frame
+
+
+def _number_density(ff: ForceField, density: float) -> tuple[float, float]:
+    """(molecules per A^3, g/mol per molecule) at ``density`` g/cm^3."""
+    o_name, h_name, _ = _water_geometry(ff)
+    m = ff.atom_type(o_name).mass + 2 * ff.atom_type(h_name).mass
+    return density * AVOGADRO / m * 1e-24, m
+
+
+def _place_waters(sites: np.ndarray, cell: np.ndarray, pbc: Sequence[bool], ff: ForceField,
+                  rng: np.random.Generator, min_dist: float = 1.7, tries: int = 24) -> np.ndarray:
+    """Positions (3N, 3) of waters with O on ``sites`` and random orientations, redrawn (up to ``tries``)
+    while any intermolecular distance to an already placed molecule is below ``min_dist`` (A)."""
+    _, _, frame = _water_geometry(ff)
+    n = len(sites)
+    lo = sites.min(axis=0) - 5.0
+    box = np.where(pbc, cell, np.ptp(sites, axis=0) + 1e4)
+    wrapped = sites - np.where(pbc, 0.0, lo)
+    wrapped = np.where(pbc, np.mod(wrapped, cell), wrapped)
+    tree = cKDTree(wrapped, boxsize=box)
+    neigh = tree.query_ball_point(wrapped, r=4.5)
+    out = np.zeros((n, 3, 3))
+    placed = np.zeros(n, bool)
+    pbc_t = tuple(bool(x) for x in pbc)
+    for i in range(n):
+        rots = Rotation.random(tries, random_state=rng).as_matrix()        # (tries, 3, 3)
+        cand = sites[i] + np.einsum("tab,kb->tka", rots, frame)           # (tries, 3 atoms, 3)
+        others = [j for j in neigh[i] if placed[j]]
+        if not others:
+            out[i] = cand[0]
+        else:
+            other = out[others].reshape(-1, 3)                            # (m, 3)
+            d = minimum_image(cand[:, :, None, :] - other[None, None, :, :], cell, pbc_t)
+            dmin = np.linalg.norm(d, axis=-1).reshape(tries, -1).min(axis=1)
+            ok = np.flatnonzero(dmin >= min_dist)
+            out[i] = cand[ok[0]] if len(ok) else cand[int(np.argmax(dmin))]
+        placed[i] = True
+    return out.reshape(-1, 3)
+
+
+def _water_system(sites: np.ndarray, cell: np.ndarray, ff: ForceField, rng, info: dict) -> System:
+    o_name, h_name, _ = _water_geometry(ff)
+    pos = _place_waters(sites, cell, (True, True, False), ff, rng)
+    n = len(sites)
+    types = [o_name, h_name, h_name] * n
+    mol = np.repeat(np.arange(1, n + 1), 3)
+    bonds = [(3 * k, 3 * k + j) for k in range(n) for j in (1, 2)]
+    s = from_types(pos, types, ff, mol_ids=mol, cell=cell, pbc=(True, True, False), bonds=bonds,
+                   groups={"water": np.arange(3 * n), "water_O": np.arange(0, 3 * n, 3)})
+    s = with_bonded_terms(s, ff)
+    info = {**info, "n_molecules": n, "n_atoms": s.n_atoms, "counts": s.type_counts(),
+            "total_charge": s.total_charge(), "model": ff.name, "seed": info.get("seed")}
+    return replace(s, info=_plain(info))
+
+
+def water_slab(lx: float, ly: float, thickness: float = 30.0, *, density: float = WATER_DENSITY,
+               vacuum: float = 15.0, seed: int = 0, forcefield: ForceField | None = None) -> System:
+    """A water film periodic in x, y (box ``lx`` x ``ly`` A), ``thickness`` A thick, centred in z with
+    ``vacuum`` above and below (for gamma_lv and density profiles, or to put on a substrate).
+
+    N = round(rho V N_A / M) molecules fill the film at ``density`` g/cm^3: O on a rectangular lattice
+    (spacing ~3.1 A, commensurate with lx, ly) with the surplus sites removed at random; orientations random
+    (seeded), redrawn to keep intermolecular distances >= 1.7 A where possible.
+    """
+    ff = forcefield or water_forcefield()
+    rng = np.random.default_rng(seed)
+    rho_n, m = _number_density(ff, density)
+    n = int(round(rho_n * lx * ly * thickness))
+    s0 = rho_n ** (-1.0 / 3.0)
+    nx, ny = max(1, round(lx / s0)), max(1, round(ly / s0))
+    nz = int(math.ceil(n / (nx * ny)))
+    dx, dy, dz = lx / nx, ly / ny, thickness / nz
+    g = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"), -1).reshape(-1, 3)
+    keep = np.sort(rng.choice(len(g), size=n, replace=False))
+    sites = (g[keep] + 0.5) * [dx, dy, dz] + [0.0, 0.0, vacuum]
+    cell = np.array([lx, ly, thickness + 2 * vacuum])
+    info = {"builder": "water_slab", "thickness_A": thickness, "area_nm2": lx * ly / 100.0,
+            "density_g_cm3": n * m / AVOGADRO / (lx * ly * thickness * 1e-24), "density_requested_g_cm3": density,
+            "lattice": (nx, ny, nz), "lattice_spacing_A": (dx, dy, dz), "z_range_A": (vacuum, vacuum + thickness),
+            "periodic_axes": "xy", "seed": seed}
+    return _water_system(sites, cell, ff, rng, info)
+
+
+def water_cylinder(radius: float, length: float, *, box_x: float | None = None, density: float = WATER_DENSITY,
+                   vacuum: float = 15.0, seed: int = 0, forcefield: ForceField | None = None) -> System:
+    """A quasi-2-D droplet: a water cylinder of ``radius`` (A) with its axis along y, periodic along y with
+    period ``length`` (A, the box y length), circular cross-section in x-z.
+
+    Molecules sit on a lattice: ny = round(length / 3.1) planes along y; in x-z a square grid whose cell area
+    times the y spacing is one molecular volume at ``density``; the grid columns nearest the axis are filled
+    first until N = round(rho pi R^2 L N_A / M). Box: x = ``box_x`` (default 2R + 2 vacuum), z = 2R + 2 vacuum,
+    axis at (box_x/2, vacuum + R).
+    """
+    ff = forcefield or water_forcefield()
+    rng = np.random.default_rng(seed)
+    rho_n, m = _number_density(ff, density)
+    n = int(round(rho_n * math.pi * radius ** 2 * length))
+    s0 = rho_n ** (-1.0 / 3.0)
+    ny = max(1, round(length / s0))
+    dy = length / ny
+    d = math.sqrt(1.0 / (rho_n * dy))
+    k = int(math.ceil(radius / d)) + 2
+    ij = np.stack(np.meshgrid(np.arange(-k, k + 1), np.arange(-k, k + 1), indexing="ij"), -1).reshape(-1, 2)
+    cols = (ij + 0.5) * d                              # offset grid: symmetric about the axis
+    r2 = np.round((cols ** 2).sum(axis=1), 6)
+    order = np.lexsort((rng.permutation(len(cols)), r2))
+    box_x = float(box_x) if box_x is not None else 2 * radius + 2 * vacuum
+    if box_x < 2 * radius + 6.0:
+        raise ValueError(f"box_x = {box_x} A is too narrow for a cylinder of radius {radius} A")
+    cx, cz = 0.5 * box_x, vacuum + radius
+    sites = []
+    for c in order.tolist():
+        for j in rng.permutation(ny).tolist():
+            sites.append((cx + cols[c, 0], (j + 0.5) * dy, cz + cols[c, 1]))
+        if len(sites) >= n:
+            break
+    sites = np.array(sites[:n])
+    cell = np.array([box_x, length, 2 * radius + 2 * vacuum])
+    r_eff = math.sqrt(n / (rho_n * math.pi * length))
+    info = {"builder": "water_cylinder", "radius_A": radius, "length_A": length, "axis": "y",
+            "axis_xz_A": (cx, cz), "density_g_cm3": n * m / AVOGADRO / (math.pi * radius ** 2 * length * 1e-24),
+            "density_requested_g_cm3": density, "radius_effective_A": r_eff,
+            "radius_outermost_site_A": float(np.sqrt(((sites[:, [0, 2]] - [cx, cz]) ** 2).sum(axis=1)).max()),
+            "lattice_spacing_A": (d, dy, d), "periodic_axes": "y", "seed": seed}
+    return _water_system(sites, cell, ff, rng, info)
+
+
+# ================================================================================================ assembly
+
+def place_on(substrate: System, adsorbate: System, gap: float = 3.0, *, vacuum: float = 15.0,
+             center: bool = True, tolerance: float = 1e-3) -> System:
+    """Put ``adsorbate`` on top of ``substrate``: its lowest atom ``gap`` (A) above the substrate's highest.
+
+    The box is the substrate's in x, y; z extends ``vacuum`` above the highest atom. Axes along which the
+    adsorbate is periodic (``info['periodic_axes']``, default 'xy' for slabs, 'y' for a water cylinder) must
+    have the substrate's length (to ``tolerance`` A); along the others the adsorbate is centred on the box
+    when ``center`` and must fit. Bonded terms are kept (no bonds across the interface). Groups of the same
+    name are concatenated; groups 'substrate' and 'adsorbate' tell the two parts apart.
+    """
+    axes = str(adsorbate.info.get("periodic_axes", "xy"))
+    shift = np.zeros(3)
+    for k, ax in enumerate("xy"):
+        if ax in axes:
+            if abs(adsorbate.cell[k] - substrate.cell[k]) > tolerance:
+                raise ValueError(f"adsorbate is periodic along {ax} with L = {adsorbate.cell[k]:.4f} A but the "
+                                 f"substrate has {substrate.cell[k]:.4f} A; build it with the substrate's length")
+        else:
+            ext = np.ptp(adsorbate.positions[:, k])
+            if ext > substrate.cell[k] - 6.0:
+                raise ValueError(f"adsorbate extends {ext:.1f} A along {ax}: does not fit the substrate's "
+                                 f"{substrate.cell[k]:.1f} A box with a gap to its periodic image")
+            if center:
+                mid = 0.5 * (adsorbate.positions[:, k].max() + adsorbate.positions[:, k].min())
+                shift[k] = 0.5 * substrate.cell[k] - mid
+    shift[2] = substrate.positions[:, 2].max() + gap - adsorbate.positions[:, 2].min()
+    moved = translate(adsorbate, shift)
+    top = moved.positions[:, 2].max()
+    cell = (substrate.cell[0], substrate.cell[1], top + vacuum)
+    info = {"builder": "place_on", "gap_A": gap, "vacuum_A": vacuum, "periodic_axes": "xy",
+            "substrate": dict(substrate.info), "adsorbate": dict(adsorbate.info)}
+    out = merge([substrate, moved], cell=cell, pbc=substrate.pbc, info=info)
+    info.update(n_atoms=out.n_atoms, counts=out.type_counts(), total_charge=out.total_charge())
+    groups = dict(out.groups)
+    groups["substrate"] = np.arange(substrate.n_atoms)
+    groups["adsorbate"] = np.arange(substrate.n_atoms, out.n_atoms)
+    out = replace(out, groups=groups, info=_plain(info))
+    return out
