@@ -28,22 +28,12 @@ def cmd_impact(args) -> int:
     from continuum.impact import run_impact, write_impact
     from continuum.scene import SceneError, resolve_scene
 
+    overrides = {"numerics.fidelity": args.fidelity} if args.fidelity else None
     try:
-        resolved = resolve_scene(args.scene, params=args.params)
+        resolved = resolve_scene(args.scene, params=args.params, overrides=overrides, override_label="command line")
     except SceneError as exc:
         print(f"nanoimpact impact: invalid scene: {exc}", file=sys.stderr)
         return 2
-    if args.fidelity:
-        from dataclasses import replace
-
-        from continuum.schema import FIDELITY
-        sc = resolved.scene
-        numerics = replace(sc.numerics, fidelity=args.fidelity,
-                           rtol=FIDELITY[args.fidelity]["rtol"] if resolved.sources.get("numerics.rtol") == "default"
-                           else sc.numerics.rtol)
-        values = {**resolved.values, "numerics.fidelity": args.fidelity}
-        sources = {**resolved.sources, "numerics.fidelity": "command line"}
-        resolved = replace(resolved, scene=replace(sc, numerics=numerics), values=values, sources=sources)
     out = Path(args.out) if args.out else Path("out") / resolved.scene.name
     sc = resolved.scene
     print(f"scene {sc.name}: {sc.body.shape}, contact {sc.contact}, adhesion {sc.physics.adhesion_law}, "
@@ -59,7 +49,29 @@ def cmd_impact(args) -> int:
     audit = result["energy_audit"]["max_relative_error"]
     print(f"status: {result['status']} after {result['n_bounces']} impacts; energy audit max error {audit:.2e}; "
           f"wall {result['timing']['wall_s']:.3f} s")
+    for w in result["warnings"]:
+        print(f"warning: {w}")
     print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png")
+    return 0
+
+
+def cmd_paper(args) -> int:
+    from continuum.paper.report import make_paper
+    from continuum.scene import SceneError, find_params
+
+    sets = [s.strip() for s in args.params.split(",") if s.strip()]
+    try:
+        for s in sets:
+            find_params(s)
+    except SceneError as exc:
+        print(f"nanoimpact paper: {exc}", file=sys.stderr)
+        return 2
+    record = make_paper(sets, args.out, fidelity=args.fidelity, workers=args.workers)
+    failed = [c for c in record["checks"] if not c["pass"]]
+    print(f"checks: {len(record['checks']) - len(failed)} pass, {len(failed)} fail "
+          f"(see {args.out}/summary.md and checks.json); wall {record['wall_s']:.1f} s")
+    for c in failed:
+        print(f"  FAIL [{c['set']}] {c['name']}: {c['threshold']}")
     return 0
 
 
@@ -78,13 +90,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no per-impact progress lines")
     p.set_defaults(func=cmd_impact)
 
+    q = sub.add_parser("paper", help="reproduce the founding paper's cases for each parameter set",
+                       description="Run every case of the paper (Hertz roller, rough silica, OTS, roughness and "
+                                   "velocity sweeps) for each parameter set; write figures, data, summary.md and "
+                                   "checks.json to --out.")
+    q.add_argument("--params", default="paper,silicon", help="parameter sets, comma-separated (default: paper,silicon)")
+    q.add_argument("--out", default="out/paper", help="output folder (default: out/paper)")
+    q.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset for every case")
+    q.add_argument("--workers", type=int, help="parallel processes (default: CPU count)")
+    q.set_defaults(func=cmd_paper)
+
     # doctor owns its own options (md.doctor.main parses them); listed here for the top-level help
     sub.add_parser("doctor", help="check the LAMMPS installation (in-process and mpirun -np 2)", add_help=False)
+    sub.add_parser("md", help="run an MD recipe (work of adhesion, pull-off, contact angle, surface tension)",
+                   add_help=False)
     return parser
 
 
 #: Subcommands that parse their own arguments (module, function).
-_DELEGATED = {"doctor": ("md.doctor", "main")}
+_DELEGATED = {"doctor": ("md.doctor", "main"), "md": ("md.cli", "main")}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -213,8 +213,11 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
     def rhs(_t, y):
         return np.array([y[1], law.force(y[0]) / mass - gravity])
 
-    solver = DOP853(rhs, t0, np.array([gap0, v0]), t_bound=settings.max_time, rtol=settings.rtol,
-                    atol=atol, first_step=1e-3 * length / speed)
+    def start(t_start, y_start):
+        return DOP853(rhs, t_start, np.asarray(y_start, float), t_bound=settings.max_time, rtol=settings.rtol,
+                      atol=atol, first_step=1e-3 * length / speed)
+
+    solver = start(t0, [gap0, v0])
     peak_force = law.force(gap0)
     max_pen = -gap0
     e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
@@ -274,6 +277,7 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                 break
             y = dense(s)
             sample(s, y[0], y[1])
+        restart = None
         for te, kind in events:
             ye = dense(te)
             if kind in ("max_approach", "turn"):
@@ -287,6 +291,9 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                         profiles["max_approach"] = {"t": te, "gap": ye[0], "force": law.force(ye[0]), **snap}
                     pull["after_max"] = True
                 law.accept(ye[0])
+                if law.has_history:
+                    # stages after the extremum used the old history: cut the step here, restart
+                    restart = (te, [ye[0], 0.0])
             if kind == "turn" and law.bound_is_final:
                 end = "stuck" if law.force(ye[0]) < mass * gravity or gravity == 0.0 else "rest"
                 return finish(te, ye[0], 0.0, end, law.dissipated(ye[0]))
@@ -297,6 +304,11 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                 # the instant after: nothing stored, the law's loss terms are booked as dissipated
                 record(te, gap_r, v_r, 0.0, -1, 0.0, extra_booked=loss)
                 return finish(te, gap_r, v_r, None, loss)
+            if restart is not None:
+                break
+        if restart is not None:
+            solver = start(*restart)
+            continue
         max_pen = max(max_pen, -y1[0])
         peak_force = max(peak_force, law.force(y1[0]))
         sample(t1, y1[0], y1[1])

@@ -12,6 +12,7 @@ from .models import select_law
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
 from .scene import ResolvedScene
+from .warnings import result_warnings
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:
@@ -33,6 +34,10 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     run = simulate(law, scene.body.mass, scene.environment.gravity, release_height=scene.release_height,
                    impact_velocity=scene.impact_velocity, settings=settings, progress=progress)
     wall = time.perf_counter() - start
+    diagnostics = law.diagnostics()
+    if diagnostics:
+        models["diagnostics"] = diagnostics
+    warnings = result_warnings(scene, law, run.bounces)
     result = {
         "schema_version": SCHEMA_VERSION,
         "scene": resolved.to_json(),
@@ -42,6 +47,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         "status": run.status,
         "stuck": run.stuck,
         "energy_audit": run.audit,
+        "warnings": warnings,
         "provenance": provenance(resolved.input_hash),
         "timing": {"wall_s": wall},
     }

@@ -22,10 +22,23 @@ def rough_law(scene: Scene) -> tuple[ContactLaw, dict]:
     datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
     summit_e_star = rough.summit_modulus if rough.summit_modulus is not None else surf.e_star
-    surface = GWJKRSurface(stats, w, summit_e_star, z_max=datum["z_max"], detachment=phys.detachment,
-                           resolution=scene.numerics.table)
-    law = RoughRoller(surface, body.radius, body.length, surf.e_star, half_space=phys.half_space == "on",
-                      grid_points=scene.numerics.grid_points)
+    if rough.mode == "discrete":
+        # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
+        from .laws.discrete_roller import DiscreteRoughRoller
+        law = DiscreteRoughRoller(stats, w, summit_e_star, body.radius, body.length, surf.e_star, seed=rough.seed,
+                                  detachment=phys.detachment, half_space=phys.half_space == "on",
+                                  grid_points=scene.numerics.grid_points,
+                                  footprint_half_width=datum["footprint_half_width"])
+        surface = law                                   # carries delta_c for the regime numbers
+    else:
+        surface = GWJKRSurface(stats, w, summit_e_star, z_max=datum["z_max"], detachment=phys.detachment,
+                               resolution=scene.numerics.table)
+        if phys.half_space == "on":
+            law = RoughRoller(surface, body.radius, body.length, surf.e_star, half_space=True,
+                              grid_points=scene.numerics.grid_points)
+        else:
+            from .laws.rough_rigid import RigidRoughRoller
+            law = RigidRoughRoller(surface, body.radius, body.length, resolution=scene.numerics.table)
     regime = {
         "summit_e_star": summit_e_star,
         "sigma_over_delta_c": rough.sigma / surface.delta_c if w > 0 else math.inf,
@@ -39,6 +52,16 @@ def rough_law(scene: Scene) -> tuple[ContactLaw, dict]:
     record = {"datum": {**datum, "z_max_m": datum["z_max"] * rough.sigma, "release_from": rough.datum},
               "regime": regime, "table": {"resolution": scene.numerics.table,
                                           "build_seconds": getattr(surface, "build_seconds", None)}}
+    if rough.mode == "discrete":
+        record["mode"] = "discrete"
+        record["seed"] = rough.seed
+        record["datum"]["realised"] = {
+            "definition": "tallest effective summit of the realisation, max(z_i - x_i^2/2R)",
+            "z_top_m": law.z_top, "z_top_sigma": law.z_top / rough.sigma,
+            "summits_in_strip": law.summits_in_strip, "summits_kept": law.summits_kept}
+        record["table"] = {"used": False, "why": "discrete mode evaluates each summit's JKR law in closed form"}
+    else:
+        record["mode"] = "averaged"
     return law, record
 
 

@@ -159,6 +159,7 @@ class ResolvedScene:
     sources: dict
     scene_file: str | None
     params_file: str | None
+    params_meta: dict | None = None
 
     def to_json(self) -> dict:
         """JSON-ready record: nested values in file units (as written), sources, files, SI dataclass."""
@@ -167,6 +168,7 @@ class ResolvedScene:
             "params_file": self.params_file,
             "values": _nest(self.values),
             "sources": self.sources,
+            "params_meta": self.params_meta,
             "si": asdict(self.scene),
         }
 
@@ -282,9 +284,11 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
     params_spec = params if params is not None else flat_scene.get("params")
     params_file = None
     flat_params: dict = {}
+    params_meta = None
     if params_spec is not None:
         params_file = find_params(params_spec, params_dir)
         raw = read_toml(params_file, "params")
+        params_meta = raw.get("meta")
         flat_params = flatten(raw, str(params_file), skip=("meta",))
         for forbidden in ("params", "name", "description"):
             if forbidden in flat_params:
@@ -312,7 +316,7 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
         sources["name"] = "file name"
     scene = _build(values, origin)
     return ResolvedScene(scene, values, sources, str(scene_file) if scene_file else None,
-                         str(params_file) if params_file else None)
+                         str(params_file) if params_file else None, params_meta)
 
 
 def _require(values: dict, path: str, origin: str, why: str):
@@ -379,7 +383,8 @@ def _build(v: dict, origin: str) -> Scene:
             raise SceneError(key, adhesion, "must be > 0 J/m^2 when physics.adhesion_law = 'jkr'", origin)
 
     preset = FIDELITY[si["numerics.fidelity"]]
-    rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else preset["rtol"]
+    default_rtol = preset["rtol_rough"] if si["contact"] == "rough" else preset["rtol"]
+    rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else default_rtol
     grid_points = si["numerics.grid_points"] if si["numerics.grid_points"] is not None else preset["grid_points"]
     return Scene(
         name=si["name"],

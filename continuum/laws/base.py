@@ -26,11 +26,16 @@ class ContactLaw(ABC):
     bound_is_final : bool
         True if, once the body turns back towards the surface while still in contact, it can
         never leave (the law is elastic while attached, so the motion is a lossless oscillation).
+    has_history : bool
+        True if the force depends on the path (e.g. GW summits attached at the deepest approach).
+        The driver then restarts the integrator at every extremum of the motion, so that no
+        Runge-Kutta stage after an extremum uses the history from before it.
     """
 
     name: str = "law"
     touch_gap: float = 0.0
     bound_is_final: bool = True
+    has_history: bool = False
 
     def prepare(self, mass: float, speed: float, gravity: float) -> None:
         """Called before each contact with the impact's mass (kg), speed (m/s) and gravity (m/s^2).
@@ -80,6 +85,10 @@ class ContactLaw(ABC):
     @abstractmethod
     def length_scale(self, mass: float, speed: float) -> float:
         """A typical approach (m) for an impact of `mass` (kg) at `speed` (m/s): scales tolerances."""
+
+    def diagnostics(self) -> dict:
+        """What the law saw during the run that a reader should know (JSON-ready)."""
+        return {}
 
     @abstractmethod
     def describe(self) -> dict:

@@ -1,0 +1,223 @@
+"""Averaged rough roller on a rigid substrate: the whole contact state in two numbers, tabulated.
+
+On a rigid substrate every cell's separation is d(x) = z_max + h + x^2/2R (h: the driver's gap,
+measured from the tallest summit z_max). After a first approach to h_min the history threshold is
+zeta*(x) = z_max + h_min + x^2/2R, and on the retreat the effective threshold is
+max(zeta*, d - Delta) = d - r with the same window r = min(h - h_min, Delta) at every x (paper
+notes on eq 11). So the force, the stored energy and the dissipation depend on (h, r) only:
+
+    W(h, r) = l int p(z_max + h + x^2/2R, r) dx = 2 l sqrt(2R) int_0^{sqrt(r - h)} p(z_max + h + s^2, r) ds,
+
+with p the GW pressure per nominal area (`GWJKRSurface.pressure` with threshold d - r), and the
+same for the stored energy E(h, r). The integral over s is done by Gauss-Legendre panels split at
+the kink s = sqrt(-h) where the separation passes the truncation height, and tabulated once per
+parameter set on a grid in h and in w = sqrt(1 - r/Delta) (which removes the square-root
+behaviour of the JKR force at the release stretch); bicubic splines evaluate it in microseconds.
+Dissipation needs no table of its own: summits that let go are those between the two thresholds,
+D = loop * [S(h_min) - S(h - r)], S(a) = summits attached on a first approach to a (1-D table).
+
+The driver stops a contact at the first turn while attached (stuck), so within a contact the path
+is one monotonic approach and one monotonic retreat and (h, h_min) describe it exactly. This law
+is the half-space-off counterpart of `RoughRoller` (which keeps a grid because the elastic
+deflection makes d - zeta vary across x); `tests/test_rough_rigid.py` compares the two.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.interpolate import CubicSpline, RectBivariateSpline
+
+from ..rough.gw import GWJKRSurface
+from .base import ContactLaw
+
+#: Table resolution per fidelity: (points per release stretch in h, points per sigma in h, w-nodes, Gauss nodes).
+RESOLUTION = {"fast": (8, 40, 9, 16), "standard": (16, 80, 17, 24), "reference": (32, 160, 33, 40)}
+
+
+class RigidRoughRoller(ContactLaw):
+    """Roller of radius R and length l (m) on averaged GW/JKR summits over a rigid substrate."""
+
+    name = "rough_roller_gw_jkr_rigid"
+    touch_gap = 0.0
+    bound_is_final = True
+    has_history = True
+
+    def __init__(self, surface: GWJKRSurface, radius: float, length: float, *, resolution: str = "standard",
+                 depth_safety: float = 1.5):
+        self.surface = surface
+        self.radius, self.length = radius, length
+        self.res = RESOLUTION[resolution]
+        self.resolution = resolution
+        self.depth_safety = depth_safety
+        self.release_stretch = float(surface.release_stretch)
+        self.sigma = surface.stats.sigma
+        self.z_top = float(surface.z_max)
+        self.table_depth = 0.0
+        self.build_seconds = 0.0
+        self.max_contacts = 0.0
+        self.max_pressure = 0.0
+        self.edge_touched = False
+        self.depth_history: list[dict] = []
+        self.reset()
+
+    # ------------------------------------------------------------------ tables
+    def _gauss(self, h: np.ndarray, r: np.ndarray):
+        """Nodes s (shape (..., k)) and weights for int_0^{sqrt(r - h)} ds, split at sqrt(-h)."""
+        nodes, weights = np.polynomial.legendre.leggauss(self.res[3])
+        top = np.sqrt(np.maximum(r - h, 0.0))
+        kink = np.minimum(np.sqrt(np.maximum(-h, 0.0)), top)
+        parts = []
+        for a, b in ((np.zeros_like(kink), kink), (kink, top)):
+            half = 0.5 * (b - a)
+            parts.append(((a + b)[..., None] * 0.5 + half[..., None] * nodes, half[..., None] * weights))
+        s = np.concatenate([parts[0][0], parts[1][0]], axis=-1)
+        w = np.concatenate([parts[0][1], parts[1][1]], axis=-1)
+        return s, w
+
+    def _integrate(self, what: str, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """2 l sqrt(2R) int_0^{sqrt(r-h)} q(z_max + h + s^2, threshold d - r) ds for q = pressure/energy/contacts."""
+        s, w = self._gauss(h, r)
+        d = self.z_top + h[..., None] + s * s
+        zeta = d - r[..., None]
+        q = getattr(self.surface, what)(d.ravel(), zeta.ravel()).reshape(d.shape)
+        return 2.0 * self.length * math.sqrt(2.0 * self.radius) * np.sum(q * w, axis=-1)
+
+    def _build(self, depth: float) -> None:
+        import time
+
+        start = time.perf_counter()
+        per_delta, per_sigma, n_w, _ = self.res
+        step = self.sigma / per_sigma
+        if self.release_stretch > 0.0:
+            step = min(step, self.release_stretch / per_delta)
+        h = np.arange(-depth, self.release_stretch + 2 * step, step)
+        w = np.linspace(0.0, 1.0, n_w)
+        r = self.release_stretch * (1.0 - w * w)
+        H, R = np.meshgrid(h, r, indexing="ij")
+        force = self._integrate("pressure", H, R)
+        energy = self._integrate("energy", H, R)
+        self._force = RectBivariateSpline(h, w, force, kx=3, ky=3)
+        self._energy = RectBivariateSpline(h, w, energy, kx=3, ky=3)
+        contacts = self._integrate("contacts", h, np.zeros_like(h))
+        self._count = CubicSpline(h, contacts)
+        self._h_lo, self._h_hi = h[0], h[-1]
+        self.table_depth = depth
+        self.build_seconds += time.perf_counter() - start
+        self.table_points = force.size
+
+    def prepare(self, mass: float, speed: float, gravity: float) -> None:
+        """Extend the tables if this impact can reach deeper than they do."""
+        depth = self.depth_safety * self.quasi_static_depth(0.5 * mass * speed**2, mass * gravity)
+        self.depth_history.append({"design_depth": depth, "speed": speed})
+        if depth > self.table_depth:
+            self._build(max(depth, 1.5 * self.table_depth))
+
+    def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
+        """Depth below the datum (m) at which the approach branch has absorbed `energy` (J)."""
+        step = min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
+        depth, work, last = 0.0, 0.0, 0.0
+        while True:
+            hs = -(depth + step * np.arange(1, 65))
+            forces = self._integrate("pressure", hs, np.zeros_like(hs)) - weight
+            for k in range(hs.size):
+                work += 0.5 * (forces[k] + last) * step
+                last = forces[k]
+                if work >= energy and forces[k] > 0.0:
+                    return -hs[k]
+            depth = -hs[-1]
+            step *= 2.0
+            if depth > 1e3 * self.sigma:
+                raise RuntimeError("rough contact: the approach branch never absorbs the impact energy")
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        self.h_min = math.inf
+        self.booked = 0.0
+        self.count_min = 0.0
+
+    def _window(self, gap: float) -> float:
+        if gap <= self.h_min:
+            return 0.0
+        return min(gap - self.h_min, self.release_stretch)
+
+    def _w(self, r: float) -> float:
+        return math.sqrt(max(1.0 - r / self.release_stretch, 0.0)) if self.release_stretch > 0 else 0.0
+
+    def _check(self, gap: float) -> None:
+        if gap < self._h_lo:
+            self.edge_touched = True
+            raise RuntimeError(f"rough contact: gap {gap:.3e} m is deeper than the tables ({self._h_lo:.3e} m); "
+                               "the impact went deeper than its quasi-static estimate")
+
+    def force(self, gap):
+        if gap >= self.release_stretch:
+            return 0.0
+        self._check(gap)
+        return float(self._force.ev(gap, self._w(self._window(gap))))
+
+    def stiffness(self, gap):
+        if gap >= self.release_stretch:
+            return 0.0
+        r = self._window(gap)
+        dh = float(self._force.ev(gap, self._w(r), dx=1))
+        return -dh
+
+    def stored_energy(self, gap):
+        if gap >= self.release_stretch or self.h_min == math.inf and gap >= 0.0:
+            return 0.0
+        self._check(gap)
+        return float(self._energy.ev(gap, self._w(self._window(gap))))
+
+    def _attached(self, gap: float) -> float:
+        """Summits attached at `gap` on the current path."""
+        a = gap - self._window(gap)
+        return float(self._count(a)) if a < 0.0 else 0.0
+
+    def dissipated(self, gap):
+        if self.h_min == math.inf:
+            return 0.0
+        return self.surface.loop_energy * max(self.count_min - self._attached(gap), 0.0)
+
+    def accept(self, gap):
+        if gap < self.h_min:
+            self.h_min = gap
+            self.count_min = float(self._count(gap)) if gap < 0.0 else 0.0
+        self.max_contacts = max(self.max_contacts, self._attached(gap))
+
+    def release_gap(self):
+        return self.release_stretch
+
+    def on_release(self):
+        return self.dissipated(self.release_stretch)
+
+    def length_scale(self, mass, speed):
+        return max(self.table_depth / self.depth_safety, self.release_stretch)
+
+    def snapshot(self, gap: float) -> dict:
+        """Pressure across the footprint at `gap` (rigid substrate: no deflection)."""
+        r = self._window(gap)
+        half = math.sqrt(2.0 * self.radius * max(r - gap, self.release_stretch))
+        x = np.linspace(-half, half, 257)
+        d = self.z_top + gap + x * x / (2.0 * self.radius)
+        zeta = d - r
+        p = self.surface.pressure(d, zeta)
+        self.max_pressure = max(self.max_pressure, float(np.max(p)))
+        comp, tens = self.surface.pressure_parts(d, zeta)
+        return {"x": x, "pressure": p, "compressive": comp, "tensile": tens, "deflection": np.zeros_like(x),
+                "separation": d - self.z_top, "contact_fraction": self.surface.contact_fraction(d, zeta)}
+
+    def diagnostics(self):
+        return {"max_contacts": self.max_contacts, "edge_touched": self.edge_touched,
+                "max_nominal_pressure": self.max_pressure, "table_depth": self.table_depth,
+                "table_points": getattr(self, "table_points", 0), "table_build_seconds": self.build_seconds,
+                "contacts_seen": len(self.depth_history)}
+
+    def describe(self):
+        s = self.surface
+        return {"name": self.name, "source": "GW (1966) summits with JKR + Fuller-Tabor hysteresis; paper eqs 9-15; "
+                "rigid substrate, exact footprint integral tabulated in (gap, window)",
+                "radius": self.radius, "length": self.length, "half_space": False, "resolution": self.resolution,
+                "sigma": s.stats.sigma, "summit_density": s.stats.density, "summit_radius": s.stats.radius,
+                "z_max": self.z_top, "delta_c": s.delta_c, "release_stretch": self.release_stretch,
+                "pull_off_force_per_summit": s.pull_off_force, "loop_energy_per_summit": s.loop_energy}

@@ -1,0 +1,183 @@
+"""Figures mirroring the paper's Figs 4, 5a, 5b, 6, 7 and 8a, and the CSV data behind each.
+
+Every function takes the collected runs, writes `data/<fig>.csv` and returns the figure's axes
+(the caller saves them). Display units (nm, ns, us, MPa, uN) are converted here only.
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..results import load_result  # noqa: E402
+
+
+def write_csv(path: Path, header: list[str], rows) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    with tmp.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows(rows)
+    tmp.replace(path)
+
+
+def characteristic(surface, depth_sigmas: float = 2.0, n: int = 400) -> dict:
+    """Fig 4: nominal pressure on a first approach to z_max - depth and on the retreat from it.
+
+    Approach: nothing attached yet (zeta* = inf, so zeta_eff = d). Retreat from d_min: zeta* = d_min,
+    zeta_eff = max(d_min, d - release stretch). Loop area = closed integral of p dd (J/m^2).
+    """
+    sigma = surface.stats.sigma
+    top = float(surface.z_max)
+    d_min = top - depth_sigmas * sigma
+    d = np.linspace(d_min, top + 1.2 * surface.release_stretch, n)
+    p_app = surface.pressure(d, np.full_like(d, np.inf))
+    p_ret = surface.pressure(d, np.full_like(d, d_min))
+    loop = float(np.trapezoid(p_app - p_ret, d))
+    return {"d": d, "h": (d - top) / sigma, "approach": p_app, "retreat": p_ret, "loop_area": abs(loop)}
+
+
+def fig4(curves: dict, set_name: str, out: Path):
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for ax, key, title in ((axes[0], "silica", "(a) silica surfaces"), (axes[1], "ots", "(b) SAM on silica")):
+        c = curves[key]
+        ax.plot(c["h"], c["approach"] / 1e6, label="approach (p_L=0)")
+        ax.plot(c["h"], c["retreat"] / 1e6, "--", label="retreat (p_L=-1)")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_xlabel("gap below the tallest summit, (d - z_max)/sigma")
+        ax.set_ylabel("nominal pressure (MPa)")
+        ax.set_title(f"{title}: loop {c['loop_area']:.3g} J/m^2", fontsize=9)
+        ax.legend(fontsize=7)
+        write_csv(out / "data" / f"fig4_{key}_{set_name}.csv", ["d_m", "h_over_sigma", "p_approach_Pa", "p_retreat_Pa"],
+                  zip(c["d"], c["h"], c["approach"], c["retreat"]))
+    fig.suptitle(f"Fig 4 ({set_name}): pressure-gap characteristics", fontsize=10)
+    return axes[0]
+
+
+def fig5a(impacts: dict, set_name: str, out: Path):
+    fig, ax = plt.subplots(figsize=(8, 3.8))
+    rows = []
+    for case, style in (("hertz", "-"), ("rough_silica", "-"), ("rough_ots", "-")):
+        if case not in impacts:
+            continue
+        ts = load_result(impacts[case]["folder"]).timeseries()
+        ax.plot(ts["t"] * 1e3, ts["gap"] * 1e9, style, lw=0.8, label=case)
+        rows += [(case, t, g) for t, g in zip(ts["t"], ts["gap"])]
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("height above datum (nm)")
+    ax.set_title(f"Fig 5a ({set_name}): rebounds of smooth, rough and OTS-covered silicon", fontsize=10)
+    ax.legend(fontsize=8)
+    write_csv(out / "data" / f"fig5a_{set_name}.csv", ["case", "t_s", "gap_m"], rows)
+    return ax
+
+
+def fig5b(impacts: dict, set_name: str, out: Path):
+    fig, ax = plt.subplots(figsize=(8, 3.8))
+    rows = []
+    for case in ("hertz", "rough_silica", "rough_ots"):
+        if case not in impacts:
+            continue
+        res = impacts[case]["result"]
+        ts = load_result(impacts[case]["folder"]).timeseries()
+        b = res["bounces"][0]
+        sel = ts["phase"] == 0
+        t = (ts["t"][sel] - b["t_contact"]) * 1e9
+        ax.plot(t, ts["force"][sel] * 1e6, lw=1.0, label=f"{case} (first impact)")
+        rows += [(case, tt * 1e-9, f) for tt, f in zip(t, ts["force"][sel])]
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xscale("symlog", linthresh=1.0)
+    ax.set_xlabel("time since touch (ns)")
+    ax.set_ylabel("contact force (uN)")
+    ax.set_title(f"Fig 5b ({set_name}): first impact duration and force", fontsize=10)
+    ax.legend(fontsize=8)
+    write_csv(out / "data" / f"fig5b_{set_name}.csv", ["case", "t_since_touch_s", "force_N"], rows)
+    return ax
+
+
+def fig6(impacts: dict, set_name: str, out: Path):
+    res = impacts["rough_silica"]["result"]
+    prof = res["bounces"][0].get("profiles") or {}
+    fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex="col")
+    rows = []
+    for col, key, title in ((0, "max_approach", "(a) maximum approach"), (1, "pull_off", "(b) pull-off")):
+        if key not in prof:
+            axes[0, col].set_title(f"{title}: not reached")
+            continue
+        p = prof[key]
+        x = np.asarray(p["x"]) * 1e6
+        axes[0, col].plot(x, np.asarray(p["pressure"]) / 1e6)
+        axes[0, col].axhline(0, color="k", lw=0.5)
+        axes[0, col].set_ylabel("pressure (MPa)")
+        axes[0, col].set_title(f"{title}: net force {p['force'] * 1e6:.3g} uN", fontsize=9)
+        axes[1, col].plot(x, np.asarray(p["deflection"]) * 1e15)
+        axes[1, col].set_ylabel("half-space deflection (fm)")
+        axes[1, col].set_xlabel("x across the contact (um)")
+        rows += [(key, xx * 1e-6, pp, dd, ss) for xx, pp, dd, ss in
+                 zip(x, p["pressure"], p["deflection"], p["separation"])]
+    fig.suptitle(f"Fig 6 ({set_name}): rough silica, first impact", fontsize=10)
+    write_csv(out / "data" / f"fig6_{set_name}.csv", ["instant", "x_m", "pressure_Pa", "deflection_m", "separation_m"], rows)
+    return axes[0, 0]
+
+
+def fig7(impacts: dict, set_name: str, out: Path):
+    fig, ax = plt.subplots(figsize=(8, 3.8))
+    rows = []
+    entries = []
+    for case, item in impacts.items():
+        res = item["result"]
+        if res["scene"]["si"]["contact"] != "rough" or res["scene"]["si"]["surfaces"]["sam"] is not None:
+            continue
+        entries.append((res["scene"]["si"]["surfaces"]["roughness"]["sigma"], res))
+    h0 = None
+    for sigma, res in sorted(entries, key=lambda e: e[0]):
+        h0 = res["scene"]["si"]["release_height"]
+        heights = [0.0 if b["rebound_height"] is None else b["rebound_height"] for b in res["bounces"]]
+        ax.plot(np.arange(1, len(heights) + 1), np.asarray(heights) / h0, "o-", ms=3, label=f"sigma {sigma * 1e9:g} nm")
+        rows += [(sigma, i + 1, h) for i, h in enumerate(heights)]
+    if h0:
+        ax.axhline(1.0, color="k", ls="--", lw=0.8, label="Hertz")
+    ax.set_xlabel("bounce")
+    ax.set_ylabel("rebound height / release height")
+    ax.set_xscale("log")
+    ax.set_title(f"Fig 7 ({set_name}): influence of roughness", fontsize=10)
+    ax.legend(fontsize=7, ncol=2)
+    write_csv(out / "data" / f"fig7_{set_name}.csv", ["sigma_m", "bounce", "rebound_height_m"], rows)
+    return ax
+
+
+def fig8a(sweeps: dict, set_name: str, out: Path):
+    fig, ax = plt.subplots(figsize=(8, 4))
+    rows = []
+    for case, s in sorted(sweeps.items(), key=lambda kv: (kv[1]["sigma"] or 0.0)):
+        label = "Hertz" if s["sigma"] is None else f"sigma {s['sigma'] * 1e9:g} nm"
+        pts = [p for p in s["points"] if not p["stuck"]]
+        if pts:
+            line, = ax.loglog([p["v_rebound"] for p in pts], [p["duration"] * 1e9 for p in pts], "o-", ms=3, label=label)
+            if s["escape"]:
+                ax.axvline(s["escape"]["escape_velocity"], color=line.get_color(), ls=":", lw=0.8)
+        rows += [(case, s["sigma"], p["v_impact"], p["v_rebound"], p["duration"], p["stuck"]) for p in s["points"]]
+        if s["escape"]:
+            rows.append((case, s["sigma"], s["escape"]["escape_velocity"], "escape_velocity", "", ""))
+    ax.set_xlabel("rebound velocity (m/s)")
+    ax.set_ylabel("impact time (ns)")
+    ax.set_title(f"Fig 8a ({set_name}): impact time against rebound velocity; dotted: escape velocities "
+                 "(impact speed)", fontsize=9)
+    ax.legend(fontsize=7)
+    write_csv(out / "data" / f"fig8a_{set_name}.csv",
+              ["case", "sigma_m", "v_impact_m_per_s", "v_rebound_m_per_s", "duration_s", "stuck"], rows)
+    return ax
+
+
+def save(ax, path: Path) -> None:
+    fig = ax.figure
+    fig.tight_layout()
+    tmp = path.with_name(path.stem + ".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    tmp.replace(path)

