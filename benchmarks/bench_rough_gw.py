@@ -30,7 +30,7 @@ ZMAX = float(expected_max_height(1e5))
 CASES = {"paper (sigma 6 nm)": 6e-9 / DELTA_C, "stress": 0.3}
 
 
-def best(fn, repeat=5, number=1, clock=time.process_time):
+def best(fn, repeat=9, number=1, clock=time.process_time):
     """Best of `repeat` timings of `number` calls, per call (s). Process CPU time by default: the
     benchmark machine is shared, and wall time would count other processes' slices."""
     t = math.inf

@@ -24,7 +24,7 @@ from scipy import integrate, optimize, special
 
 from continuum.reference import jkr
 from continuum.rough.gw import (TENSILE_ONSET, GWJKRSurface, SummitStatistics, expected_max_height,
-                                quadrature_pressure)
+                                quadrature_energy, quadrature_pressure)
 
 BETA, DGAMMA, ESTAR, DENSITY = 1e-7, 0.1, 38e9, 1e14      # silica-like summits, n = 100 per um^2
 DELTA_C = float(jkr.critical_approach(BETA, DGAMMA, ESTAR))
@@ -104,13 +104,13 @@ def test_hertz_summits_reproduce_the_classical_gw_load_separation_integral():
 def test_truncated_hertz_matches_the_truncated_integral_where_the_closed_form_is_many_times_too_large():
     s = surface(None, z_max=ZMAX, dgamma=0.0)
     full = surface(None, dgamma=0.0)
-    h = np.concatenate([np.linspace(-3.0, ZMAX - 0.05, 25), ZMAX - np.array([1e-2, 1e-3, 1e-4])])
+    h = np.concatenate([np.linspace(-3.0, ZMAX - 0.2, 25), ZMAX - np.array([1e-1, 1e-2, 1e-3, 1e-4])])
     d = h * s.sigma
     p = s.pressure(d, np.inf)
     ref = classical_gw_hertz(d, s.sigma, t_max=ZMAX)
     assert np.max(rel_err(p, ref)) < 1e-6                      # relative to the local pressure
     ratio = full.pressure(d, np.inf) / p
-    assert ratio[-3] > 10.0 and ratio[-1] > 1e3                # untruncated F_3/2 is far too large there
+    assert ratio[-4] > 30.0 and ratio[-3] > 1e3                # untruncated F_3/2 is far too large there
     assert np.all(s.pressure(np.array([ZMAX, ZMAX + 1.0]) * s.sigma, np.inf) == 0.0)
     assert s.z_max == pytest.approx(ZMAX * s.sigma, rel=1e-15, abs=0)
 
@@ -162,6 +162,23 @@ def test_states_deeper_than_the_tables_are_still_exact():
     for z in (np.inf, -40.0 * s.sigma):
         ref = quadrature_pressure(d, z, s.stats, DGAMMA, ESTAR, z_max=ZMAX)
         assert np.max(rel_err(s.pressure(d, z), ref, DENSITY * PC)) < 1e-6
+
+
+@pytest.mark.parametrize("ratio", [0.3, 30.0])
+def test_states_near_and_above_the_tallest_summit_match_quadrature(ratio):
+    """Within x0 delta_c below z_max and up to z_max + Delta: every threshold regime, including a
+    threshold above z_max (all summits have let go) and the last stretched summits."""
+    s = surface(ratio, ZMAX)
+    top, dc, dr = s.z_max, s.delta_c, s.release_stretch
+    d = top + np.array([-1.0, -0.5, -0.01, 0.01, 0.3, 0.6, 0.9, 0.99]) * np.repeat([TENSILE_ONSET * dc, dr], [3, 5])
+    args = (s.stats, DGAMMA, ESTAR)
+    for z in (np.full(d.size, np.inf), d - 0.5 * dr, d - 0.98 * dr, np.full(d.size, top - 0.5 * dr),
+              np.full(d.size, top + 0.2 * dr), d - 2.0 * dr):
+        ref = quadrature_pressure(d, z, *args, z_max=ZMAX)
+        assert np.max(rel_err(s.pressure(d, z), ref, DENSITY * PC)) < 1e-6
+        ref_e = quadrature_energy(d, z, *args, z_max=ZMAX)
+        assert np.max(rel_err(s.energy(d, z), ref_e, DENSITY * PC * dc)) < 1e-6
+    assert np.all(s.pressure(top + 1.01 * dr, top - 3.0 * dr) == 0.0)
 
 
 # ---------------------------------------------------------------------------------- 4. pull-off vs brute force

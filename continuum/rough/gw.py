@@ -535,7 +535,8 @@ class GWJKRSurface:
             t = h[i] + lam * _x_of_s(sn)
             ph = _phi(t)
             vals[:, i] = ker @ ph
-            ders[:, i] = (ker @ (-ph * t)) * (-lam * dxi_dw[i]) + lam * _q_of_s(s[i:i + 1])[:, 0] * _phi(tm) * dxi_dw[i]
+            ders[:, i] = ((ker @ (-ph * t)) * (-lam * dxi_dw[i])
+                          + lam * _q_of_s(s[i:i + 1])[:, 0] * _phi(tm) * dxi_dw[i])
         tb = _Cubic1D(0.0, 1.0 / nw, vals, ders)
         self._band = [np.ascontiguousarray(tb.coef[:, j].T) for j in range(3)]      # (4, ncell)
         self._band_n = nw
@@ -709,26 +710,43 @@ class GWJKRSurface:
         val = hs * H + As * (G + Wr * rel)
         dval = hs * dH + As * (dV[:, 1] + dV[:, 2] * rel) if deriv else None
         tens = As * (A0 + Wr * rel) if parts else None
-        if np.count_nonzero(fix):          # threshold inside the window: general 2-D term
-            k = np.flatnonzero(fix)
-            hk = h[k]
-            A, Ah, Axi = self._window(j, hk, (zt[k] - hk) / self._lam, deriv)
-            val[k] += As * (A - A0[k])
-            if deriv:
-                dval[k] += As * (Ah - Axi / self._lam - dV[k, 3])
-            if parts:
-                tens[k] = As * A
+        lam = self._lam
+        nf = np.count_nonzero(fix)
+        kf = np.flatnonzero(fix) if nf else None          # threshold inside the window (d <= z_max)
+        kb = None
         if self.truncated:
             # d > z_max: only stretched summits remain (none at all on approach: G = H = 0 there)
             beyond = above & ~app
             if np.count_nonzero(beyond):
                 k = np.flatnonzero(beyond)
-                vk, dk = self._beyond_top(j, h[k], zt[k], deriv)
+                vk, dk, m = self._beyond_top(j, h[k], zt[k], deriv)
                 val[k] = vk
                 if deriv:
                     dval[k] = dk
-            if parts:                      # within x0 delta_c of z_max no summit is compressive
-                tens = np.where(h > self._hband, val, tens)
+                if m.size:
+                    kb = k[m]                                 # window thresholds above z_max
+        if kf is not None or kb is not None:
+            # one bicubic evaluation for all of them: A(h, xi_eff), and A(h, xi_top) above z_max
+            hf = h[kf] if kf is not None else h[:0]
+            hb = h[kb] if kb is not None else h[:0]
+            A, Ah, Axi = self._window(j, np.concatenate([hf, hb, hb]),
+                                      np.concatenate([(zt[kf] - hf) / lam if kf is not None else hf,
+                                                      (zt[kb] - hb) / lam if kb is not None else hb,
+                                                      (self._tmax - hb) / lam]), deriv)
+            n1, n2 = hf.size, hf.size + hb.size
+            if kf is not None:
+                val[kf] += As * (A[:n1] - A0[kf])
+                if deriv:
+                    dval[kf] += As * (Ah[:n1] - Axi[:n1] / lam - dV[kf, 3])
+                if parts:
+                    tens[kf] = As * A[:n1]
+            if kb is not None:
+                on = zt[kb] < self._tmax                    # else every summit has let go
+                val[kb] = As * (A[n1:n2] - A[n2:]) * on
+                if deriv:
+                    dval[kb] = As * ((Ah[n1:n2] - Axi[n1:n2] / lam) - (Ah[n2:] - Axi[n2:] / lam)) * on
+        if parts and self.truncated:       # within x0 delta_c of z_max no summit is compressive
+            tens = np.where(h > self._hband, val, tens)
         if parts:
             return (val - tens).reshape(shape), tens.reshape(shape)
         return val.reshape(shape), (dval * self._inv_sigma).reshape(shape) if deriv else None
@@ -745,10 +763,11 @@ class GWJKRSurface:
         return A, Ah, Aw / (2.0 * self._L * np.maximum(w, 1e-150))
 
     def _beyond_top(self, j, h, zt, deriv):
-        """Truncated surface, z_max < d, threshold below d: only stretched summits remain.
+        """Truncated surface, d > z_max, threshold below d: only stretched summits remain.
 
-        Release thresholds: the 1-D band table T_rel; a threshold inside the window:
-        A(h, xi_eff) - A(h, xi_top) from the 2-D table. Zero beyond z_max + Delta.
+        Release thresholds: the 1-D band table T_rel (zero beyond z_max + Delta). Returns
+        (value, d/dh, m) where m indexes the points whose threshold lies inside the window and that
+        still hold summits: the caller adds A(h, xi_eff) - A(h, xi_top) for them (2-D table).
         """
         lam, xr = self._lam, self._xr
         val = np.zeros(h.size)
@@ -756,10 +775,10 @@ class GWJKRSurface:
         w2 = ((self._tmax - h) / lam + xr) * (1.0 / xr)         # band coordinate squared
         live = w2 > 0.0
         if not np.count_nonzero(live):
-            return val, dval
+            return val, dval, np.zeros(0, np.intp)
         k = np.flatnonzero(live)
-        hk, ztk, w2k = h[k], zt[k], w2[k]
-        wb = np.sqrt(w2k)
+        hk, ztk = h[k], zt[k]
+        wb = np.sqrt(w2[k])
         a = wb * self._band_n
         i = a.astype(np.intp)
         np.minimum(i, self._band_n - 1, out=i)
@@ -767,26 +786,11 @@ class GWJKRSurface:
         c0, c1, c2, c3 = np.take(self._band[j], i, axis=1)
         rel = ztk <= hk - self._dn
         As = self._as[j]
-        vk = As * (((c3 * t + c2) * t + c1) * t + c0) * rel
+        val[k] = As * (((c3 * t + c2) * t + c1) * t + c0) * rel
         if deriv:
             dwdh = -0.5 / (lam * xr * np.maximum(wb, 1e-150))      # h = z_max + lam x_r (1 - w^2)
-            dk = As * ((3.0 * c3 * t + 2.0 * c2) * t + c1) * (self._band_n * dwdh) * rel
-        fix = ~rel
-        if np.count_nonzero(fix):
-            m = np.flatnonzero(fix)
-            hm = hk[m]
-            xe = (ztk[m] - hm) / lam
-            xt = (self._tmax - hm) / lam
-            n = m.size
-            A, Ah, Axi = self._window(j, np.concatenate([hm, hm]), np.concatenate([xe, xt]), deriv)
-            on = xt > xe
-            vk[m] = As * (A[:n] - A[n:]) * on
-            if deriv:
-                dk[m] = As * ((Ah[:n] - Axi[:n] / lam) - (Ah[n:] - Axi[n:] / lam)) * on
-        val[k] = vk
-        if deriv:
-            dval[k] = dk
-        return val, dval
+            dval[k] = As * ((3.0 * c3 * t + 2.0 * c2) * t + c1) * (self._band_n * dwdh) * rel
+        return val, dval, k[~rel]
 
     # ------------------------------------------------------------------------------ public API
     def pressure(self, d, zeta):
@@ -835,7 +839,8 @@ class GWJKRSurface:
         m = _gauss_mass(np.where(up, np.minimum(zo, top), 0.0), np.where(up, np.minimum(zn, top), 0.0))
         return _out(np.where(up, self.density * self.loop_energy * m, 0.0))
 
-    def table_error(self, n_points: int = 48, seed: int = 0, h_range=None, quantities=("pressure", "energy", "contact_fraction")):
+    def table_error(self, n_points: int = 48, seed: int = 0, h_range=None,
+                    quantities=("pressure", "energy", "contact_fraction")):
         """Measured table error against scipy.integrate.quad of the defining integrals.
 
         Random states: h = d/sigma uniform in h_range (default [-4, min(z_max, 6) + Delta/sigma],
@@ -913,7 +918,8 @@ def _quadrature(kind, d, zeta, stats, g, e_star, z_max, detachment, part):
     sigma, n = stats.sigma, stats.density
     if g > 0:
         dc = float(_jkr.critical_approach(stats.radius, g, e_star))
-        rel = dc if detachment == "displacement" else -float(_jkr.load_controlled_detach_approach(stats.radius, g, e_star))
+        rel = dc if detachment == "displacement" else \
+            -float(_jkr.load_controlled_detach_approach(stats.radius, g, e_star))
         pc = float(_jkr.pull_off_force(stats.radius, g))
         scale = [pc, pc * dc, math.pi * stats.radius * dc][kind]
         x0 = TENSILE_ONSET * dc
