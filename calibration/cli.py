@@ -43,7 +43,11 @@ def cmd_impact(args) -> int:
         if not args.quiet and (b.index < 5 or (b.index + 1) % 10 == 0):
             print(f"  impact {b.index + 1}: e = {b.restitution:.6f}", file=sys.stderr)
 
-    result, trace = run_impact(resolved, progress=progress)
+    try:
+        result, trace = run_impact(resolved, progress=progress)
+    except (SceneError, ValueError) as exc:            # refusals that need the model (datum, depth range)
+        print(f"nanoimpact impact: refused: {exc}", file=sys.stderr)
+        return 2
     write_impact(out, result, trace)
     print(bounce_table(result["bounces"]))
     audit = result["energy_audit"]["max_relative_error"]

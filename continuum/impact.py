@@ -11,7 +11,7 @@ from .driver import Bounce, DriverSettings, simulate
 from .models import select_law
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
-from .scene import ResolvedScene
+from .scene import ResolvedScene, SceneError
 from .warnings import result_warnings
 
 
@@ -31,7 +31,20 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     n = scene.numerics
     settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
                               rest_fraction=n.rest_fraction, samples_per_flight=n.samples_per_flight)
-    run = simulate(law, scene.body.mass, scene.environment.gravity, release_height=scene.release_height,
+    release = scene.release_height
+    rough = scene.surfaces.roughness if scene.contact == "rough" else None
+    if rough is not None and release is not None:
+        z_top = float(law.z_top)                      # tallest summit above the summits' mean plane (m)
+        if rough.datum == "mean_plane":
+            release = scene.release_height - z_top
+            if release <= 0.0:
+                raise SceneError("release_height", scene.release_height,
+                                 f"with surfaces.roughness.datum = 'mean_plane' the body would start in contact: the "
+                                 f"tallest summit expected in the footprint is {z_top:.3g} m above the mean plane",
+                                 resolved.scene_file or "")
+        models["contact_law"]["datum"]["heights_measured_from"] = "tallest summit (gap coordinate of bounces and trace)"
+        models["contact_law"]["datum"]["release_above_tallest_summit"] = release
+    run = simulate(law, scene.body.mass, scene.environment.gravity, release_height=release,
                    impact_velocity=scene.impact_velocity, settings=settings, progress=progress)
     wall = time.perf_counter() - start
     diagnostics = law.diagnostics()

@@ -4,6 +4,10 @@ from __future__ import annotations
 import math
 
 from . import regimes
+from .reference import jkr as jkr_ref
+
+#: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
+FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
 from .laws.base import ContactLaw
 from .laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
 from .laws.jkr import JKRSphere
@@ -31,8 +35,12 @@ def rough_law(scene: Scene) -> tuple[ContactLaw, dict]:
                                   footprint_half_width=datum["footprint_half_width"])
         surface = law                                   # carries delta_c for the regime numbers
     else:
+        table = scene.numerics.table
+        if table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
+                jkr_ref.critical_approach(rough.summit_radius, w, summit_e_star)):
+            table = "standard"          # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
         surface = GWJKRSurface(stats, w, summit_e_star, z_max=datum["z_max"], detachment=phys.detachment,
-                               resolution=scene.numerics.table)
+                               resolution=table)
         if phys.half_space == "on":
             law = RoughRoller(surface, body.radius, body.length, surf.e_star, half_space=True,
                               grid_points=scene.numerics.grid_points)
@@ -50,8 +58,13 @@ def rough_law(scene: Scene) -> tuple[ContactLaw, dict]:
         regime["plasticity_index"] = regimes.plasticity_index(summit_e_star, surf.hardness, rough.sigma,
                                                               rough.summit_radius)
     record = {"datum": {**datum, "z_max_m": datum["z_max"] * rough.sigma, "release_from": rough.datum},
-              "regime": regime, "table": {"resolution": scene.numerics.table,
+              "regime": regime, "table": {"resolution": getattr(surface, "resolution", scene.numerics.table),
                                           "build_seconds": getattr(surface, "build_seconds", None)}}
+    if rough.mode != "discrete" and table != scene.numerics.table:
+        record["table"]["why"] = (f"the '{scene.numerics.table}' preset asked for '{scene.numerics.table}' tables, "
+                                  f"but sigma/delta_c < {FAST_TABLE_MIN_SIGMA_OVER_DELTA_C:g}, where they miss their "
+                                  "1e-6 accuracy: 'standard' tables were built")
+        record["table"]["resolution"] = table
     if rough.mode == "discrete":
         record["mode"] = "discrete"
         record["seed"] = rough.seed

@@ -21,10 +21,13 @@ def result_warnings(scene, law, bounces) -> list[str]:
     diag = law.diagnostics()
     if scene.contact == "rough":
         n = diag.get("max_contacts", 0.0)
-        if n < MIN_CONTACTS:
+        if n < MIN_CONTACTS and surf.roughness.mode == "averaged":
             out.append(f"averaged rough contact with only {n:.3g} summits attached at most (< {MIN_CONTACTS:g}): "
                        "the Greenwood-Williamson average is not reliable here; compare with "
                        "surfaces.roughness.mode = 'discrete'")
+        elif n < MIN_CONTACTS:
+            out.append(f"discrete realisation with {n:.3g} summits attached at most: its result depends on the "
+                       "seed; run several seeds to see the spread")
         if diag.get("edge_touched"):
             out.append("attached summits reached the edge of the grid: the footprint was larger than the grid's "
                        "design depth; raise numerics.grid_points or report this case")

@@ -17,9 +17,8 @@ def test_ci_runs_the_readme_test_command_verbatim():
     assert f"```bash\n{command}\n```" in readme
 
 
-def test_readme_main_command_runs_a_shipped_scene():
+def test_readme_main_command_is_the_paper_reproduction():
     readme = (ROOT / "README.md").read_text()
-    main = [ln for ln in readme.splitlines() if "nanoimpact impact inputs/scenes/" in ln and ln.startswith("python3.11")]
+    main = [ln for ln in readme.splitlines() if ln.startswith("python3.11") and "pytest" not in ln]
     assert len(main) == 1
-    scene = main[0].rsplit(" ", 1)[-1]
-    assert (ROOT / scene).is_file()
+    assert main[0].endswith(".venv/bin/nanoimpact paper")

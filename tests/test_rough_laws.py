@@ -82,3 +82,17 @@ def test_half_space_matters_in_the_heavy_scene_and_not_under_the_paper_roller():
     paper, _ = run_impact(resolve_scene(SILICA, overrides={"numerics.max_bounces": 1}))
     assert paper["models"]["diagnostics"]["max_deflection"] < 1e-4 * paper["scene"]["si"]["surfaces"]["roughness"]["sigma"]
     assert math.isfinite(paper["energy_audit"]["max_relative_error"])
+
+
+def test_mean_plane_datum_shifts_the_release_by_the_tallest_summit_or_refuses():
+    base = {"numerics.max_bounces": 1, "physics.half_space": "off"}
+    top, _ = run_impact(resolve_scene(SILICA, overrides=base))
+    z_top = top["models"]["contact_law"]["z_max"]
+    h0 = top["scene"]["si"]["release_height"]
+    shifted, _ = run_impact(resolve_scene(SILICA, overrides={**base, "surfaces.roughness.datum": "mean_plane",
+                                                             "release_height": h0 + z_top}))
+    assert shifted["bounces"][0]["v_impact"] == pytest.approx(top["bounces"][0]["v_impact"], rel=1e-9, abs=0)
+    from continuum.scene import SceneError
+    with pytest.raises(SceneError, match="start in contact"):
+        run_impact(resolve_scene(SILICA, overrides={**base, "surfaces.roughness.datum": "mean_plane",
+                                                    "release_height": 0.5 * z_top}))

@@ -31,6 +31,10 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 from ..rough.gw import GWJKRSurface
 from .base import ContactLaw
 
+#: The averaged model's range: deeper than this many sigma below the mean plane every summit is in
+#: contact (the GW tables switch to slow exact quadrature there) and the contact is flat, not rough.
+DEPTH_LIMIT_SIGMAS = 10.0
+
 #: Table resolution per fidelity: (points per release stretch in h, points per sigma in h, w-nodes, Gauss nodes).
 RESOLUTION = {"fast": (8, 40, 9, 16), "standard": (16, 80, 17, 24), "reference": (32, 160, 33, 40)}
 
@@ -130,8 +134,14 @@ class RigidRoughRoller(ContactLaw):
                     return -hs[k]
             depth = -hs[-1]
             step *= 2.0
-            if depth > 1e3 * self.sigma:
-                raise RuntimeError("rough contact: the approach branch never absorbs the impact energy")
+            limit = self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma
+            if depth > limit:
+                raise ValueError(
+                    f"rough contact refused: the impact would press the roller more than {DEPTH_LIMIT_SIGMAS:g} sigma "
+                    f"below the summits' mean plane (deeper than {limit * 1e9:.3g} nm below the tallest summit, "
+                    f"sigma = {self.sigma * 1e9:.3g} nm, sigma/delta_c = {self.sigma / max(self.surface.delta_c, 1e-300):.3g}): "
+                    "every summit in the footprint would be in contact and the surface acts as a flat adhesive "
+                    "contact, outside the averaged GW model's range; use contact = 'smooth' or a larger sigma")
 
     # ------------------------------------------------------------------ state
     def reset(self) -> None:

@@ -93,7 +93,8 @@ def evaluate(set_name: str, impacts: dict, sweeps: dict, fig4: dict) -> list[dic
                           {"hertz_duration_s": t_h, "rough_durations_s": t_r, "hertz_peak_N": f_h, "rough_peaks_N": f_r},
                           "hertz duration < rough, hertz peak > rough", all(t_h < t for t in t_r) and all(f_h > f for f in f_r)))
     # Fig 6
-    prof = (si or {}).get("bounces", [{}])[0].get("profiles") if si else None
+    fig6 = impacts.get("fig6_halfspace") or si
+    prof = fig6["bounces"][0].get("profiles") if fig6 else None
     if prof and "max_approach" in prof:
         m = prof["max_approach"]
         x, p = np.asarray(m["x"]), np.asarray(m["pressure"])

@@ -101,7 +101,7 @@ def fig5b(impacts: dict, set_name: str, out: Path):
 
 
 def fig6(impacts: dict, set_name: str, out: Path):
-    res = impacts["rough_silica"]["result"]
+    res = impacts.get("fig6_halfspace", impacts["rough_silica"])["result"]
     prof = res["bounces"][0].get("profiles") or {}
     fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex="col")
     rows = []
@@ -131,7 +131,8 @@ def fig7(impacts: dict, set_name: str, out: Path):
     entries = []
     for case, item in impacts.items():
         res = item["result"]
-        if res["scene"]["si"]["contact"] != "rough" or res["scene"]["si"]["surfaces"]["sam"] is not None:
+        if (res["scene"]["si"]["contact"] != "rough" or res["scene"]["si"]["surfaces"]["sam"] is not None
+                or case == "fig6_halfspace"):
             continue
         entries.append((res["scene"]["si"]["surfaces"]["roughness"]["sigma"], res))
     h0 = None
