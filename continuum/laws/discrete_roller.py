@@ -53,6 +53,7 @@ from ..reference import jkr as ref
 from ..rough.datum import tallest_summit
 from ..rough.gw import SummitStatistics
 from .base import ContactLaw
+from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
 _DC = 0.75 * 4.0 ** (-1.0 / 3.0)            # delta_c / delta0
 #: h(s) = U / (pi dgamma beta delta0 (s - 1)), Horner coefficients (continuum.reference.jkr)
@@ -367,17 +368,10 @@ class DiscreteRoughRoller(ContactLaw):
 
     def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
         """Approach (m, below the datum) at which the rigid approach branch has absorbed `energy` (J)."""
-        depth, work, last_force = 0.0, 0.0, self.approach_force(0.0) - weight
-        step = min(self.sigma, max(self.release_stretch, 1e-3 * self.sigma)) / 64.0
-        for _ in range(20000):
-            nxt = depth + step
-            force = self.approach_force(-nxt) - weight
-            work += 0.5 * (force + last_force) * step
-            depth, last_force = nxt, force
-            if work >= energy and force > 0.0:
-                return depth
-            step *= 1.05
-        raise RuntimeError("discrete rough contact: the approach branch never absorbs the impact energy")
+        first = min(self.sigma, max(self.release_stretch, 1e-3 * self.sigma)) / 32.0
+        return absorbing_depth(lambda ds: np.array([self.approach_force(-d) for d in ds]), energy,
+                               first_step=first, weight=weight,
+                               max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma, what="discrete rough contact")
 
     def _summits_at(self, gap: float, de_lo: float, de_of=None):
         """Trial state over the prefix of summits that are attached or within reach.

@@ -30,10 +30,7 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 from ..rough.gw import GWJKRSurface
 from .base import ContactLaw
-
-#: The averaged model's range: deeper than this many sigma below the mean plane every summit is in
-#: contact (the GW tables switch to slow exact quadrature there) and the contact is flat, not rough.
-DEPTH_LIMIT_SIGMAS = 10.0
+from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
 #: Table resolution per fidelity: (points per release stretch in h, points per sigma in h, w-nodes, Gauss nodes).
 RESOLUTION = {"fast": (8, 40, 9, 16), "standard": (16, 80, 17, 24), "reference": (32, 160, 33, 40)}
@@ -122,26 +119,10 @@ class RigidRoughRoller(ContactLaw):
 
     def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
         """Depth below the datum (m) at which the approach branch has absorbed `energy` (J)."""
-        step = min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
-        depth, work, last = 0.0, 0.0, 0.0
-        while True:
-            hs = -(depth + step * np.arange(1, 65))
-            forces = self._integrate("pressure", hs, np.zeros_like(hs)) - weight
-            for k in range(hs.size):
-                work += 0.5 * (forces[k] + last) * step
-                last = forces[k]
-                if work >= energy and forces[k] > 0.0:
-                    return -hs[k]
-            depth = -hs[-1]
-            step *= 2.0
-            limit = self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma
-            if depth > limit:
-                raise ValueError(
-                    f"rough contact refused: the impact would press the roller more than {DEPTH_LIMIT_SIGMAS:g} sigma "
-                    f"below the summits' mean plane (deeper than {limit * 1e9:.3g} nm below the tallest summit, "
-                    f"sigma = {self.sigma * 1e9:.3g} nm, sigma/delta_c = {self.sigma / max(self.surface.delta_c, 1e-300):.3g}): "
-                    "every summit in the footprint would be in contact and the surface acts as a flat adhesive "
-                    "contact, outside the averaged GW model's range; use contact = 'smooth' or a larger sigma")
+        first = min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
+        return absorbing_depth(lambda ds: self._integrate("pressure", -ds, np.zeros_like(ds)), energy,
+                               first_step=first, weight=weight,
+                               max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma)
 
     # ------------------------------------------------------------------ state
     def reset(self) -> None:

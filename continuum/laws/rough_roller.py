@@ -34,6 +34,7 @@ import numpy as np
 from ..halfspace import LineHalfSpace, solve_coupled
 from ..rough.gw import GWJKRSurface
 from .base import ContactLaw
+from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
 
 class RoughRoller(ContactLaw):
@@ -104,17 +105,10 @@ class RoughRoller(ContactLaw):
 
     def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
         """Approach (m, below the datum) at which the rigid approach branch has absorbed `energy` (J)."""
-        depth, work, last_force = 0.0, 0.0, 0.0
-        step = min(self.surface.stats.sigma, max(self.release_stretch, 1e-3 * self.surface.stats.sigma)) / 64.0
-        for _ in range(200000):
-            nxt = depth + step
-            force = self.approach_force(-nxt) - weight
-            work += 0.5 * (force + last_force) * step
-            depth, last_force = nxt, force
-            if work >= energy and force > 0.0:
-                return depth
-            step *= 1.05
-        raise RuntimeError("rough contact: the approach branch never absorbs the impact energy")
+        sigma = self.surface.stats.sigma
+        first = min(sigma, max(self.release_stretch, 1e-3 * sigma)) / 32.0
+        return absorbing_depth(lambda ds: np.array([self.approach_force(-d) for d in ds]), energy,
+                               first_step=first, weight=weight, max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * sigma)
 
     def approach_force(self, gap: float, samples: int = 2001) -> float:
         """Force (N) of a monotonic first approach to `gap` on a rigid substrate (for grid sizing)."""
