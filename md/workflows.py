@@ -507,7 +507,7 @@ class PullOff(Workflow):
         # sample of the equilibration has it exactly
         zh0 = float(app["z_holder"][0])
         sep = lambda d: s0 + (d["z_holder"] - zh0)
-        results, curves, figures, per_speed = {}, {}, {}, []
+        curves, figures, per_speed = {}, {}, []
         retracts = [l for l in ctx.plan.legs if l.name.startswith("retract_")]
         smooth = None
         for l in retracts:
@@ -542,8 +542,8 @@ class PullOff(Workflow):
                  f"start ({s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
                  f"flat's deformation); force = compute group/group (asperity body vs flat, kspace yes), "
                  f"positive = repulsive.",
-                 f"stderr of the pull-off force is the noise of one curve (std of the raw minus smoothed force), "
-                 f"not a spread over repeated pulls.",
+                 "stderr of the pull-off force is the noise of one curve (std of the raw minus smoothed force), "
+                 "not a spread over repeated pulls.",
                  f"R = {s['asperity_radius_A']:g} A (the requested radius of the carved, faceted dome)."]
         if s["surface"] == "ots":
             notes.append("OTS chains on the asperity are grafted on dome silanols within graft_max_polar_deg of "

@@ -16,7 +16,6 @@ single-asperity laws of continuum.reference.jkr, or explicit sums over individua
 """
 import functools
 import math
-import warnings
 
 import numpy as np
 import pytest

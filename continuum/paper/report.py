@@ -77,7 +77,7 @@ def explain(set_name: str, impacts: dict, set_checks: list[dict]) -> list[str]:
     lines = [f"What happens with `{set_name}`: the first impact of rough silica loses {loss:.3g} of its kinetic "
              f"energy to summit hysteresis, with at most {contacts:.3g} summits attached at once."]
     if contacts < 10:
-        lines.append(f"Fewer than 10 summits carry the impact, so the GW average is at the edge of its validity "
+        lines.append("Fewer than 10 summits carry the impact, so the GW average is at the edge of its validity "
                      "(the discrete mode shows the spread of single realisations).")
     if mu < 1:
         lines.append(f"The Tabor parameter of the summits is {mu:.2g} < 1: the summits sit on the DMT side of the "

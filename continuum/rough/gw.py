@@ -549,7 +549,7 @@ class GWJKRSurface:
         A0 = int_0^{x0} q phi lam dx     (compressed summits with P < 0)
         G is integrated in y = sqrt(s - 1) (q - q_H ~ x^{3/2} is analytic in y), Wr and A0 in s.
         """
-        lam, ttop, x0 = self._lam, self._ttop, TENSILE_ONSET
+        lam, ttop = self._lam, self._ttop
         out = np.zeros((9, hn.size))
         dout = np.zeros((9, hn.size))
         # ---- G
