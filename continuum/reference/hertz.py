@@ -239,6 +239,19 @@ def line_max_approach(radius, length, e_star):
     return _out(w * _log_factor_min() / (np.pi * l * e))
 
 
+def _checked_load_factor(load, radius, length, e_star):
+    """(W > 0 mask, W with non-positive entries replaced by 1, log factor 2 ln(2l/b) + 1, pi l E*).
+
+    Raises ValueError if the half-width of a positive load exceeds the roller length.
+    """
+    w = np.asarray(load, float)
+    pos = w > 0.0
+    wsafe = np.where(pos, w, 1.0)
+    factor = _line_log_factor_from_load(wsafe, radius, length, e_star)
+    _check_log_factor(np.where(pos, factor, np.inf), "load")
+    return pos, wsafe, factor, np.pi * np.asarray(length, float) * np.asarray(e_star, float)
+
+
 def line_stiffness(load, radius, length, e_star):
     """Secant ("constant K") roller stiffness of paper eq 1 at load W (N/m).
 
@@ -246,14 +259,8 @@ def line_stiffness(load, radius, length, e_star):
     evaluated at the half-width of that load. load W (N), radius R (m), length l (m), e_star (Pa).
     K -> 0 as W -> 0 (returns 0 for W <= 0). Raises ValueError if b > l.
     """
-    w = np.asarray(load, float)
-    l = np.asarray(length, float)
-    e = np.asarray(e_star, float)
-    pos = w > 0.0
-    wsafe = np.where(pos, w, 1.0)
-    factor = _line_log_factor_from_load(wsafe, radius, length, e_star)
-    _check_log_factor(np.where(pos, factor, np.inf), "load")
-    return _out(np.where(pos, np.pi * l * e / factor, 0.0))
+    pos, wsafe, factor, ple = _checked_load_factor(load, radius, length, e_star)
+    return _out(np.where(pos, ple / factor, 0.0))
 
 
 def line_approach(load, radius, length, e_star):
@@ -261,14 +268,8 @@ def line_approach(load, radius, length, e_star):
 
     load W (N), radius R (m), length l (m), e_star (Pa). 0 for W <= 0. Raises ValueError if b > l.
     """
-    w = np.asarray(load, float)
-    l = np.asarray(length, float)
-    e = np.asarray(e_star, float)
-    pos = w > 0.0
-    wsafe = np.where(pos, w, 1.0)
-    factor = _line_log_factor_from_load(wsafe, radius, length, e_star)
-    _check_log_factor(np.where(pos, factor, np.inf), "load")
-    return _out(np.where(pos, wsafe * factor / (np.pi * l * e), 0.0))
+    pos, wsafe, factor, ple = _checked_load_factor(load, radius, length, e_star)
+    return _out(np.where(pos, wsafe * factor / ple, 0.0))
 
 
 def _line_solve(delta, radius, length, e_star):
