@@ -216,18 +216,29 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
     speed = abs(v0)
     law.prepare(mass, speed, gravity)
     law.reset()
-    release = law.release_gap()
     length = law.length_scale(mass, speed)
     atol = np.array([settings.rtol * length, settings.rtol * speed]) * 0.1
+    timed = law.time_dependent
+    pending_times = sorted(t0 + te for te in law.time_events()) if timed else []
+
+    def at(s):
+        """Tell a time-dependent law the contact time of the state it evaluates next."""
+        if timed:
+            law.set_time(s - t0)
 
     def rhs(_t, y):
+        at(_t)
         return np.array([y[1], law.force(y[0]) / mass - gravity])
 
     def start(t_start, y_start):
+        at(t_start)
+        first = 1e-3 * length / speed
+        cap = law.max_step(speed)
         return DOP853(rhs, t_start, np.asarray(y_start, float), t_bound=settings.max_time, rtol=settings.rtol,
-                      atol=atol, first_step=1e-3 * length / speed)
+                      atol=atol, first_step=min(first, cap), max_step=cap)
 
     solver = start(t0, [gap0, v0])
+    at(t0)
     peak_force = law.force(gap0)
     max_pen = -gap0
     e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
@@ -236,6 +247,7 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
     profiles: dict = {}
 
     def sample(s, gap_, v_):
+        at(s)
         f = law.force(gap_)
         record(s, gap_, v_, f, index, law.stored_energy(gap_), law.dissipated(gap_))
         if pull["after_max"] and f < pull["force"]:
@@ -247,6 +259,7 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
     sample(t0, gap0, v0)
 
     def finish(t_end, gap_end, v_end, end, booked):
+        at(t_end)
         e_mech_out = 0.5 * mass * v_end * v_end + mass * gravity * gap_end
         free = end is None
         rebound = None
@@ -262,6 +275,7 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
         return {"bounce": b, "t": t_end, "gap": gap_end, "v": v_end, "end": end, "booked": booked}
 
     while True:
+        release = law.release_gap()       # may grow during a contact (bridges hold beyond the dry release)
         t_prev, y_prev = solver.t, solver.y.copy()
         msg = solver.step()
         if solver.status == "failed":
@@ -281,6 +295,11 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
             # the gap crossed the release point and came back within one step (slow release):
             # the endpoints miss it, the turning point does not
             events.append((_root(lambda s: dense(s)[0] - release, t_prev, t_turn), "release"))
+        while pending_times and pending_times[0] <= t_prev:
+            pending_times.pop(0)
+        if pending_times and pending_times[0] <= t1:
+            # the law's force jumps here (e.g. bridges condense at t_a): end the step exactly there
+            events.append((pending_times.pop(0), "time"))
         events.sort()
         for s in np.linspace(t_prev, t1, settings.samples_per_step + 2)[1:-1]:
             if events and s >= events[0][0]:
@@ -290,6 +309,12 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
         restart = None
         for te, kind in events:
             ye = dense(te)
+            at(te)
+            if kind == "time":
+                sample(te, ye[0], ye[1])
+                law.accept(ye[0])
+                restart = (te, [ye[0], ye[1]])
+                break
             if kind in ("max_approach", "turn"):
                 # extrema of the gap: history must see them (paper notes on eq 11)
                 max_pen = max(max_pen, -ye[0])
@@ -319,9 +344,11 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
         if restart is not None:
             solver = start(*restart)
             continue
+        at(t1)
         max_pen = max(max_pen, -y1[0])
         peak_force = max(peak_force, law.force(y1[0]))
         sample(t1, y1[0], y1[1])
+        at(t1)
         law.accept(y1[0])
         if solver.status == "finished":
             return finish(t1, y1[0], y1[1], "max_time", 0.0)

@@ -8,7 +8,7 @@ from typing import Callable
 
 from . import plots
 from .driver import Bounce, DriverSettings, simulate
-from .models import select_law
+from .models import meniscus_parameters, select_law
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
 from .scene import ResolvedScene, SceneError
@@ -28,24 +28,26 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     scene = resolved.scene
     start = time.perf_counter()
     law, models = select_law(scene, first_impact_speed(resolved))
-    n = scene.numerics
-    settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
-                              rest_fraction=n.rest_fraction, samples_per_flight=n.samples_per_flight)
-    release = scene.release_height
-    rough = scene.surfaces.roughness if scene.contact == "rough" else None
-    if rough is not None and release is not None:
-        z_top = float(law.z_top)                      # tallest summit above the summits' mean plane (m)
-        if rough.datum == "mean_plane":
-            release = scene.release_height - z_top
-            if release <= 0.0:
-                raise SceneError("release_height", scene.release_height,
-                                 f"with surfaces.roughness.datum = 'mean_plane' the body would start in contact: the "
-                                 f"tallest summit expected in the footprint is {z_top:.3g} m above the mean plane",
-                                 resolved.scene_file or "")
-        models["contact_law"]["datum"]["heights_measured_from"] = "tallest summit (gap coordinate of bounces and trace)"
-        models["contact_law"]["datum"]["release_above_tallest_summit"] = release
-    run = simulate(law, scene.body.mass, scene.environment.gravity, release_height=release,
-                   impact_velocity=scene.impact_velocity, settings=settings, progress=progress)
+    run, release = _simulate(resolved, law, models, progress)
+    if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
+        # auto menisci: bridges cannot form before t_a, so a dry run whose contacts all end sooner is exact
+        t_a = meniscus_parameters(scene)["condensation_time"]
+        released = [b.duration for b in run.bounces if b.duration is not None]
+        longest = max(released, default=0.0)
+        decision = {"longest_contact_s": longest, "condensation_time_s": t_a,
+                    "final_contact": None if run.status not in ("stuck", "rest") else
+                    f"the run ended '{run.status}': the last contact never ends, bridges would form in it after "
+                    "t_a but cannot change any rebound (the body is already held)"}
+        if longest < t_a:
+            models["menisci"].update(decision, used=False, why=(
+                f"auto: the longest contact of the dry run lasted {longest:.3g} s < t_a = {t_a:.3g} s, so no "
+                "bridge can form: the dry run is the wet run"))
+        else:
+            dry_bounces = len(run.bounces)
+            law, models = select_law(scene, first_impact_speed(resolved), menisci=True)
+            models["menisci"].update(decision, dry_run_bounces=dry_bounces, why=(
+                f"auto: a contact of the dry run lasted {longest:.3g} s >= t_a = {t_a:.3g} s: rerun with menisci"))
+            run, release = _simulate(resolved, law, models, progress)
     wall = time.perf_counter() - start
     diagnostics = law.diagnostics()
     if diagnostics:
@@ -65,6 +67,30 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         "timing": {"wall_s": wall},
     }
     return result, run.trace.arrays()
+
+
+def _simulate(resolved: ResolvedScene, law, models: dict, progress):
+    """Drive `law` through the scene's release; returns the run and the release height used (m)."""
+    scene = resolved.scene
+    n = scene.numerics
+    settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
+                              rest_fraction=n.rest_fraction, samples_per_flight=n.samples_per_flight)
+    release = scene.release_height
+    rough = scene.surfaces.roughness if scene.contact == "rough" else None
+    if rough is not None and release is not None:
+        z_top = float(law.z_top)                      # tallest summit above the summits' mean plane (m)
+        if rough.datum == "mean_plane":
+            release = scene.release_height - z_top
+            if release <= 0.0:
+                raise SceneError("release_height", scene.release_height,
+                                 f"with surfaces.roughness.datum = 'mean_plane' the body would start in contact: the "
+                                 f"tallest summit expected in the footprint is {z_top:.3g} m above the mean plane",
+                                 resolved.scene_file or "")
+        models["contact_law"]["datum"]["heights_measured_from"] = "tallest summit (gap coordinate of bounces and trace)"
+        models["contact_law"]["datum"]["release_above_tallest_summit"] = release
+    run = simulate(law, scene.body.mass, scene.environment.gravity, release_height=release,
+                   impact_velocity=scene.impact_velocity, settings=settings, progress=progress)
+    return run, release
 
 
 def write_impact(out_dir: str | Path, result: dict, trace: dict) -> Path:

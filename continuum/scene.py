@@ -67,11 +67,14 @@ class Roughness:
 @dataclass(frozen=True)
 class SAM:
     """A self-assembled monolayer on both surfaces: thickness (m), SAM-SAM work of adhesion (J/m^2),
-    water contact angle (rad or None)."""
+    water contact angle (rad or None), and optionally its Young's modulus (Pa) and Poisson's ratio as a
+    compliant layer in series with every summit (None: rigid layer)."""
 
     thickness: float | None
     work_of_adhesion: float
     contact_angle: float | None
+    layer_modulus: float | None = None
+    layer_poisson_ratio: float = 0.3
 
 
 @dataclass(frozen=True)
@@ -88,6 +91,15 @@ class Surfaces:
     yield_strength: float | None = None
     hardness: float | None = None
     sam: SAM | None = None
+    interaction_range: float = 0.3e-9
+    """z0 (m): range of the surface attraction (Tabor parameter, Maugis-Dugdale stress)."""
+
+    @property
+    def contact_angles(self) -> tuple[float | None, float | None]:
+        """Water contact angles (rad) of the two contacting faces: the SAM's on both when covered."""
+        if self.sam is not None:
+            return self.sam.contact_angle, self.sam.contact_angle
+        return self.body.contact_angle, self.substrate.contact_angle
 
     @property
     def interface_work_of_adhesion(self) -> float:
@@ -112,12 +124,25 @@ class Environment:
 
 @dataclass(frozen=True)
 class Physics:
-    """Model choices."""
+    """Model choices ('auto' entries are decided per scene in continuum.models)."""
 
     adhesion_law: str
     detachment: str
     line_stiffness: str
-    half_space: str = "on"
+    half_space: str = "auto"
+    menisci: str = "auto"
+
+
+@dataclass(frozen=True)
+class Menisci:
+    """Capillary condensation settings: t_a (s) and its model, growth length h1 (m, None = from humidity),
+    liquid surface tension (N/m) and molar volume (m^3/mol)."""
+
+    condensation_time: float = 25e-6
+    condensation_model: str = "fixed"
+    growth_length: float | None = None
+    surface_tension: float = 0.072
+    molar_volume: float = 1.807e-5
 
 
 @dataclass(frozen=True)
@@ -148,6 +173,7 @@ class Scene:
     environment: Environment
     physics: Physics
     numerics: Numerics
+    menisci: Menisci = Menisci()
 
 
 @dataclass(frozen=True)
@@ -370,17 +396,50 @@ def _build(v: dict, origin: str) -> Scene:
     if si["surfaces.sam.coverage"] == "both":
         sam = SAM(si["surfaces.sam.thickness"],
                   _require(si, "surfaces.sam.work_of_adhesion", origin, "when surfaces.sam.coverage = 'both'"),
-                  si["surfaces.sam.contact_angle"])
+                  si["surfaces.sam.contact_angle"], si["surfaces.sam.layer_modulus"],
+                  si["surfaces.sam.layer_poisson_ratio"])
+        if sam.layer_modulus is not None:
+            _require(si, "surfaces.sam.thickness", origin, "when surfaces.sam.layer_modulus is set (the layer's "
+                     "compliance is thickness / modulus)")
+    elif si["surfaces.sam.layer_modulus"] is not None:
+        raise SceneError("surfaces.sam.layer_modulus", v["surfaces.sam.layer_modulus"],
+                         "is for a SAM; set surfaces.sam.coverage = 'both' or remove it", origin)
     adhesion = sam.work_of_adhesion if sam is not None else si["surfaces.work_of_adhesion"]
 
-    if si["physics.adhesion_law"] == "jkr":
+    law = si["physics.adhesion_law"]
+    if law in ("jkr", "dmt", "maugis_dugdale"):
         if shape == "cylinder" and si["contact"] == "smooth":
-            raise SceneError("physics.adhesion_law", "jkr",
-                             "a smooth cylinder has no JKR law here (2-D JKR is not implemented); "
+            raise SceneError("physics.adhesion_law", law,
+                             "a smooth cylinder has no adhesive law here (2-D JKR is not implemented); "
                              "use body.shape = 'sphere' or contact = 'rough'", origin)
+        if law != "jkr" and si["contact"] == "smooth":
+            raise SceneError("physics.adhesion_law", law, "a smooth sphere takes 'none', 'jkr' or 'auto'; "
+                             "DMT and Maugis-Dugdale are summit laws of rough contact", origin)
         if adhesion <= 0.0:
             key = "surfaces.sam.work_of_adhesion" if sam is not None else "surfaces.work_of_adhesion"
-            raise SceneError(key, adhesion, "must be > 0 J/m^2 when physics.adhesion_law = 'jkr'", origin)
+            raise SceneError(key, adhesion, f"must be > 0 J/m^2 when physics.adhesion_law = '{law}'", origin)
+    if si["contact"] == "rough" and si["surfaces.roughness.mode"] == "discrete" and law in ("dmt", "maugis_dugdale"):
+        raise SceneError("physics.adhesion_law", law, "discrete summits use JKR or Hertz; DMT and Maugis-Dugdale "
+                         "summits run in surfaces.roughness.mode = 'averaged'", origin)
+
+    menisci = si["physics.menisci"]
+    rh = si["environment.relative_humidity"]
+    if menisci == "on":
+        if si["contact"] != "rough" or si["surfaces.roughness.mode"] != "averaged":
+            raise SceneError("physics.menisci", "on", "menisci are modelled for averaged rough contact only "
+                             "(contact = 'rough', surfaces.roughness.mode = 'averaged')", origin)
+        if rh <= 0.0:
+            raise SceneError("environment.relative_humidity", rh, "must be > 0 when physics.menisci = 'on'", origin)
+    if menisci != "off" and si["contact"] == "rough" and rh > 0.0:
+        if rh >= 1.0:
+            raise SceneError("environment.relative_humidity", rh, "must be < 1 for menisci (the Kelvin radius "
+                             "diverges at saturation); set physics.menisci = 'off' to ignore humidity", origin)
+        keys = (("surfaces.sam.contact_angle",) if sam is not None
+                else ("surfaces.body.contact_angle", "surfaces.substrate.contact_angle"))
+        for key in keys:
+            _require(si, key, origin, f"when environment.relative_humidity = {rh:g} > 0 and physics.menisci = "
+                     f"'{menisci}' (the bridge force needs both faces' water contact angles; or set "
+                     "physics.menisci = 'off')")
 
     preset = FIDELITY[si["numerics.fidelity"]]
     default_rtol = preset["rtol_rough"] if si["contact"] == "rough" else preset["rtol"]
@@ -400,14 +459,17 @@ def _build(v: dict, origin: str) -> Scene:
             Material(si["surfaces.substrate.youngs_modulus"], si["surfaces.substrate.poisson_ratio"],
                      si["surfaces.substrate.contact_angle"]),
             roughness, si["surfaces.substrate.yield_strength"], si["surfaces.substrate.hardness"], sam,
+            si["surfaces.interaction_range"],
         ),
         environment=Environment(si["environment.gravity"], si["environment.relative_humidity"],
                                 si["environment.temperature"]),
         physics=Physics(si["physics.adhesion_law"], si["physics.detachment"], si["physics.line_stiffness"],
-                        si["physics.half_space"]),
+                        si["physics.half_space"], si["physics.menisci"]),
         numerics=Numerics(si["numerics.fidelity"], rtol, si["numerics.max_bounces"], si["numerics.max_time"],
                           si["numerics.rest_fraction"], si["numerics.samples_per_flight"], grid_points,
                           preset["table"]),
+        menisci=Menisci(si["menisci.condensation_time"], si["menisci.condensation_model"],
+                        si["menisci.growth_length"], si["menisci.surface_tension"], si["menisci.molar_volume"]),
     )
 
 

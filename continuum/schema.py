@@ -84,13 +84,13 @@ FIELDS: tuple[Field, ...] = (
           0.0, low=0.0, high=10.0),
     Field("surfaces.body.youngs_modulus", doc="Young's modulus of the body.", default=REQUIRED, **_MODULUS),
     Field("surfaces.body.poisson_ratio", doc="Poisson's ratio of the body.", default=REQUIRED, **_POISSON),
-    Field("surfaces.body.contact_angle", doc="Water contact angle on the body (menisci; later issue).",
+    Field("surfaces.body.contact_angle", doc="Water contact angle on the body (menisci).",
           default=None, **_ANGLE),
     Field("surfaces.substrate.youngs_modulus", doc="Young's modulus of the substrate.", default=REQUIRED,
           **_MODULUS),
     Field("surfaces.substrate.poisson_ratio", doc="Poisson's ratio of the substrate.", default=REQUIRED,
           **_POISSON),
-    Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci; later issue).",
+    Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci).",
           default=None, **_ANGLE),
     Field("surfaces.substrate.yield_strength", float, "Pa", "Tensile yield strength of the substrate: warn "
           "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
@@ -103,6 +103,14 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.sam.work_of_adhesion", float, "J/m^2", "Work of adhesion between the two SAM-covered "
           "surfaces.", None, low=0.0, high=10.0),
     Field("surfaces.sam.contact_angle", doc="Water contact angle on the SAM.", default=None, **_ANGLE),
+    Field("surfaces.sam.layer_modulus", float, "Pa", "Young's modulus of the SAM as a compliant layer in series "
+          "with every summit (thin-layer, Winkler limit; needs surfaces.sam.thickness). Not set: the layer is rigid "
+          "and only shifts every gap equally.", None, low=1e6, high=1e12),
+    Field("surfaces.sam.layer_poisson_ratio", doc="Poisson's ratio of the SAM layer (confined modulus).",
+          default=0.3, **_POISSON),
+    Field("surfaces.interaction_range", float, "m", "Range z0 of the surface attraction (equilibrium separation "
+          "of the Lennard-Jones surface law): sets the summits' Tabor parameter and the Maugis-Dugdale stress "
+          "1.03 dgamma/z0. Default 0.3 nm (Tabor 1977; Johnson & Greenwood 1997).", 0.3e-9, low=5e-11, high=1e-8),
     Field("surfaces.roughness.sigma", float, "m", "Standard deviation of summit heights (composite of both "
           "surfaces; the paper's 'average asperity height'). Required for contact = 'rough'.", None,
           low=1e-11, high=1e-5),
@@ -127,16 +135,37 @@ FIELDS: tuple[Field, ...] = (
           low=0.0, high=1.0),
     Field("environment.temperature", float, "K", "Temperature.", 298.15, low=0.0, high=2000.0, low_open=True),
     # --- physics -------------------------------------------------------------------------
-    Field("physics.adhesion_law", str, "", "'none' (Hertz) or 'jkr' (JKR with Fuller-Tabor hysteresis).",
-          "none", choices=("none", "jkr")),
+    Field("physics.adhesion_law", str, "", "Summit (or sphere) law: 'none' (Hertz), 'jkr' (JKR with Fuller-Tabor "
+          "hysteresis), 'dmt' (no loop), 'maugis_dugdale' (jump-in/out from its own solution), or 'auto': from the "
+          "Tabor parameter (> 5 JKR, < 0.1 DMT, else Maugis-Dugdale), left out when its estimated loss per impact "
+          "is negligible. Rough contact takes all five; a smooth sphere 'none', 'jkr' or 'auto'.",
+          "auto", choices=("auto", "none", "jkr", "dmt", "maugis_dugdale")),
     Field("physics.detachment", str, "", "JKR detachment criterion: 'displacement' (let go at -delta_c, as "
           "the paper) or 'load' (let go at -P_c).", "displacement", choices=("displacement", "load")),
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",
           "implicit", choices=("implicit", "constant")),
     Field("physics.half_space", str, "", "Rough contact: couple the summits to the elastic half-space "
-          "under them (eqs 16-17, FFT influence coefficients) or treat the substrate below the summits as rigid.",
-          "on", choices=("on", "off")),
+          "under them (eqs 16-17, FFT influence coefficients), treat the substrate below the summits as rigid, or "
+          "'auto': on unless its estimated deflection across the footprint is below 1e-3 sigma.",
+          "auto", choices=("auto", "on", "off")),
+    Field("physics.menisci", str, "", "Rough contact: capillary bridges at summits after the condensation time "
+          "(section 'menisci'). 'auto': left out when dry, hydrophobic (cos t1 + cos t2 <= 0), or when no contact "
+          "of the dry run lasts the condensation time.", "auto", choices=("auto", "on", "off")),
+    # --- menisci -------------------------------------------------------------------------
+    Field("menisci.condensation_time", float, "s", "t_a: contact time before the first bridges form "
+          "(25 us, the paper's value from Riedo et al. 2002). Used when condensation_model = 'fixed'.", 25e-6,
+          low=0.0, high=1e3, low_open=True),
+    Field("menisci.condensation_model", str, "", "'fixed' (t_a = condensation_time) or 'nucleation' (thermally "
+          "activated: t_a = tau0 exp(dE(RH)/kT), dE = 7.8e-20 J ln(1/RH)/ln(1/0.4), tau0 = 2.6e-11 s, fitted to "
+          "Szoszkiewicz & Riedo 2005: 4.2 ms at 40% RH, 299 K).", "fixed", choices=("fixed", "nucleation")),
+    Field("menisci.growth_length", float, "m", "h1 in h_mw(t) = h1 ln(t/t_a), the growth of the bridgeable gap "
+          "(Riedo et al. 2002). Not set: 1/(n_w d_w^2 ln(1/RH)), one water molecule's cross-section d_w^2 as the "
+          "condensing column.", None, low=1e-12, high=1e-6),
+    Field("menisci.surface_tension", float, "N/m", "Liquid-vapour surface tension gamma_lv (water 0.072 at 25 C; "
+          "SPC/E water 0.0636).", 0.072, low=1e-3, high=1.0),
+    Field("menisci.molar_volume", float, "m^3/mol", "Molar volume of the liquid (Kelvin radius; water 1.807e-5).",
+          1.807e-5, low=1e-6, high=1e-3),
     # --- numerics ------------------------------------------------------------------------
     Field("numerics.fidelity", str, "", "Preset for tolerances (and later grid and table sizes).", "standard",
           choices=("fast", "standard", "reference")),

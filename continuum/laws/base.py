@@ -30,12 +30,29 @@ class ContactLaw(ABC):
         True if the force depends on the path (e.g. GW summits attached at the deepest approach).
         The driver then restarts the integrator at every extremum of the motion, so that no
         Runge-Kutta stage after an extremum uses the history from before it.
+    time_dependent : bool
+        True if the force also depends on the time since touch (capillary bridges condensing);
+        the driver then calls `set_time` before every evaluation and cuts steps at `time_events`.
     """
 
     name: str = "law"
     touch_gap: float = 0.0
     bound_is_final: bool = True
     has_history: bool = False
+    time_dependent: bool = False
+
+    def set_time(self, t_contact: float) -> None:
+        """Time-dependent laws (`time_dependent`): the contact time (s since this impact's touch) of the
+        state that the next calls evaluate. The driver sets it before every evaluation."""
+
+    def max_step(self, speed: float) -> float:
+        """Largest integrator step (s) the law allows at the current contact time, for an impact at
+        `speed` (m/s); the driver applies it whenever it (re)starts the integrator. Default: no limit."""
+        return float("inf")
+
+    def time_events(self) -> list[float]:
+        """Contact times (s) at which the force jumps; the driver ends a step exactly there and restarts."""
+        return []
 
     def prepare(self, mass: float, speed: float, gravity: float) -> None:
         """Called before each contact with the impact's mass (kg), speed (m/s) and gravity (m/s^2).

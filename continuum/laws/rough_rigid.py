@@ -14,7 +14,13 @@ the kink s = sqrt(-h) where the separation passes the truncation height, and tab
 parameter set on a grid in h and in w = sqrt(1 - r/Delta) (which removes the square-root
 behaviour of the JKR force at the release stretch); bicubic splines evaluate it in microseconds.
 Dissipation needs no table of its own: summits that let go are those between the two thresholds,
-D = loop * [S(h_min) - S(h - r)], S(a) = summits attached on a first approach to a (1-D table).
+D = loop * [S(h_min) - S(h - r + r_in)], S(a) = summits attached on a first approach to a (1-D table).
+
+Summit laws that snap in before touching (Maugis-Dugdale: jump-in at delta_in = -r_in < 0) and
+attract out of contact (range `reach`) fit the same reduction: on approach the threshold is
+d + delta_in, so r = r_in; after h_min, r = min(h - h_min + r_in, Delta). The footprint integral
+runs to x^2/2R = max(r, reach) - h, the contact starts at gap `reach` and ends at max(Delta, reach).
+For JKR and DMT summits r_in = reach = 0.
 
 The driver stops a contact at the first turn while attached (stuck), so within a contact the path
 is one monotonic approach and one monotonic retreat and (h, h_min) describe it exactly. This law
@@ -52,6 +58,10 @@ class RigidRoughRoller(ContactLaw):
         self.resolution = resolution
         self.depth_safety = depth_safety
         self.release_stretch = float(surface.release_stretch)
+        self.attach_stretch = float(getattr(surface, "attach_stretch", 0.0))   # r_in = -delta_in (m)
+        self.reach = float(getattr(surface, "reach", 0.0))                     # attraction range (m)
+        self.touch_gap = self.reach
+        self.end_gap = max(self.release_stretch, self.reach)
         self.sigma = surface.stats.sigma
         self.z_top = float(surface.z_max)
         self.table_depth = 0.0
@@ -66,7 +76,7 @@ class RigidRoughRoller(ContactLaw):
     def _gauss(self, h: np.ndarray, r: np.ndarray):
         """Nodes s (shape (..., k)) and weights for int_0^{sqrt(r - h)} ds, split at sqrt(-h)."""
         nodes, weights = np.polynomial.legendre.leggauss(self.res[3])
-        top = np.sqrt(np.maximum(r - h, 0.0))
+        top = np.sqrt(np.maximum(np.maximum(r, self.reach) - h, 0.0))
         kink = np.minimum(np.sqrt(np.maximum(-h, 0.0)), top)
         parts = []
         for a, b in ((np.zeros_like(kink), kink), (kink, top)):
@@ -94,7 +104,7 @@ class RigidRoughRoller(ContactLaw):
         step = min(self.sigma / per_sigma, depth / (4 * per_sigma))
         if self.release_stretch > 0.0:
             step = min(step, self.release_stretch / per_delta)
-        h = np.arange(-depth, self.release_stretch + 2 * step, step)
+        h = np.arange(-depth, self.end_gap + 2 * step, step)
         w = np.linspace(0.0, 1.0, n_w)
         r = self.release_stretch * (1.0 - w * w)
         H, R = np.meshgrid(h, r, indexing="ij")
@@ -102,7 +112,7 @@ class RigidRoughRoller(ContactLaw):
         energy = self._integrate("energy", H, R)
         self._force = RectBivariateSpline(h, w, force, kx=3, ky=3)
         self._energy = RectBivariateSpline(h, w, energy, kx=3, ky=3)
-        contacts = self._integrate("contacts", h, np.zeros_like(h))
+        contacts = self._integrate("contacts", h, np.full_like(h, self.attach_stretch))
         self._count = CubicSpline(h, contacts)
         self._h_lo, self._h_hi = h[0], h[-1]
         self.table_depth = depth
@@ -132,8 +142,8 @@ class RigidRoughRoller(ContactLaw):
 
     def _window(self, gap: float) -> float:
         if gap <= self.h_min:
-            return 0.0
-        return min(gap - self.h_min, self.release_stretch)
+            return min(self.attach_stretch, self.release_stretch)
+        return min(gap - self.h_min + self.attach_stretch, self.release_stretch)
 
     def _w(self, r: float) -> float:
         return math.sqrt(max(1.0 - r / self.release_stretch, 0.0)) if self.release_stretch > 0 else 0.0
@@ -145,28 +155,28 @@ class RigidRoughRoller(ContactLaw):
                                "the impact went deeper than its quasi-static estimate")
 
     def force(self, gap):
-        if gap >= self.release_stretch:
+        if gap >= self.end_gap:
             return 0.0
         self._check(gap)
         return float(self._force.ev(gap, self._w(self._window(gap))))
 
     def stiffness(self, gap):
-        if gap >= self.release_stretch:
+        if gap >= self.end_gap:
             return 0.0
         r = self._window(gap)
         dh = float(self._force.ev(gap, self._w(r), dx=1))
         return -dh
 
     def stored_energy(self, gap):
-        if gap >= self.release_stretch or self.h_min == math.inf and gap >= 0.0:
+        if gap >= self.end_gap or self.h_min == math.inf and gap >= self.reach:
             return 0.0
         self._check(gap)
         return float(self._energy.ev(gap, self._w(self._window(gap))))
 
     def _attached(self, gap: float) -> float:
         """Summits attached at `gap` on the current path."""
-        a = gap - self._window(gap)
-        return float(self._count(a)) if a < 0.0 else 0.0
+        a = gap - self._window(gap) + self.attach_stretch
+        return float(self._count(a)) if a < self.attach_stretch else 0.0
 
     def dissipated(self, gap):
         if self.h_min == math.inf:
@@ -176,14 +186,14 @@ class RigidRoughRoller(ContactLaw):
     def accept(self, gap):
         if gap < self.h_min:
             self.h_min = gap
-            self.count_min = float(self._count(gap)) if gap < 0.0 else 0.0
+            self.count_min = float(self._count(gap)) if gap < self.attach_stretch else 0.0
         self.max_contacts = max(self.max_contacts, self._attached(gap))
 
     def release_gap(self):
-        return self.release_stretch
+        return self.end_gap
 
     def on_release(self):
-        return self.dissipated(self.release_stretch)
+        return self.dissipated(self.end_gap)
 
     def length_scale(self, mass, speed):
         return max(self.table_depth / self.depth_safety, self.release_stretch)
@@ -191,7 +201,7 @@ class RigidRoughRoller(ContactLaw):
     def snapshot(self, gap: float) -> dict:
         """Pressure across the footprint at `gap` (rigid substrate: no deflection)."""
         r = self._window(gap)
-        half = math.sqrt(2.0 * self.radius * max(r - gap, self.release_stretch))
+        half = math.sqrt(2.0 * self.radius * max(max(r, self.reach) - gap, self.end_gap))
         x = np.linspace(-half, half, 257)
         d = self.z_top + gap + x * x / (2.0 * self.radius)
         zeta = d - r
@@ -209,7 +219,7 @@ class RigidRoughRoller(ContactLaw):
 
     def describe(self):
         s = self.surface
-        return {"name": self.name, "source": "GW (1966) summits with JKR + Fuller-Tabor hysteresis; paper eqs 9-15; "
+        return {"name": self.name, "source": f"GW (1966) summits ({getattr(s, 'law_name', 'jkr')}); paper eqs 9-15; "
                 "rigid substrate, exact footprint integral tabulated in (gap, window)",
                 "radius": self.radius, "length": self.length, "half_space": False, "resolution": self.resolution,
                 "sigma": s.stats.sigma, "summit_density": s.stats.density, "summit_radius": s.stats.radius,

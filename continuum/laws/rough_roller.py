@@ -72,6 +72,9 @@ class RoughRoller(ContactLaw):
         self.coupling_tol = coupling_tol
         self.z_top = float(surface.z_max)        # tallest summit above the mean plane (m)
         self.release_stretch = float(surface.release_stretch)
+        self.reach = float(getattr(surface, "reach", 0.0))        # non-contact attraction range (m)
+        self.touch_gap = self.reach
+        self.end_gap = max(self.release_stretch, self.reach)
         self.edge_touched = False
         self.max_deflection = 0.0                # largest |delta_e| seen (m)
         self.max_contacts = 0.0                  # most summits attached at once
@@ -82,7 +85,7 @@ class RoughRoller(ContactLaw):
     # ------------------------------------------------------------------ grid and state
     def _set_grid(self, depth: float) -> None:
         """Grid spanning |x| <= sqrt(2R (depth + 2 * release stretch))."""
-        half = math.sqrt(2.0 * self.radius * (depth + 2.0 * self.release_stretch))
+        half = math.sqrt(2.0 * self.radius * (depth + 2.0 * self.end_gap))
         self.dx = 2.0 * half / self.n
         self.x = (np.arange(self.n) - (self.n - 1) / 2.0) * self.dx
         self.parabola = self.x**2 / (2.0 * self.radius)
@@ -199,10 +202,10 @@ class RoughRoller(ContactLaw):
                                 float(self.length * self.dx * np.sum(self.surface.contacts(d, zeta_eff))))
 
     def release_gap(self):
-        return self.release_stretch
+        return self.end_gap
 
     def on_release(self):
-        return self.dissipated(self.release_stretch)
+        return self.dissipated(self.end_gap)
 
     def length_scale(self, mass, speed):
         return max(self.depth / self.depth_safety, self.release_stretch)
