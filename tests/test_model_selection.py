@@ -1,0 +1,75 @@
+"""`auto` model selection: each omission is safe (forcing the model back on moves every rebound by
+less than 0.5 % of the release height), each choice is recorded with the number that decided it."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from continuum import regimes
+from continuum.impact import first_impact_speed, run_impact
+from continuum.models import TABOR_DMT, TABOR_JKR, decide_adhesion, select_law
+from continuum.scene import resolve_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "inputs" / "scenes"
+SAFE = 5e-3        # the issue's bound: every rebound within 0.5 % of the release height
+
+
+def _rebounds(result):
+    return [b["rebound_height"] for b in result["bounces"] if b["rebound_height"] is not None]
+
+
+def _assert_same_rebounds(left, right, h0):
+    a, b = _rebounds(left), _rebounds(right)
+    assert len(a) == len(b) and left["status"] == right["status"]
+    for x, y in zip(a, b):
+        assert abs(x - y) < SAFE * h0
+
+
+def test_half_space_left_out_under_the_paper_roller_is_safe():
+    auto, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
+                                       overrides={"physics.half_space": "auto", "numerics.max_bounces": 6}))
+    rec = auto["models"]["half_space"]
+    assert rec["used"] is False and rec["decided_by"] == "deflection_over_sigma"
+    assert rec["deflection_over_sigma"] < 1e-3
+    forced, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
+                                         overrides={"physics.half_space": "on", "numerics.max_bounces": 6}))
+    _assert_same_rebounds(auto, forced, 100e-9)
+
+
+def test_half_space_kept_where_it_deflects_a_fraction_of_sigma():
+    r = resolve_scene(SCENES / "rough_halfspace_heavy.toml", overrides={"physics.half_space": "auto"})
+    _, models = select_law(r.scene, first_impact_speed(r))
+    rec = models["half_space"]
+    assert rec["used"] is True and rec["deflection_over_sigma"] > 1e-2
+
+
+def test_menisci_left_out_when_no_contact_lasts_t_a_is_safe():
+    auto, _ = run_impact(resolve_scene(SCENES / "wet_silica.toml", overrides={"physics.half_space": "off"}))
+    rec = auto["models"]["menisci"]
+    assert rec["used"] is False and rec["longest_contact_s"] < rec["condensation_time_s"]
+    forced, _ = run_impact(resolve_scene(SCENES / "wet_silica.toml",
+                                         overrides={"physics.half_space": "off", "physics.menisci": "on"}))
+    _assert_same_rebounds(auto, forced, 100e-9)
+
+
+@pytest.mark.parametrize("z0, law", [(0.05e-9, "jkr"), (0.3e-9, "maugis_dugdale"), (8e-9, "dmt")])
+def test_summit_law_follows_the_tabor_parameter(z0, law):
+    r = resolve_scene(SCENES / "rough_silica.toml", overrides={"physics.adhesion_law": "auto",
+                                                               "surfaces.interaction_range": z0})
+    chosen, rec = decide_adhesion(r.scene)
+    mu = regimes.tabor_parameter(0.2e-6, 0.12, 10e9, z0)       # the `paper` summits, written out
+    assert rec["tabor_parameter"] == pytest.approx(mu, rel=1e-12, abs=0)
+    expected = "jkr" if mu > TABOR_JKR else "dmt" if mu < TABOR_DMT else "maugis_dugdale"
+    assert chosen == law == expected
+
+
+def test_every_choice_is_recorded_with_what_decided_it():
+    result, _ = run_impact(resolve_scene(SCENES / "wet_ots.toml", overrides={"numerics.max_bounces": 2}))
+    models = result["models"]
+    for key in ("adhesion", "half_space", "menisci"):
+        assert {"decided_by", "why"} <= set(models[key]), key
+    assert models["menisci"]["decided_by"] == "contact_angles"
+    assert models["adhesion"]["decided_by"] == "scene"        # the paper's JKR, forced in the scene
+    assert models["sam"]["used"] is True
