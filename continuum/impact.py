@@ -48,6 +48,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
             models["menisci"].update(decision, dry_run_bounces=dry_bounces, why=(
                 f"auto: a contact of the dry run lasted {longest:.3g} s >= t_a = {t_a:.3g} s: rerun with menisci"))
             run, release = _simulate(resolved, law, models, progress)
+    models["regimes"] = regime_numbers(scene, models, run)
     wall = time.perf_counter() - start
     diagnostics = law.diagnostics()
     if diagnostics:
@@ -67,6 +68,40 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         "timing": {"wall_s": wall},
     }
     return result, run.trace.arrays()
+
+
+def regime_numbers(scene, models: dict, run) -> dict:
+    """The numbers that place a scene (recorded whatever was decided): Tabor parameter of the summits
+    (or sphere), Fuller-Tabor theta, half-space deflection span / sigma, expected contacts, and the
+    longest contact of the run against the condensation time t_a (SI)."""
+    from . import menisci as men
+    from . import regimes
+    from .models import summit_e_star
+
+    surf = scene.surfaces
+    w = surf.interface_work_of_adhesion
+    rough = scene.contact == "rough"
+    beta = surf.roughness.summit_radius if rough else scene.body.radius
+    e_s = summit_e_star(scene) if rough else surf.e_star
+    est = models.get("estimate", {})
+    longest = max((b.duration for b in run.bounces if b.duration is not None), default=0.0)
+    m = scene.menisci
+    rh = scene.environment.relative_humidity
+    if m.condensation_model == "nucleation":
+        t_a = men.nucleation_condensation_time(rh, scene.environment.temperature) if 0 < rh < 1 else float("inf")
+    else:
+        t_a = m.condensation_time
+    return {
+        "tabor_parameter": regimes.tabor_parameter(beta, w, e_s, surf.interaction_range) if w > 0 else 0.0,
+        "interaction_range_z0": surf.interaction_range,
+        "fuller_tabor_theta": regimes.fuller_tabor_theta(surf.roughness.sigma, beta, w, e_s) if rough else None,
+        "deflection_over_sigma": (est["deflection_span"] / surf.roughness.sigma) if rough and est else None,
+        "expected_contacts": est.get("contacts") if rough else None,
+        "longest_contact_s": longest, "condensation_time_s": t_a,
+        "longest_contact_over_t_a": longest / t_a,
+        "note": "Tabor > 5 JKR, < 0.1 DMT; deflection/sigma < 1e-3 leaves the half-space out; contacts < 10 make "
+                "the GW average unreliable; contacts shorter than t_a cannot grow bridges",
+    }
 
 
 def _simulate(resolved: ResolvedScene, law, models: dict, progress):
