@@ -92,8 +92,8 @@ def regime_numbers(scene, models: dict, run) -> dict:
     else:
         t_a = m.condensation_time
     return {
-        "tabor_parameter": regimes.tabor_parameter(beta, w, e_s, surf.interaction_range) if w > 0 else 0.0,
-        "interaction_range_z0": surf.interaction_range,
+        "tabor_parameter": regimes.tabor_parameter(beta, w, e_s, surf.interface_interaction_range) if w > 0 else 0.0,
+        "interaction_range_z0": surf.interface_interaction_range,
         "fuller_tabor_theta": regimes.fuller_tabor_theta(surf.roughness.sigma, beta, w, e_s) if rough else None,
         "deflection_over_sigma": (est["deflection_span"] / surf.roughness.sigma) if rough and est else None,
         "expected_contacts": est.get("contacts") if rough else None,

@@ -74,7 +74,7 @@ def summit_law(name: str, scene: Scene):
     surf = scene.surfaces
     beta, w, e_s = surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star(scene)
     layer = sam_layer(scene)
-    return sl.make_summit_law(name, beta, w, e_s, z0=surf.interaction_range, layer=layer,
+    return sl.make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range, layer=layer,
                               detachment=scene.physics.detachment)
 
 
@@ -94,13 +94,13 @@ def decide_adhesion(scene: Scene, estimate=None) -> tuple[str, dict]:
     surf, phys = scene.surfaces, scene.physics
     w = surf.interface_work_of_adhesion
     source = "SAM-SAM" if surf.sam is not None else "surfaces.work_of_adhesion"
-    rec = {"work_of_adhesion": w, "source": source, "interaction_range_z0": surf.interaction_range}
+    rec = {"work_of_adhesion": w, "source": source, "interaction_range_z0": surf.interface_interaction_range}
     if scene.contact == "rough":
         beta, e_s = surf.roughness.summit_radius, summit_e_star(scene)
     else:
         beta, e_s = scene.body.radius, surf.e_star
     if w > 0:
-        mu = regimes.tabor_parameter(beta, w, e_s, surf.interaction_range)
+        mu = regimes.tabor_parameter(beta, w, e_s, surf.interface_interaction_range)
         rec["tabor_parameter"] = mu
         if scene.contact == "rough":
             rec["fuller_tabor_theta"] = regimes.fuller_tabor_theta(surf.roughness.sigma, beta, w, e_s)
@@ -281,9 +281,9 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
         "summit_e_star": e_s,
         "sigma_over_delta_c": rough.sigma / surface.delta_c if w > 0 else math.inf,
         "fuller_tabor_theta": regimes.fuller_tabor_theta(rough.sigma, rough.summit_radius, w, e_s),
-        "tabor_parameter": regimes.tabor_parameter(rough.summit_radius, w, e_s, surf.interaction_range)
+        "tabor_parameter": regimes.tabor_parameter(rough.summit_radius, w, e_s, surf.interface_interaction_range)
         if w > 0 else 0.0,
-        "tabor_z0": surf.interaction_range,
+        "tabor_z0": surf.interface_interaction_range,
     }
     if surf.hardness is not None:
         regime["plasticity_index"] = regimes.plasticity_index(e_s, surf.hardness, rough.sigma, rough.summit_radius)

@@ -75,6 +75,7 @@ class SAM:
     contact_angle: float | None
     layer_modulus: float | None = None
     layer_poisson_ratio: float = 0.3
+    interaction_range: float | None = None
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,14 @@ class Surfaces:
     hardness: float | None = None
     sam: SAM | None = None
     interaction_range: float = 0.3e-9
-    """z0 (m): range of the surface attraction (Tabor parameter, Maugis-Dugdale stress)."""
+    """z0 (m): range of the bare surfaces' attraction (Tabor parameter, Maugis-Dugdale stress)."""
+
+    @property
+    def interface_interaction_range(self) -> float:
+        """z0 (m) of the contacting pair: the SAM's when both sides carry one and it is given."""
+        if self.sam is not None and self.sam.interaction_range is not None:
+            return self.sam.interaction_range
+        return self.interaction_range
 
     @property
     def contact_angles(self) -> tuple[float | None, float | None]:
@@ -397,7 +405,7 @@ def _build(v: dict, origin: str) -> Scene:
         sam = SAM(si["surfaces.sam.thickness"],
                   _require(si, "surfaces.sam.work_of_adhesion", origin, "when surfaces.sam.coverage = 'both'"),
                   si["surfaces.sam.contact_angle"], si["surfaces.sam.layer_modulus"],
-                  si["surfaces.sam.layer_poisson_ratio"])
+                  si["surfaces.sam.layer_poisson_ratio"], si["surfaces.sam.interaction_range"])
         if sam.layer_modulus is not None:
             _require(si, "surfaces.sam.thickness", origin, "when surfaces.sam.layer_modulus is set (the layer's "
                      "compliance is thickness / modulus)")

@@ -108,6 +108,9 @@ FIELDS: tuple[Field, ...] = (
           "and only shifts every gap equally.", None, low=1e6, high=1e12),
     Field("surfaces.sam.layer_poisson_ratio", doc="Poisson's ratio of the SAM layer (confined modulus).",
           default=0.3, **_POISSON),
+    Field("surfaces.sam.interaction_range", float, "m", "Range z0 of the SAM-SAM attraction (Tabor parameter, "
+          "Maugis-Dugdale stress) when both surfaces are covered; not set: surfaces.interaction_range.", None,
+          low=5e-11, high=1e-8),
     Field("surfaces.interaction_range", float, "m", "Range z0 of the surface attraction (equilibrium separation "
           "of the Lennard-Jones surface law): sets the summits' Tabor parameter and the Maugis-Dugdale stress "
           "1.03 dgamma/z0. Default 0.3 nm (Tabor 1977; Johnson & Greenwood 1997).", 0.3e-9, low=5e-11, high=1e-8),
