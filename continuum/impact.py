@@ -12,7 +12,7 @@ from .models import meniscus_parameters, select_law
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
 from .scene import ResolvedScene, SceneError
-from .warnings import result_warnings
+from .warnings import model_warnings, result_warnings
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:
@@ -53,7 +53,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     diagnostics = law.diagnostics()
     if diagnostics:
         models["diagnostics"] = diagnostics
-    warnings = result_warnings(scene, law, run.bounces)
+    warnings = result_warnings(scene, law, run.bounces) + model_warnings(models)
     result = {
         "schema_version": SCHEMA_VERSION,
         "scene": resolved.to_json(),

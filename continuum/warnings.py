@@ -57,3 +57,25 @@ def result_warnings(scene, law, bounces) -> list[str]:
         elif psi > 0.6 and math.isfinite(psi):
             out.append(f"plasticity index psi = {psi:.3g} between 0.6 and 1: some summits yield")
     return out
+
+
+#: Bridges are modelled with r_K << beta; above this D_K/beta the azimuthal curvature matters.
+MAX_KELVIN_GAP_OVER_RADIUS = 0.1
+
+
+def model_warnings(models: dict) -> list[str]:
+    """Warnings about the models chosen (from result.json -> models)."""
+    out = []
+    adhesion = models.get("adhesion", {})
+    if "map_suggests" in adhesion:
+        out.append(f"the Tabor parameter ({adhesion.get('tabor_parameter', float('nan')):.3g}) puts the summits in the "
+                   f"'{adhesion['map_suggests']}' regime, but discrete summits are JKR only: run the averaged mode to "
+                   "use that law")
+    men = models.get("menisci", {})
+    ratio = men.get("kelvin_gap_over_summit_radius")
+    if men.get("used") and ratio is not None and ratio > MAX_KELVIN_GAP_OVER_RADIUS:
+        out.append(f"Kelvin gap / summit radius = {ratio:.3g} > {MAX_KELVIN_GAP_OVER_RADIUS:g}: the bridge force "
+                   "assumes r_K << beta (humidity close to saturation or tiny summits)")
+    if adhesion.get("decided_by") == "geometry" and not adhesion.get("used", True) and adhesion.get("work_of_adhesion"):
+        out.append("work of adhesion given but a smooth roller has no adhesive law here: adhesion left out")
+    return out
