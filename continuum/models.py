@@ -68,14 +68,16 @@ def sam_layer(scene: Scene) -> tuple[float, float, float] | None:
 
 
 def summit_law(name: str, scene: Scene):
-    """The per-summit law object (continuum.rough.summit_laws) for a law name and the scene's surfaces."""
-    from .rough import summit_laws as sl
+    """The per-summit law (continuum.rough.branch_laws) for a law name and the scene's surfaces.
+
+    Tabulated to a compression of 30 sigma (the rough model refuses impacts deeper than 10 sigma
+    below the mean plane; the tallest summit is < 6 sigma above it)."""
+    from .rough.branch_laws import make_summit_law
 
     surf = scene.surfaces
     beta, w, e_s = surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star(scene)
-    layer = sam_layer(scene)
-    return sl.make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range, layer=layer,
-                              detachment=scene.physics.detachment)
+    return make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range, layer=sam_layer(scene),
+                           detachment=scene.physics.detachment, delta_max=30.0 * surf.roughness.sigma)
 
 
 def loop_per_summit(name: str, scene: Scene) -> float:
@@ -263,7 +265,7 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
         surface = law                                   # carries delta_c for the regime numbers
     else:
         if generic:
-            from .rough.gw_branch import GWBranchSurface
+            from .rough.gw_branches import GWBranchSurface
             surface = GWBranchSurface(stats, summit_law(adhesion, scene), z_max=datum["z_max"], resolution=table)
         else:
             if table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
