@@ -73,3 +73,15 @@ def test_every_choice_is_recorded_with_what_decided_it():
     assert models["menisci"]["decided_by"] == "contact_angles"
     assert models["adhesion"]["decided_by"] == "scene"        # the paper's JKR, forced in the scene
     assert models["sam"]["used"] is True
+
+
+def test_adhesion_left_out_for_stiff_weakly_adhesive_summits_is_safe():
+    stiff = {"surfaces.roughness.summit_modulus": 150e9, "surfaces.work_of_adhesion": 0.01,
+             "physics.half_space": "off", "numerics.max_bounces": 20}
+    auto, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml", overrides={**stiff, "physics.adhesion_law": "auto"}))
+    rec = auto["models"]["adhesion"]
+    assert rec["used"] is False and rec["decided_by"] == "estimated_loss_fraction"
+    assert rec["tabor_parameter"] < TABOR_DMT and rec["estimated_pull_fraction"] < 1e-2
+    forced, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml", overrides={**stiff, "physics.adhesion_law": "dmt"}))
+    assert forced["models"]["adhesion"]["used"] is True
+    _assert_same_rebounds(auto, forced, 100e-9)
