@@ -128,6 +128,17 @@ def _piece(delta, force, radius, run, start_pos, end_pos):
     return d[keep], p[keep], a[keep]
 
 
+def _first_run_at(delta, runs, value, admissible):
+    """(run, fractional position) of the first run in `runs` that `admissible` accepts and that holds
+    delta = value, or None."""
+    for r in runs:
+        if admissible(r):
+            pos = _locate(delta, r, value)
+            if pos is not None:
+                return r, pos
+    return None
+
+
 def follow_folds(delta, force, radius):
     """Approach and retreat paths of a curve (arrays along s, s = 0 the free end with P = 0).
 
@@ -144,14 +155,7 @@ def follow_folds(delta, force, radius):
     pieces, jumps = [], []
     value, after, first = delta[0], 0, True
     while True:
-        hit = None
-        for r in runs:
-            if r[0] < after:
-                continue
-            pos = _locate(delta, r, value)
-            if pos is not None:
-                hit = (r, pos)
-                break
+        hit = _first_run_at(delta, runs, value, lambda q, after=after: q[0] >= after)
         if hit is None:
             break
         r, pos = hit
@@ -171,14 +175,7 @@ def follow_folds(delta, force, radius):
             rpieces.append(_piece(delta, force, radius, r, float(r[0]), end))
         value = delta[r[0]]
         rjumps.append(float(value))
-        back = None
-        for q in reversed(runs):
-            if q[1] > r[0]:
-                continue
-            pos = _locate(delta, q, value)
-            if pos is not None:
-                back = (q, pos)
-                break
+        back = _first_run_at(delta, runs[::-1], value, lambda q, start=r[0]: q[1] <= start)
         if back is None:
             break
         r, end = back
