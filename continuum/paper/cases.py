@@ -1,7 +1,9 @@
 """The paper's cases: a scene file plus overrides (file units), and the sweeps behind Figs 7 and 8.
 
 Dry cases (issue 3): the Hertz roller, rough silica and OTS-covered silica (sigma = 6 nm), the
-roughness sweep (Fig 7) and the velocity sweep with escape velocities (Fig 8a).
+roughness sweep (Fig 7) and the velocity sweep with escape velocities (Fig 8a). Wet cases (issue
+4): the 100 nm drop onto wet silica and wet OTS, and their velocity sweeps near the escape
+velocity (Fig 8a's t_a limit, Fig 8b).
 """
 from __future__ import annotations
 
@@ -49,3 +51,9 @@ def dry_cases() -> list[Case]:
              Case("fig6_halfspace", "rough_silica.toml", {"numerics.max_bounces": 1}, ("6",))]
     cases += [sigma_case(s) for s in SIGMAS_NM]
     return cases
+
+
+def wet_cases() -> list[Case]:
+    """Section 4.3 and Fig 8b: silica at 40 % RH (bridges after t_a) and OTS (hydrophobic), sigma = 6 nm."""
+    return [Case("wet_silica", "wet_silica.toml", {"physics.half_space": RIGID}, ("8a", "8b")),
+            Case("wet_ots", "wet_ots.toml", {"physics.half_space": RIGID}, ("8b",))]

@@ -158,3 +158,79 @@ def evaluate(set_name: str, impacts: dict, sweeps: dict, fig4: dict) -> list[dic
                           {"sigma_m": [s for s, _ in esc], "escape_velocity_m_per_s": vals},
                           "strictly decreasing in sigma", ok))
     return out
+
+
+def evaluate_wet(set_name: str, wet: dict, impacts: dict) -> list[dict]:
+    """Wet and SAM claims (Fig 8a's t_a limit, Fig 8b) from the near-escape sweeps `wet` (case -> sweep)."""
+    out = []
+    si, ots = wet.get("wet_silica"), wet.get("wet_ots")
+    if si and si["menisci_possible"]:
+        t_a = si["condensation_time"]
+        pts = si["points"]
+        wet_free = [p["wet"]["duration"] for p in pts if not p["wet"]["stuck"]]
+        longest = max(wet_free, default=0.0)
+        outlast = [p for p in pts if not p["dry"]["stuck"] and p["dry"]["duration"] >= t_a]
+        ended = all(p["wet"]["stuck"] for p in outlast)
+        out.append(_check("fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a", set_name,
+                          {"t_a_s": t_a, "dry_rebounding_impacts_outlasting_t_a": len(outlast),
+                           "of_which_stick_with_menisci": sum(p["wet"]["stuck"] for p in outlast),
+                           "longest_rebounding_wet_impact_s": longest},
+                          "at least one dry impact outlasts t_a and still rebounds; with menisci every such impact "
+                          "sticks, and every wet impact that rebounds lasts < t_a",
+                          bool(outlast) and ended and longest < t_a))
+        shorter = [p for p in pts if not p["dry"]["stuck"] and p["dry"]["duration"] < t_a]
+        same = all(not p["wet"]["stuck"] and abs(p["wet"]["restitution"] - p["dry"]["restitution"])
+                   <= 1e-5 * max(p["dry"]["restitution"], 1e-12) for p in shorter)
+        out.append(_check("fig8a_impacts_shorter_than_t_a_are_unchanged_by_humidity", set_name,
+                          {"impacts": len(shorter)}, "same restitution within 1e-5 with and without menisci",
+                          bool(shorter) and same))
+        e_dry, e_wet = si["escape_dry"], si["escape_wet"]
+        out.append(_check("fig8a_menisci_raise_the_escape_velocity", set_name,
+                          {"dry_m_per_s": (e_dry or {}).get("escape_velocity"),
+                           "wet_m_per_s": (e_wet or {}).get("escape_velocity")},
+                          "wet > dry", bool(e_dry and e_wet and e_wet["escape_velocity"] > e_dry["escape_velocity"])))
+    if si and ots:
+        esc_si = (si["escape_wet"] or si["escape_dry"] or {}).get("escape_velocity")
+        esc_ots = (ots["escape_dry"] or {}).get("escape_velocity")
+        g = si["gravity"]
+        gap = {k: (v * v / (2 * g) if v else None) for k, v in (("silica", esc_si), ("ots", esc_ots))}
+        out.append(_check("fig8b_ots_lower_escape_velocity", set_name,
+                          {"silica_m_per_s": esc_si, "ots_m_per_s": esc_ots,
+                           "limiting_gap_silica_m": gap["silica"], "limiting_gap_ots_m": gap["ots"]},
+                          "OTS < bare silica (so bare silica's limiting gap v^2/2g is larger)",
+                          bool(esc_si and esc_ots and esc_ots < esc_si)))
+        if esc_si:
+            v = 1.2 * esc_si
+
+            def duration_at(sweep, key):
+                pts = [p for p in sweep["points"] if not p[key]["stuck"]]
+                vs = np.array([p["v_impact"] for p in pts])
+                ds = np.array([p[key]["duration"] for p in pts])
+                return float(np.exp(np.interp(math.log(v), np.log(vs), np.log(ds)))) if len(pts) > 1 else math.nan
+
+            t_si = duration_at(si, "wet" if si["menisci_possible"] else "dry")
+            t_ots = duration_at(ots, "dry")
+            out.append(_check("fig8b_ots_impact_shorter_at_the_same_low_velocity", set_name,
+                              {"impact_velocity_m_per_s": v, "silica_duration_s": t_si, "ots_duration_s": t_ots},
+                              "OTS < bare silica at 1.2x silica's escape velocity", t_ots < t_si))
+    # Fig 5 (paper section 5): "no effect from meniscus, because the impact durations are below water
+    # condensation time" -- the 100 nm drop onto wet silica is the dry drop, and OTS grows no bridge
+    drop, dry = impacts.get("wet_silica"), impacts.get("rough_silica")
+    if drop is not None and dry is not None:
+        m = drop["models"]["menisci"]
+        a, b = rebounds(drop), rebounds(dry)
+        h0 = drop["scene"]["si"]["release_height"]
+        same = len(a) == len(b) and all(abs(x - y) <= 1e-6 * h0 for x, y in zip(a, b))
+        out.append(_check("fig5_wet_drop_is_the_dry_drop_contacts_shorter_than_t_a", set_name,
+                          {"menisci_used": m.get("used"), "longest_contact_s": m.get("longest_contact_s"),
+                           "t_a_s": m.get("condensation_time_s"), "rebounds_wet": len(a), "rebounds_dry": len(b)},
+                          "menisci left out (longest contact < t_a) and every rebound within 1e-6 h0 of the dry drop",
+                          m.get("used") is False and same))
+    drop_ots = impacts.get("wet_ots")
+    if drop_ots is not None:
+        m = drop_ots["models"]["menisci"]
+        out.append(_check("fig8b_ots_grows_no_bridges", set_name,
+                          {"decided_by": m.get("decided_by"), "cos_theta1_plus_cos_theta2": m.get("cos_theta1_plus_cos_theta2")},
+                          "menisci left out as hydrophobic (cos t1 + cos t2 <= 0)",
+                          m.get("used") is False and m.get("decided_by") == "contact_angles"))
+    return out

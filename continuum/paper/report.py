@@ -92,18 +92,47 @@ def explain(set_name: str, impacts: dict, set_checks: list[dict]) -> list[str]:
     return lines
 
 
+def wet_lines(set_name: str, wet: dict, impacts: dict) -> list[str]:
+    """Wet and SAM section of summary.md: meniscus decisions of the drops, escape velocities, t_a."""
+    out = ["Wet and SAM (40 % RH, sigma = 6 nm, rigid substrate):", ""]
+    for case in ("wet_silica", "wet_ots"):
+        if case in impacts:
+            m = impacts[case]["result"]["models"]["menisci"]
+            out.append(f"- drop `{case}`: menisci {'used' if m.get('used') else 'left out'}: {m.get('why')}")
+    si, ots = wet.get("wet_silica"), wet.get("wet_ots")
+    if si:
+        e_d, e_w = (si["escape_dry"] or {}).get("escape_velocity"), (si["escape_wet"] or {}).get("escape_velocity")
+        t_a = si["condensation_time"]
+        if si["menisci_possible"]:
+            free = [p["wet"]["duration"] for p in si["points"] if not p["wet"]["stuck"]]
+            outlast = [p for p in si["points"] if not p["dry"]["stuck"] and p["dry"]["duration"] >= t_a]
+            out.append(f"- bare silica: escape velocity {_fmt(e_d)} m/s dry, {_fmt(e_w)} m/s with menisci "
+                       f"(t_a = {_fmt(t_a)} s); {len(outlast)} dry impacts near escape outlast t_a and still rebound, "
+                       f"{sum(p['wet']['stuck'] for p in outlast)} of them stick with menisci; the longest wet impact "
+                       f"that rebounds lasts {_fmt(max(free, default=0.0))} s")
+        else:
+            out.append(f"- bare silica: no menisci ({si['why_no_menisci']}); escape velocity {_fmt(e_d)} m/s")
+    if ots:
+        e_o = (ots["escape_dry"] or {}).get("escape_velocity")
+        g = ots["gravity"]
+        out.append(f"- OTS: no bridges ({ots['why_no_menisci']}); escape velocity {_fmt(e_o)} m/s, limiting gap "
+                   f"{_fmt(e_o * e_o / (2 * g) if e_o else None)} m")
+    return out
+
+
 def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
                progress: Callable[[str], None] = print) -> dict:
     """Run every case for every set into `out`; returns {"checks": [...], "wall_s": ...}."""
     out = Path(out)
     start = time.perf_counter()
     collected = run_paper(sets, out, fidelity=fidelity, workers=workers, progress=progress)
-    all_checks, summary = [], ["# nanoimpact paper: dry cases", "",
+    all_checks, summary = [], ["# nanoimpact paper: dry, wet and SAM cases", "",
                                f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
                                "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]
     for set_name in (Path(s).stem for s in sets):
         impacts = {c: v for (c, s), v in collected["impacts"].items() if s == set_name}
         sweeps = {c: v for (c, s), v in collected["sweeps"].items() if s == set_name}
+        wet = {c: v for (c, s), v in collected["wet"].items() if s == set_name}
         curves = fig4_curves(set_name if set_name in sets else next(s for s in sets if Path(s).stem == set_name),
                              fidelity)
         figures.save(figures.fig4(curves, set_name, out), out / f"fig4_{set_name}.png")
@@ -111,9 +140,11 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
         figures.save(figures.fig5b(impacts, set_name, out), out / f"fig5b_{set_name}.png")
         figures.save(figures.fig6(impacts, set_name, out), out / f"fig6_{set_name}.png")
         figures.save(figures.fig7(impacts, set_name, out), out / f"fig7_{set_name}.png")
-        figures.save(figures.fig8a(sweeps, set_name, out), out / f"fig8a_{set_name}.png")
+        figures.save(figures.fig8a(sweeps, set_name, out, wet), out / f"fig8a_{set_name}.png")
+        figures.save(figures.fig8b(wet, set_name, out), out / f"fig8b_{set_name}.png")
         set_checks = checks.evaluate(set_name, {c: v["result"] for c, v in impacts.items()}, sweeps,
                                      {k: {"loop_area": v["loop_area"]} for k, v in curves.items()})
+        set_checks += checks.evaluate_wet(set_name, wet, {c: v["result"] for c, v in impacts.items()})
         all_checks += set_checks
         summary += summary_table(set_name, impacts) + ["", "Regime:", ""] + regime_lines(set_name, impacts) + [""]
         summary += ["Claims:", ""] + [f"- {'PASS' if c['pass'] else 'FAIL'} `{c['name']}`: {c['threshold']}"
@@ -121,6 +152,7 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
         summary += explain(set_name, impacts, set_checks) + [""]
         esc = {c: (s["escape"] or {}).get("escape_velocity") for c, s in sweeps.items()}
         summary += ["Escape velocities (m/s): " + ", ".join(f"{c} {_fmt(v)}" for c, v in sorted(esc.items())), ""]
+        summary += wet_lines(set_name, wet, impacts) + [""]
     wall = time.perf_counter() - start
     summary += [f"Total wall time {wall:.1f} s (runs {collected['total_wall_s']:.1f} s).", ""]
     record = {"checks": all_checks, "sets": sets, "fidelity": fidelity, "wall_s": wall,

@@ -21,12 +21,15 @@ import numpy as np
 
 from ..escape import escape_velocity, single_impact
 from ..impact import first_impact_speed, run_impact, write_impact
-from ..models import select_law
+from ..models import decide_menisci, meniscus_parameters, select_law
 from ..scene import ResolvedScene, resolve_scene
-from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case
+from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 
 #: Fig 8a velocity sweep: impact speeds as multiples of the 100 nm drop speed.
 FIG8_SPEED_FACTORS = tuple(np.geomspace(0.05, 20.0, 10))
+#: Wet sweeps: impact speeds just above the dry escape velocity, v = v_esc (1 + eps), where the
+#: impact time diverges and outlasts t_a.
+WET_EPS = tuple(np.geomspace(1e-3, 2.0, 12))
 
 
 def resolve_case(case: Case, params: str, fidelity: str | None) -> ResolvedScene:
@@ -69,10 +72,54 @@ def _sweep_task(case: Case, params: str, fidelity: str | None) -> dict:
             "v_drop": v0, "sigma": sigma if scene.contact == "rough" else None}
 
 
+def _outcome(law, mass, g, v, rtol) -> dict:
+    run = single_impact(law, mass, g, v, rtol)
+    b = run.bounces[0]
+    return {"stuck": run.stuck, "duration": b.duration, "v_rebound": b.v_rebound, "restitution": b.restitution}
+
+
+def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
+    """Near-escape sweep of a wet case: each speed run without and (if bridges can pull) with menisci.
+
+    The dry escape velocity is bracketed on the drop-speed grid and bisected; then speeds just above
+    it (WET_EPS), where the impact time passes t_a, run dry and wet; the wet escape velocity is
+    bisected with the wet law.
+    """
+    resolved = resolve_case(case, params, fidelity)
+    scene = resolved.scene
+    v0 = first_impact_speed(resolved)
+    mass, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
+    dry, _ = select_law(scene, v0, menisci=False)
+    wet_possible = decide_menisci(scene)[0] != "off"
+    wet = select_law(scene, v0, menisci=True)[0] if wet_possible else None
+    grid = [v0 * f for f in FIG8_SPEED_FACTORS]
+    stuck = [v for v in grid if single_impact(dry, mass, g, v, rtol).stuck]
+    free = [v for v in grid if v not in stuck]
+    esc_dry = escape_velocity(dry, mass, g, max(stuck), min(free), rel_tol=1e-3, rtol=rtol) if stuck and free else None
+    speeds = sorted(set(grid) | ({esc_dry["upper"] * (1.0 + e) for e in WET_EPS} if esc_dry else set()))
+    points = []
+    for v in speeds:
+        p = {"v_impact": v, "dry": _outcome(dry, mass, g, v, rtol)}
+        if wet is not None:
+            p["wet"] = _outcome(wet, mass, g, v, rtol)
+        points.append(p)
+    esc_wet = None
+    if wet is not None and esc_dry is not None:
+        free_wet = [p["v_impact"] for p in points if not p["wet"]["stuck"]]
+        if free_wet:
+            esc_wet = escape_velocity(wet, mass, g, esc_dry["lower"], min(free_wet), rel_tol=1e-3, rtol=rtol)
+    m = meniscus_parameters(scene) if wet is not None else {}
+    return {"kind": "wet", "case": case.name, "set": Path(params).stem, "points": points, "escape_dry": esc_dry,
+            "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": m.get("condensation_time"),
+            "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length")} if m else None,
+            "why_no_menisci": None if wet_possible else decide_menisci(scene)[1]["why"],
+            "gravity": g, "v_drop": v0, "sigma": scene.surfaces.roughness.sigma}
+
+
 def _run(task):
     kind, args = task
     start = time.perf_counter()
-    out = _impact_task(*args) if kind == "impact" else _sweep_task(*args)
+    out = {"impact": _impact_task, "sweep": _sweep_task, "wet": _wet_task}[kind](*args)
     out["wall_s"] = time.perf_counter() - start
     return out
 
@@ -91,16 +138,17 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
     """Run every dry case and sweep for every parameter set; returns the collected outputs."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = [("impact", (case, s, fidelity, str(out))) for s in sets for case in dry_cases()]
+    tasks = [("impact", (case, s, fidelity, str(out))) for s in sets for case in dry_cases() + wet_cases()]
     tasks += [("sweep", (case, s, fidelity)) for s in sets for case in fig8_cases()]
+    tasks += [("wet", (case, s, fidelity)) for s in sets for case in wet_cases()]
     workers = workers or os.cpu_count() or 1
-    collected = {"impacts": {}, "sweeps": {}, "wall_s": {}}
+    collected = {"impacts": {}, "sweeps": {}, "wet": {}, "wall_s": {}}
     start = time.perf_counter()
     progress(f"paper: {len(tasks)} runs on {workers} worker(s) for set(s) {', '.join(sets)}")
     with ProcessPoolExecutor(max_workers=workers) as pool:
         for done, item in enumerate(pool.map(_run, tasks), 1):
             key = (item["case"], item["set"])
-            collected["impacts" if item["kind"] == "impact" else "sweeps"][key] = item
+            collected[{"impact": "impacts", "sweep": "sweeps", "wet": "wet"}[item["kind"]]][key] = item
             collected["wall_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["wall_s"]
             progress(f"  [{done}/{len(tasks)}] {item['kind']} {item['case']} ({item['set']}): {item['wall_s']:.1f} s")
     collected["total_wall_s"] = time.perf_counter() - start
