@@ -79,6 +79,36 @@ def cmd_paper(args) -> int:
     return 0
 
 
+def cmd_calibrate(args) -> int:
+    from calibration.pipeline import CalibrationError, calibrate
+    from continuum.scene import SceneError
+
+    try:
+        calibrate(args.recipe, args.out, md_fidelity=args.md_fidelity, executor_name=args.executor,
+                  workers=args.workers, scheduler=args.scheduler, params_out=args.params_out, md_cache=args.md_cache,
+                  progress=lambda m: print(m, file=sys.stderr))
+    except (CalibrationError, SceneError) as exc:
+        print(f"nanoimpact calibrate: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from calibration.sweep import parse_vary, run_sweep
+    from continuum.scene import SceneError
+
+    try:
+        vary = parse_vary(args.vary)
+        record = run_sweep(args.scene, vary, args.out, params=args.params, executor_name=args.executor,
+                           workers=args.workers, scheduler=args.scheduler, progress=lambda m: print(m, file=sys.stderr))
+    except SceneError as exc:
+        print(f"nanoimpact sweep: invalid point: {exc}", file=sys.stderr)
+        return 2
+    print(f"sweep: {record['computed']} points run, {record['reused']} reused; wrote {args.out}/sweep.csv and "
+          f"sweep.png ({record['wall_s']:.1f} s)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="nanoimpact", description=(
         "Nanoscale adhesive impact of rough surfaces: continuum impact runs, LAMMPS calibration."))
@@ -103,6 +133,36 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset for every case")
     q.add_argument("--workers", type=int, help="parallel processes (default: CPU count)")
     q.set_defaults(func=cmd_paper)
+
+    c = sub.add_parser("calibrate", help="MD results -> calibrated parameter set -> the paper's cases, with bands",
+                       description="Run the MD recipes a calibration needs (reusing committed or cached results whose "
+                                   "hash is current), write the parameter set, run the paper's dry, wet and SAM cases "
+                                   "with it beside the base and silicon sets, propagate the MD errors and user ranges "
+                                   "(Latin hypercube), and write report.md. See docs/calibration.md.")
+    c.add_argument("recipe", help="calibration recipe, e.g. inputs/calibration/quick.toml")
+    c.add_argument("--md-fidelity", choices=("smoke", "quick", "production"), default="quick")
+    c.add_argument("--executor", choices=("local", "processes", "dask"), default="local",
+                   help="where independent jobs run (default: local, no server)")
+    c.add_argument("--scheduler", help="dask scheduler address (tcp://host:port) of an existing cluster")
+    c.add_argument("--workers", type=int, help="worker processes (processes, dask LocalCluster, paper pool)")
+    c.add_argument("--out", default="out/calibration", help="output folder (default: out/calibration)")
+    c.add_argument("--params-out", help="write the set here instead of inputs/params/<name>.toml")
+    c.add_argument("--md-cache", help="MD cache directory (default: $NANOIMPACT_CACHE or ~/.cache/nanoimpact/md)")
+    c.set_defaults(func=cmd_calibrate)
+
+    w = sub.add_parser("sweep", help="run a scene over a grid of overrides (resumable), with a table and a plot",
+                       description="Cartesian product of --vary KEY=V1,V2 overrides (file units); each point's "
+                                   "result.json is kept under OUT/points/<input hash>, so a rerun skips finished "
+                                   "points. Writes OUT/sweep.csv and OUT/sweep.png.")
+    w.add_argument("scene", help="scene file")
+    w.add_argument("--vary", action="append", required=True, metavar="KEY=V1,V2,...",
+                   help="dotted scene key and comma-separated values (repeat for a grid)")
+    w.add_argument("--params", help="parameter set NAME or FILE; replaces the scene's")
+    w.add_argument("--executor", choices=("local", "processes", "dask"), default="local")
+    w.add_argument("--scheduler", help="dask scheduler address of an existing cluster")
+    w.add_argument("--workers", type=int, help="worker processes")
+    w.add_argument("--out", default="out/sweep", help="output folder (default: out/sweep)")
+    w.set_defaults(func=cmd_sweep)
 
     # doctor owns its own options (md.doctor.main parses them); listed here for the top-level help
     sub.add_parser("doctor", help="check the LAMMPS installation (in-process and mpirun -np 2)", add_help=False)

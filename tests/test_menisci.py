@@ -170,6 +170,8 @@ def test_auto_menisci_records_why_they_are_left_out():
 def test_wet_scene_without_contact_angles_is_refused_naming_the_key():
     from continuum.scene import SceneError
     table = tomllib.loads((ROOT / "inputs" / "scenes" / "rough_silica.toml").read_text())
+    table["params"] = "silica"              # a set without water contact angles
+    table["surfaces"] = {"work_of_adhesion": 0.1, "roughness": {"sigma": 6e-9, "summit_density": 1e13, "summit_radius": 0.2e-6}}
     with pytest.raises(SceneError, match="surfaces.body.contact_angle = None: is required when environment"):
         resolve_scene(table=table, overrides={"environment.relative_humidity": 0.4})
     resolve_scene(table=table, overrides={"environment.relative_humidity": 0.4, "physics.menisci": "off"})

@@ -1,0 +1,218 @@
+"""MD results -> a calibrated continuum parameter set (inputs/params/NAME.toml), with provenance.
+
+Which MD quantity feeds which scene key (`MAPPING`), SI in and out; the only conversion is none:
+scene files take contact angles in degrees, as the MD results give them. Everything the MD does
+not measure (moduli, roughness statistics, SAM thickness) comes from a named base set.
+
+Work of adhesion: the MD adhesion workflow gives the energy difference dE/A (`work_of_adhesion`)
+and, by thermodynamic integration of the mean force over a few separation windows, an estimate of
+the free energy of separation (`work_of_adhesion_free_energy`). The Dupre work of adhesion the
+continuum needs is a free energy, but at smoke and quick fidelity the integration's window grid is
+coarse and its discretisation error is not in its stderr (docs/md.md): the quick runs give
+0.0055 J/m^2 for silica against dE/A = 0.123 J/m^2, a factor the entropy cannot explain. So dE/A
+is used, and the free-energy estimate is recorded beside it ([meta.calibration] ->
+`free_energy_estimate`) for the reader; the report says both.
+
+A value outside the scene schema's range, or not finite, or a contact angle the analysis could not
+measure (0 deg: a film, 180 deg: no contact yet -- what smoke runs give) is not used: the base set's
+value is kept for that key, and [meta.rejected] and the report name the MD run and the value.
+"""
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from continuum.scene import SceneError, check_value, find_params
+from continuum.schema import FIELD_BY_PATH
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS_DIR = ROOT / "inputs" / "md" / "results"
+
+
+@dataclass(frozen=True)
+class Source:
+    """Scene key <- MD recipe, quantities in order of preference."""
+
+    key: str
+    recipe: str
+    quantities: tuple[str, ...]
+
+
+MAPPING: tuple[Source, ...] = (
+    Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion",)),
+    Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion",)),
+    Source("surfaces.body.contact_angle", "contact_angle_silica", ("contact_angle",)),
+    Source("surfaces.substrate.contact_angle", "contact_angle_silica", ("contact_angle",)),
+    Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",)),
+    Source("menisci.surface_tension", "surface_tension_spce", ("surface_tension",)),
+    Source("surfaces.interaction_range", "pulloff_silica", ("interaction_range_z0",)),
+    Source("surfaces.sam.interaction_range", "pulloff_ots", ("interaction_range_z0",)),
+)
+
+
+def recipes_needed(mapping=MAPPING) -> list[str]:
+    """MD recipes a calibration needs, in mapping order, each once."""
+    return list(dict.fromkeys(s.recipe for s in mapping))
+
+
+def _pick(result: dict, source: Source):
+    """(quantity name, value, stderr, units) chosen from a result, or (None, reason)."""
+    q = result.get("quantities", {})
+    for name in source.quantities:
+        if name not in q:
+            continue
+        v, e = q[name].get("value"), q[name].get("stderr")
+        if v is None or not math.isfinite(v):
+            continue
+        return name, float(v), (float(e) if e is not None and math.isfinite(e) else None), q[name].get("units", "")
+    return None, f"none of {source.quantities} is finite in the result"
+
+
+def _rejection(key: str, value: float, quantity: str) -> str | None:
+    if quantity == "contact_angle" and (value <= 0.0 or value >= 180.0):
+        return f"{value:g} deg is the analysis's 'no droplet contact / film' mark, not a measured angle"
+    try:
+        check_value(FIELD_BY_PATH[key], value, "md")
+    except SceneError as exc:
+        return f"outside the scene schema: {exc.allowed}"
+    return None
+
+
+def _set_nested(table: dict, key: str, value) -> None:
+    *parents, leaf = key.split(".")
+    node = table
+    for p in parents:
+        node = node.setdefault(p, {})
+    node[leaf] = value
+
+
+def _get_nested(table: dict, key: str):
+    node = table
+    for p in key.split("."):
+        if not isinstance(node, dict) or p not in node:
+            return None
+        node = node[p]
+    return node
+
+
+def build_parameter_set(results: dict[str, dict], base: str, name: str, *, description: str = "",
+                        mapping=MAPPING, extra_meta: dict | None = None) -> tuple[dict, list[dict]]:
+    """The set as a TOML-ready dict and one row per mapped key (used / rejected / missing).
+
+    `results` maps recipe name -> MD result.json dict. `base` is a parameter-set name or file.
+    """
+    base_path = find_params(base)
+    table = tomllib.loads(Path(base_path).read_text())
+    meta = table.pop("meta", {}) or {}
+    sources = dict(meta.get("sources", {}))
+    rows, calib, rejected = [], {}, {}
+    for src in mapping:
+        res = results.get(src.recipe)
+        row = {"key": src.key, "recipe": src.recipe, "base_value": _get_nested(table, src.key)}
+        if res is None:
+            row.update(status="missing", why=f"no {src.recipe} result")
+            rows.append(row)
+            continue
+        picked = _pick(res, src)
+        if picked[0] is None:
+            row.update(status="rejected", why=picked[1], run_hash=res.get("run_hash"))
+            rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "why": picked[1]}
+            rows.append(row)
+            continue
+        qname, value, stderr, units = picked
+        row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
+                   fidelity=res.get("fidelity"))
+        why = _rejection(src.key, value, qname)
+        if why:
+            row.update(status="rejected", why=why)
+            rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "quantity": qname,
+                                 "value": value, "why": why, "kept": "base set value"}
+        else:
+            row["status"] = "used"
+            _set_nested(table, src.key, value)
+            entry = {"value": value, "units": units, "recipe": src.recipe, "quantity": qname,
+                     "fidelity": res.get("fidelity"), "run_hash": res.get("run_hash")}
+            if stderr is not None:
+                entry["stderr"] = stderr
+            fe = res.get("quantities", {}).get("work_of_adhesion_free_energy")
+            if qname == "work_of_adhesion" and fe and fe.get("value") is not None:
+                entry["free_energy_estimate"] = {"value": fe["value"], "stderr": fe.get("stderr"),
+                                                 "note": "thermodynamic integration on a coarse window grid: "
+                                                         "discretisation error not in its stderr; not used"}
+            calib[src.key] = entry
+            kind = "potential-energy difference dE/A (not a free energy)" if "work_of_adhesion" in qname else qname
+            sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} +- "
+                                f"{stderr if stderr is not None else float('nan'):.3g} {units}, run {str(res.get('run_hash'))[:16]}")
+        rows.append(row)
+    out_meta = {"description": description or f"MD-calibrated set '{name}' on base '{Path(base).stem}'",
+                "base": Path(base).stem, "sources": sources, "calibration": calib}
+    if rejected:
+        out_meta["rejected"] = rejected
+    if extra_meta:
+        out_meta.update(extra_meta)
+    return {"meta": out_meta, **table}, rows
+
+
+# ----------------------------------------------------------------------------- TOML writing
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        if isinstance(v, float) and not math.isfinite(v):
+            return '"nan"'
+        return repr(v)
+    if v is None:
+        return '""'
+    return json.dumps(str(v))
+
+
+def _inline(d: dict) -> str:
+    return "{ " + ", ".join(f"{json.dumps(k)} = {_inline(v) if isinstance(v, dict) else _toml_value(v)}"
+                            for k, v in d.items()) + " }"
+
+
+def to_toml(table: dict, header: str = "") -> str:
+    """Serialise a set (nested dicts of scalars; [meta] sub-tables of dicts become inline tables)."""
+    lines = [f"# {line}" for line in header.splitlines()] if header else []
+
+    def emit(prefix: str, node: dict):
+        scalars = {k: v for k, v in node.items() if not isinstance(v, dict)}
+        tables = {k: v for k, v in node.items() if isinstance(v, dict)}
+        if prefix:
+            lines.append(f"\n[{prefix}]")
+        for k, v in scalars.items():
+            lines.append(f"{json.dumps(k) if '.' in k else k} = {_toml_value(v)}")
+        for k, v in tables.items():
+            key = json.dumps(k) if "." in k else k
+            if prefix.startswith("meta") and any(isinstance(x, dict) for x in v.values()):
+                lines.append(f"\n[{prefix}.{key}]")
+                for kk, vv in v.items():
+                    lines.append(f"{json.dumps(kk)} = {_inline(vv) if isinstance(vv, dict) else _toml_value(vv)}")
+            else:
+                emit(f"{prefix}.{key}" if prefix else key, v)
+
+    emit("", table)
+    return "\n".join(lines) + "\n"
+
+
+def write_parameter_set(table: dict, path: Path, header: str = "") -> Path:
+    """Write atomically and check that the file parses back and loads as a parameter set."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = to_toml(table, header)
+    parsed = tomllib.loads(text)
+    if parsed.get("surfaces") != table.get("surfaces"):
+        raise RuntimeError("parameter set did not round-trip through TOML")
+    tmp = path.with_suffix(".toml.tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+    return path
+
+
+def committed_result(recipe: str, fidelity: str, results_dir: Path = RESULTS_DIR) -> dict | None:
+    """The committed result of `recipe` at `fidelity` (inputs/md/results/<recipe>-<fidelity>/result.json), or None."""
+    path = Path(results_dir) / f"{recipe}-{fidelity}" / "result.json"
+    return json.loads(path.read_text()) if path.is_file() else None

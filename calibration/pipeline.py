@@ -1,0 +1,319 @@
+"""`nanoimpact calibrate RECIPE.toml`: MD jobs -> calibrated parameter set -> paper cases -> report.
+
+Steps (each timed in the report):
+1. MD jobs: every recipe the mapping needs (calibration.mdset.MAPPING) at --md-fidelity, as
+   independent jobs on the executor. A committed result (inputs/md/results/<recipe>-<fidelity>/) is
+   used only if its run_hash equals the hash md would compute now (same recipe content, force-field
+   files, package and LAMMPS versions); otherwise md's own engine runs it, reusing its hashed cache.
+2. The set: calibration.mdset.build_parameter_set on the recipe's base set, written atomically to
+   inputs/params/<name>.toml (or --params-out), every value with its MD run hash in [meta].
+3. The paper's dry, wet and SAM cases for the base set, the literature `silicon` set and the new set
+   (continuum.paper.report.make_paper), into OUT/paper.
+4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr) and the
+   user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
+   scene, giving first rebound heights, rebound counts and the escape velocity as median and
+   5-95 % bands (OUT/uncertainty.csv, OUT/uncertainty.png); every band says which inputs it covers.
+5. OUT/report.md.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import platform
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from .executors import executor
+from .mdset import MAPPING, RESULTS_DIR, build_parameter_set, committed_result, recipes_needed, write_parameter_set
+
+ROOT = Path(__file__).resolve().parent.parent
+PARAMS_DIR = ROOT / "inputs" / "params"
+
+
+class CalibrationError(ValueError):
+    """An invalid calibration recipe: names the key, the value and what is allowed."""
+
+
+def load_calibration(path: str | Path) -> dict:
+    """Read and check a calibration recipe (inputs/calibration/NAME.toml)."""
+    path = Path(path)
+    if not path.is_file():
+        raise CalibrationError(f"{path}: file not found")
+    raw = tomllib.loads(path.read_text())
+    allowed = {"name", "base", "description", "uncertainty"}
+    unknown = set(raw) - allowed
+    if unknown:
+        raise CalibrationError(f"{path}: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+    for key in ("name", "base"):
+        if not isinstance(raw.get(key), str) or not raw[key]:
+            raise CalibrationError(f"{path}: {key} = {raw.get(key)!r}: a non-empty string is required")
+    unc = raw.get("uncertainty", {})
+    ok_unc = {"samples", "seed", "scene", "max_bounces", "ranges"}
+    if set(unc) - ok_unc:
+        raise CalibrationError(f"{path}: uncertainty has unknown key(s) {sorted(set(unc) - ok_unc)}; allowed: "
+                               f"{sorted(ok_unc)}")
+    samples = unc.get("samples", 16)
+    if not isinstance(samples, int) or not 2 <= samples <= 10000:
+        raise CalibrationError(f"{path}: uncertainty.samples = {samples!r}: an integer in 2..10000")
+    for key, rng in unc.get("ranges", {}).items():
+        if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, (int, float)) for x in rng)
+                and rng[0] < rng[1]):
+            raise CalibrationError(f"{path}: uncertainty.ranges.{key} = {rng!r}: [low, high] with low < high")
+    return {**raw, "path": str(path), "uncertainty": {"samples": samples, "seed": unc.get("seed", 0),
+                                                      "scene": unc.get("scene", "inputs/scenes/rough_silica.toml"),
+                                                      "max_bounces": unc.get("max_bounces", 6),
+                                                      "ranges": unc.get("ranges", {})}}
+
+
+# ----------------------------------------------------------------------------- MD jobs
+def current_hash(recipe_name: str, fidelity: str) -> str:
+    """The run hash md would give `recipe_name` at `fidelity` now."""
+    from md.recipe import load_recipe
+    from md.runner import run_hash
+    from md.workflows import get_workflow
+
+    recipe = load_recipe(recipe_name)
+    wf = get_workflow(recipe.workflow)
+    return run_hash(recipe, fidelity, wf.forcefield_files(recipe.settings(fidelity)))[0]
+
+
+def md_job(task: tuple) -> dict:
+    """One MD recipe: the committed result if its hash is current, else md's engine (cached). Picklable."""
+    recipe_name, fidelity, cache, results_dir = task
+    start = time.perf_counter()
+    digest = current_hash(recipe_name, fidelity)
+    committed = committed_result(recipe_name, fidelity, Path(results_dir))
+    if committed is not None and committed.get("run_hash") == digest:
+        return {"recipe": recipe_name, "result": committed, "source": "committed", "wall_s": time.perf_counter() - start}
+    from md.recipe import load_recipe
+    from md.runner import run_recipe
+
+    outcome = run_recipe(load_recipe(recipe_name), fidelity, cache=cache, progress=False, echo=None)
+    note = "md cache" if outcome.reused else "ran"
+    if committed is not None:
+        note += f" (committed result's hash {str(committed.get('run_hash'))[:16]} is not current {digest[:16]})"
+    return {"recipe": recipe_name, "result": outcome.result, "source": note, "wall_s": time.perf_counter() - start}
+
+
+# ----------------------------------------------------------------------------- uncertainty
+def latin_hypercube(n: int, dims: int, rng: np.random.Generator) -> np.ndarray:
+    """n points in [0, 1)^dims, each dimension's n strata hit exactly once (McKay et al. 1979)."""
+    u = (rng.random((n, dims)) + np.arange(n)[:, None]) / n
+    for j in range(dims):
+        u[:, j] = u[rng.permutation(n), j]
+    return u
+
+
+def sample_inputs(calibration: dict, ranges: dict, n: int, seed: int) -> tuple[list[str], list[dict]]:
+    """Latin-hypercube samples of the calibrated values (normal, MD stderr) and user ranges (uniform)."""
+    from scipy.stats import norm
+
+    normal = {k: (v["value"], v["stderr"]) for k, v in calibration.items() if v.get("stderr")}
+    keys = list(normal) + list(ranges)
+    u = latin_hypercube(n, len(keys), np.random.default_rng(seed)) if keys else np.zeros((n, 0))
+    samples = []
+    for row in u:
+        s = {}
+        for j, key in enumerate(keys):
+            if key in normal:
+                mu, sd = normal[key]
+                s[key] = float(mu + sd * norm.ppf(min(max(row[j], 1e-9), 1 - 1e-9)))
+            else:
+                lo, hi = ranges[key]
+                s[key] = float(lo + (hi - lo) * row[j])
+        samples.append(s)
+    return keys, samples
+
+
+def uncertainty_sample(task: tuple) -> dict:
+    """One sample: the scene with the set and the sampled overrides; rebounds and escape velocity. Picklable."""
+    scene, params, overrides, max_bounces = task
+    from continuum.escape import escape_velocity, single_impact
+    from continuum.impact import first_impact_speed, run_impact
+    from continuum.models import select_law
+    from continuum.scene import SceneError, resolve_scene
+
+    try:
+        resolved = resolve_scene(scene, params=params, overrides={**overrides, "numerics.max_bounces": max_bounces},
+                                 override_label="uncertainty sample")
+        result, _ = run_impact(resolved)
+    except (SceneError, ValueError) as exc:
+        return {"overrides": overrides, "error": str(exc)}
+    h0 = result["scene"]["si"]["release_height"]
+    reb = [b["rebound_height"] or 0.0 for b in result["bounces"]]
+    sc = resolved.scene
+    v0 = first_impact_speed(resolved)
+    law, _ = select_law(sc, v0)
+    esc = None
+    grid = [v0 * f for f in np.geomspace(0.05, 2.0, 8)]
+    stuck = [v for v in grid if single_impact(law, sc.body.mass, sc.environment.gravity, v, sc.numerics.rtol).stuck]
+    free = [v for v in grid if v not in stuck]
+    if stuck and free and max(stuck) < min(free):
+        esc = escape_velocity(law, sc.body.mass, sc.environment.gravity, max(stuck), min(free), rel_tol=1e-2,
+                              rtol=sc.numerics.rtol)["escape_velocity"]
+    return {"overrides": overrides, "rebounds_over_h0": [r / h0 for r in reb[:3]],
+            "rebound_count": sum(r > 1e-3 * h0 for r in reb), "escape_velocity": esc}
+
+
+def _band(values) -> dict:
+    v = np.asarray([x for x in values if x is not None and math.isfinite(x)], float)
+    if v.size == 0:
+        return {"median": None, "p05": None, "p95": None, "n": 0}
+    return {"median": float(np.median(v)), "p05": float(np.percentile(v, 5)), "p95": float(np.percentile(v, 95)),
+            "n": int(v.size)}
+
+
+# ----------------------------------------------------------------------------- pipeline
+def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "quick", executor_name: str = "local",
+              workers: int | None = None, scheduler: str | None = None, params_out: str | Path | None = None,
+              md_cache: str | None = None, results_dir: str | Path = RESULTS_DIR, paper_sets: tuple = ("silicon",),
+              progress=print) -> dict:
+    """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json)."""
+    t_all = time.perf_counter()
+    cal = load_calibration(recipe_path)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    timings = {}
+    # 1. MD jobs
+    t = time.perf_counter()
+    recipes = recipes_needed()
+    progress(f"calibrate {cal['name']}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}'")
+    ex = executor(executor_name, workers, scheduler)
+    results, sources = {}, {}
+    try:
+        tasks = [(r, md_fidelity, md_cache, str(results_dir)) for r in recipes]
+        for _, job in ex.map(md_job, tasks):
+            results[job["recipe"]] = job["result"]
+            sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],
+                                      "run_hash": job["result"].get("run_hash")}
+            progress(f"  MD {job['recipe']}: {job['source']} ({job['wall_s']:.1f} s)")
+        timings["md_s"] = time.perf_counter() - t
+        # 2. the set
+        machine = {"cores": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}
+        table, rows = build_parameter_set(results, cal["base"], cal["name"], description=cal.get("description", ""),
+                                          extra_meta={"md_fidelity": md_fidelity, "machine": machine,
+                                                      "md_wall_s": timings["md_s"],
+                                                      "created_by": f"nanoimpact calibrate {cal['path']}"})
+        set_path = Path(params_out) if params_out else PARAMS_DIR / f"{cal['name']}.toml"
+        write_parameter_set(table, set_path, header=(
+            f"The `{cal['name']}` parameter set, written by `nanoimpact calibrate {cal['path']} --md-fidelity "
+            f"{md_fidelity}`: MD-measured values on the `{cal['base']}` base set; [meta.calibration] gives each "
+            "value's stderr and MD run hash, [meta.rejected] what was not used and why."))
+        progress(f"  wrote {set_path}")
+        # 3. the paper's cases
+        t = time.perf_counter()
+        from continuum.paper.report import make_paper
+
+        sets = [cal["base"], *[s for s in paper_sets if s != cal["base"]], str(set_path)]
+        paper = make_paper(sets, out / "paper", workers=workers, progress=lambda m: None)
+        timings["paper_s"] = time.perf_counter() - t
+        # 4. uncertainty
+        t = time.perf_counter()
+        unc = cal["uncertainty"]
+        keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc["ranges"], unc["samples"], unc["seed"])
+        sample_out = [None] * len(samples)
+        for i, s in ex.map(uncertainty_sample, [(unc["scene"], str(set_path), smp, unc["max_bounces"])
+                                                 for smp in samples]):
+            sample_out[i] = s
+        timings["uncertainty_s"] = time.perf_counter() - t
+    finally:
+        ex.close()
+    bands = {"first_rebound_over_h0": _band(s.get("rebounds_over_h0", [None])[0] if s.get("rebounds_over_h0") else 0.0
+                                            for s in sample_out if "error" not in s),
+             "rebound_count": _band(s["rebound_count"] for s in sample_out if "error" not in s),
+             "escape_velocity_m_per_s": _band(s.get("escape_velocity") for s in sample_out if "error" not in s),
+             "covers": keys or ["(no input with an uncertainty: every band is a single point)"],
+             "samples": len(samples), "failed_samples": sum("error" in s for s in sample_out),
+             "seed": unc["seed"], "scene": unc["scene"]}
+    _write_uncertainty(out, keys, sample_out, bands)
+    timings["total_s"] = time.perf_counter() - t_all
+    record = {"calibration": cal, "set": str(set_path), "rows": rows, "md_sources": sources, "bands": bands,
+              "timings": timings, "machine": machine, "paper_checks": paper["checks"]}
+    (out / "calibration.json").write_text(json.dumps(record, indent=1, default=str) + "\n")
+    _write_report(out, record)
+    progress(f"calibrate: report {out / 'report.md'}; total {timings['total_s']:.1f} s")
+    return record
+
+
+def _write_uncertainty(out: Path, keys, samples, bands) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with open(out / "uncertainty.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(keys + ["rebound1_over_h0", "rebound2_over_h0", "rebound3_over_h0", "rebound_count",
+                           "escape_velocity_m_per_s", "error"])
+        for s in samples:
+            r = (s.get("rebounds_over_h0") or []) + [None] * 3
+            w.writerow([s["overrides"].get(k) for k in keys] + r[:3] +
+                       [s.get("rebound_count"), s.get("escape_velocity"), s.get("error", "")])
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ok = [s for s in samples if "error" not in s]
+    for s in ok:
+        ax.plot(range(1, len(s["rebounds_over_h0"]) + 1), s["rebounds_over_h0"], color="0.7", lw=0.7)
+    if ok:
+        m = max(len(s["rebounds_over_h0"]) for s in ok)
+        arr = np.array([(s["rebounds_over_h0"] + [0.0] * m)[:m] for s in ok])
+        x = np.arange(1, m + 1)
+        ax.fill_between(x, np.percentile(arr, 5, axis=0), np.percentile(arr, 95, axis=0), alpha=0.3,
+                        label="5-95 %")
+        ax.plot(x, np.median(arr, axis=0), "k-o", ms=3, label="median")
+    ax.set_xlabel("bounce")
+    ax.set_ylabel("rebound height / h0")
+    ax.set_title("rebound bands; inputs: " + ", ".join(k.split(".")[-1] for k in bands["covers"])[:90], fontsize=8)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "uncertainty.png.tmp.png", dpi=110)
+    plt.close(fig)
+    (out / "uncertainty.png.tmp.png").replace(out / "uncertainty.png")
+
+
+def _fmt(x, spec=".4g"):
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def _write_report(out: Path, rec: dict) -> None:
+    cal = rec["calibration"]
+    lines = [f"# Calibration `{cal['name']}` (base `{cal['base']}`)", "",
+             f"Recipe `{cal['path']}`; machine: {rec['machine']['cores']} cores, {rec['machine']['platform']}, "
+             f"Python {rec['machine']['python']}. Wall time: MD {rec['timings']['md_s']:.1f} s, paper cases "
+             f"{rec['timings']['paper_s']:.1f} s, uncertainty {rec['timings']['uncertainty_s']:.1f} s, total "
+             f"{rec['timings']['total_s']:.1f} s. Set written to `{rec['set']}`.", "",
+             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | status | why / run |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rec["rows"]:
+        lines.append(f"| `{r['key']}` | {r['recipe']} | {r.get('quantity', '-')} | {_fmt(r.get('value'))} "
+                     f"{r.get('units', '')} | {_fmt(r.get('stderr'))} | {r['status']} | "
+                     f"{r.get('why') or str(r.get('run_hash', ''))[:16]} |")
+    lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec["md_sources"].items()), "",
+              "A rejected or missing value keeps the base set's value (its [meta.sources] entry says so).",
+              "The work of adhesion is the energy difference dE/A, not a free energy: the quick thermodynamic-"
+              "integration estimate (recorded in the set's [meta.calibration]) is not converged (docs/calibration.md).",
+              "", "## The paper's claims per set", "",
+              "| claim | " + " | ".join(sorted({c['set'] for c in rec['paper_checks']})) + " |",
+              "|---|" + "---|" * len({c['set'] for c in rec['paper_checks']})]
+    sets = sorted({c["set"] for c in rec["paper_checks"]})
+    by = {}
+    for c in rec["paper_checks"]:
+        by.setdefault(c["name"], {})[c["set"]] = "pass" if c["pass"] else "**fail**"
+    for name, res in by.items():
+        lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
+    b = rec["bands"]
+    lines += ["", "## Uncertainty", "",
+              f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "
+              f"{', '.join(b['covers'])}; failed samples: {b['failed_samples']}.", "",
+              "| output | median | 5 % | 95 % | n |", "|---|---|---|---|---|"]
+    for key in ("first_rebound_over_h0", "rebound_count", "escape_velocity_m_per_s"):
+        v = b[key]
+        lines.append(f"| {key} | {_fmt(v['median'])} | {_fmt(v['p05'])} | {_fmt(v['p95'])} | {v['n']} |")
+    lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`; data: `uncertainty.csv`, "
+              "`calibration.json`, `paper/checks.json`.", ""]
+    (out / "report.md.tmp").write_text("\n".join(lines))
+    (out / "report.md.tmp").replace(out / "report.md")

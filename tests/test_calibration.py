@@ -1,0 +1,144 @@
+"""MD results -> parameter set, Latin hypercube, executors, sweeps and the smoke pipeline."""
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from calibration.executors import executor
+from calibration.mdset import build_parameter_set, recipes_needed, write_parameter_set
+from calibration.pipeline import latin_hypercube, load_calibration, CalibrationError
+from calibration.sweep import parse_vary, run_sweep
+from continuum.scene import SceneError, resolve_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _result(recipe, quantities, run_hash=None):
+    return {"recipe": recipe, "fidelity": "quick", "run_hash": run_hash or f"{recipe:0<64}"[:64],
+            "quantities": {k: {"value": v, "stderr": e, "units": u} for k, (v, e, u) in quantities.items()}}
+
+
+def _results(**changes):
+    res = {
+        "adhesion_silica": _result("adhesion_silica", {"work_of_adhesion": (0.21, 0.02, "J/m^2"),
+                                                       "work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2")}),
+        "adhesion_ots": _result("adhesion_ots", {"work_of_adhesion": (0.045, 0.004, "J/m^2"),
+                                                 "work_of_adhesion_free_energy": (0.04, None, "J/m^2")}),
+        "contact_angle_silica": _result("contact_angle_silica", {"contact_angle": (31.0, 3.0, "deg")}),
+        "contact_angle_ots": _result("contact_angle_ots", {"contact_angle": (108.0, 4.0, "deg")}),
+        "surface_tension_spce": _result("surface_tension_spce", {"surface_tension": (0.0615, 0.002, "N/m")}),
+        "pulloff_silica": _result("pulloff_silica", {"interaction_range_z0": (0.35e-9, 0.05e-9, "m")}),
+        "pulloff_ots": _result("pulloff_ots", {"interaction_range_z0": (0.42e-9, 0.06e-9, "m")}),
+    }
+    res.update(changes)
+    return res
+
+
+def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
+    table, rows = build_parameter_set(_results(), "paper", "cal")
+    s = table["surfaces"]
+    assert s["work_of_adhesion"] == 0.21                       # dE/A (the coarse TI free energy is only recorded)
+    assert s["sam"]["work_of_adhesion"] == 0.045
+    assert s["body"]["contact_angle"] == s["substrate"]["contact_angle"] == 31.0
+    assert s["sam"]["contact_angle"] == 108.0 and s["sam"]["interaction_range"] == 0.42e-9
+    assert s["interaction_range"] == 0.35e-9 and table["menisci"]["surface_tension"] == 0.0615
+    cal = table["meta"]["calibration"]
+    assert cal["surfaces.work_of_adhesion"]["quantity"] == "work_of_adhesion"
+    assert cal["surfaces.work_of_adhesion"]["stderr"] == 0.02
+    assert cal["surfaces.work_of_adhesion"]["free_energy_estimate"]["value"] == 0.18
+    assert cal["menisci.surface_tension"]["run_hash"] == _results()["surface_tension_spce"]["run_hash"]
+    assert s["roughness"]["summit_modulus"] == 10e9            # from the base set
+    assert all(r["status"] == "used" for r in rows)
+    path = write_parameter_set(table, tmp_path / "cal.toml", header="test set")
+    assert tomllib.loads(path.read_text())["meta"]["calibration"]["surfaces.sam.contact_angle"]["value"] == 108.0
+    scene = resolve_scene(ROOT / "inputs" / "scenes" / "wet_silica.toml", params=str(path)).scene
+    assert math.degrees(scene.surfaces.body.contact_angle) == pytest.approx(31.0, rel=1e-12, abs=0)
+    assert scene.surfaces.interaction_range == 0.35e-9 and scene.menisci.surface_tension == 0.0615
+
+
+def test_unusable_md_values_keep_the_base_value_and_say_so():
+    bad = _results(contact_angle_ots=_result("contact_angle_ots", {"contact_angle": (180.0, 0.0, "deg")}),
+                   adhesion_silica=_result("adhesion_silica", {"work_of_adhesion": (-0.3, 0.5, "J/m^2")}))
+    del bad["pulloff_ots"]
+    table, rows = build_parameter_set(bad, "paper", "cal")
+    base = tomllib.loads((ROOT / "inputs" / "params" / "paper.toml").read_text())
+    assert table["surfaces"]["sam"]["contact_angle"] == base["surfaces"]["sam"]["contact_angle"]
+    assert table["surfaces"]["work_of_adhesion"] == base["surfaces"]["work_of_adhesion"]
+    rej = table["meta"]["rejected"]
+    assert "no droplet contact" in rej["surfaces.sam.contact_angle"]["why"]
+    assert "outside the scene schema" in rej["surfaces.work_of_adhesion"]["why"]
+    status = {r["key"]: r["status"] for r in rows}
+    assert status["surfaces.sam.interaction_range"] == "missing"
+    assert "surfaces.sam.interaction_range" not in table["surfaces"]["sam"]
+
+
+def test_recipes_needed_are_the_seven_mapped_ones():
+    assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "contact_angle_silica", "contact_angle_ots",
+                                "surface_tension_spce", "pulloff_silica", "pulloff_ots"]
+
+
+def test_latin_hypercube_hits_every_stratum_once_per_dimension():
+    u = latin_hypercube(50, 4, np.random.default_rng(3))
+    assert u.shape == (50, 4) and np.all((u >= 0) & (u < 1))
+    for j in range(4):
+        assert sorted(np.floor(u[:, j] * 50).astype(int)) == list(range(50))
+
+
+def _square(x):
+    return x * x
+
+
+@pytest.mark.parametrize("name", ["local", "processes"])
+def test_executors_return_every_result_at_its_index(name):
+    ex = executor(name, workers=2)
+    try:
+        got = dict(ex.map(_square, [3, 1, 4, 1, 5]))
+    finally:
+        ex.close()
+    assert got == {0: 9, 1: 1, 2: 16, 3: 1, 4: 25}
+
+
+def test_bad_executor_and_calibration_recipe_are_refused(tmp_path):
+    with pytest.raises(ValueError, match="one of local, processes, dask"):
+        executor("slurm")
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\nbase = "paper"\n[uncertainty]\nsamples = 1\n')
+    with pytest.raises(CalibrationError, match="uncertainty.samples = 1"):
+        load_calibration(bad)
+
+
+def test_sweep_validates_first_then_resumes_without_rerunning(tmp_path):
+    scene = ROOT / "inputs" / "scenes" / "rough_silica.toml"
+    with pytest.raises(SceneError, match="surfaces.roughness.sigma"):
+        run_sweep(scene, parse_vary(["surfaces.roughness.sigma=6e-9,-1"]), tmp_path / "bad", progress=lambda m: None)
+    assert not (tmp_path / "bad").exists()
+    vary = parse_vary(["surfaces.roughness.sigma=6e-9,10e-9", "numerics.max_bounces=2"])
+    first = run_sweep(scene, vary, tmp_path / "sw", progress=lambda m: None)
+    again = run_sweep(scene, vary, tmp_path / "sw", progress=lambda m: None)
+    assert (first["computed"], first["reused"]) == (2, 0) and (again["computed"], again["reused"]) == (0, 2)
+    assert [r["first_rebound_height_m"] for r in first["rows"]] == [r["first_rebound_height_m"] for r in again["rows"]]
+    text = (tmp_path / "sw" / "sweep.csv").read_text().splitlines()
+    assert text[0].startswith("surfaces.roughness.sigma,numerics.max_bounces,status") and len(text) == 3
+    assert (tmp_path / "sw" / "sweep.png").stat().st_size > 0
+
+
+@pytest.mark.md
+def test_smoke_pipeline_on_two_dask_workers(tmp_path):
+    from calibration.pipeline import calibrate
+
+    out = tmp_path / "cal"
+    record = calibrate(ROOT / "inputs" / "calibration" / "smoke.toml", out, md_fidelity="smoke", executor_name="dask",
+                       workers=2, params_out=tmp_path / "calibrated_smoke.toml", md_cache=str(tmp_path / "md"),
+                       progress=lambda m: None)
+    assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
+    assert (out / "paper" / "checks.json").is_file()
+    assert len(record["md_sources"]) == 7
+    scene = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params=str(tmp_path / "calibrated_smoke.toml"))
+    assert scene.scene.surfaces.roughness.summit_modulus == 10e9
+    saved = json.loads((out / "calibration.json").read_text())
+    assert saved["bands"]["samples"] == 4
