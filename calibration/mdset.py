@@ -144,8 +144,9 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
                                                          "discretisation error not in its stderr; not used"}
             calib[src.key] = entry
             kind = "potential-energy difference dE/A (not a free energy)" if "work_of_adhesion" in qname else qname
-            sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} +- "
-                                f"{stderr if stderr is not None else float('nan'):.3g} {units}, run {str(res.get('run_hash'))[:16]}")
+            err = f"+- {stderr:.3g}" if stderr is not None else "(no stderr)"
+            sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}, "
+                                f"run {str(res.get('run_hash'))[:16]}")
         rows.append(row)
     out_meta = {"description": description or f"MD-calibrated set '{name}' on base '{Path(base).stem}'",
                 "base": Path(base).stem, "sources": sources, "calibration": calib}
