@@ -53,7 +53,7 @@ def load_calibration(path: str | Path) -> dict:
         if not isinstance(raw.get(key), str) or not raw[key]:
             raise CalibrationError(f"{path}: {key} = {raw.get(key)!r}: a non-empty string is required")
     unc = raw.get("uncertainty", {})
-    ok_unc = {"samples", "seed", "scene", "max_bounces", "ranges"}
+    ok_unc = {"samples", "seed", "scene", "max_bounces", "ranges", "overrides"}
     if set(unc) - ok_unc:
         raise CalibrationError(f"{path}: uncertainty has unknown key(s) {sorted(set(unc) - ok_unc)}; allowed: "
                                f"{sorted(ok_unc)}")
@@ -67,7 +67,8 @@ def load_calibration(path: str | Path) -> dict:
     return {**raw, "path": str(path), "uncertainty": {"samples": samples, "seed": unc.get("seed", 0),
                                                       "scene": unc.get("scene", "inputs/scenes/rough_silica.toml"),
                                                       "max_bounces": unc.get("max_bounces", 6),
-                                                      "ranges": unc.get("ranges", {})}}
+                                                      "ranges": unc.get("ranges", {}),
+                                                      "overrides": unc.get("overrides", {})}}
 
 
 # ----------------------------------------------------------------------------- MD jobs
@@ -142,22 +143,26 @@ def uncertainty_sample(task: tuple) -> dict:
         resolved = resolve_scene(scene, params=params, overrides={**overrides, "numerics.max_bounces": max_bounces},
                                  override_label="uncertainty sample")
         result, _ = run_impact(resolved)
-    except (SceneError, ValueError) as exc:
+    except (SceneError, ValueError, RuntimeError) as exc:      # refused or failed: counted and reported
         return {"overrides": overrides, "error": str(exc)}
     h0 = result["scene"]["si"]["release_height"]
     reb = [b["rebound_height"] or 0.0 for b in result["bounces"]]
     sc = resolved.scene
     v0 = first_impact_speed(resolved)
     law, _ = select_law(sc, v0)
-    esc = None
-    grid = [v0 * f for f in np.geomspace(0.05, 2.0, 8)]
-    stuck = [v for v in grid if single_impact(law, sc.body.mass, sc.environment.gravity, v, sc.numerics.rtol).stuck]
-    free = [v for v in grid if v not in stuck]
-    if stuck and free and max(stuck) < min(free):
-        esc = escape_velocity(law, sc.body.mass, sc.environment.gravity, max(stuck), min(free), rel_tol=1e-2,
-                              rtol=sc.numerics.rtol)["escape_velocity"]
+    esc, esc_error = None, None
+    try:
+        grid = [v0 * f for f in np.geomspace(0.05, 2.0, 8)]
+        stuck = [v for v in grid if single_impact(law, sc.body.mass, sc.environment.gravity, v, sc.numerics.rtol).stuck]
+        free = [v for v in grid if v not in stuck]
+        if stuck and free and max(stuck) < min(free):
+            esc = escape_velocity(law, sc.body.mass, sc.environment.gravity, max(stuck), min(free), rel_tol=1e-2,
+                                  rtol=sc.numerics.rtol)["escape_velocity"]
+    except (ValueError, RuntimeError) as exc:
+        esc_error = str(exc)
     return {"overrides": overrides, "rebounds_over_h0": [r / h0 for r in reb[:3]],
-            "rebound_count": sum(r > 1e-3 * h0 for r in reb), "escape_velocity": esc}
+            "rebound_count": sum(r > 1e-3 * h0 for r in reb), "escape_velocity": esc,
+            **({"escape_error": esc_error} if esc_error else {})}
 
 
 def _md_wall(result: dict) -> float:
@@ -228,8 +233,8 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         unc = cal["uncertainty"]
         keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc["ranges"], unc["samples"], unc["seed"])
         sample_out = [None] * len(samples)
-        for i, s in ex.map(uncertainty_sample, [(unc["scene"], str(set_path), smp, unc["max_bounces"])
-                                                 for smp in samples]):
+        for i, s in ex.map(uncertainty_sample, [(unc["scene"], str(set_path), {**unc["overrides"], **smp},
+                                                  unc["max_bounces"]) for smp in samples]):
             sample_out[i] = s
         timings["uncertainty_s"] = time.perf_counter() - t
     finally:
