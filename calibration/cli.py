@@ -63,6 +63,9 @@ def cmd_paper(args) -> int:
     from continuum.paper.report import make_paper
     from continuum.scene import SceneError, find_params
 
+    if args.params is None:
+        from continuum.scene import PARAMS_DIR
+        args.params = "paper,silicon" + (",calibrated" if (PARAMS_DIR / "calibrated.toml").is_file() else "")
     sets = [s.strip() for s in args.params.split(",") if s.strip()]
     try:
         for s in sets:
@@ -128,7 +131,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Run every case of the paper (Hertz roller, rough silica, OTS, roughness and "
                                    "velocity sweeps) for each parameter set; write figures, data, summary.md and "
                                    "checks.json to --out.")
-    q.add_argument("--params", default="paper,silicon", help="parameter sets, comma-separated (default: paper,silicon)")
+    q.add_argument("--params", default=None, help="parameter sets, comma-separated (default: paper,silicon and, "
+                                                    "when inputs/params/calibrated.toml exists, calibrated)")
     q.add_argument("--out", default="out/paper", help="output folder (default: out/paper)")
     q.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset for every case")
     q.add_argument("--workers", type=int, help="parallel processes (default: CPU count)")

@@ -324,6 +324,16 @@ def _write_report(out: Path, rec: dict) -> None:
         by.setdefault(c["name"], {})[c["set"]] = "pass" if c["pass"] else "**fail**"
     for name, res in by.items():
         lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
+    name = Path(rec["set"]).stem
+    mine = [c for c in rec["paper_checks"] if c["set"] == name]
+    agree = [c["name"] for c in mine if c["pass"]]
+    differ = [c for c in mine if not c["pass"]]
+    lines += ["", f"**Where the calibrated physics agrees with the paper:** {len(agree)} of {len(mine)} claims hold "
+              f"with the `{name}` set.", ""]
+    if differ:
+        lines += [f"**Where it does not** ({len(differ)}):", ""]
+        lines += [f"- `{c['name']}`: needs {c['threshold']}; got {json.dumps(c['values'], default=str)[:300]}"
+                  for c in differ]
     b = rec["bands"]
     lines += ["", "## Uncertainty", "",
               f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "
