@@ -284,7 +284,11 @@ def _write_uncertainty(out: Path, keys, samples, bands) -> None:
         ax.plot(x, np.median(arr, axis=0), "k-o", ms=3, label="median")
     ax.set_xlabel("bounce")
     ax.set_ylabel("rebound height / h0")
-    ax.set_title("rebound bands; inputs: " + ", ".join(k.split(".")[-1] for k in bands["covers"])[:90], fontsize=8)
+    import textwrap
+
+    ax.set_xticks(range(1, 4))
+    ax.set_title("\n".join(textwrap.wrap(f"rebound bands, {bands['samples']} samples; inputs: " +
+                                          ", ".join(bands["covers"]), 95)), fontsize=7)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "uncertainty.png.tmp.png", dpi=110)
