@@ -80,7 +80,7 @@ def main(argv=None):
           f"{'FP plateau':>10s}")
     for r in rows:
         fp = f"{r['stderr_fp_plateau_mN_m']:.2f}" if r["stderr_fp_plateau_mN_m"] is not None else "n/a"
-        print(f"{r['run']:34s} {r['atoms']:5d} {r['fraction']:5.2f} {r["sampled_ps"]:6.1f} {r['wall_s']:7.0f} "
+        print(f"{r['run']:34s} {r['atoms']:5d} {r['fraction']:5.2f} {r['sampled_ps']:6.1f} {r['wall_s']:7.0f} "
               f"{r['gamma_mN_m']:11.2f} {r['stderr_mN_m']:7.2f} {fp:>10s}")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
