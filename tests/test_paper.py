@@ -24,10 +24,12 @@ def test_every_dry_claim_holds_for_the_paper_set(paper_run):
     _, record = paper_run
     failed = [(c["name"], c["values"]) for c in record["checks"] if not c["pass"]]
     assert not failed, failed
-    assert len(record["checks"]) >= 26
+    assert len(record["checks"]) >= 28
     names = {c["name"] for c in record["checks"]}
     assert {"fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a", "fig8b_ots_lower_escape_velocity",
-            "fig8b_ots_impact_shorter_at_the_same_low_velocity"} <= names
+            "fig8b_ots_impact_shorter_at_the_same_low_velocity", "fig8a_t_a_line_separates_rebounds_from_sticking",
+            "fig8a_menisci_raise_the_escape_velocity", "fig8b_bare_silica_limiting_gap_larger",
+            "fig5_wet_drop_is_the_dry_drop_contacts_shorter_than_t_a", "fig8b_ots_grows_no_bridges"} <= names
 
 
 def test_paper_output_has_figures_data_summary_and_case_results(paper_run):
@@ -40,3 +42,30 @@ def test_paper_output_has_figures_data_summary_and_case_results(paper_run):
     assert "Parameter set `paper`" in (out / "summary.md").read_text()
     result = json.loads((out / "cases" / "rough_silica" / "paper" / "result.json").read_text())
     assert result["schema_version"] == "1.0" and result["n_bounces"] >= 2
+
+
+def _wet_sweep(wet_durations, wet_stuck):
+    """A synthetic near-escape sweep of wet silica: dry impacts rebound with the given times."""
+    pts = [{"v_impact": 1e-3 * (1 + i), "dry": {"stuck": False, "duration": d, "v_rebound": 1e-4, "restitution": 0.3},
+            "wet": {"stuck": st, "duration": None if st else d, "v_rebound": 0.0 if st else 1e-4,
+                    "restitution": 0.0 if st else 0.3}}
+           for i, (d, st) in enumerate(zip(wet_durations, wet_stuck))]
+    return {"points": pts, "menisci_possible": True, "condensation_time": 25e-6, "gravity": 9.81,
+            "escape_dry": {"escape_velocity": 4e-4}, "escape_wet": {"escape_velocity": 5e-4}}
+
+
+def test_wet_claims_can_fail():
+    from continuum.paper.checks import evaluate_wet
+
+    def verdicts(sweep):
+        return {c["name"]: c["pass"] for c in evaluate_wet("x", {"wet_silica": sweep}, {})}
+
+    good = verdicts(_wet_sweep([10e-6, 20e-6, 30e-6], [False, False, True]))
+    assert good["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]
+    assert good["fig8a_t_a_line_separates_rebounds_from_sticking"]
+    # a wet impact that outlasts t_a and still rebounds breaks both claims
+    bad = verdicts(_wet_sweep([10e-6, 20e-6, 30e-6], [False, False, False]))
+    assert not bad["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]
+    assert not bad["fig8a_t_a_line_separates_rebounds_from_sticking"]
+    # no dry impact outlasting t_a: the claim is not exercised, so it fails
+    assert not verdicts(_wet_sweep([10e-6, 20e-6], [False, False]))["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]

@@ -171,13 +171,24 @@ def evaluate_wet(set_name: str, wet: dict, impacts: dict) -> list[dict]:
         longest = max(wet_free, default=0.0)
         outlast = [p for p in pts if not p["dry"]["stuck"] and p["dry"]["duration"] >= t_a]
         ended = all(p["wet"]["stuck"] for p in outlast)
+        e_dry, e_wet = si["escape_dry"], si["escape_wet"]
+        v_dry = (e_dry or {}).get("escape_velocity")
+        v_wet = (e_wet or {}).get("escape_velocity")
         out.append(_check("fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a", set_name,
                           {"t_a_s": t_a, "dry_rebounding_impacts_outlasting_t_a": len(outlast),
                            "of_which_stick_with_menisci": sum(p["wet"]["stuck"] for p in outlast),
-                           "longest_rebounding_wet_impact_s": longest},
+                           "longest_rebounding_wet_impact_s": longest,
+                           "escape_velocity_dry_m_per_s": v_dry, "escape_velocity_wet_m_per_s": v_wet},
                           "at least one dry impact outlasts t_a and still rebounds; with menisci every such impact "
-                          "sticks, and every wet impact that rebounds lasts < t_a",
-                          bool(outlast) and ended and longest < t_a))
+                          "sticks, every wet impact that rebounds lasts < t_a, and wet escape velocity >= dry",
+                          bool(outlast) and ended and longest < t_a and bool(v_dry and v_wet and v_wet >= v_dry)))
+        shortest_stuck = min((p["dry"]["duration"] for p in pts if p["wet"]["stuck"] and not p["dry"]["stuck"]),
+                             default=None)
+        out.append(_check("fig8a_t_a_line_separates_rebounds_from_sticking", set_name,
+                          {"t_a_s": t_a, "longest_rebounding_wet_impact_s": longest,
+                           "shortest_dry_impact_that_sticks_with_menisci_s": shortest_stuck},
+                          "longest rebounding wet impact < t_a <= every dry impact time that sticks with menisci",
+                          bool(wet_free) and longest < t_a and shortest_stuck is not None and shortest_stuck >= t_a))
         shorter = [p for p in pts if not p["dry"]["stuck"] and p["dry"]["duration"] < t_a]
         # compare rebound energies against the impact energy: near escape the rebound speed is small and
         # the table interpolation error (~1e-7 of the force; the wet law sizes its tables deeper) is
@@ -189,7 +200,6 @@ def evaluate_wet(set_name: str, wet: dict, impacts: dict) -> list[dict]:
                           {"impacts": len(shorter), "max_abs_difference_e_squared": worst},
                           "every one rebounds with and without menisci, |e_wet^2 - e_dry^2| <= 1e-5",
                           bool(shorter) and same))
-        e_dry, e_wet = si["escape_dry"], si["escape_wet"]
         out.append(_check("fig8a_menisci_raise_the_escape_velocity", set_name,
                           {"dry_m_per_s": (e_dry or {}).get("escape_velocity"),
                            "wet_m_per_s": (e_wet or {}).get("escape_velocity")},
@@ -204,6 +214,10 @@ def evaluate_wet(set_name: str, wet: dict, impacts: dict) -> list[dict]:
                            "limiting_gap_silica_m": gap["silica"], "limiting_gap_ots_m": gap["ots"]},
                           "OTS < bare silica (so bare silica's limiting gap v^2/2g is larger)",
                           bool(esc_si and esc_ots and esc_ots < esc_si)))
+        out.append(_check("fig8b_bare_silica_limiting_gap_larger", set_name,
+                          {"limiting_gap_silica_m": gap["silica"], "limiting_gap_ots_m": gap["ots"]},
+                          "bare silica's v_esc^2/2g > OTS's",
+                          bool(gap["silica"] and gap["ots"] and gap["silica"] > gap["ots"])))
         if esc_si:
             v = 1.2 * esc_si
 

@@ -13,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.transforms import blended_transform_factory  # noqa: E402
 
 from ..results import load_result  # noqa: E402
 
@@ -152,43 +153,62 @@ def fig7(impacts: dict, set_name: str, out: Path):
     return ax
 
 
-def fig8a(sweeps: dict, set_name: str, out: Path, wet: dict | None = None):
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+def fig8a(sweeps: dict, set_name: str, out: Path, wet: dict | None = None, ax=None):
+    """Impact time against impact velocity (mm/s, us): dry curves (Hertz, sigma 3-30 nm) with their escape
+    velocities, the t_a line, and the humid sigma = 6 nm sweep near escape (menisci forced on). Crosses: sticks."""
+    if ax is None:
+        _, ax = plt.subplots(figsize=(8.5, 5))
+    edge = blended_transform_factory(ax.transData, ax.transAxes)
     rows = []
     for case, s in sorted(sweeps.items(), key=lambda kv: (kv[1]["sigma"] or 0.0)):
-        label = "Hertz" if s["sigma"] is None else f"sigma {s['sigma'] * 1e9:g} nm"
+        label = "Hertz (dry)" if s["sigma"] is None else f"sigma {s['sigma'] * 1e9:g} nm (dry)"
         pts = [p for p in s["points"] if not p["stuck"]]
+        stuck = [p for p in s["points"] if p["stuck"]]
+        color = None
         if pts:
-            line, = ax.loglog([p["v_rebound"] for p in pts], [p["duration"] * 1e9 for p in pts], "o-", ms=3, label=label)
-            if s["escape"]:
-                ax.axvline(s["escape"]["escape_velocity"], color=line.get_color(), ls=":", lw=0.8)
+            line, = ax.loglog([p["v_impact"] * 1e3 for p in pts], [p["duration"] * 1e6 for p in pts], "o-", ms=3,
+                              label=label)
+            color = line.get_color()
+        if stuck:  # a stuck impact never ends: cross at the bottom edge, at its impact velocity
+            ax.plot([p["v_impact"] * 1e3 for p in stuck], [0.02] * len(stuck), "x", color=color or "k", ms=5,
+                    transform=edge)
+        if s["escape"] and color is not None:
+            ax.axvline(s["escape"]["escape_velocity"] * 1e3, color=color, ls=":", lw=0.8)
         rows += [(case, s["sigma"], p["v_impact"], p["v_rebound"], p["duration"], p["stuck"]) for p in s["points"]]
         if s["escape"]:
             rows.append((case, s["sigma"], s["escape"]["escape_velocity"], "escape_velocity", "", ""))
     si = (wet or {}).get("wet_silica")
-    if si and si["menisci_possible"]:
-        t_a = si["condensation_time"]
-        dry_free = [p for p in si["points"] if not p["dry"]["stuck"]]
-        ax.loglog([p["dry"]["v_rebound"] for p in dry_free], [p["dry"]["duration"] * 1e9 for p in dry_free], "s",
+    t_a = si["condensation_time"] if si and si["menisci_possible"] else None
+    if t_a is not None:
+        pts = si["points"]
+        dry_free = [p for p in pts if not p["dry"]["stuck"]]
+        ax.loglog([p["v_impact"] * 1e3 for p in dry_free], [p["dry"]["duration"] * 1e6 for p in dry_free], "s",
                   mfc="none", mec="k", ms=4, label="sigma 6 nm near escape, dry")
-        wet_free = [p for p in dry_free if not p["wet"]["stuck"]]
-        ax.loglog([p["wet"]["v_rebound"] for p in wet_free], [p["wet"]["duration"] * 1e9 for p in wet_free], "s",
-                  color="tab:blue", ms=2.5, label="... with menisci (40 % RH): rebounds")
-        ended = [p for p in dry_free if p["wet"]["stuck"]]
-        if ended:
-            ax.loglog([p["dry"]["v_rebound"] for p in ended], [p["dry"]["duration"] * 1e9 for p in ended], "x",
-                      color="tab:red", ms=6, label="... with menisci: sticks (dry impact shown)")
-        ax.axhline(t_a * 1e9, color="k", ls=":", lw=1.0)
-        ax.text(ax.get_xlim()[1] / 1.5, t_a * 1e9 * 1.12, f"t_a = {t_a * 1e6:g} us", fontsize=7, ha="right")
+        wet_free = [p for p in pts if not p["wet"]["stuck"]]
+        ax.loglog([p["v_impact"] * 1e3 for p in wet_free], [p["wet"]["duration"] * 1e6 for p in wet_free], "s",
+                  color="tab:blue", ms=2.5, label="sigma 6 nm with menisci (40 % RH): rebounds")
+        # a stuck wet impact never ends: mark it at the time the dry impact would have lasted
+        wet_stuck = [p for p in pts if p["wet"]["stuck"] and not p["dry"]["stuck"]]
+        if wet_stuck:
+            ax.loglog([p["v_impact"] * 1e3 for p in wet_stuck], [p["dry"]["duration"] * 1e6 for p in wet_stuck], "x",
+                      color="tab:red", ms=7, mew=1.5, label="with menisci: sticks (at its dry impact time)")
+        for esc, ls, name in ((si["escape_dry"], "--", "dry"), (si["escape_wet"], "-", "wet")):
+            if esc:
+                ax.axvline(esc["escape_velocity"] * 1e3, color="tab:red" if name == "wet" else "k", ls=ls, lw=0.8,
+                           label=f"sigma 6 nm escape velocity, {name}: {esc['escape_velocity'] * 1e3:.4g} mm/s")
+        ax.axhline(t_a * 1e6, color="k", ls=":", lw=1.2, label=f"t_a = {t_a * 1e6:g} us (condensation time)")
         rows += [("wet_silica_dry", si["sigma"], p["v_impact"], p["dry"]["v_rebound"], p["dry"]["duration"],
-                  p["dry"]["stuck"]) for p in si["points"]]
+                  p["dry"]["stuck"]) for p in pts]
         rows += [("wet_silica_menisci", si["sigma"], p["v_impact"], p["wet"]["v_rebound"], p["wet"]["duration"],
-                  p["wet"]["stuck"]) for p in si["points"]]
-    ax.set_xlabel("rebound velocity (m/s)")
-    ax.set_ylabel("impact time (ns)")
-    ax.set_title(f"Fig 8a ({set_name}): impact time against rebound velocity; dotted verticals: escape velocities "
-                 "(impact speed); dotted horizontal: t_a", fontsize=8)
-    ax.legend(fontsize=6)
+                  p["wet"]["stuck"]) for p in pts]
+        for name, esc in (("wet_silica_dry", si["escape_dry"]), ("wet_silica_menisci", si["escape_wet"])):
+            if esc:
+                rows.append((name, si["sigma"], esc["escape_velocity"], "escape_velocity", "", ""))
+    ax.set_xlabel("impact velocity (mm/s)")
+    ax.set_ylabel("impact time (us)")
+    ax.set_title(f"Fig 8a ({set_name}): impact time against impact velocity; x: sticks (dry: on the bottom edge); "
+                 "dotted verticals: dry escape velocities", fontsize=8)
+    ax.legend(fontsize=6, loc="upper right")
     write_csv(out / "data" / f"fig8a_{set_name}.csv",
               ["case", "sigma_m", "v_impact_m_per_s", "v_rebound_m_per_s", "duration_s", "stuck"], rows)
     return ax
@@ -201,34 +221,34 @@ def fig8b(wet: dict, set_name: str, out: Path, ax=None):
         _, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
     else:
         ax2 = None
-    rows, notes = [], []
+    rows = []
     for case, label, key in (("wet_silica", "bare silica, 40 % RH", "wet"), ("wet_ots", "OTS-covered", "dry")):
         s = wet.get(case)
         if not s:
             continue
         k = key if key in s["points"][0] else "dry"
         pts = [p for p in s["points"] if not p[k]["stuck"]]
-        line, = ax.loglog([p[k]["v_rebound"] for p in pts], [p[k]["duration"] * 1e9 for p in pts], "o-", ms=3,
-                          label=label)
         esc = s["escape_wet"] if k == "wet" else s["escape_dry"]
-        if ax2 is not None:
-            ax2.loglog([p["v_impact"] for p in pts], [p[k]["duration"] * 1e9 for p in pts], "o-", ms=3,
-                       color=line.get_color(), label=label)
-            if esc:
-                ax2.axvline(esc["escape_velocity"], color=line.get_color(), ls=":", lw=0.8)
         if esc:
             v = esc["escape_velocity"]
-            notes.append(f"{label}: escape {v * 1e3:.3g} mm/s, limiting gap {v * v / (2 * s['gravity']) * 1e9:.3g} nm")
-            rows.append((case, "escape_velocity", v, "", ""))
+            label += f" (escape {v * 1e3:.3g} mm/s, limiting gap {v * v / (2 * s['gravity']) * 1e9:.3g} nm)"
+        line, = ax.loglog([p[k]["v_rebound"] * 1e3 for p in pts], [p[k]["duration"] * 1e6 for p in pts], "o-", ms=3,
+                          label=label)
+        if ax2 is not None:
+            ax2.loglog([p["v_impact"] * 1e3 for p in pts], [p[k]["duration"] * 1e6 for p in pts], "o-", ms=3,
+                       color=line.get_color(), label=label)
+            if esc:
+                ax2.axvline(esc["escape_velocity"] * 1e3, color=line.get_color(), ls=":", lw=0.8)
+        if esc:
+            rows.append((case, "escape_velocity", esc["escape_velocity"], "", ""))
         rows += [(case, k, p["v_impact"], p[k]["v_rebound"], p[k]["duration"]) for p in pts]
-    ax.text(0.02, 0.04, "\n".join(notes), transform=ax.transAxes, fontsize=7, va="bottom")
-    ax.set_xlabel("rebound velocity (m/s)")
-    ax.set_ylabel("impact time (ns)")
+    ax.set_xlabel("rebound velocity (mm/s)")
+    ax.set_ylabel("impact time (us)")
     ax.set_title(f"Fig 8b ({set_name}): 2 nm OTS on 6 nm silica against bare silica", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, title="limiting gap = v_esc^2 / 2g", title_fontsize=7)
     if ax2 is not None:
-        ax2.set_xlabel("impact velocity (m/s)")
-        ax2.set_ylabel("impact time (ns)")
+        ax2.set_xlabel("impact velocity (mm/s)")
+        ax2.set_ylabel("impact time (us)")
         ax2.set_title("same runs against impact velocity; dotted: escape velocities", fontsize=9)
     write_csv(out / "data" / f"fig8b_{set_name}.csv",
               ["case", "branch", "v_impact_m_per_s", "v_rebound_m_per_s", "duration_s"], rows)

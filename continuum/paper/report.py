@@ -109,7 +109,9 @@ def wet_lines(set_name: str, wet: dict, impacts: dict) -> list[str]:
             out.append(f"- bare silica: escape velocity {_fmt(e_d)} m/s dry, {_fmt(e_w)} m/s with menisci "
                        f"(t_a = {_fmt(t_a)} s); {len(outlast)} dry impacts near escape outlast t_a and still rebound, "
                        f"{sum(p['wet']['stuck'] for p in outlast)} of them stick with menisci; the longest wet impact "
-                       f"that rebounds lasts {_fmt(max(free, default=0.0))} s")
+                       f"that rebounds lasts {_fmt(max(free, default=0.0))} s (t_a {_fmt(t_a)} s); limiting gap "
+                       f"{_fmt(e_w * e_w / (2 * si['gravity']) if e_w else None)} m with menisci, "
+                       f"{_fmt(e_d * e_d / (2 * si['gravity']) if e_d else None)} m dry")
         else:
             out.append(f"- bare silica: no menisci ({si['why_no_menisci']}); escape velocity {_fmt(e_d)} m/s")
     if ots:

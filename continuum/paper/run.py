@@ -138,9 +138,10 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
     """Run every dry case and sweep for every parameter set; returns the collected outputs."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = [("impact", (case, s, fidelity, str(out))) for s in sets for case in dry_cases() + wet_cases()]
+    # longest first (the wet near-escape sweeps, then the Fig 8a sweeps), so no long run starts last
+    tasks = [("wet", (case, s, fidelity)) for s in sets for case in wet_cases()]
     tasks += [("sweep", (case, s, fidelity)) for s in sets for case in fig8_cases()]
-    tasks += [("wet", (case, s, fidelity)) for s in sets for case in wet_cases()]
+    tasks += [("impact", (case, s, fidelity, str(out))) for s in sets for case in dry_cases() + wet_cases()]
     workers = workers or os.cpu_count() or 1
     collected = {"impacts": {}, "sweeps": {}, "wet": {}, "wall_s": {}}
     start = time.perf_counter()
