@@ -74,6 +74,10 @@ def main(argv=None):
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
     dirs = [Path(d) for d in args.dirs] or sorted((ROOT / "inputs/md/results").glob("surface_tension_spce*"))
+    missing = [d for d in dirs if not (d / "result.json").exists()]
+    for d in missing:
+        print(f"{d.name}: no result.json (recipe prepared, not run yet): skipped")
+    dirs = [d for d in dirs if d not in missing]
     fr = [float(x) for x in args.fractions.split(",")]
     rows = [r for d in dirs for r in analyse(d, fr)]
     print(f"{'run':34s} {'atoms':>5s} {'frac':>5s} {'ps':>6s} {'wall s':>7s} {'gamma mN/m':>11s} {'stderr':>7s} "

@@ -242,10 +242,18 @@ def forcefield_hashes(names: Sequence[str]) -> dict[str, str]:
 
 def run_hash(recipe: Recipe, fidelity: str, forcefield_files: Sequence[str]) -> tuple[str, dict[str, Any]]:
     """SHA-256 of (recipe content at ``fidelity``, fidelity, force-field file bytes, package and LAMMPS
-    versions); returns the hex digest and the hashed document."""
+    versions, and the workflow's ``version`` once it is above 1); returns the hex digest and the hashed document.
+
+    A workflow whose simulation protocol changes raises its ``version`` (:class:`md.workflows.Workflow`), so its
+    cached and committed runs stop matching. Version 1 is left out of the document, so workflows that never
+    changed keep the hashes their committed results carry."""
+    from md.workflows import get_workflow   # noqa: PLC0415  (workflows import this module)
     doc = {"recipe": recipe.canonical(fidelity), "fidelity": fidelity,
            "forcefields": forcefield_hashes(sorted(set(forcefield_files))),
            "package_version": package_version(), "lammps_version": lammps_version()}
+    wf_version = get_workflow(recipe.workflow).version
+    if wf_version != 1:
+        doc["workflow_version"] = wf_version
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest(), doc
 
