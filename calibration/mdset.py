@@ -5,13 +5,15 @@ scene files take contact angles in degrees, as the MD results give them. Everyth
 not measure (moduli, roughness statistics, SAM thickness) comes from a named base set.
 
 Work of adhesion: the MD adhesion workflow gives the energy difference dE/A (`work_of_adhesion`)
-and, by thermodynamic integration of the mean force over a few separation windows, an estimate of
-the free energy of separation (`work_of_adhesion_free_energy`). The Dupre work of adhesion the
-continuum needs is a free energy, but at smoke and quick fidelity the integration's window grid is
-coarse and its discretisation error is not in its stderr (docs/md.md): the quick runs give
-0.0055 J/m^2 for silica against dE/A = 0.123 J/m^2, a factor the entropy cannot explain. So dE/A
-is used, and the free-energy estimate is recorded beside it ([meta.calibration] ->
-`free_energy_estimate`) for the reader; the report says both.
+and, by thermodynamic integration of the mean force over separation windows, the free energy of
+separation (`work_of_adhesion_free_energy`, with its statistical stderr and the window grid's
+`discretisation_error`). The Dupre work of adhesion the JKR/GW summits need is a free energy
+(Israelachvili, Intermolecular and Surface Forces, 3rd ed., section 17.2), so the free energy is used when
+the result has it, with stderr = hypot(statistical, discretisation); dE/A is recorded beside it
+([meta.calibration] -> `energy_estimate`), and a result without the free energy falls back to dE/A, which
+the set's sources and the report then name as "not a free energy". (The adhesion workflow before version
+2 started its windows outside the adhesive well and gave W_F 20x too small; those runs no longer match
+the run hash and are not read.)
 
 A value outside the scene schema's range, or not finite, or a contact angle the analysis could not
 measure (0 deg: a film, 180 deg: no contact yet -- what smoke runs give) is not used: the base set's
@@ -42,8 +44,8 @@ class Source:
 
 
 MAPPING: tuple[Source, ...] = (
-    Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion",)),
-    Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion",)),
+    Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),
+    Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion_free_energy", "work_of_adhesion")),
     Source("surfaces.body.contact_angle", "contact_angle_silica", ("contact_angle",)),
     Source("surfaces.substrate.contact_angle", "contact_angle_silica", ("contact_angle",)),
     Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",)),
@@ -67,7 +69,11 @@ def _pick(result: dict, source: Source):
         v, e = q[name].get("value"), q[name].get("stderr")
         if v is None or not math.isfinite(v):
             continue
-        return name, float(v), (float(e) if e is not None and math.isfinite(e) else None), q[name].get("units", "")
+        e = float(e) if e is not None and math.isfinite(e) else None
+        disc = q[name].get("discretisation_error")
+        if e is not None and disc is not None and math.isfinite(disc):
+            e = math.hypot(e, float(disc))      # a quadrature's grid error counts like a statistical one
+        return name, float(v), e, q[name].get("units", "")
     return None, f"none of {source.quantities} is finite in the result"
 
 
@@ -137,13 +143,19 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
                      "fidelity": res.get("fidelity"), "run_hash": res.get("run_hash")}
             if stderr is not None:
                 entry["stderr"] = stderr
-            fe = res.get("quantities", {}).get("work_of_adhesion_free_energy")
-            if qname == "work_of_adhesion" and fe and fe.get("value") is not None:
-                entry["free_energy_estimate"] = {"value": fe["value"], "stderr": fe.get("stderr"),
-                                                 "note": "thermodynamic integration on a coarse window grid: "
-                                                         "discretisation error not in its stderr; not used"}
+            qs = res.get("quantities", {})
+            if qname == "work_of_adhesion_free_energy":
+                entry["stderr_statistical"] = qs[qname].get("stderr")
+                entry["discretisation_error"] = qs[qname].get("discretisation_error")
+                de = qs.get("work_of_adhesion", {})
+                if de.get("value") is not None:
+                    entry["energy_estimate"] = {"value": de["value"], "stderr": de.get("stderr"),
+                                                "note": "dE/A, potential-energy difference (includes T dS/A); "
+                                                        "recorded, not used"}
             calib[src.key] = entry
-            kind = "potential-energy difference dE/A (not a free energy)" if "work_of_adhesion" in qname else qname
+            kind = {"work_of_adhesion": "potential-energy difference dE/A (not a free energy)",
+                    "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
+                                                    "incl. the window grid's discretisation error"}.get(qname, qname)
             err = f"+- {stderr:.3g}" if stderr is not None else "(no stderr)"
             sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}, "
                                 f"run {str(res.get('run_hash'))[:16]}")

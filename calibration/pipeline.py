@@ -300,6 +300,22 @@ def _fmt(x, spec=".4g"):
     return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
 
 
+def _work_sentence(rows: list[dict]) -> str:
+    """What the work-of-adhesion values are: free energies (force integration) or energy differences."""
+    used = {r["key"]: r.get("quantity") for r in rows if "work_of_adhesion" in r["key"] and r["status"] == "used"}
+    fe = sorted(k for k, q in used.items() if q == "work_of_adhesion_free_energy")
+    de = sorted(k for k, q in used.items() if q == "work_of_adhesion")
+    parts = []
+    if fe:
+        parts.append(f"{', '.join(f'`{k}`' for k in fe)}: free energy of separation by force integration (the "
+                     "Dupre work JKR needs); its stderr includes the window grid's discretisation error, and dE/A "
+                     "is recorded beside it in [meta.calibration]")
+    if de:
+        parts.append(f"{', '.join(f'`{k}`' for k in de)}: the energy difference dE/A, not a free energy (the run "
+                     "has no force integration)")
+    return ("Work of adhesion: " + "; ".join(parts) + " (docs/calibration.md).") if parts else ""
+
+
 def _write_report(out: Path, rec: dict) -> None:
     cal = rec["calibration"]
     lines = [f"# Calibration `{cal['name']}` (base `{cal['base']}`)", "",
@@ -317,8 +333,7 @@ def _write_report(out: Path, rec: dict) -> None:
                      f"{r.get('why') or str(r.get('run_hash', ''))[:16]} |")
     lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec["md_sources"].items()), "",
               "A rejected or missing value keeps the base set's value (its [meta.sources] entry says so).",
-              "The work of adhesion is the energy difference dE/A, not a free energy: the quick thermodynamic-"
-              "integration estimate (recorded in the set's [meta.calibration]) is not converged (docs/calibration.md).",
+              _work_sentence(rec["rows"]),
               "", "## The paper's claims per set", "",
               "| claim | " + " | ".join(sorted({c['set'] for c in rec['paper_checks']})) + " |",
               "|---|" + "---|" * len({c['set'] for c in rec['paper_checks']})]

@@ -40,17 +40,21 @@ def _results(**changes):
 
 
 def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
-    table, rows = build_parameter_set(_results(), "paper", "cal")
+    results = _results()
+    results["adhesion_silica"]["quantities"]["work_of_adhesion_free_energy"]["discretisation_error"] = 0.04
+    table, rows = build_parameter_set(results, "paper", "cal")
     s = table["surfaces"]
-    assert s["work_of_adhesion"] == 0.21                       # dE/A (the coarse TI free energy is only recorded)
-    assert s["sam"]["work_of_adhesion"] == 0.045
+    assert s["work_of_adhesion"] == 0.18                       # the free energy (Dupre work), not dE/A = 0.21
+    assert s["sam"]["work_of_adhesion"] == 0.04
     assert s["body"]["contact_angle"] == s["substrate"]["contact_angle"] == 31.0
     assert s["sam"]["contact_angle"] == 108.0 and s["sam"]["interaction_range"] == 0.42e-9
     assert s["interaction_range"] == 0.35e-9 and table["menisci"]["surface_tension"] == 0.0615
     cal = table["meta"]["calibration"]
-    assert cal["surfaces.work_of_adhesion"]["quantity"] == "work_of_adhesion"
-    assert cal["surfaces.work_of_adhesion"]["stderr"] == 0.02
-    assert cal["surfaces.work_of_adhesion"]["free_energy_estimate"]["value"] == 0.18
+    w = cal["surfaces.work_of_adhesion"]
+    assert w["quantity"] == "work_of_adhesion_free_energy"
+    assert w["stderr"] == pytest.approx(0.05) and w["stderr_statistical"] == 0.03   # hypot(0.03, grid 0.04)
+    assert w["discretisation_error"] == 0.04 and w["energy_estimate"]["value"] == 0.21
+    assert "free energy" in table["meta"]["sources"]["surfaces.work_of_adhesion"]
     assert cal["menisci.surface_tension"]["run_hash"] == _results()["surface_tension_spce"]["run_hash"]
     assert s["roughness"]["summit_modulus"] == 10e9            # from the base set
     assert all(r["status"] == "used" for r in rows)
@@ -59,6 +63,14 @@ def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
     scene = resolve_scene(ROOT / "inputs" / "scenes" / "wet_silica.toml", params=str(path)).scene
     assert math.degrees(scene.surfaces.body.contact_angle) == pytest.approx(31.0, rel=1e-12, abs=0)
     assert scene.surfaces.interaction_range == 0.35e-9 and scene.menisci.surface_tension == 0.0615
+
+
+def test_without_a_free_energy_the_energy_difference_is_used_and_named():
+    res = _results(adhesion_silica=_result("adhesion_silica", {"work_of_adhesion": (0.21, 0.02, "J/m^2")}))
+    table, _ = build_parameter_set(res, "paper", "cal")
+    assert table["surfaces"]["work_of_adhesion"] == 0.21
+    assert table["meta"]["calibration"]["surfaces.work_of_adhesion"]["quantity"] == "work_of_adhesion"
+    assert "not a free energy" in table["meta"]["sources"]["surfaces.work_of_adhesion"]
 
 
 def test_unusable_md_values_keep_the_base_value_and_say_so():

@@ -105,6 +105,31 @@ def lj93_energy(d, eps, sig):
 LJ93_EMIN = -(2.0 / 3.0) * math.sqrt(2.5)      # min of (2/15) x^9 - x^3 (x = sig/D), at D = (2/5)^(1/6) sig
 
 
+def test_force_integration_of_a_lj93_traction_law_gives_its_work():
+    """The 9-3 traction law sigma(g) = (8W/3z0)[(z0/g)^3 - (z0/g)^9] integrates to W from z0 to infinity;
+    as a mean-force curve F = -A sigma (attraction negative) on a dense grid both quadratures recover W, on a
+    coarse grid they part, and the stated discretisation error covers the trapezoid's true error."""
+    from md.analysis import force_integration_work
+    W, z0, area = 0.2, 2.0, 500.0                           # kcal/mol/A^2, A, A^2
+    sigma = lambda g: 8 * W / (3 * z0) * ((z0 / g) ** 3 - (z0 / g) ** 9)
+    exact = W * (1 - 4 / 3 * (z0 / 40.0) ** 2 + (z0 / 40.0) ** 8 / 3) * KCALMOL_PER_A2_TO_J_PER_M2   # z0 to 40 A
+    for n, tol in ((400, 1e-3), (12, None)):
+        d = z0 + (40.0 - z0) * (np.arange(n) / (n - 1)) ** 2
+        f = -area * sigma(d)
+        r = force_integration_work(d[::-1], f[::-1], np.full(n, 0.5), area)     # any order
+        if tol:
+            assert r["value"] == pytest.approx(exact, rel=tol) and r["value_pchip"] == pytest.approx(exact, rel=tol)
+        else:
+            assert abs(r["value"] - exact) > 1e-3 * exact             # the coarse grid misses part of the well
+            assert abs(r["value"] - exact) <= 1.5 * r["discretisation_error"]
+    # statistical error: trapezoid weights times the window errors, in quadrature
+    d = np.array([0.0, 1.0, 3.0])
+    r = force_integration_work(d, np.zeros(3), np.array([1.0, 2.0, 3.0]), 1.0)
+    assert r["stderr"] == pytest.approx(math.sqrt(0.5 ** 2 + 3.0 ** 2 + 3.0 ** 2) * KCALMOL_PER_A2_TO_J_PER_M2)
+    with pytest.raises(ValueError, match="same separation"):
+        force_integration_work([0.0, 0.0, 1.0], [1, 2, 3], [1, 1, 1], 1.0)
+
+
 def test_work_from_lj93_wall_energy_curve_long_tail():
     eps, sig, area = 3.0, 3.5, 250.0
     d = np.linspace(2.6, 40 * sig, 4000)
