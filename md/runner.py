@@ -690,6 +690,9 @@ def run_recipe(recipe: Recipe, fidelity: str, *, out: str | Path | None = None, 
     atom_steps = sum(l.n_atoms * l.total_steps for l in plan.legs)
     prov = _provenance(recipe, plan, legs_state, np_)
     prov["recipe_content_sha256"] = recipe.canonical_sha256(fidelity)
+    if resume and done == total:
+        # every leg had finished: this invocation only re-ran the analysis (e.g. after an analysis fix)
+        prov["reanalysed_without_md"] = True
     notes = list(analysis.notes)
     if figure_errors:
         notes.append(f"figures not drawn: {figure_errors}")

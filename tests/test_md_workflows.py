@@ -239,6 +239,13 @@ def test_resume_after_an_interruption_loses_and_duplicates_no_sample(needs_lammp
     legs = outcome.result["legs"]["film"]
     assert legs["resumed_from"] == 300 and legs["dropped_on_resume"] == 1
     assert math.isfinite(outcome.result["quantities"]["surface_tension"]["value"])
+    assert "reanalysed_without_md" not in outcome.result["provenance"]
+    # every leg finished, result deleted: --resume runs no MD, only the analysis, and says so
+    (run_dir / "result.json").unlink()
+    again, _ = _run(name, tmp_path / "cache", None, resume=True)
+    assert again.result["provenance"]["reanalysed_without_md"] is True
+    assert again.result["quantities"] == outcome.result["quantities"]
+    assert read_samples(leg / "samples.csv")["step"].tolist() == steps.tolist()
 
 
 @pytest.mark.md
