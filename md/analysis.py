@@ -652,7 +652,19 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
     if not fmin < 0:
         raise ValueError("the force curve has no tensile (negative) part to fit")
     use = f <= 3.0 * abs(fmin)
-    ds, fs = d[use] / dmin, f[use] / abs(fmin)      # scaled: the minimum at (1, -1)
+    # scaled: the minimum at (1, -1). Without an offset the law's origin is d = 0, so d is scaled by dmin
+    # (> 0 required). With an offset, d is measured from the first point used, d0, in units of dmin - d0, so
+    # MD separations that start at or below zero (a compressed contact) scale the same way.
+    if offset:
+        d0 = float(d[use].min())
+        scale = dmin - d0
+        if not scale > 0:
+            raise ValueError("the most tensile point is the first one used: no attractive branch to fit")
+    else:
+        if not dmin > 0:
+            raise ValueError("separations must be positive when the law's origin is not fitted (offset=False)")
+        d0, scale = 0.0, dmin
+    ds, fs = (d[use] - d0) / scale, f[use] / abs(fmin)
     peak_x = _LJ93_PEAK if kind == "lj93" else 1.0
     peak_val = -float(shape(np.array(peak_x)))       # |shape| at its minimum
 
@@ -665,7 +677,7 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
         return model(p, ds) - fs
 
     best = None
-    offs = (0.0, 0.3, 0.6) if offset else (0.0,)
+    offs = (-0.2, -0.5, -1.0, -2.0) if offset else (0.0,)
     for off0 in offs:
         z00 = (1.0 - off0) / peak_x
         p0 = [1.0 / peak_val, z00] + ([off0] if offset else [])
@@ -680,8 +692,8 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
             best = sol
     if best is None:
         raise RuntimeError("traction-law fit failed")
-    amp, z0 = best.x[0] * abs(fmin), best.x[1] * dmin
-    off = best.x[2] * dmin if offset else 0.0
+    amp, z0 = best.x[0] * abs(fmin), best.x[1] * scale
+    off = d0 + best.x[2] * scale if offset else 0.0
     rms = float(np.sqrt(np.mean(best.fun ** 2))) * abs(fmin)
     out = {"kind": kind, "z0": float(z0), "offset": float(off), "rms": rms,
            "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0)}

@@ -549,8 +549,13 @@ class PullOff(Workflow):
         slow = int(np.argmin(speeds))
         best = per_speed[slow][1]
         # the force noise sets the error of a single curve's maximum: std of the smoothed-minus-raw residual
+        # near the maximum only: under compression the force (and its noise) is many times larger
         resid = best["curve"]["force"] - best["curve"]["force_smoothed"]
-        f_err = float(np.std(resid)) if smooth else None
+        f_err = None
+        if smooth:
+            i_max = int(np.argmin(np.abs(best["curve"]["separation"] - best["separation_at_max"])))
+            lo, hi = max(0, i_max - 2 * smooth), min(len(resid), i_max + 2 * smooth + 1)
+            f_err = float(np.std(resid[lo:hi]))
         q = {"pull_off_force": _q(best["max_tensile_force"], f_err, "N",
                                   speed_m_s=float(speeds[slow]), kind="maximum tensile force on retraction"),
              "separation_at_max_tension": _q(best["separation_at_max"], None, "m"),
@@ -563,7 +568,8 @@ class PullOff(Workflow):
                  f"start ({s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
                  f"flat's deformation); force = compute group/group (asperity body vs flat, kspace yes), "
                  f"positive = repulsive.",
-                 "stderr of the pull-off force is the noise of one curve (std of the raw minus smoothed force), "
+                 "stderr of the pull-off force is the noise of one curve (std of the raw minus smoothed force within "
+                 "two smoothing windows of the maximum), "
                  "not a spread over repeated pulls.",
                  f"R = {s['asperity_radius_A']:g} A (the requested radius of the carved, faceted dome)."]
         if s["surface"] == "ots":

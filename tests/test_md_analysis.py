@@ -257,6 +257,19 @@ def test_traction_law_fit_recovers_an_offset_origin():
     assert fit["w"] == rel(3 * z0 * amp / 8, 1e-5)
 
 
+def test_traction_law_fit_works_when_separations_start_below_zero():
+    """A compressed MD contact reports separations below zero (the rigid-holder gap); the law's origin is then
+    negative and the curve includes a stiff wall, which the fit must leave out and still recover the law."""
+    amp, z0, off = 1.5, 2.8, -5.0
+    d = np.linspace(off + 1.6, off + 14.0, 800)
+    f = lj93_force(d - off, amp, z0)
+    assert f.max() > 3 * abs(f.min()) and d.min() < 0
+    fit = fit_traction_law(d, f, offset=True)
+    assert fit["z0"] == rel(z0, 1e-5) and fit["offset"] == pytest.approx(off, abs=1e-4)
+    with pytest.raises(ValueError, match="positive"):
+        fit_traction_law(d, f, offset=False)
+
+
 def test_sphere_law_gives_dmt_work_for_rigid_sphere():
     r_m, w_si, z0 = 4e-9, 0.1, 3.2                                     # m, J/m^2, A
     fc = 2 * math.pi * r_m * w_si / (KCAL / (N_A * 1e-10))           # kcal/mol/A
