@@ -166,10 +166,11 @@ def uncertainty_sample(task: tuple) -> dict:
 
 
 def _md_wall(result: dict) -> float:
-    """Wall time (s) the MD run itself took (its result's record; 0 if absent)."""
+    """Wall time (s) the MD dynamics took, summed over the run's legs (its result's record; 0 if absent).
+    Not the last invocation's wall time: a resumed or re-analysed run spent most of its time in earlier ones."""
     w = result.get("wall_s")
     if isinstance(w, dict):
-        return float(w.get("total_this_invocation") or w.get("dynamics") or 0.0)
+        return float(w.get("dynamics") or w.get("total_this_invocation") or 0.0)
     return float(w or 0.0)
 
 
@@ -244,6 +245,9 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
              "rebound_count": _band(s["rebound_count"] for s in sample_out if "error" not in s),
              "escape_velocity_m_per_s": _band(s.get("escape_velocity") for s in sample_out if "error" not in s),
              "covers": keys or ["(no input with an uncertainty: every band is a single point)"],
+             "max_bounces": unc["max_bounces"],
+             "rebound_count_capped": sum(s["rebound_count"] >= unc["max_bounces"] for s in sample_out
+                                         if "error" not in s),
              "samples": len(samples), "failed_samples": sum("error" in s for s in sample_out),
              "seed": unc["seed"], "scene": unc["scene"]}
     _write_uncertainty(out, keys, sample_out, bands)
@@ -361,6 +365,10 @@ def _write_report(out: Path, rec: dict) -> None:
     for key in ("first_rebound_over_h0", "rebound_count", "escape_velocity_m_per_s"):
         v = b[key]
         lines.append(f"| {key} | {_fmt(v['median'])} | {_fmt(v['p05'])} | {_fmt(v['p95'])} | {v['n']} |")
+    if b.get("rebound_count_capped"):
+        lines += ["", f"**rebound_count is a lower bound:** {b['rebound_count_capped']} of {b['rebound_count']['n']} "
+                      f"samples reached the `max_bounces` cap ({b['max_bounces']}) without sticking; raise "
+                      "`[uncertainty] max_bounces` for the full count."]
     lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`; data: `uncertainty.csv`, "
               "`calibration.json`, `paper/checks.json`.", ""]
     (out / "report.md.tmp").write_text("\n".join(lines))
