@@ -53,11 +53,13 @@ def loop_times(log: Path) -> tuple[float, int, int]:
     return t, steps, atoms
 
 
-def bench_recipe(name: str, fidelity: str, steps: int, chunk: int):
+def bench_recipe(name: str, fidelity: str, steps: int, chunk: int, **overrides):
+    """The recipe ``name`` at ``fidelity`` cut to ``steps`` MD steps (a fifth equilibration) in chunks of ``chunk``,
+    with any other fidelity keys replaced by ``overrides``; also used by md_cost.py."""
     table = tomllib.loads((RECIPE_DIR / f"{name}.toml").read_text())
     fid = dict(table["fidelity"][fidelity])
     eq = steps // 5
-    fid.update(equilibrate_steps=eq, sample_steps=steps - eq, chunk_steps=chunk)
+    fid.update(equilibrate_steps=eq, sample_steps=steps - eq, chunk_steps=chunk, **overrides)
     if "frame_interval" in fid:
         fid["frame_interval"] = max(fid["frame_interval"], fid["sample_interval"])
     table["fidelity"] = {**table["fidelity"], fidelity: fid}

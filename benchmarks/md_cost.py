@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 import tempfile
 import time
@@ -33,13 +32,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from bench_md_engine import LOOP, bench_recipe    # noqa: E402  (same folder; sys.path[0] when run as a script)
 from md import runner as R                        # noqa: E402
-from md.recipe import RECIPE_DIR, load_recipe, parse_recipe   # noqa: E402
+from md.recipe import RECIPE_DIR, load_recipe     # noqa: E402
 from md.workflows import get_workflow             # noqa: E402
 
 FIDELITIES = ("smoke", "quick", "production")
 RESULTS = ROOT / "inputs" / "md" / "results"
-LOOP = re.compile(r"^Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 
 
 def plan_size(recipe, fidelity: str) -> tuple[int, int, float]:
@@ -77,15 +76,10 @@ def md_loop_seconds(log: Path) -> tuple[float, int]:
 
 def timed_recipe(name: str, fidelity: str, steps: int, overrides: dict, np_: int, cache: Path) -> float:
     """Seconds per MD step (LAMMPS 'Loop time', minimisation excluded) of a one-leg recipe cut to ``steps``."""
-    table = tomllib.loads((RECIPE_DIR / f"{name}.toml").read_text())
-    fid = dict(table["fidelity"][fidelity])
-    eq = steps // 5
-    fid.update(equilibrate_steps=eq, sample_steps=steps - eq, chunk_steps=steps // 3 // fid["sample_interval"]
-               * fid["sample_interval"], minimize_steps=min(fid.get("minimize_steps", 1000), 50), **overrides)
-    if "frame_interval" in fid:
-        fid["frame_interval"] = max(fid["frame_interval"], fid["sample_interval"])
-    table["fidelity"] = {**table["fidelity"], fidelity: fid}
-    recipe = parse_recipe(table, name=f"cost_{name}", origin="md_cost")
+    fid = tomllib.loads((RECIPE_DIR / f"{name}.toml").read_text())["fidelity"][fidelity]
+    chunk = steps // 3 // fid["sample_interval"] * fid["sample_interval"]
+    recipe = bench_recipe(name, fidelity, steps, chunk, minimize_steps=min(fid.get("minimize_steps", 1000), 50),
+                          **overrides)
     out = R.run_recipe(recipe, fidelity, cache=cache, np_=np_, progress=False, force=True, echo=None)
     legs = sorted((out.run_dir / "legs").iterdir())
     t, n = md_loop_seconds(legs[0] / "log.lammps")

@@ -374,13 +374,14 @@ class Adhesion(Workflow):
             # separation from contact, measured: the window's (held) back height minus the contact leg's mean
             # back height at zero load; the windows start from the contact leg's last state, whose back height
             # is one sample of that fluctuating value, so the first window sits near (not at) zero
-            d_A = np.array([float(np.mean(ctx.samples(l)["z_back"])) for l in legs]) - zc
-            f_mean, f_err = [], []
+            d_A, f_mean, f_err = [], [], []
             for l in legs:
-                m, e = A.block_average(ctx.samples(l)["fz"], min(nb, max(2, len(ctx.samples(l)["fz"]) // 2)))
+                win = ctx.samples(l)                   # one read of the window's samples
+                m, e = A.block_average(win["fz"], min(nb, max(2, len(win["fz"]) // 2)))
+                d_A.append(float(np.mean(win["z_back"])) - zc)
                 f_mean.append(m)
                 f_err.append(e)
-            f_mean, f_err = np.array(f_mean), np.array(f_err)
+            d_A, f_mean, f_err = np.array(d_A), np.array(f_mean), np.array(f_err)
             order = np.argsort(d_A)
             d_A, f_mean, f_err = d_A[order], f_mean[order], f_err[order]
             details["pmf_windows"] = {"separation_A": d_A.tolist(), "mean_force_kcal_mol_A": f_mean.tolist(),
