@@ -64,8 +64,8 @@ def cmd_paper(args) -> int:
     from continuum.scene import SceneError, find_params
 
     if args.params is None:
-        from continuum.scene import PARAMS_DIR
-        args.params = "paper,silicon" + (",calibrated" if (PARAMS_DIR / "calibrated.toml").is_file() else "")
+        from nanoimpact import data
+        args.params = "paper,silicon" + (",calibrated" if "calibrated" in data.names("params") else "")
     sets = [s.strip() for s in args.params.split(",") if s.strip()]
     try:
         for s in sets:

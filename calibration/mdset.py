@@ -30,8 +30,10 @@ from pathlib import Path
 from continuum.scene import SceneError, check_value, find_params
 from continuum.schema import FIELD_BY_PATH
 
-ROOT = Path(__file__).resolve().parent.parent
-RESULTS_DIR = ROOT / "inputs" / "md" / "results"
+from nanoimpact import data
+
+#: Committed MD results shipped with the package (inputs/md/results, installed as package data).
+RESULTS_DIR = data.shipped_root() / "md" / "results"
 
 
 @dataclass(frozen=True)
@@ -225,7 +227,12 @@ def write_parameter_set(table: dict, path: Path, header: str = "") -> Path:
     return path
 
 
-def committed_result(recipe: str, fidelity: str, results_dir: Path = RESULTS_DIR) -> dict | None:
-    """The committed result of `recipe` at `fidelity` (inputs/md/results/<recipe>-<fidelity>/result.json), or None."""
-    path = Path(results_dir) / f"{recipe}-{fidelity}" / "result.json"
-    return json.loads(path.read_text()) if path.is_file() else None
+def committed_result(recipe: str, fidelity: str, results_dir: Path | None = None) -> dict | None:
+    """The committed result of `recipe` at `fidelity` (`md/results/<recipe>-<fidelity>/result.json` in the user
+    data folder, then in the shipped data; or in `results_dir` alone when given), or None."""
+    folders = [Path(results_dir)] if results_dir is not None else data.md_results_dirs()
+    for folder in folders:
+        path = folder / f"{recipe}-{fidelity}" / "result.json"
+        if path.is_file():
+            return json.loads(path.read_text())
+    return None

@@ -29,10 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from .executors import executor
-from .mdset import MAPPING, RESULTS_DIR, build_parameter_set, committed_result, recipes_needed, write_parameter_set
+from .mdset import MAPPING, build_parameter_set, committed_result, recipes_needed, write_parameter_set
 
-ROOT = Path(__file__).resolve().parent.parent
-PARAMS_DIR = ROOT / "inputs" / "params"
+from nanoimpact import data
 
 
 class CalibrationError(ValueError):
@@ -88,7 +87,7 @@ def md_job(task: tuple) -> dict:
     recipe_name, fidelity, cache, results_dir = task
     start = time.perf_counter()
     digest = current_hash(recipe_name, fidelity)
-    committed = committed_result(recipe_name, fidelity, Path(results_dir))
+    committed = committed_result(recipe_name, fidelity, None if results_dir is None else Path(results_dir))
     if committed is not None and committed.get("run_hash") == digest:
         return {"recipe": recipe_name, "result": committed, "source": "committed", "wall_s": time.perf_counter() - start}
     from md.recipe import load_recipe
@@ -185,7 +184,7 @@ def _band(values) -> dict:
 # ----------------------------------------------------------------------------- pipeline
 def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "quick", executor_name: str = "local",
               workers: int | None = None, scheduler: str | None = None, params_out: str | Path | None = None,
-              md_cache: str | None = None, results_dir: str | Path = RESULTS_DIR, paper_sets: tuple = ("silicon",),
+              md_cache: str | None = None, results_dir: str | Path | None = None, paper_sets: tuple = ("silicon",),
               progress=print) -> dict:
     """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json)."""
     t_all = time.perf_counter()
@@ -200,7 +199,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     ex = executor(executor_name, workers, scheduler)
     results, sources = {}, {}
     try:
-        tasks = [(r, md_fidelity, md_cache, str(results_dir)) for r in recipes]
+        tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir)) for r in recipes]
         for _, job in ex.map(md_job, tasks):
             results[job["recipe"]] = job["result"]
             sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],
@@ -216,7 +215,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
                                                       "md_compute_wall_s": md_compute,
                                                       "md_compute_total_s": sum(md_compute.values()),
                                                       "created_by": f"nanoimpact calibrate {cal['path']}"})
-        set_path = Path(params_out) if params_out else PARAMS_DIR / f"{cal['name']}.toml"
+        set_path = Path(params_out) if params_out else data.writable_root() / "params" / f"{cal['name']}.toml"
         write_parameter_set(table, set_path, header=(
             f"The `{cal['name']}` parameter set, written by `nanoimpact calibrate {cal['path']} --md-fidelity "
             f"{md_fidelity}`: MD-measured values on the `{cal['base']}` base set; [meta.calibration] gives each "

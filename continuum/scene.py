@@ -15,20 +15,19 @@ import tomllib
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from nanoimpact import data
+from nanoimpact.errors import InputError
+
 from .reference.hertz import effective_modulus
 from .schema import FIDELITY, FIELD_BY_PATH, FIELDS, REQUIRED, Field, is_section, to_internal
 
-#: Default folder of parameter sets, relative to the project root (inputs/params).
-PARAMS_DIR = Path(__file__).resolve().parent.parent / "inputs" / "params"
+#: The shipped parameter sets (inputs/params, installed as package data); names are looked up in
+#: the user data folder first (nanoimpact.data).
+PARAMS_DIR = data.shipped_root() / "params"
 
 
-class SceneError(ValueError):
+class SceneError(InputError):
     """An invalid scene: names the key, the value and what is allowed."""
-
-    def __init__(self, key: str, value, allowed: str, origin: str = ""):
-        self.key, self.value, self.allowed, self.origin = key, value, allowed, origin
-        where = f"{origin}: " if origin else ""
-        super().__init__(f"{where}{key} = {value!r}: {allowed}")
 
 
 # ----------------------------------------------------------------------------- dataclasses
@@ -252,18 +251,32 @@ def _unknown(path: str) -> str:
 
 
 def find_params(spec: str, params_dir: Path | None = None) -> Path:
-    """A parameter-set name (inputs/params/NAME.toml) or a path to a TOML file."""
+    """A parameter-set name (user data folder, then the shipped sets) or a path to a TOML file."""
     candidate = Path(spec)
     if candidate.suffix == ".toml" or candidate.is_file():
         if not candidate.is_file():
             raise SceneError("params", spec, "parameter file not found")
         return candidate
-    folder = Path(params_dir) if params_dir else PARAMS_DIR
+    if params_dir is None:
+        try:
+            return data.find("params", spec)
+        except data.DataNotFound:
+            raise SceneError("params", spec, "no parameter set of that name; available: "
+                                             f"{', '.join(data.names('params')) or 'none'}") from None
+    folder = Path(params_dir)
     path = folder / f"{spec}.toml"
     if not path.is_file():
         names = sorted(p.stem for p in folder.glob("*.toml")) if folder.is_dir() else []
         raise SceneError("params", spec, f"no parameter set of that name; available: {', '.join(names) or 'none'}")
     return path
+
+
+def find_scene(spec: str | Path) -> Path:
+    """A scene file: a path, or the name of a shipped (or user-folder) scene (`hertz_roller`)."""
+    try:
+        return data.find("scenes", spec, key="scene")
+    except data.DataNotFound as exc:
+        raise SceneError("scene", str(spec), exc.allowed) from None
 
 
 # ----------------------------------------------------------------------------- validation
@@ -305,6 +318,7 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
     if table is None:
         if scene_file is None:
             raise ValueError("give a scene file or a table")
+        scene_file = find_scene(scene_file)
         table = read_toml(Path(scene_file))
     flat_scene = flatten(table, origin)
     for path, value in flat_scene.items():

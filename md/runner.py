@@ -56,6 +56,7 @@ import numpy as np
 
 from md import units
 from md.forcefield import FORCEFIELD_DIR
+from nanoimpact.errors import RunFailed
 from md.recipe import Recipe
 
 __all__ = ["Stage", "Leg", "Frames", "Plan", "Analysis", "RunContext", "MDRunError", "Interrupted", "RunOutcome",
@@ -68,7 +69,7 @@ DEFAULT_CACHE = Path("~/.cache/nanoimpact/md")
 RESTARTS_KEPT = 2
 
 
-class MDRunError(RuntimeError):
+class MDRunError(RunFailed):
     """LAMMPS failed. ``log_tail`` holds the last lines of the leg's log."""
 
     def __init__(self, message: str, log_tail: str = "", log_path: Path | None = None):

@@ -10,7 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-SCENES = Path(__file__).resolve().parents[2] / "inputs" / "scenes"
+from nanoimpact import data
+
+#: The shipped scenes (inputs/scenes, installed as package data).
+SCENES = data.shipped_root() / "scenes"
 
 #: Fig 7's roughness sweep (nm); 6 nm is the rough_silica case itself.
 SIGMAS_NM = (3.0, 4.5, 6.0, 10.0, 15.0, 20.0, 30.0)

@@ -1,0 +1,65 @@
+"""Error classes shared by every layer, and the one map from error class to exit code.
+
+Every input error is one line naming the key, the value and what is allowed
+(`InputError`); the command line prints that line and exits with `exit_code(exc)`.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+#: Exit codes of the `nanoimpact` command (sysexits-like where one fits).
+EXIT_OK = 0
+EXIT_FAILED = 1          # a run failed (LAMMPS error, a solver that could not finish)
+EXIT_INPUT = 2           # an invalid input: scene, recipe, calibration recipe, option
+EXIT_BACKEND = 3         # a backend is missing (LAMMPS, MPI, dask)
+EXIT_PARTIAL = 4         # some points of a sweep or some paper claims failed; the rest were written
+EXIT_BUSY = 75           # EX_TEMPFAIL: another process holds the run directory; try again later
+EXIT_INTERRUPTED = 130   # Ctrl-C (128 + SIGINT)
+
+
+class NanoimpactError(Exception):
+    """Base class of the errors the command line turns into one line and an exit code."""
+
+    exit_code = EXIT_FAILED
+
+
+class InputError(NanoimpactError, ValueError):
+    """An invalid input: names the key, the value and what is allowed (one line)."""
+
+    exit_code = EXIT_INPUT
+
+    def __init__(self, key: str, value: Any, allowed: str, origin: str = ""):
+        self.key, self.value, self.allowed, self.origin = key, value, allowed, origin
+        where = f"{origin}: " if origin else ""
+        super().__init__(f"{where}{key} = {value!r}: {allowed}")
+
+
+class DataNotFound(InputError):
+    """A shipped or user data file (scene, parameter set, recipe, force field) that is not there."""
+
+
+class BackendUnavailable(NanoimpactError, RuntimeError):
+    """A backend the job needs (LAMMPS, MPI, dask.distributed) cannot be loaded."""
+
+    exit_code = EXIT_BACKEND
+
+
+class RunFailed(NanoimpactError, RuntimeError):
+    """A run started and failed (a LAMMPS error, a solver that did not converge)."""
+
+    exit_code = EXIT_FAILED
+
+
+class RunBusy(NanoimpactError, RuntimeError):
+    """Another live process is writing the same run directory."""
+
+    exit_code = EXIT_BUSY
+
+
+def exit_code(exc: BaseException) -> int:
+    """The exit code for an exception reaching the command line."""
+    if isinstance(exc, KeyboardInterrupt):
+        return EXIT_INTERRUPTED
+    if isinstance(exc, NanoimpactError):
+        return exc.exit_code
+    return EXIT_FAILED

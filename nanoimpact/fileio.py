@@ -1,0 +1,40 @@
+"""Atomic file writes: a reader never sees a half-written file, a crash never leaves one.
+
+Each write goes to a uniquely named temporary file in the target's folder (so two writers never
+share a temporary name), is flushed and fsync'ed, then moved into place with `os.replace`.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write `data` to `path` atomically; returns the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write UTF-8 `text` to `path` atomically; returns the path."""
+    return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_write_json(path: str | Path, obj: Any, *, indent: int | None = 2, default=None) -> Path:
+    """Write `obj` as JSON (keys sorted) to `path` atomically; returns the path."""
+    text = json.dumps(obj, indent=indent, sort_keys=True, default=default)
+    return atomic_write_text(path, text + "\n")
