@@ -261,10 +261,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
 
 
 def _write_uncertainty(out: Path, keys, samples, bands) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     with open(out / "uncertainty.csv", "w", newline="") as fh:
         w = csv.writer(fh)
@@ -274,7 +271,8 @@ def _write_uncertainty(out: Path, keys, samples, bands) -> None:
             r = (s.get("rebounds_over_h0") or []) + [None] * 3
             w.writerow([s["overrides"].get(k) for k in keys] + r[:3] +
                        [s.get("rebound_count"), s.get("escape_velocity"), s.get("error", "")])
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = Figure(figsize=(6, 4))
+    ax = fig.subplots()
     ok = [s for s in samples if "error" not in s]
     for s in ok:
         ax.plot(range(1, len(s["rebounds_over_h0"]) + 1), s["rebounds_over_h0"], color="0.7", lw=0.7)
@@ -295,7 +293,6 @@ def _write_uncertainty(out: Path, keys, samples, bands) -> None:
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "uncertainty.png.tmp.png", dpi=110)
-    plt.close(fig)
     (out / "uncertainty.png.tmp.png").replace(out / "uncertainty.png")
 
 

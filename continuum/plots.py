@@ -1,19 +1,20 @@
 """Figures of an impact run. Functions take `ax=None`, return the axes and never call plt.show().
 
+Figures are built with matplotlib's object API (`matplotlib.figure.Figure`), never through pyplot's
+global state, so importing this module never switches a user's backend (a notebook keeps its own).
+
 Plot units (nm, ns, ms, uN) are converted here, at the edge; data stay in SI.
 """
 from __future__ import annotations
 
 import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
+from matplotlib.figure import Figure
 
 
 def height_vs_time(trace: dict, ax=None, label: str | None = None):
     """Gap of the body's lowest point (nm) against time (ms)."""
-    ax = ax or plt.figure(figsize=(7, 3.5)).gca()
+    ax = ax or Figure(figsize=(7, 3.5)).subplots()
     ax.plot(np.asarray(trace["t"]) * 1e3, np.asarray(trace["gap"]) * 1e9, lw=1.0, label=label)
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("height above datum (nm)")
@@ -23,11 +24,11 @@ def height_vs_time(trace: dict, ax=None, label: str | None = None):
 
 def force_vs_time(trace: dict, bounces: list[dict], ax=None, max_impacts: int = 12):
     """Contact force (uN) against time since touch (ns), one line per impact."""
-    ax = ax or plt.figure(figsize=(7, 3.5)).gca()
+    ax = ax or Figure(figsize=(7, 3.5)).subplots()
     t = np.asarray(trace["t"])
     force = np.asarray(trace["force"])
     phase = np.asarray(trace["phase"])
-    cmap = plt.get_cmap("viridis")
+    cmap = matplotlib.colormaps["viridis"]
     shown = bounces[:max_impacts]
     for k, b in enumerate(shown):
         sel = phase == b["index"]
@@ -45,10 +46,9 @@ def force_vs_time(trace: dict, bounces: list[dict], ax=None, max_impacts: int = 
 
 
 def save(ax, path, title: str | None = None) -> None:
-    """Save the figure of `ax` to `path` (PNG) and close it."""
+    """Save the figure of `ax` to `path` (PNG)."""
     fig = ax.figure
     if title:
         ax.set_title(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)

@@ -196,16 +196,12 @@ def _q(value: float, stderr: float | None, units: str, **extra) -> dict[str, Any
 
 def _figure(draw: Callable) -> Callable[[Path], None]:
     def save(path: Path) -> None:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(6.0, 4.2), dpi=110)
-        try:
-            draw(ax)
-            fig.tight_layout()
-            fig.savefig(path)
-        finally:
-            plt.close(fig)
+        from matplotlib.figure import Figure    # object API: no pyplot state, no backend switch
+        fig = Figure(figsize=(6.0, 4.2), dpi=110)
+        ax = fig.subplots()
+        draw(ax)
+        fig.tight_layout()
+        fig.savefig(path)
     return save
 
 

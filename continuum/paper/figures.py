@@ -8,14 +8,17 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.transforms import blended_transform_factory
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.transforms import blended_transform_factory  # noqa: E402
+from ..results import load_result
 
-from ..results import load_result  # noqa: E402
+
+def _subplots(*args, figsize, **kw):
+    """A new figure and its axes through the object API (no pyplot state, no backend switch)."""
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(*args, **kw)
 
 
 def write_csv(path: Path, header: list[str], rows) -> None:
@@ -45,7 +48,7 @@ def characteristic(surface, depth_sigmas: float = 2.0, n: int = 400) -> dict:
 
 
 def fig4(curves: dict, set_name: str, out: Path):
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    fig, axes = _subplots(1, 2, figsize=(10, 3.8))
     for ax, key, title in ((axes[0], "silica", "(a) silica surfaces"), (axes[1], "ots", "(b) SAM on silica")):
         c = curves[key]
         ax.plot(c["h"], c["approach"] / 1e6, label="approach (p_L=0)")
@@ -62,7 +65,7 @@ def fig4(curves: dict, set_name: str, out: Path):
 
 
 def fig5a(impacts: dict, set_name: str, out: Path):
-    fig, ax = plt.subplots(figsize=(8, 3.8))
+    fig, ax = _subplots(figsize=(8, 3.8))
     rows = []
     for case, style in (("hertz", "-"), ("rough_silica", "-"), ("rough_ots", "-")):
         if case not in impacts:
@@ -79,7 +82,7 @@ def fig5a(impacts: dict, set_name: str, out: Path):
 
 
 def fig5b(impacts: dict, set_name: str, out: Path):
-    fig, ax = plt.subplots(figsize=(8, 3.8))
+    fig, ax = _subplots(figsize=(8, 3.8))
     rows = []
     for case in ("hertz", "rough_silica", "rough_ots"):
         if case not in impacts:
@@ -104,7 +107,7 @@ def fig5b(impacts: dict, set_name: str, out: Path):
 def fig6(impacts: dict, set_name: str, out: Path):
     res = impacts.get("fig6_halfspace", impacts["rough_silica"])["result"]
     prof = res["bounces"][0].get("profiles") or {}
-    fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex="col")
+    fig, axes = _subplots(2, 2, figsize=(10, 6), sharex="col")
     rows = []
     for col, key, title in ((0, "max_approach", "(a) maximum approach"), (1, "pull_off", "(b) pull-off")):
         if key not in prof:
@@ -127,7 +130,7 @@ def fig6(impacts: dict, set_name: str, out: Path):
 
 
 def fig7(impacts: dict, set_name: str, out: Path):
-    fig, ax = plt.subplots(figsize=(8, 3.8))
+    fig, ax = _subplots(figsize=(8, 3.8))
     rows = []
     entries = []
     for case, item in impacts.items():
@@ -157,7 +160,7 @@ def fig8a(sweeps: dict, set_name: str, out: Path, wet: dict | None = None, ax=No
     """Impact time against impact velocity (mm/s, us): dry curves (Hertz, sigma 3-30 nm) with their escape
     velocities, the t_a line, and the humid sigma = 6 nm sweep near escape (menisci forced on). Crosses: sticks."""
     if ax is None:
-        _, ax = plt.subplots(figsize=(8.5, 5))
+        _, ax = _subplots(figsize=(8.5, 5))
     edge = blended_transform_factory(ax.transData, ax.transAxes)
     rows = []
     for case, s in sorted(sweeps.items(), key=lambda kv: (kv[1]["sigma"] or 0.0)):
@@ -218,7 +221,7 @@ def fig8b(wet: dict, set_name: str, out: Path, ax=None):
     """Bare (wet) vs OTS-covered silica, sigma = 6 nm: impact time against rebound velocity (the paper's
     axes) and, on a second panel, against impact velocity (where the claim is read), down to escape."""
     if ax is None:
-        _, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
+        _, (ax, ax2) = _subplots(1, 2, figsize=(11, 4.5))
     else:
         ax2 = None
     rows = []
@@ -260,5 +263,4 @@ def save(ax, path: Path) -> None:
     fig.tight_layout()
     tmp = path.with_name(path.stem + ".tmp.png")
     fig.savefig(tmp, dpi=110)
-    plt.close(fig)
     tmp.replace(path)
