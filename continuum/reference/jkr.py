@@ -90,6 +90,12 @@ __all__ = [
 _DC = 0.75 * 4.0 ** (-1.0 / 3.0)
 # Relative slack for delta slightly below -delta_c (rounding in the caller's delta_c).
 _FOLD_RTOL = 1e-12
+# Band above -d_c that is the fold itself for the stiffness: delta = -critical_approach(...) lands
+# within about 2 eps of -d_c on either side (critical_approach and delta0 are rounded separately;
+# measured +-1.6 eps over 2e5 random parameter sets), so "at -delta_c" must not depend on which side
+# rounding puts it. 16 eps keeps a margin; the double root is unresolvable there anyway (s is only
+# good to sqrt(eps)).
+_FOLD_SNAP = 16.0 * np.finfo(float).eps
 
 
 def _out(x):
@@ -216,10 +222,12 @@ def _solve_s(d, branch):
     if branch == "unstable" and np.any(d > 0.0):
         raise ValueError("the unstable JKR branch exists only for -delta_c <= delta <= 0")
     d = np.maximum(d, -_DC)
+    # At the fold the resolvent's discriminant 1/256 + d^3/27 vanishes, but not in floating point
+    # (_DC**3/27 is not exactly 1/256): decide "at the fold" on d itself, within _FOLD_SNAP.
+    at_fold = d <= -_DC * (1.0 - _FOLD_SNAP)
     # resolvent cubic m^3 + d m - 1/8 = 0: C^3 = 1/16 + sqrt(1/256 + d^3/27), D = -d/(3C),
     # m = C + D = (C^3 + D^3)/(C^2 - C D + D^2) = (1/8)/(C^2 + d/3 + D^2).
     rad = np.maximum(1.0 / 256.0 + d**3 / 27.0, 0.0)
-    at_fold = rad <= 0.0
     cc = np.cbrt(1.0 / 16.0 + np.sqrt(rad))
     dd = -d / (3.0 * cc)
     m = 0.125 / (cc * cc + d / 3.0 + dd * dd)
@@ -276,7 +284,11 @@ def stiffness_from_approach(delta, radius, work_of_adhesion, e_star, branch="sta
 
     = (pi dgamma beta / delta0) 4 s^2 (4 s^3 - 3)/(4 s^3 - 1). At delta = -delta_c (the fold,
     d delta/da = 0) the stiffness is infinite: returns -np.inf on the stable branch (its limit
-    there: dP/d delta < 0 for -delta_c < delta < the P = -P_c point) and +np.inf on the unstable one. radius beta (m), work_of_adhesion dgamma (J/m^2), e_star (Pa).
+    there: dP/d delta < 0 for -delta_c < delta < the P = -P_c point) and +np.inf on the unstable one.
+    "At -delta_c" means within 16 eps above it (the rounding of critical_approach, either side of
+    the exact fold) or up to 1e-12 below it; just outside, |dP/d delta| ~ 0.4714 P_c/delta_c /
+    sqrt(delta/delta_c + 1) is large but finite. radius beta (m), work_of_adhesion dgamma (J/m^2),
+    e_star (Pa).
     """
     b, g, e = _arr(radius, work_of_adhesion, e_star)
     d0 = _delta0(b, g, e)
