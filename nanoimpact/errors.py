@@ -38,6 +38,12 @@ class DataNotFound(InputError):
     """A shipped or user data file (scene, parameter set, recipe, force field) that is not there."""
 
 
+class UsageError(NanoimpactError, ValueError):
+    """A command-line usage error (argparse's own errors, options that do not go together): one line."""
+
+    exit_code = EXIT_INPUT
+
+
 class BackendUnavailable(NanoimpactError, RuntimeError):
     """A backend the job needs (LAMMPS, MPI, dask.distributed) cannot be loaded."""
 
@@ -56,6 +62,12 @@ class RunBusy(NanoimpactError, RuntimeError):
     exit_code = EXIT_BUSY
 
 
+class RunInterrupted(NanoimpactError):
+    """A run stopped by Ctrl-C (or a test's stop hook); the message says how to continue."""
+
+    exit_code = EXIT_INTERRUPTED
+
+
 def exit_code(exc: BaseException) -> int:
     """The exit code for an exception reaching the command line."""
     if isinstance(exc, KeyboardInterrupt):
@@ -63,3 +75,30 @@ def exit_code(exc: BaseException) -> int:
     if isinstance(exc, NanoimpactError):
         return exc.exit_code
     return EXIT_FAILED
+
+
+def one_line(exc: BaseException) -> str:
+    """The message of `exc` for the command line, on one line (a multi-line message is joined with '; ')."""
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted"
+    text = str(exc).strip() or type(exc).__name__
+    return "; ".join(part.strip() for part in text.splitlines() if part.strip())
+
+
+def run_command(fn, *args, prog: str = "nanoimpact", stream=None) -> int:
+    """Call `fn(*args)` (a command returning its exit code) and turn the errors above into one line on
+    `stream` (default: sys.stderr at call time) and their exit code; Ctrl-C gives 130 and no traceback.
+
+    The one try/except of the command line: every entry point (`nanoimpact`, `python -m md.cli`,
+    `nanoimpact doctor`) runs through it. Anything else (a bug) keeps its traceback.
+    """
+    import sys
+
+    try:
+        code = fn(*args)
+    except SystemExit as exc:                 # argparse's --help / --version, or an explicit sys.exit
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_FAILED)
+    except (NanoimpactError, KeyboardInterrupt) as exc:
+        print(f"{getattr(exc, 'prog', None) or prog}: {one_line(exc)}", file=stream or sys.stderr)
+        return exit_code(exc)
+    return EXIT_OK if code is None else int(code)
