@@ -147,7 +147,7 @@ def cmd_sweep(args) -> int:
                        workers=args.workers, scheduler=args.scheduler, progress=log.info)
     print(f"sweep: {record['computed']} points run, {record['reused']} reused; wrote {args.out}/sweep.csv and "
           f"sweep.png ({record['wall_s']:.1f} s)")
-    return 0
+    return record.get("exit_code", 0)          # EXIT_PARTIAL when some points failed (calibration.sweep)
 
 
 def _global_options(parser: argparse.ArgumentParser) -> None:
@@ -261,7 +261,7 @@ def _apply_globals(args: argparse.Namespace) -> None:
 def _labelled(prog: str, fn, *a) -> int:
     try:
         return fn(*a)
-    except NanoimpactError as exc:            # name the subcommand in the one line; run_command prints it
+    except (NanoimpactError, KeyboardInterrupt) as exc:   # name the subcommand in the line run_command prints
         if not getattr(exc, "prog", None):
             exc.prog = prog
         raise
