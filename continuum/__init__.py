@@ -1,2 +1,18 @@
-"""nanoimpact continuum layer: contact laws, closed-form references and the impact driver (SI units)."""
-__version__ = "0.1.0"
+"""nanoimpact continuum layer: contact laws, closed-form references and the impact driver (SI units).
+
+The front door (imported lazily, so `import continuum.reference.hertz` stays light):
+
+    from continuum import run_scene
+    result = run_scene("hertz_roller", overrides={"numerics.max_bounces": 3})
+"""
+from nanoimpact import __version__
+
+_API = ("run_scene", "load_scene", "read_result", "ImpactResult", "ModelDecision", "EnergyAudit")
+__all__ = ["__version__", *_API]
+
+
+def __getattr__(name: str):
+    if name in _API:
+        from . import api
+        return getattr(api, name)
+    raise AttributeError(f"module 'continuum' has no attribute {name!r}")
