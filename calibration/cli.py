@@ -24,8 +24,8 @@ from nanoimpact.errors import (EXIT_PARTIAL, BackendUnavailable, InputError, Nan
 log = logging.getLogger("calibration.cli")      # not __name__: it is __main__ under python -m
 
 EXIT_CODES = ("exit codes: 0 done; 1 a run failed; 2 invalid input or option (one line on stderr, nothing "
-              "written); 3 a backend is missing (LAMMPS, MPI, dask); 4 `paper --strict` with a failing claim; "
-              "75 another process holds the run directory; 130 interrupted (Ctrl-C)")
+              "written); 3 a backend is missing (LAMMPS, MPI, dask); 4 `paper --strict` with a failing claim, "
+              "or a sweep with failed points; 75 another process holds the run directory; 130 interrupted (Ctrl-C)")
 
 
 def _fmt(x, scale=1.0, spec=".4g"):
@@ -123,13 +123,12 @@ def cmd_paper(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
-    from calibration.pipeline import calibrate
-
     check_out_dir(args.out)
     check_out_dir(args.md_cache, "--md-cache")
     if args.params_out is not None and Path(args.params_out).is_dir():
         raise InputError("--params-out", args.params_out, "is an existing folder; give the set's file path")
     check_executor(args.executor, args.scheduler)
+    from calibration.pipeline import calibrate      # after the option checks: they need none of the physics
     # calibrate checks the whole recipe (pipeline.load_calibration) before any MD or paper run starts
     calibrate(args.recipe, args.out, md_fidelity=args.md_fidelity, executor_name=args.executor,
               workers=args.workers, scheduler=args.scheduler, params_out=args.params_out, md_cache=args.md_cache,
@@ -138,10 +137,9 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from calibration.sweep import parse_vary, run_sweep
-
     check_out_dir(args.out)
     check_executor(args.executor, args.scheduler)
+    from calibration.sweep import parse_vary, run_sweep
     vary = parse_vary(args.vary)             # run_sweep validates every point before anything runs or is written
     record = run_sweep(args.scene, vary, args.out, params=args.params, executor_name=args.executor,
                        workers=args.workers, scheduler=args.scheduler, progress=log.info)
@@ -180,7 +178,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output folder (default: out/<scene name>)")
     p.add_argument("--params", help="parameter set NAME (inputs/params/NAME.toml) or FILE; replaces the scene's")
     p.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset")
-    p.set_defaults(func=cmd_impact)
 
     q = _sub(sub, "paper", help="reproduce the founding paper's cases for each parameter set",
              description="Run every case of the paper (Hertz roller, rough silica, OTS, roughness and "
@@ -193,7 +190,6 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--workers", type=positive_int, help="parallel processes, >= 1 (default: CPU count)")
     q.add_argument("--strict", action="store_true",
                    help=f"exit {EXIT_PARTIAL} when any of the paper's claims fails (everything is still written)")
-    q.set_defaults(func=cmd_paper)
 
     c = _sub(sub, "calibrate", help="MD results -> calibrated parameter set -> the paper's cases, with bands",
              description="Run the MD recipes a calibration needs (reusing committed or cached results whose "
@@ -212,7 +208,6 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--out", default="out/calibration", help="output folder (default: out/calibration)")
     c.add_argument("--params-out", help="write the set here instead of <data folder>/params/<name>.toml")
     c.add_argument("--md-cache", help="MD cache directory (default: $NANOIMPACT_CACHE or ~/.cache/nanoimpact/md)")
-    c.set_defaults(func=cmd_calibrate)
 
     w = _sub(sub, "sweep", help="run a scene over a grid of overrides (resumable), with a table and a plot",
              description="Cartesian product of --vary KEY=V1,V2 overrides (file units); each point's "
@@ -226,7 +221,6 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--scheduler", help="dask scheduler address of an existing cluster; --executor dask only")
     w.add_argument("--workers", type=positive_int, help="worker processes, >= 1")
     w.add_argument("--out", default="out/sweep", help="output folder (default: out/sweep)")
-    w.set_defaults(func=cmd_sweep)
 
     # doctor and md own their options (md.doctor / md.cli parse them); listed here for the top-level help
     sub.add_parser("doctor", help="check the LAMMPS installation (in-process and mpirun -np 2)", add_help=False)
@@ -267,17 +261,30 @@ def _labelled(prog: str, fn, *a) -> int:
         raise
 
 
+_parsers: dict[str, argparse.ArgumentParser] = {}
+
+
+def _parser(which: str = "full") -> argparse.ArgumentParser:
+    """The parsers, built once per process (argparse's construction costs more than a refused input)."""
+    if which not in _parsers:
+        if which == "full":
+            _parsers[which] = build_parser()
+        else:
+            _parsers[which] = g = ArgumentParser(prog="nanoimpact", add_help=False)
+            _global_options(g)
+    return _parsers[which]
+
+
 def _run(argv: list[str]) -> int:
     head, rest = _split_globals(argv)
     if rest and rest[0] in _DELEGATED and not {"-h", "--help", "--version"} & set(head):
-        g = ArgumentParser(prog="nanoimpact", add_help=False)
-        _global_options(g)
-        _apply_globals(g.parse_args(head))
+        _apply_globals(_parser("globals").parse_args(head))
         module, func = _DELEGATED[rest[0]]
         return _labelled(f"nanoimpact {rest[0]}", getattr(importlib.import_module(module), func), rest[1:])
-    args = build_parser().parse_args(argv)
+    args = _parser().parse_args(argv)
     _apply_globals(args)
-    return _labelled(f"nanoimpact {args.command}", args.func, args)
+    # looked up at call time (not bound in the cached parser), so a command can be replaced (tests)
+    return _labelled(f"nanoimpact {args.command}", globals()[f"cmd_{args.command}"], args)
 
 
 def main(argv: list[str] | None = None) -> int:

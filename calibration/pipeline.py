@@ -118,7 +118,7 @@ def load_calibration(spec: str | Path) -> dict:
         raise CalibrationError("name", _short(name), "is required: the set's name, letters, digits, '_' and '-' "
                                "(it names params/<name>.toml)", origin)
     if not isinstance(base, str) or not base:
-        raise CalibrationError("base", _short(base), "is required: a parameter set name or file", origin)
+        raise CalibrationError("base", _short(base), "must be given: a parameter set name or file", origin)
     if not isinstance(description, str):
         raise CalibrationError("description", _short(description), "must be a string", origin)
     try:
@@ -180,10 +180,11 @@ def load_calibration(spec: str | Path) -> dict:
         try:
             resolve_scene(scene_file, params=str(base_file), overrides=trial, override_label="uncertainty")
         except SceneError as exc:
-            at = f" with the ranges at their {('low', 'high')[end]} ends" if ranges else ""
+            at = f", ranges at their {('low', 'high')[end]} ends" if ranges else ""
+            inner = "" if exc.origin in ("", "uncertainty", str(scene_file)) else f" ({exc.origin})"
             raise CalibrationError(exc.key, _short(exc.value), exc.allowed,
-                                   f"{origin}: uncertainty.scene {scene_spec} with base {base}{at}"
-                                   + (f" ({exc.origin})" if exc.origin else "")) from None
+                                   f"{origin}: uncertainty.scene {scene_spec!r} with base {base!r} and the "
+                                   f"overrides{at}{inner}") from None
     for recipe in recipes_needed():
         try:
             load_recipe(recipe)

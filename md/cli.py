@@ -154,10 +154,15 @@ def format_quantities(quantities: dict) -> str:
     return "\n".join(rows)
 
 
+_parser: argparse.ArgumentParser | None = None
+
+
 def run(argv: list[str]) -> int:
     """``nanoimpact md`` without the error handling: raises the nanoimpact.errors classes (``main`` and
     ``nanoimpact`` turn them into one line and an exit code)."""
-    args = build_parser().parse_args(list(argv))
+    global _parser
+    _parser = _parser or build_parser()           # built once per process
+    args = _parser.parse_args(list(argv))
     verbosity = getattr(args, "verbose", 0) - getattr(args, "quiet", 0)
     if not logging_ready() or hasattr(args, "verbose") or hasattr(args, "quiet"):
         setup_logging(verbosity)
