@@ -175,7 +175,8 @@ def run(argv: list[str]) -> int:
     out = Path(args.out) if args.out else Path("out") / "md" / f"{recipe.name}-{args.fidelity}"
     try:
         outcome = run_recipe(recipe, args.fidelity, out=out, cache=args.cache, resume=args.resume, np_=args.np,
-                             progress=getattr(args, "quiet", 0) <= 0, force=args.force, wait=args.wait)
+                             progress=log.isEnabledFor(logging.INFO),    # -q here or before `md`: no bar
+                             force=args.force, wait=args.wait)
     except MDRunError as exc:                 # the log tail is the point here: printed whole, not one line
         print(f"nanoimpact md: {exc}", file=sys.stderr)
         print("nanoimpact md: the run failed; no result.json was written", file=sys.stderr)
