@@ -192,7 +192,9 @@ def load_calibration(spec: str | Path) -> dict:
             raise CalibrationError(exc.key, _short(exc.value), exc.allowed,
                                    f"{origin}: MD recipe {recipe}, which the calibration needs"
                                    + (f" ({exc.origin})" if getattr(exc, "origin", "") else "")) from None
+    # a base set given as a path is kept as the file found (it may have been found from the recipe's folder)
     return {**raw, "path": str(path), "description": description,
+            "base": str(base_file) if data.is_path_spec(base) else base,
             "uncertainty": {"samples": samples, "seed": seed, "scene": str(scene_file), "max_bounces": max_bounces,
                             "ranges": ranges, "overrides": overrides}}
 
