@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from calibration.executors import executor
+from nanoimpact.executors import executor
 from calibration.mdset import build_parameter_set, recipes_needed, write_parameter_set
 from calibration.pipeline import latin_hypercube, load_calibration, CalibrationError
 from calibration.sweep import parse_vary, run_sweep
