@@ -6,26 +6,34 @@ result.json lands in DIR/points/<input hash[:16]>/ (the hash of the resolved phy
 rerun skips finished points and never mixes a changed input with an old result. DIR/sweep.csv has
 one row per point; DIR/sweep.png plots the first rebound height and the rebound count against the
 first varied key.
+
+A point that fails while running (a refusal that needs the model, a solver that does not finish, a
+Dask worker lost) does not stop the others: its row says status `failed` with the one-line reason in
+the `error` column, DIR/failures.json lists every failed point, and the record's `failed` list and
+`exit_code` (nanoimpact.errors.EXIT_PARTIAL) tell the command line to exit non-zero. A failed point
+writes no result.json, so a rerun tries it again and reuses the rest.
 """
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import json
+import logging
 import time
 from pathlib import Path
 
-import matplotlib
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from continuum.scene import SceneError, resolve_scene
+from nanoimpact.errors import EXIT_OK, EXIT_PARTIAL
+from nanoimpact.executors import Failure, Local, check_executor, executor
+from nanoimpact.fileio import atomic_write_bytes, atomic_write_json, atomic_write_text
 
-from continuum.scene import SceneError, resolve_scene  # noqa: E402
-
-from .executors import executor  # noqa: E402
+log = logging.getLogger(__name__)
 
 COLUMNS = ("status", "n_bounces", "rebounds_above_1e-3_h0", "first_rebound_height_m", "first_restitution",
-           "longest_contact_s", "adhesion_law", "half_space", "menisci", "input_hash")
+           "longest_contact_s", "adhesion_law", "half_space", "menisci", "input_hash", "error")
 
 
 def parse_vary(specs: list[str]) -> dict[str, list]:
@@ -69,7 +77,12 @@ def _row(result: dict) -> dict:
             "first_rebound_height_m": reb[0] if reb else 0.0, "first_restitution": b[0]["restitution"] if b else None,
             "longest_contact_s": m.get("regimes", {}).get("longest_contact_s"),
             "adhesion_law": m.get("adhesion", {}).get("law"), "half_space": m.get("half_space", {}).get("used"),
-            "menisci": m.get("menisci", {}).get("used"), "input_hash": result["provenance"].get("input_hash")}
+            "menisci": m.get("menisci", {}).get("used"), "input_hash": result["provenance"].get("input_hash"),
+            "error": ""}
+
+
+def _failed_row(input_hash: str, reason: str) -> dict:
+    return {**{k: None for k in COLUMNS}, "status": "failed", "input_hash": input_hash, "error": reason}
 
 
 def run_point(task: tuple) -> dict:
@@ -80,20 +93,27 @@ def run_point(task: tuple) -> dict:
 
     resolved = resolve_scene(scene, params=params, overrides=overrides, override_label="sweep")
     result, _ = run_impact(resolved)
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    tmp = folder / "result.json.tmp"
-    tmp.write_text(dumps(result) + "\n")
-    tmp.replace(folder / "result.json")
+    atomic_write_text(Path(folder) / "result.json", dumps(result) + "\n")
     return _row(result)
+
+
+def _absolute(spec):
+    """A path that exists here, made absolute (a Dask worker's working directory may differ); names unchanged."""
+    return str(Path(spec).resolve()) if spec is not None and Path(spec).is_file() else spec
 
 
 def run_sweep(scene: str, vary: dict[str, list], out: str | Path, *, params: str | None = None,
               executor_name: str = "local", workers: int | None = None, scheduler: str | None = None,
               progress=print) -> dict:
-    """Run (or resume) the sweep; returns {"rows": [...], "computed": n, "reused": n, "wall_s": s}."""
+    """Run (or resume) the sweep; a point that fails is recorded and the others go on.
+
+    Returns {"rows", "computed", "reused", "failed": [{overrides, input_hash, error}], "exit_code", "wall_s"};
+    `exit_code` is EXIT_PARTIAL (4) when any point failed, else 0. SceneError (nothing run or written) for an
+    invalid point; the executor's errors (InputError, BackendUnavailable) for a bad executor choice.
+    """
     start = time.perf_counter()
     points = plan(scene, vary, params)
+    check_executor(executor_name, workers, scheduler)
     out = Path(out)
     rows: list[dict | None] = [None] * len(points)
     todo = []
@@ -102,38 +122,57 @@ def run_sweep(scene: str, vary: dict[str, list], out: str | Path, *, params: str
         if (folder / "result.json").is_file():
             rows[i] = _row(json.loads((folder / "result.json").read_text()))
         else:
-            todo.append((i, (str(scene), params, p["overrides"], str(folder))))
+            todo.append((i, (_absolute(scene), _absolute(params), p["overrides"], str(folder.resolve()))))
     progress(f"sweep: {len(points)} points, {len(points) - len(todo)} reused, {len(todo)} to run "
              f"({executor_name})")
-    ex = executor(executor_name, workers, scheduler)
-    try:
-        for done, (k, row) in enumerate(ex.map(run_point, [t for _, t in todo]), 1):
-            rows[todo[k][0]] = row
-            progress(f"  [{done}/{len(todo)}] {points[todo[k][0]]['overrides']}: {row['status']}, "
+    failed = []
+    # the executor logs where it runs (a Dask dashboard's address); nothing to run: no cluster started
+    with executor(executor_name, workers, scheduler) if todo else Local() as ex:
+        results = ex.map(run_point, [t for _, t in todo], on_error="collect")
+        for done, (k, row) in enumerate(results, 1):
+            i = todo[k][0]
+            if isinstance(row, Failure):
+                rows[i] = _failed_row(points[i]["hash"], row.reason)
+                failed.append({"overrides": points[i]["overrides"], "input_hash": points[i]["hash"],
+                               "error": row.reason})
+                progress(f"  [{done}/{len(todo)}] {points[i]['overrides']}: FAILED: {row.reason}")
+                continue
+            rows[i] = row
+            progress(f"  [{done}/{len(todo)}] {points[i]['overrides']}: {row['status']}, "
                      f"{row['rebounds_above_1e-3_h0']} rebounds")
-    finally:
-        ex.close()
     keys = list(vary)
     table = [{**{k: p["overrides"][k] for k in keys}, **r} for p, r in zip(points, rows)]
     out.mkdir(parents=True, exist_ok=True)
-    with open(out / "sweep.csv.tmp", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys + list(COLUMNS))
-        w.writeheader()
-        w.writerows(table)
-    (out / "sweep.csv.tmp").replace(out / "sweep.csv")
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=keys + list(COLUMNS))
+    w.writeheader()
+    w.writerows(table)
+    atomic_write_text(out / "sweep.csv", buf.getvalue())
     plot(table, keys, out / "sweep.png")
-    return {"rows": table, "computed": len(todo), "reused": len(points) - len(todo),
-            "wall_s": time.perf_counter() - start}
+    order = {p["hash"]: i for i, p in enumerate(points)}
+    failed.sort(key=lambda f: order[f["input_hash"]])
+    if failed:
+        atomic_write_json(out / "failures.json", {"scene": str(scene), "params": params, "failed": failed,
+                                                  "points": len(points)})
+        log.warning("sweep: %d of %d points failed (%s)", len(failed), len(points), out / "failures.json")
+    else:
+        (out / "failures.json").unlink(missing_ok=True)      # a rerun that ran them all: no stale list
+    return {"rows": table, "computed": len(todo), "reused": len(points) - len(todo), "failed": failed,
+            "exit_code": EXIT_PARTIAL if failed else EXIT_OK, "wall_s": time.perf_counter() - start}
 
 
 def plot(table: list[dict], keys: list[str], path: Path, ax=None):
-    """First rebound height and rebound count against the first varied key (one line per other combo)."""
+    """First rebound height and rebound count against the first varied key (one line per other combo).
+
+    Failed points (status `failed`) are left out. Drawn on matplotlib's object API (no backend, no pyplot)."""
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 4))
+        ax = Figure(figsize=(7, 4)).subplots()
     ax2 = ax.twinx()
     x_key = keys[0]
     groups: dict[tuple, list[dict]] = {}
     for row in table:
+        if row.get("status") == "failed":
+            continue
         groups.setdefault(tuple((k, row[k]) for k in keys[1:]), []).append(row)
     for label, rows in groups.items():
         rows = sorted(rows, key=lambda r: r[x_key])
@@ -141,13 +180,16 @@ def plot(table: list[dict], keys: list[str], path: Path, ax=None):
         name = ", ".join(f"{k}={v}" for k, v in label) or "sweep"
         line, = ax.plot(xs, [r["first_rebound_height_m"] * 1e9 for r in rows], "o-", label=f"{name}: first rebound")
         ax2.plot(xs, [r["rebounds_above_1e-3_h0"] for r in rows], "s--", color=line.get_color(), mfc="none")
+    n_failed = sum(row.get("status") == "failed" for row in table)
+    if n_failed:
+        ax.set_title(f"{n_failed} of {len(table)} points failed (left out; see failures.json)", fontsize=8)
     ax.set_xlabel(x_key)
     ax.set_ylabel("first rebound height (nm), filled")
     ax2.set_ylabel("rebounds above 1e-3 h0, open")
-    ax.legend(fontsize=7)
+    if groups:
+        ax.legend(fontsize=7)
     ax.figure.tight_layout()
-    tmp = path.with_name(path.stem + ".tmp.png")
-    ax.figure.savefig(tmp, dpi=110)
-    plt.close(ax.figure)
-    tmp.replace(path)
+    buf = io.BytesIO()
+    ax.figure.savefig(buf, format="png", dpi=110)
+    atomic_write_bytes(path, buf.getvalue())
     return ax
