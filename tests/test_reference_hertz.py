@@ -88,6 +88,13 @@ def test_line_force_is_zero_without_contact_and_refuses_beyond_the_validity_limi
     dmax = hertz.line_max_approach(*LINE)
     # at the limit the half-width equals the roller length
     assert hertz.line_half_width(hertz.line_force(dmax, *LINE), *LINE) == approx(L, rel=1e-10)
+    # ... for any geometry: the limit check must not rest on last bits (it once compared against
+    # e^{C - q} q, whose rounding ~|C| eps, C up to ~40, exceeded its 1e-14 slack for 1 in 2e4 of these)
+    rng = np.random.default_rng(0)
+    r, l, e = (10 ** rng.uniform(-7, -2, 20000), 10 ** rng.uniform(-4, -1, 20000),
+               10 ** rng.uniform(9, 11.3, 20000))
+    w_lim = hertz.line_force(hertz.line_max_approach(r, l, e), r, l, e)
+    np.testing.assert_allclose(hertz.line_half_width(w_lim, r, l, e), l, rtol=1e-10)
     with pytest.raises(ValueError, match="half-width"):
         hertz.line_force(1.01 * dmax, *LINE)
     with pytest.raises(ValueError, match="half-width"):

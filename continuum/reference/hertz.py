@@ -292,7 +292,11 @@ def _line_solve(delta, radius, length, e_star):
     limit = -np.exp(-1.0)
     # The admitted range (b <= l) keeps the argument well inside (-1/e, 0); check it first.
     q_min = _log_factor_min()
-    d_lim = np.exp(c - q_min) * q_min  # D at the limit: x q with x = e^{C - q}
+    # D at the limit, x q with x the load at b = ratio l, computed as line_max_approach does: the
+    # equivalent e^{C - q_min} q_min carries a relative rounding of ~|C| eps (C reaches ~40), more
+    # than the 1e-14 slack, and refused line_max_approach's own value for some geometries.
+    b_lim = LINE_MAX_HALF_WIDTH_RATIO * l
+    d_lim = np.pi * e * l * b_lim**2 / (4.0 * np.asarray(radius, float)) * q_min
     if np.any(pos & (big_d > d_lim * (1.0 + 1e-14))):
         _check_log_factor(np.where(pos & (big_d > d_lim * (1.0 + 1e-14)), 0.0, np.inf), "approach")
     arg = np.maximum(arg, limit)
