@@ -16,7 +16,7 @@ import logging
 import sys
 from pathlib import Path
 
-from md.cli import ArgumentParser, add_verbosity, check_out_dir, positive_int, setup_logging
+from nanoimpact.cli import ArgumentParser, add_verbosity, check_out_dir, positive_int, setup_logging
 from nanoimpact import __version__, data
 from nanoimpact.errors import (EXIT_PARTIAL, BackendUnavailable, InputError, NanoimpactError, UsageError,
                                run_command)

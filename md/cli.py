@@ -6,10 +6,8 @@ into ``--out``. Exit codes (``nanoimpact.errors``): 0 done (or reused from the c
 and the last lines of its log on stderr; no result.json is written), 2 invalid recipe or arguments (one line),
 3 LAMMPS not installed (one line), 130 interrupted (Ctrl-C; continue with ``--resume``).
 
-This module also holds the command-line plumbing that ``nanoimpact`` (``calibration.cli``) and
-``nanoimpact doctor`` share: :class:`ArgumentParser` (usage errors in one line, exit 2), :func:`add_verbosity`,
-:func:`setup_logging` (the only place a handler is installed; library code only logs) and the option checks
-:func:`positive_int` and :func:`check_out_dir`.
+The command-line plumbing every command shares (one-line usage errors, -v/-q, the logging handler, option
+checks) is :mod:`nanoimpact.cli`.
 """
 from __future__ import annotations
 
@@ -19,98 +17,17 @@ import math
 import sys
 from pathlib import Path
 
+from nanoimpact.cli import ArgumentParser, add_verbosity, check_out_dir, logging_ready, positive_int, setup_logging
 from nanoimpact.errors import (EXIT_BACKEND, EXIT_FAILED, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, InputError,
                                RunInterrupted, UsageError, run_command)
 
-__all__ = ["main", "run", "build_parser", "format_quantities", "ArgumentParser", "add_verbosity", "setup_logging",
-           "positive_int", "check_out_dir"]
+__all__ = ["main", "run", "build_parser", "format_quantities"]
 
 #: Kept for callers of the old names; the codes are nanoimpact.errors'.
 EXIT_OK, EXIT_LAMMPS, EXIT_INVALID, EXIT_UNAVAILABLE, EXIT_INTERRUPTED = (EXIT_OK, EXIT_FAILED, EXIT_INPUT,
                                                                          EXIT_BACKEND, EXIT_INTERRUPTED)
 
 log = logging.getLogger("md.cli")      # not __name__: it is __main__ under python -m
-
-
-# ------------------------------------------------------------------------------------------ shared CLI plumbing
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse with usage errors as one line (raised as UsageError: exit 2, printed by run_command)."""
-
-    def error(self, message: str):
-        exc = UsageError(f"error: {' '.join(message.split())} (see {self.prog} --help)")
-        exc.prog = self.prog
-        raise exc
-
-
-def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1 (--workers, --np)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: an integer >= 1 is required") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value}: an integer >= 1 is required")
-    return value
-
-
-def check_out_dir(value: str | Path | None, option: str = "--out") -> None:
-    """Refuse an output folder that is an existing file (before any work is done)."""
-    if value is not None and Path(value).exists() and not Path(value).is_dir():
-        raise InputError(option, str(value), "is an existing file; give a folder (new or existing)")
-
-
-def add_verbosity(parser: argparse.ArgumentParser, *, suppress: bool = False, quiet_help: str = "",
-                  dest_prefix: str = "") -> None:
-    """-v/--verbose and -q/--quiet (repeatable), stored as `<dest_prefix>verbose` and `<dest_prefix>quiet`.
-    `suppress`: no attribute when not given (tells "not given" from 0)."""
-    kw = {"default": argparse.SUPPRESS} if suppress else {"default": 0}
-    parser.add_argument("-v", "--verbose", action="count", dest=f"{dest_prefix}verbose",
-                        help="more diagnostics on stderr (-vv: debug)", **kw)
-    parser.add_argument("-q", "--quiet", action="count", dest=f"{dest_prefix}quiet",
-                        help=quiet_help or "fewer diagnostics on stderr: warnings and errors only (-qq: errors)", **kw)
-
-
-class _StderrHandler(logging.StreamHandler):
-    """Writes to whatever sys.stderr is when a record is emitted (pytest's capture, a redirected stream)."""
-
-    def __init__(self):
-        super().__init__(sys.stderr)
-
-    @property
-    def stream(self):
-        return sys.stderr
-
-    @stream.setter
-    def stream(self, value):
-        pass
-
-
-_handler: logging.Handler | None = None
-_PACKAGES = ("nanoimpact", "continuum", "md", "calibration")
-
-
-def setup_logging(verbosity: int = 0) -> None:
-    """Install the command line's stderr handler (replacing an earlier one) and set the levels.
-
-    verbosity 0: INFO from nanoimpact's packages, WARNING from everything else; each -v one step more
-    (-vv: DEBUG everywhere), each -q one step less (-q: WARNING, -qq: ERROR).
-    """
-    global _handler
-    root = logging.getLogger()
-    if _handler is not None:
-        root.removeHandler(_handler)
-    _handler = _StderrHandler()
-    _handler.setFormatter(logging.Formatter("%(message)s" if verbosity < 1 else "%(levelname)s %(name)s: %(message)s"))
-    root.addHandler(_handler)
-    ours = min(max(logging.INFO - 10 * verbosity, logging.DEBUG), logging.CRITICAL)
-    for name in _PACKAGES:
-        logging.getLogger(name).setLevel(ours)
-    root.setLevel(logging.DEBUG if verbosity >= 2 else max(ours, logging.WARNING))
-
-
-def logging_ready() -> bool:
-    """True when setup_logging has installed its handler (the top-level command did)."""
-    return _handler is not None and _handler in logging.getLogger().handlers
 
 
 # ------------------------------------------------------------------------------------------ nanoimpact md

@@ -351,7 +351,7 @@ def _positive_float(text: str) -> float:
 
 def run(argv: list[str] | None = None) -> int:
     """``nanoimpact doctor`` without the error handling (``main`` turns errors into one line and an exit code)."""
-    from md.cli import ArgumentParser, positive_int
+    from nanoimpact.cli import ArgumentParser, positive_int
     from nanoimpact.errors import InputError
 
     parser = ArgumentParser(
