@@ -173,8 +173,9 @@ def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(needs
     The reference is a run alone in its own cache, started at the same moment (it shares no file with the other
     two, so this costs one run's wall time instead of two). Same recipe, seeds and binary on one rank: LAMMPS is
     deterministic across processes here, so the numbers are compared for equality, not within a tolerance --
-    the samples and frames of the two run directories are bit-identical too (measured: gamma_lv 0.0709267 N/m,
-    the 0.0709 of the issue, in all three)."""
+    the samples and frames of the two run directories are bit-identical too (measured: gamma_lv equal to the
+    last digit in all three; 0.0709267 N/m with the analysis of the issue's time). Without the lock (the runner
+    before this test) both runs exited 0 and reported 0.0625448 N/m, neither the single run's value."""
     t0 = time.monotonic()
     (tmp_path / "alone").mkdir()
     procs = {"alone": _md(tmp_path / "alone" / "cache", tmp_path / "alone" / "out")}
