@@ -57,9 +57,9 @@ from md.forcefield import ForceField, combine, load_forcefield
 from md.topology import (System, flip_upside_down, from_types, merge, minimum_image, remove_atoms, translate,
                          with_bonded_terms)
 
-__all__ = ["silica_slab", "silica_asperity", "ots_sam", "water_slab", "water_cylinder", "place_on",
-           "flip_upside_down", "silica_forcefield", "sam_forcefield", "water_forcefield",
-           "CRISTOBALITE_A", "QUARTZ", "WATER_DENSITY", "AVOGADRO"]
+__all__ = ["silica_slab", "silica_asperity", "ots_sam", "water_slab", "water_cylinder", "water_cap", "place_on",
+           "flip_upside_down", "silica_forcefield", "sam_forcefield", "water_forcefield", "cap_radius",
+           "CRISTOBALITE_A", "QUARTZ", "WATER_DENSITY", "AVOGADRO", "DEFAULT_FACE", "SILICA_FACE"]
 
 AVOGADRO = 6.02214076e23                  #: 1/mol (SI 2019, exact)
 CRISTOBALITE_A = 7.16                     #: A, idealised cubic beta-cristobalite (Wyckoff 1925)
@@ -68,6 +68,13 @@ QUARTZ = {"a": 4.916, "c": 5.4054, "spacegroup": 154,     # P3_221
 WATER_DENSITY = 0.997                     #: g/cm^3, liquid water at 298 K
 SIO_BOND_CUTOFF = 2.0                     #: A, Si-O bond search radius in the bulk crystals (bonds 1.55-1.61 A)
 SIOH_ANGLE = 115.0                        #: deg, IFF SC4-OC24-HOY theta0 (used to place H)
+#: The silica surface of every recipe (contact angle, adhesion, pull-off): cristobalite (111), isolated Q3
+#: silanols at 4.50 OH/nm^2 on a 5.06 A hexagonal lattice (nearest silanol O-O 5.06 A), the hydrophilic Q3
+#: chemistry IFF was validated with (Emami et al., Chem. Mater. 26 (2014) 2647). The (001) face holds
+#: geminal/vicinal silanol pairs 2.53 A apart, which H-bond to each other instead of to water.
+SILICA_FACE = "111"
+#: Default face of each polymorph when ``face`` is not given.
+DEFAULT_FACE = {"cristobalite": SILICA_FACE, "quartz": "0001"}
 
 SOURCES = {
     "cristobalite": "idealised beta-cristobalite Fd-3m, a = 7.16 A: R. W. G. Wyckoff, Z. Kristallogr. 62 (1925) 189; "
@@ -468,14 +475,15 @@ def silica_slab(nx: int = 4, ny: int = 4, *, thickness: float | None = 25.0, lay
     or ``layers``: number of crystal periods along z (overrides ``thickness``). ``silanol_density``
     (OH/nm^2, per face): the cut face's natural density is lowered by condensation (module docstring); if the
     achieved value is more than ``density_tolerance`` (relative) from the request, ValueError states the
-    achievable range. ``face`` defaults to '001' (cristobalite) / '0001' (quartz). ``vacuum`` (A) is added
+    achievable range. ``face`` defaults to :data:`SILICA_FACE` = '111' (cristobalite: isolated Q3 silanols, the
+    surface every recipe uses) / '0001' (quartz); '001' gives 3.9-7.8 OH/nm^2 with geminal pairs. ``vacuum`` (A) is added
     below and above. ``frozen_depth`` (A): atoms this close to the bottom form the group 'frozen'.
 
     Groups: 'silica', 'slab', 'silanol_O_top', 'silanol_H_top', 'silanol_O_bottom', 'silanol_H_bottom',
     'frozen'. ``info``: counts, per-face silanol densities and achievable ranges, Q distribution, thicknesses.
     """
     ff = forcefield or silica_forcefield()
-    face = face or ("0001" if polymorph == "quartz" else "001")
+    face = face or DEFAULT_FACE.get(polymorph, "")
     rng = np.random.default_rng(seed)
     probe = _bulk(polymorph, face, 1, 1, 1, lattice_a)
     if layers is None and (thickness is None or thickness <= 0):
@@ -529,7 +537,7 @@ def silica_asperity(radius: float = 15.0, holder_thickness: float = 10.0, *, nx:
     ``frozen_depth`` of the holder's back), 'silanol_O_top'/'_dome'/'_bottom' and the matching H groups.
     """
     ff = forcefield or silica_forcefield()
-    face = face or ("0001" if polymorph == "quartz" else "001")
+    face = face or DEFAULT_FACE.get(polymorph, "")
     rng = np.random.default_rng(seed)
     probe = _bulk(polymorph, face, 1, 1, 1, lattice_a)
     ux, uy = probe.unit_xy
@@ -902,6 +910,67 @@ def water_cylinder(radius: float, length: float, *, box_x: float | None = None, 
             "axis_xz_A": (cx, cz), "density_g_cm3": n * m / AVOGADRO / (math.pi * radius ** 2 * length * 1e-24),
             "density_requested_g_cm3": density, "radius_effective_A": r_eff,
             "radius_outermost_site_A": float(np.sqrt(((sites[:, [0, 2]] - [cx, cz]) ** 2).sum(axis=1)).max()),
+            "lattice_spacing_A": (d, dy, d), "periodic_axes": "y", "seed": seed}
+    return _water_system(sites, cell, ff, rng, info)
+
+
+def cap_radius(radius_equivalent: float, contact_angle_deg: float) -> float:
+    """Radius R (A) of the circular cap (a circular segment with contact angle theta on its chord) whose area
+    equals that of a circle of ``radius_equivalent`` R0: R^2 (theta - sin theta cos theta) = pi R0^2."""
+    th = math.radians(float(contact_angle_deg))
+    if not 0.0 < th <= math.pi:
+        raise ValueError(f"contact angle must be in (0, 180] deg, got {contact_angle_deg}")
+    return float(radius_equivalent) * math.sqrt(math.pi / (th - math.sin(th) * math.cos(th)))
+
+
+def water_cap(radius: float, length: float, *, contact_angle_deg: float = 90.0, box_x: float | None = None,
+              density: float = WATER_DENSITY, vacuum: float = 15.0, seed: int = 0,
+              forcefield: ForceField | None = None) -> System:
+    """A quasi-2-D droplet started near its resting shape: a cylindrical cap, periodic along y (period
+    ``length`` A), whose flat base lies on the plane z = ``vacuum`` and meets the circular surface at
+    ``contact_angle_deg`` (90 = a half-cylinder). Its cross-section holds as much water as a full circle of
+    ``radius`` R0 (the droplet's equivalent radius): cap radius R = :func:`cap_radius` (R0, theta).
+
+    Molecules sit on the lattice of :func:`water_cylinder` (ny planes along y, a square x-z grid whose cell times
+    the y spacing is one molecular volume at ``density``); the grid cells above the base plane nearest the
+    circle's centre (0, -R cos theta) are filled first until N = round(rho pi R0^2 L N_A / M), so the filled
+    region is the cap. Box: x = ``box_x`` (default the base width + 2 vacuum), z = cap height + 2 vacuum.
+    """
+    ff = forcefield or water_forcefield()
+    rng = np.random.default_rng(seed)
+    rho_n, m = _number_density(ff, density)
+    n = int(round(rho_n * math.pi * radius ** 2 * length))
+    th = math.radians(float(contact_angle_deg))
+    R = cap_radius(radius, contact_angle_deg)
+    zc = -R * math.cos(th)                             # circle centre relative to the base plane
+    half = R if th >= math.pi / 2 else R * math.sin(th)
+    height = R + zc
+    s0 = rho_n ** (-1.0 / 3.0)
+    ny = max(1, round(length / s0))
+    dy = length / ny
+    d = math.sqrt(1.0 / (rho_n * dy))
+    kx, kz = int(math.ceil(half / d)) + 3, int(math.ceil(height / d)) + 3
+    ij = np.stack(np.meshgrid(np.arange(-kx, kx), np.arange(0, kz), indexing="ij"), -1).reshape(-1, 2)
+    cols = (ij + 0.5) * d                              # offset grid: symmetric about x = 0, first row d/2 up
+    r2 = np.round(cols[:, 0] ** 2 + (cols[:, 1] - zc) ** 2, 6)
+    order = np.lexsort((rng.permutation(len(cols)), r2))
+    box_x = float(box_x) if box_x is not None else 2 * half + 2 * vacuum
+    if box_x < 2 * half + 6.0:
+        raise ValueError(f"box_x = {box_x} A is too narrow for a cap of base width {2 * half:.1f} A")
+    cx = 0.5 * box_x
+    sites = []
+    for c in order.tolist():
+        for j in rng.permutation(ny).tolist():
+            sites.append((cx + cols[c, 0], (j + 0.5) * dy, vacuum + cols[c, 1]))
+        if len(sites) >= n:
+            break
+    sites = np.array(sites[:n])
+    cell = np.array([box_x, length, height + 2 * vacuum])
+    info = {"builder": "water_cap", "radius_equivalent_A": radius, "length_A": length, "axis": "y",
+            "contact_angle_initial_deg": float(contact_angle_deg), "cap_radius_A": R,
+            "base_half_width_A": R * math.sin(th), "cap_height_A": height, "base_z_A": vacuum,
+            "centre_xz_A": (cx, vacuum + zc), "density_requested_g_cm3": density,
+            "density_g_cm3": n * m / AVOGADRO / (math.pi * radius ** 2 * length * 1e-24),
             "lattice_spacing_A": (d, dy, d), "periodic_axes": "y", "seed": seed}
     return _water_system(sites, cell, ff, rng, info)
 

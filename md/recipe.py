@@ -102,8 +102,12 @@ FIELDS: tuple[Field, ...] = (
           "to face the lower one).", REQUIRED, choices=SURFACES, workflows=_ADH, item=str, length=(2,)),
     Field("surface", "system", str, "", "Pull-off: the coating of both the asperity and the flat; contact "
           "angle: the substrate.", REQUIRED, choices=SURFACES, workflows=_PULL + _CA),
-    Field("silanol_density", "system", float, "OH/nm^2", "Silanol density requested on the (001) faces of "
-          "bare cristobalite (the (111) face used under OTS has 4.50 fixed).", 4.7, low=3.9, high=7.8,
+    Field("silica_face", "system", str, "", "Cristobalite face of every bare silica surface: '111' = isolated Q3 "
+          "silanols at 4.50 OH/nm^2 (nearest silanol O-O 5.06 A), IFF's hydrophilic Q3 surface and the shared "
+          "default of all recipes; '001' = geminal/vicinal pairs 2.53 A apart, 3.9-7.8 OH/nm^2 (silanol_density). "
+          "OTS is always grafted on (111).", "111", choices=("111", "001"), workflows=_SURF),
+    Field("silanol_density", "system", float, "OH/nm^2", "Silanol density requested on the (001) face "
+          "(silica_face = '001'); the (111) face has 4.50 fixed.", 4.7, low=3.9, high=7.8,
           workflows=_SURF),
     Field("sam_coverage", "system", float, "chains/nm^2", "OTS grafting density (cristobalite (111) holds at "
           "most 4.50).", 4.5, low=0.5, high=4.5, workflows=_SURF),
@@ -118,9 +122,14 @@ FIELDS: tuple[Field, ...] = (
     Field("graft_max_polar_deg", "system", float, "deg", "Pull-off with OTS: chains are grafted on dome "
           "silanols within this polar angle of the apex (chains point along the pulling axis).", 60.0,
           low=10.0, high=80.0, workflows=_PULL),
-    Field("droplet_radius_A", "both", float, "A", "Contact angle: initial radius of the cylindrical droplet.",
-          REQUIRED, low=8.0, high=200.0, workflows=_CA),
-    Field("water_model", "system", str, "", "Water model.", "spce", choices=("spce",), workflows=_CA + _ST),
+    Field("droplet_radius_A", "both", float, "A", "Contact angle: equivalent radius R0 of the droplet (its "
+          "cross-section holds as much water as a circle of radius R0).", REQUIRED, low=8.0, high=200.0,
+          workflows=_CA),
+    Field("droplet_initial_angle_deg", "system", float, "deg", "Contact angle: the droplet starts as a "
+          "cylindrical cap with this angle on the substrate (90 = half-cylinder); start near the expected angle.",
+          90.0, low=10.0, high=170.0, workflows=_CA),
+    Field("water_model", "system", str, "", "Water model; one model throughout a calibration (the contact "
+          "angles and gamma_lv must come from the same water).", "spce", choices=("spce",), workflows=_CA + _ST),
     # ---------------------------------------------------------------- fidelity: numerics shared by all
     Field("timestep_fs", "fidelity", float, "fs", "MD timestep.", REQUIRED, low=0.1, high=4.0),
     Field("thermostat", "fidelity", str, "", "NVT thermostat.", "nose-hoover", choices=THERMOSTATS),
@@ -187,6 +196,10 @@ FIELDS: tuple[Field, ...] = (
           "(a rate scan, extrapolated to low rate) only at production.", REQUIRED, low=0.01, high=2000.0,
           workflows=_PULL, item=float),
     # ---------------------------------------------------------------- fidelity: contact angle
+    Field("substrate_equilibrate_steps", "fidelity", int, "steps", "Contact angle: NVT steps of the substrate "
+          "alone (minimised with nothing held, then its deep Si and bridging O held) before the droplet is "
+          "placed: equilibrates the SAM / silanols the water lands on.", 1000, low=1, high=100_000_000,
+          workflows=_CA),
     Field("bin_A", "fidelity", float, "A", "Contact angle / surface tension: bin size of density maps and "
           "profiles.", 1.0, low=0.1, high=10.0, workflows=_CA + _ST),
     # ---------------------------------------------------------------- fidelity: surface tension

@@ -41,6 +41,7 @@ surface_tension
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -48,12 +49,12 @@ import numpy as np
 
 from md import analysis as A
 from md import units as U
-from md.builders import (flip_upside_down, ots_sam, place_on, silica_asperity, silica_slab, water_cylinder,
-                         water_slab)
+from md.builders import (SILICA_FACE, flip_upside_down, ots_sam, place_on, silica_asperity, silica_slab,
+                         water_cap, water_slab)
 from md.forcefield import ForceField, combine, lammps_type_ids, load_forcefield
 from md.lammps_data import lammps_setup_commands, write_data
 from md.runner import Analysis, Frames, Leg, Plan, RunContext, Stage, id_ranges
-from md.topology import System, with_groups
+from md.topology import System, remove_atoms, with_groups
 
 __all__ = ["get_workflow", "WORKFLOWS", "ENERGY_NOT_FREE_ENERGY"]
 
@@ -132,9 +133,16 @@ def _minimize_water(settings: Mapping[str, Any], write: Path | None = None) -> l
     return _minimize(settings, write, style="cg")
 
 
-def _shake(ff: ForceField) -> list[str]:
-    """``fix shake`` on every bond/angle type the force field marks rigid (SPC/E); [] if none."""
-    b = [k for k, t in enumerate(ff.bond_types, start=1) if t.constraint == "shake"]
+#: silanol O-H bond (IFF OC24-HOY, 0.945 A): constrained where silanols are mobile at a 2 fs timestep
+SILANOL_OH = (("OC24", "HOY"),)
+
+
+def _shake(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[str]:
+    """``fix shake`` on every bond/angle type the force field marks rigid (SPC/E), and on the bond types
+    between the atom-type pairs in ``also`` (e.g. :data:`SILANOL_OH`); [] if none."""
+    pairs = {tuple(sorted(p)) for p in also}
+    b = [k for k, t in enumerate(ff.bond_types, start=1)
+         if t.constraint == "shake" or tuple(sorted(t.types)) in pairs]
     a = [k for k, t in enumerate(ff.angle_types, start=1) if t.constraint == "shake"]
     if not b and not a:
         return []
@@ -205,6 +213,23 @@ def _figure(draw: Callable) -> Callable[[Path], None]:
     return save
 
 
+def _silica_face(settings: Mapping[str, Any]) -> str:
+    """The cristobalite face of a recipe's silica: the recipe's ``silica_face`` (default
+    :data:`md.builders.SILICA_FACE` = '111', isolated Q3 silanols) for bare silica; always (111) when an OTS SAM
+    is involved (it is grafted on (111), and the two slabs of a pair must share the lateral cell)."""
+    kinds = settings.get("surfaces") or [settings.get("surface")]
+    if "ots" in kinds:
+        return "111"
+    return settings.get("silica_face", SILICA_FACE)
+
+
+def _held_deep(system: System, group: str = "frozen") -> np.ndarray:
+    """Atoms of ``group`` (the builder's deep layer) that are Si or bridging O: only these are held; silanol O
+    and H stay mobile everywhere."""
+    idx = np.asarray(system.group(group), int)
+    return idx[np.isin(system.types[idx], ["SC4", "OC23"])]
+
+
 def _surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mapping[str, Any], seed: int,
                   face: str) -> System:
     if kind == "silica":
@@ -257,7 +282,7 @@ class Adhesion(Workflow):
     def plan(self, s, run_dir):
         ff = _ff(self.forcefield_files(s))
         lower_kind, upper_kind = s["surfaces"]
-        face = "111" if "ots" in s["surfaces"] else "001"
+        face = _silica_face(s)
         seed = int(s["seed"])
         lower = _surface_slab(lower_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed, face)
         upper = _surface_slab(upper_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10, face)
@@ -434,7 +459,7 @@ class PullOff(Workflow):
     def build(self, s) -> tuple[System, dict[str, Any]]:
         seed = int(s["seed"])
         R = float(s["asperity_radius_A"])
-        face = "111" if s["surface"] == "ots" else "001"
+        face = _silica_face(s)
         dens = s["silanol_density"] if face == "001" else 4.5
         asp = silica_asperity(radius=R, holder_thickness=s["holder_thickness_A"], margin=s["asperity_margin_A"],
                               silanol_density=dens, face=face, seed=seed)
@@ -650,60 +675,132 @@ def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, d
 
 # ================================================================================================ water
 
+#: Water models a recipe may name: their force-field files and the model's own liquid-vapour surface tension at
+#: 300 K (published), which turns every contact angle into W_SL = gamma_lv (1 + cos theta) and gamma_lv cos theta.
+#: One model throughout a calibration: the angles and gamma_lv of the menisci must describe the same water.
+WATER_MODELS: dict[str, dict[str, Any]] = {
+    "spce": {"name": "SPC/E", "forcefields": ["water_spce"], "gamma_lv_N_m": 0.0636, "gamma_T_K": 300.0,
+             "gamma_source": "SPC/E, 300 K, Ewald with LJ tail: Vega & de Miguel, J. Chem. Phys. 126 (2007) 154707 "
+                             "(this project's quick films: 60.7 +/- 3.0 mN/m at 25 A, 64.0 +/- 1.9 mN/m at 35 A)"},
+}
+
+
 def _water_ff_names(model: str) -> list[str]:
-    return {"spce": ["water_spce"]}[model]
+    return list(WATER_MODELS[model]["forcefields"])
+
+
+#: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
+DROPLET_GAP_A = 3.0
+#: water molecules closer than this to a substrate atom when the droplet is added are deleted (A)
+DROPLET_OVERLAP_A = 2.0
+#: the density map starts this far below the solid's reference atoms, so the water's dividing plane is found
+#: from below even where water sits between the outer atoms (A)
+MAP_FLOOR_A = 3.0
 
 
 class ContactAngleWorkflow(Workflow):
-    """Cylindrical droplet on silica or OTS; density map -> circle fit -> contact angle."""
+    """Cylindrical droplet on silica or OTS; density map -> circle fit -> contact angle, W_SL and a drift check.
+
+    Two legs. *substrate*: the substrate alone (the water's box) is minimised with nothing held, then only its
+    deep Si and bridging O are held (silanol O and H mobile, O-H constrained by SHAKE) and it is equilibrated
+    (the SAM relaxes before any water touches it). *droplet*: the water cap is added to the substrate's last
+    state (``read_data ... add append``; molecules overlapping the substrate deleted), minimised, equilibrated and
+    sampled. The angle is read at the water's own dividing plane (half the bulk density under the droplet).
+
+    Version 2 (this protocol). Version 1 froze the whole silica (silanol H included) before minimising it, used
+    the (001) face's silanol pairs, started a full cylinder on an unequilibrated SAM and read the angle at the
+    plane of the solid's atoms (OTS: 140 deg there against 129 deg at the water's plane, same map)."""
     name = "contact_angle"
+    version = 2
 
     def forcefield_files(self, s):
         return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else []) + \
             _water_ff_names(s["water_model"])
 
+    def build(self, s) -> tuple[System, System, System]:
+        """(substrate, droplet, both placed in one box) -- the substrate's coordinates are those of the combined
+        system, so atom ids 1..n_substrate are the same in both legs."""
+        seed = int(s["seed"])
+        sub = _surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, _silica_face(s))
+        R0 = float(s["droplet_radius_A"])
+        wff = _ff(_water_ff_names(s["water_model"]))
+        drop = water_cap(R0, float(sub.cell[1]), contact_angle_deg=s["droplet_initial_angle_deg"], seed=seed + 1,
+                         forcefield=wff)
+        system = place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0))
+        return sub, drop, system
+
     def plan(self, s, run_dir):
         ff = _ff(self.forcefield_files(s))
         seed = int(s["seed"])
-        face = "111" if s["surface"] == "ots" else "001"
-        sub = _surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, face)
-        R = float(s["droplet_radius_A"])
-        drop = water_cylinder(R, float(sub.cell[1]), seed=seed + 1)
-        system = place_on(sub, drop, gap=2.5, vacuum=max(20.0, R))
-        data = run_dir / "system.data"
-        write_data(system, ff, data)
+        sub, drop, system = self.build(s)
         substrate = system.group("substrate")
+        water = system.group("adsorbate")
+        held = np.intersect1d(_held_deep(system), substrate)
+        sub_data, water_data = run_dir / "substrate.data", run_dir / "water.data"
+        write_data(system, ff, run_dir / "system.data", title="contact_angle system (reference; the legs read the "
+                   "two parts)")
+        write_data(remove_atoms(system, water), ff, sub_data, title="contact_angle substrate")
+        write_data(remove_atoms(system, substrate), ff, water_data, title="contact_angle droplet")
         if s["surface"] == "silica":
-            frozen, ref = substrate, _intersect(system, "silanol_O_top", "substrate")
+            ref = _intersect(system, "silanol_O_top", "substrate")
         else:
-            frozen = _intersect(system, "silica", "substrate")
             ref = system.group("sam_ch3")
-        water_o = np.intersect1d(system.group("water_O"), system.group("adsorbate"))
-        groups = {"water": system.group("adsorbate"), "substrate": substrate, "frozen": frozen,
-                  "framed": np.union1d(water_o, ref)}
-        n = system.n_atoms
-        fi = s["frame_interval"] or s["sample_interval"]
+        water_o = np.intersect1d(system.group("water_O"), water)
+        n_sub, n = len(substrate), system.n_atoms
+        dt = s["timestep_fs"]
+        shake = _shake(ff, also=SILANOL_OH)
+        sub_groups = {"substrate": substrate, "frozen": held}
 
-        def fresh(leg_dir: Path) -> list[str]:
-            return _fresh_from_data(ff, data, s, groups) + ["group mobile subtract all frozen"]
+        def fresh_substrate(leg_dir: Path) -> list[str]:
+            # minimised with nothing held (no setforce, no exclusions): the deep layer is held only afterwards,
+            # at its relaxed positions
+            return _fresh_from_data(ff, sub_data, s, sub_groups) + ["group mobile subtract all frozen"] + \
+                _minimize(s, leg_dir / "minimized.data")
 
-        def define(step: int) -> list[str]:
-            return _common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + _shake(ff) + \
-                ["fix hold frozen setforce 0.0 0.0 0.0"] + \
-                _thermostat("mobile", s, step)
+        def define(salt: int, with_water: bool):
+            def d(step: int) -> list[str]:
+                return _common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake + \
+                    ["fix hold frozen setforce 0.0 0.0 0.0"] + \
+                    (["variable nw equal count(water)/3"] if with_water else []) + \
+                    _thermostat("mobile", s, step, salt)
+            return d
 
-        leg = Leg(name="droplet", fresh=fresh, define=define, prepare=lambda d: _minimize_water(s),
-                  restart_head=_restart_head(s),
-                  stages=_stages(_equil(s, "mobile", 1), Stage("sample", _steps(s, "sample_steps"))),
-                  columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s["sample_interval"],
-                  chunk_steps=s["chunk_steps"], n_atoms=n, frames=Frames("framed", fi))
+        t = s["temperature_K"]
+        sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=define(0, False), prepare=lambda d: [],
+                      restart_head=_restart_head(s),
+                      stages=[Stage("equilibrate", _steps(s, "substrate_equilibrate_steps"),
+                                    (f"velocity mobile create {t:g} {_seed(seed, 3, 0)} mom yes rot no "
+                                     f"dist gaussian",), sampled=False)],
+                      columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s["sample_interval"],
+                      chunk_steps=s["chunk_steps"], n_atoms=n_sub)
+        sub_dir = run_dir / "legs" / "substrate"
+
+        def fresh_droplet(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
+            # the equilibrated substrate, then the water: ids n_sub+1.. as in the combined build
+            return _restart_head(s)(sub_dir / f"restart.{_total}") + [
+                f"timestep {dt:g}",
+                f"read_data {water_data.as_posix()} add append group water",
+                f"group framed id {id_ranges(np.union1d(water_o, ref))}",
+                "group mobile subtract all frozen",
+                f"delete_atoms overlap {DROPLET_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
+
+        drop_leg = Leg(name="droplet", fresh=fresh_droplet, define=define(1, True),
+                       prepare=lambda d: _minimize_water(s), restart_head=_restart_head(s),
+                       stages=_stages(_equil(s, "mobile", 1), Stage("sample", _steps(s, "sample_steps"))),
+                       columns={"pe": "v_pe", "temp": "v_temp", "n_water": "v_nw"},
+                       sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"], n_atoms=n,
+                       frames=Frames("framed", s["frame_interval"] or s["sample_interval"]))
         ids = lammps_type_ids(ff)
         info = {"substrate": _summary(sub), "droplet": dict(drop.info), "box_A": system.cell.tolist(),
+                "n_substrate": int(n_sub), "n_water_molecules_built": int(len(water_o)),
+                "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
+                "silica_face": _silica_face(s),
                 "water_O_ids": (water_o + 1).tolist(), "surface_ref_ids": (ref + 1).tolist(),
                 "surface_ref": "top silanol O" if s["surface"] == "silica" else "OTS CH3 groups",
-                "type_ids": ids}
-        return Plan(legs=[leg], timestep_fs=s["timestep_fs"], n_atoms=n,
-                    seeds={"structure_substrate": seed, "structure_water": seed + 1, "velocities": _seed(seed, 3, 1),
+                "water_model": s["water_model"], "type_ids": ids}
+        return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
+                    seeds={"structure_substrate": seed, "structure_water": seed + 1,
+                           "velocities_substrate": _seed(seed, 3, 0), "velocities": _seed(seed, 3, 1),
                            "thermostat_base": seed}, forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
@@ -717,63 +814,132 @@ class ContactAngleWorkflow(Workflow):
             raise RuntimeError("no stored configurations: sample_steps shorter than frame_interval?")
         is_o = np.isin(ids, info["water_O_ids"])
         is_ref = np.isin(ids, info["surface_ref_ids"])
-        surface_z = float(pos[:, is_ref, 2].mean())
+        solid_z = float(pos[:, is_ref, 2].mean())
+        floor = solid_z - MAP_FLOOR_A
         opos = pos[:, is_o, :].astype(np.float32)
         u = mda.Universe.empty(int(is_o.sum()), trajectory=False)
         u.add_TopologyAttr("type", ["OW"] * int(is_o.sum()))
         dims = np.column_stack([box, np.full((len(box), 3), 90.0)]).astype(np.float32)
         u.load_new(opos, format=MemoryReader, dimensions=dims)
-        ca = A.ContactAngle(u.select_atoms("type OW"), surface_z=surface_z, axis="y", bin_size=s["bin_A"],
-                            n_blocks=min(s["n_blocks"], len(steps)))
-        ca.run()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            ca = A.ContactAngle(u.select_atoms("type OW"), surface_z=floor, axis="y", bin_size=s["bin_A"],
+                                n_blocks=min(s["n_blocks"], len(steps)), reference="dividing_surface")
+            ca.run()
         r = ca.results
         xc, zc, rad = r.circle
-        angle, extra_note = r.angle_deg, None
-        if not np.isfinite(angle) and np.isfinite(rad) and rad > 0:
-            # the fitted circle misses the surface plane: entirely above it = no contact (180 deg), entirely
-            # below = a film (0 deg); md.analysis leaves the angle undefined (nan)
-            sgn = (zc - surface_z) / rad
-            angle = 180.0 if sgn > 1 else 0.0
-            extra_note = (f"the fitted circle (centre {zc - surface_z:+.1f} A from the surface plane, r = {rad:.1f} "
-                          f"A) does not cross the surface plane: reported as {angle:.0f} deg "
-                          f"({'droplet not (yet) in contact' if angle else 'water film'}).")
-        q = {"contact_angle": _q(angle, r.stderr_deg, "deg"),
+        z_ref = float(r.reference_z)
+        wet = r.wetting
+        model = WATER_MODELS[s["water_model"]]
+        gamma = model["gamma_lv_N_m"]
+        notes: list[str] = []
+        if abs(s["temperature_K"] - model["gamma_T_K"]) > 1.0:
+            notes.append(f"gamma_lv = {gamma * 1e3:.1f} mN/m is the model's value at {model['gamma_T_K']:g} K, not at "
+                         f"the run's {s['temperature_K']:g} K: W_SL and gamma_lv cos theta carry that mismatch.")
+        # what the map shows: a measured angle, no contact yet, or a film / a cap too flat to fit ("wets")
+        if np.isfinite(r.angle_deg) and not wet["spans_box"]:
+            status, angle, angle_err = "measured", float(r.angle_deg), r.stderr_deg
+        elif np.isfinite(rad) and rad > 0 and (zc - z_ref) / rad > 1 and not wet["spans_box"]:
+            status, angle, angle_err = "no_contact", 180.0, None
+            notes.append(f"the fitted circle (centre {zc - z_ref:+.1f} A from the water's plane, r = {rad:.1f} A) "
+                         f"lies above the plane: the droplet is not (yet) in contact; reported as 180 deg.")
+        else:
+            status, angle, angle_err = "wets", 0.0, None
+        q = {"contact_angle": _q(angle, angle_err, "deg",
+                                 kind={"measured": "circle fit, read at the water's dividing plane",
+                                       "no_contact": "180 = no contact (mark, not a measurement)",
+                                       "wets": "0 = wets (mark, not a measurement): see contact_angle_upper_bound"}
+                                 [status], status=status),
              "droplet_bulk_density": _q(U.g_per_cm3_to_kg_per_m3(r.bulk_density), None, "kg/m^3"),
              "base_half_width": _q(U.angstrom_to_m(r.base_half_width_A), None, "m")}
+        q["surface_tension_lv"] = _q(gamma, None, "N/m", kind=f"the water model's published gamma_lv "
+                                     f"({model['gamma_source']})")
+        if status == "wets":
+            bound, why = (wet["theta_max_deg"], "the water spans the periodic box (a film); a cap of this volume "
+                          f"touches its image at {wet['theta_max_deg']:.1f} deg") if wet["spans_box"] else \
+                (wet["theta_resolvable_deg"], f"no circle can be fitted above the excluded layer "
+                 f"({r.fit_error}); a cap of this volume is that flat below {wet['theta_resolvable_deg']:.1f} deg")
+            q["contact_angle_upper_bound"] = _q(bound, None, "deg", kind="wets: theta below this bound")
+            wl = A.work_of_adhesion_sl(gamma, bound)
+            q["work_of_adhesion_sl"] = _q(wl["value"], None, "J/m^2", kind="lower bound (wets): "
+                                          "gamma_lv (1 + cos theta_upper_bound)")
+            q["gamma_lv_cos_theta"] = _q(wl["gamma_cos_theta"], None, "N/m", kind="lower bound (wets)")
+            notes.append(f"wets: theta < {bound:.1f} deg ({why}); W_SL >= {wl['value'] * 1e3:.1f} mJ/m^2. "
+                         f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
+                         f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
+        elif status == "measured":
+            wl = A.work_of_adhesion_sl(gamma, angle, None, angle_err)
+            q["work_of_adhesion_sl"] = _q(wl["value"], wl["stderr"], "J/m^2",
+                                          kind="Young-Dupre W_SL = gamma_lv (1 + cos theta), this water model's gamma")
+            q["gamma_lv_cos_theta"] = _q(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
+                                         kind="gamma_lv cos theta (meniscus force), this water model's gamma")
+        # drift of the block angles against time
+        dt_ns = ctx.plan.timestep_fs * 1e-6
+        t_blocks = np.interp(r.block_frames, np.arange(len(steps)), steps.astype(float)) * dt_ns
+        drift = A.block_drift(r.block_angles_deg, t_blocks)
+        if status == "measured":
+            q["contact_angle_drift"] = _q(drift["slope"], drift["stderr"], "deg/ns",
+                                          kind="slope of the block angles against time (OLS)",
+                                          drifting=bool(drift["drifting"]))
+            if drift["drifting"]:
+                notes.append(f"DRIFTING: the block angles still change by {drift['slope']:+.0f} +/- "
+                             f"{drift['stderr']:.0f} deg/ns ({drift['change']:+.1f} deg over the sampled "
+                             f"{np.ptp(t_blocks) * 1e3:.0f} ps, |slope| > 2 stderr): not equilibrated; the mean "
+                             f"depends on where the run stopped.")
+            h = float(r.cap_height_A)
+            if h < 3 * 5.0:
+                notes.append(f"the cap is {h:.1f} A high, less than 3x the 5 A excluded layer: few interface "
+                             f"points carry the fit.")
+        notes += [f"angle read at the water's dividing plane z = {z_ref:.2f} A (half the bulk density under the "
+                  f"droplet), {z_ref - solid_z:+.2f} A from the mean height of the {info['surface_ref']} "
+                  f"({solid_z:.2f} A); circle fitted to the half-bulk contour above that plane + 5 A "
+                  f"(md.analysis.ContactAngle, {r.n_frames} frames).",
+                  "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
+                  "mobile (O-H by SHAKE)" + ("; the OTS SAM equilibrated alone before the droplet was placed"
+                                              if s["surface"] == "ots" else "") +
+                  f"; water rigid {model['name']} (SHAKE); the droplet started as a "
+                  f"{s['droplet_initial_angle_deg']:g} deg cylindrical cap.",
+                  "a cylindrical droplet has a straight contact line: no line-tension correction.",
+                  f"W_SL and gamma_lv cos theta use gamma_lv = {gamma * 1e3:.1f} mN/m of the same water model "
+                  f"({s['water_model']}); combine the angle only with a gamma_lv of that model."]
         ue, ze = r.edges
         rho = r.density_map
         curves = {"density_map": (["u_m", "z_m", "density_kg_m3"],
                                   np.column_stack([np.repeat(U.angstrom_to_m(0.5 * (ue[1:] + ue[:-1])), len(ze) - 1),
                                                    np.tile(U.angstrom_to_m(0.5 * (ze[1:] + ze[:-1])), len(ue) - 1),
                                                    U.g_per_cm3_to_kg_per_m3(rho.ravel())])),
-                  "interface_points": (["u_m", "z_m"], U.angstrom_to_m(np.asarray(r.interface_points)))}
+                  "interface_points": (["u_m", "z_m"], U.angstrom_to_m(np.asarray(r.interface_points).reshape(-1, 2)))}
+        d_app = ctx.samples("droplet", False)
+        n_water = int(round(d_app["n_water"][-1])) if len(d_app.get("n_water", [])) else None
 
         def draw(ax):
             ax.pcolormesh(ue, ze, rho.T, cmap="Blues", shading="flat")
-            t = np.linspace(0, 2 * np.pi, 400)
-            cx, cz = xc + rad * np.cos(t), zc + rad * np.sin(t)
-            keep = cz >= surface_z
-            ax.plot(cx[keep], cz[keep], "r-", lw=1.2, label="fitted circle")
-            pts = np.asarray(r.interface_points)
+            if np.isfinite(rad):
+                tt = np.linspace(0, 2 * np.pi, 400)
+                cx, cz = xc + rad * np.cos(tt), zc + rad * np.sin(tt)
+                keep = cz >= z_ref
+                ax.plot(cx[keep], cz[keep], "r-", lw=1.2, label="fitted circle")
+            pts = np.asarray(r.interface_points).reshape(-1, 2)
             ax.plot(pts[:, 0], pts[:, 1], "k.", ms=2, label="interface points")
-            ax.axhline(surface_z, color="k", lw=0.8)
+            ax.axhline(z_ref, color="k", lw=0.8, label="water's dividing plane")
+            ax.axhline(solid_z, color="grey", lw=0.8, ls="--", label=info["surface_ref"])
             ax.set_aspect("equal")
             ax.set_xlabel("x (Å, droplet-centred)")
             ax.set_ylabel("z (Å)")
-            ax.set_title(f"θ = {angle:.1f} ± {r.stderr_deg:.1f}° ({s['surface']})")
+            title = {"measured": f"θ = {angle:.1f} ± {(angle_err or float('nan')):.1f}°",
+                     "no_contact": "no contact", "wets": "wets"}[status]
+            ax.set_title(f"{title} ({s['surface']})")
             ax.legend(fontsize=7)
-        notes = [f"surface plane z = {surface_z:.2f} A = mean height of the {info['surface_ref']} over the stored "
-                 f"frames; contact angle from a circle fitted to the half-bulk-density contour above "
-                 f"z + 5 A (md.analysis.ContactAngle, {r.n_frames} frames).",
-                 "the silica is held fixed (silanol H included); water is rigid SPC/E (SHAKE)"
-                 + ("; the OTS chains are mobile." if s["surface"] == "ots" else "."),
-                 "a cylindrical droplet has a straight contact line: no line-tension correction."]
-        if extra_note:
-            notes.append(extra_note)
+        block_w = [A.work_of_adhesion_sl(gamma, a)["value"] if np.isfinite(a) else None for a in r.block_angles_deg]
+        details = {"status": status, "reference_z_A": z_ref, "surface_z_A": solid_z,
+                   "reference_above_solid_A": z_ref - solid_z, "circle_A": [float(xc), float(zc), float(rad)],
+                   "block_angles_deg": np.asarray(r.block_angles_deg).tolist(),
+                   "block_times_ns": t_blocks.tolist(), "block_work_of_adhesion_sl_J_m2": block_w,
+                   "drift": drift, "wetting": wet, "fit_error": r.fit_error, "cap_height_A": r.cap_height_A,
+                   "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames), "n_water_molecules": n_water,
+                   "water_model": s["water_model"], "gamma_lv_N_m": gamma}
         return Analysis(quantities=q, curves=curves, figures={"density_map": _figure(draw)}, notes=notes,
-                        details={"surface_z_A": surface_z, "circle_A": [float(xc), float(zc), float(rad)],
-                                 "block_angles_deg": np.asarray(r.block_angles_deg).tolist(),
-                                 "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames)})
+                        details=details)
 
 
 class SurfaceTension(Workflow):

@@ -12,9 +12,9 @@ import re
 import numpy as np
 import pytest
 
-from md.builders import (AVOGADRO, WATER_DENSITY, flip_upside_down, ots_sam, place_on, sam_forcefield,
-                         silica_asperity, silica_forcefield, silica_slab, water_cylinder, water_forcefield,
-                         water_slab)
+from md.builders import (AVOGADRO, SILICA_FACE, WATER_DENSITY, flip_upside_down, ots_sam, place_on,
+                         sam_forcefield, silica_asperity, silica_forcefield, silica_slab, water_cap, water_cylinder,
+                         water_forcefield, water_slab)
 from md.forcefield import (combine, lammps_angle_coeffs, lammps_bond_coeffs, lammps_dihedral_coeffs,
                            lammps_type_ids)
 from md.lammps_data import read_back_check, write_data
@@ -29,7 +29,7 @@ SILICA = ("SC4", "OC23", "OC24", "HOY")
 
 @pytest.fixture(scope="module")
 def slab001():
-    return silica_slab(4, 4, thickness=25.0, silanol_density=4.7, seed=11)
+    return silica_slab(4, 4, face="001", thickness=25.0, silanol_density=4.7, seed=11)
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +44,7 @@ def quartz():
 
 @pytest.fixture(scope="module")
 def asperity():
-    return silica_asperity(radius=15.0, holder_thickness=10.0, seed=14)
+    return silica_asperity(radius=15.0, holder_thickness=10.0, face="001", seed=14)
 
 
 @pytest.fixture(scope="module")
@@ -191,6 +191,26 @@ def test_cristobalite_111_gives_q3_silanols_at_4_50_per_nm2(slab111):
         assert s.positions[o, 2] - s.positions[si, 2] == pytest.approx(7.16 * math.sqrt(3) / 8, rel=1e-6, abs=0)
 
 
+def test_default_silica_face_has_isolated_q3_silanols_no_pair_closer_than_4_A():
+    """The surface every recipe shares (review item 1): the default cristobalite face is (111), one Q3 silanol per
+    surface Si on a 5.06 A hexagonal lattice; no two silanol O of a face are closer than 4 A (minimum image).
+    The (001) face has geminal/vicinal pairs 2.53 A apart, which H-bond to each other instead of to water."""
+    assert SILICA_FACE == "111"
+
+    def min_oo(s, group):
+        p = s.positions[s.group(group)]
+        d = np.linalg.norm(minimum_image(p[:, None] - p[None], s.cell, (True, True, False)), axis=-1)
+        np.fill_diagonal(d, np.inf)
+        return d.min()
+
+    s = silica_slab(8, 3, thickness=4.0, seed=3)
+    assert s.info["face"] == "111" and s.info["q_distribution"]["Q2"] == 0
+    for face in ("top", "bottom"):
+        assert min_oo(s, f"silanol_O_{face}") == pytest.approx(7.16 / math.sqrt(2), rel=1e-6)   # 5.06 A > 4 A
+    pairs = silica_slab(4, 4, face="001", thickness=6.0, silanol_density=4.7, seed=3)
+    assert min_oo(pairs, "silanol_O_top") < 3.0
+
+
 def test_quartz_0001_condenses_to_q3_and_meets_the_request(quartz):
     assert quartz.info["silanol_density_top"] == pytest.approx(4.7, rel=0.10, abs=0)
     lo, hi = quartz.info["silanol_density_range_nm2"]
@@ -216,7 +236,7 @@ def test_unreachable_silanol_density_fails_with_the_achievable_range():
     with pytest.raises(ValueError, match=r"achievable 4\.50\.\.4\.50"):
         silica_slab(2, 2, face="111", thickness=6.0, silanol_density=7.0)
     with pytest.raises(ValueError, match="achievable"):
-        silica_slab(2, 2, thickness=6.0, silanol_density=9.0)
+        silica_slab(2, 2, face="001", thickness=6.0, silanol_density=9.0)
 
 
 def test_asperity_is_a_hydroxylated_hemisphere_on_its_holder(asperity):
@@ -240,9 +260,9 @@ def test_asperity_is_a_hydroxylated_hemisphere_on_its_holder(asperity):
 
 
 def test_silica_builders_are_reproducible_with_a_seed():
-    a = silica_slab(3, 3, thickness=8.0, seed=5)
-    b = silica_slab(3, 3, thickness=8.0, seed=5)
-    c = silica_slab(3, 3, thickness=8.0, seed=6)
+    a = silica_slab(3, 3, face="001", thickness=8.0, seed=5)        # (001): condensation draws at random
+    b = silica_slab(3, 3, face="001", thickness=8.0, seed=5)
+    c = silica_slab(3, 3, face="001", thickness=8.0, seed=6)
     assert np.array_equal(a.positions, b.positions) and list(a.types) == list(b.types)
     assert a.n_atoms == c.n_atoms and not np.array_equal(a.positions, c.positions)
 
@@ -299,7 +319,7 @@ def test_ots_grafting_keeps_neutrality_algebraically(sam):
 
 def test_ots_sam_refuses_a_coverage_the_sites_cannot_hold():
     with pytest.raises(ValueError, match="grafting sites fit"):
-        ots_sam(silica_slab(3, 3, thickness=6.0), coverage=4.5)   # (001): at most one chain per surface Si
+        ots_sam(silica_slab(3, 3, face="001", thickness=6.0), coverage=4.5)   # (001): at most one chain per surface Si
 
 
 # ------------------------------------------------------------------------------------------------ water
@@ -450,17 +470,17 @@ def test_data_file_has_topology_coefficients_and_no_pair_coeffs(sam, tmp_path):
 
 def smoke_systems() -> dict[str, System]:
     """One small (< 2000 atoms) system per workflow."""
-    a = silica_slab(3, 3, thickness=8.0, seed=1)
-    b = silica_slab(3, 3, thickness=8.0, seed=2)
-    asp = silica_asperity(radius=10.0, holder_thickness=4.0, margin=4.0, seed=3)
-    flat = silica_slab(4, 4, thickness=4.0, seed=4)
-    sub = silica_slab(6, 2, thickness=4.0, seed=5)
+    a = silica_slab(3, 3, face="001", thickness=8.0, seed=1)
+    b = silica_slab(3, 3, face="001", thickness=8.0, seed=2)
+    asp = silica_asperity(radius=10.0, holder_thickness=4.0, margin=4.0, face="001", seed=3)
+    flat = silica_slab(4, 4, face="001", thickness=4.0, seed=4)
+    sub = silica_slab(13, 2, thickness=4.0, seed=5)                  # the default face: (111), Q3
     sam = ots_sam(silica_slab(3, 2, face="111", thickness=4.0, seed=8), seed=9)
     counter = silica_slab(3, 2, face="111", thickness=4.0, seed=10)
     return {
         "work_of_adhesion": place_on(a, flip_upside_down(b), gap=3.0),
         "pull_off": place_on(flat, flip_upside_down(asp), gap=4.0),
-        "contact_angle": place_on(sub, water_cylinder(11.0, sub.cell[1], seed=6), gap=2.5),
+        "contact_angle": place_on(sub, water_cap(11.0, sub.cell[1], contact_angle_deg=40.0, seed=6), gap=3.0),
         "gamma_lv": water_slab(20.0, 20.0, 20.0, seed=7),
         "sam_adhesion": place_on(sam, flip_upside_down(counter), gap=3.0),
     }
@@ -495,7 +515,7 @@ def test_quick_cutoff_check_and_condensed_bridges_relax(needs_lammps, tmp_path):
     from md.lammps_data import lammps_setup_commands
     from md.lammps_loader import new_lammps
 
-    s = silica_slab(2, 2, thickness=4.0, seed=3)
+    s = silica_slab(2, 2, face="001", thickness=4.0, seed=3)          # (001): condensation bridges
     ff = silica_forcefield()
     path = write_data(s, ff, tmp_path / "slab.data")
     rb = read_back_check(path, ff, pair="cut")
