@@ -29,9 +29,12 @@ pulloff
     scan branches several retractions from the same held contact and extrapolates
     (:func:`md.analysis.rate_extrapolation`).
 contact_angle
-    A cylindrical SPC/E droplet (periodic along y) on silica (the substrate fixed) or on an OTS monolayer
-    (silica fixed, chains mobile); water rigid (SHAKE). Water-oxygen configurations ->
-    :class:`md.analysis.ContactAngle` through an in-memory MDAnalysis universe.
+    A cylindrical droplet (periodic along y) on (111) silica with isolated Q3 silanols or on an OTS monolayer.
+    The substrate is minimised with nothing held, then only its deep Si and bridging O are held (silanol O-H by
+    SHAKE) and it is equilibrated alone; the water is added as a cylindrical cap near its expected angle; water
+    rigid (SHAKE). Water-oxygen configurations -> :class:`md.analysis.ContactAngle` (an in-memory MDAnalysis
+    universe): the angle at the water's own dividing plane, W_SL = gamma_lv (1 + cos theta), a drift test of
+    the block angles, and "wets" with an upper bound on the angle when the water spreads into a film.
 surface_tension
     A free-standing SPC/E film; gamma = Lz/2 (<Pzz> - (<Pxx> + <Pyy>)/2) from the LAMMPS pressure tensor
     (:func:`md.analysis.surface_tension`) with the analytic LJ tail correction for the truncated LJ term
