@@ -4,7 +4,8 @@ Runs one MD recipe (``inputs/md/*.toml``, or a recipe name such as ``adhesion_si
 :func:`md.runner.run_recipe`, prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
 into ``--out``. Exit codes (``nanoimpact.errors``): 0 done (or reused from the cache), 1 LAMMPS failed (message
 and the last lines of its log on stderr; no result.json is written), 2 invalid recipe or arguments (one line),
-3 LAMMPS not installed (one line), 130 interrupted (Ctrl-C; continue with ``--resume``).
+3 LAMMPS not installed (one line), 75 the same run is in progress in another process and ``--no-wait`` was
+given (one line), 130 interrupted (Ctrl-C; continue with ``--resume``).
 
 The command-line plumbing every command shares (one-line usage errors, -v/-q, the logging handler, option
 checks) is :mod:`nanoimpact.cli`.
@@ -40,7 +41,8 @@ def build_parser() -> argparse.ArgumentParser:
                "folder, --data or $NANOIMPACT_DATA). Results are cached by a hash of the recipe, "
                "fidelity, force-field files, package and LAMMPS versions under --cache (default "
                "$NANOIMPACT_CACHE or ~/.cache/nanoimpact/md); a finished run is reused, not repeated. "
-               "Exit codes: 0 done, 1 LAMMPS failed, 2 invalid input, 3 LAMMPS missing, 130 interrupted.")
+               "Exit codes: 0 done, 1 LAMMPS failed, 2 invalid input, 3 LAMMPS missing, 75 run busy (--no-wait), "
+               "130 interrupted.")
     p.add_argument("recipe", help="recipe file (inputs/md/adhesion_silica.toml) or name (adhesion_silica)")
     p.add_argument("--fidelity", choices=("smoke", "quick", "production"), default="quick",
                    help="size and length preset from the recipe (default: quick, about an hour on 2 cores; "
