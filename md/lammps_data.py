@@ -59,6 +59,12 @@ def write_data(system: System, forcefield: ForceField, path: str | Path, *, titl
     (build systems with :func:`md.topology.with_bonded_terms`); otherwise KeyError names the missing one.
     Periodic axes are wrapped into the box [0, L). The first line records the force-field name and the
     periodicity (``boundary p p f``), which :func:`read_back_check` reads.
+
+    No image flags are written (LAMMPS takes them as 0). LAMMPS evaluates bonds, angles and dihedrals between
+    the closest images, so a bond across a periodic boundary needs none; it only warns "Inconsistent image
+    flags" for such bonds. For a slab bonded across x and y the warning cannot be avoided: a bond path around
+    the box adds up to a box length, so no image flags make every bond's unwrapped length its minimum-image
+    length. (tests/test_md_substrate_start.py checks that every bond is at its length under minimum image.)
     """
     path = Path(path)
     ids = lammps_type_ids(forcefield)
