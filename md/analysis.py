@@ -33,7 +33,9 @@ from md import units as _units
 
 __all__ = [
     "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M", "WATER_MOLAR_MASS",
-    "block_average", "block_analysis",
+    "block_average", "block_analysis", "statistical_inefficiency", "detect_equilibration", "timeseries_stats",
+    "force_integration_work", "registry_average", "traction_peak", "flat_slab_range", "lj_tail_between",
+    "MAUGIS_LJ93",
     "energy_separation_work", "work_from_energy_curve",
     "ContactAngle", "fit_contact_angle", "fit_circle", "dividing_plane", "wetting_bound", "block_drift",
     "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height",
@@ -107,40 +109,160 @@ def block_analysis(x, min_blocks: int = 4) -> dict:
             "stderr_error": derrs_a, "stderr_plateau": plateau}
 
 
+# ----------------------------------------------------------------------------- statistical inefficiency
+#
+# Chodera, "A simple method for automated equilibration detection in molecular simulations", J. Chem. Theory
+# Comput. 12 (2016) 1799, the estimators of pymbar.timeseries (statisticalInefficiency, detectEquilibration),
+# written here with an FFT autocovariance so that pymbar is not a dependency. Every MD quantity's stderr goes
+# through timeseries_stats (or, for a derived quantity, through the stderrs it returns), not fixed block counts.
+
+def _autocorrelation(x: np.ndarray) -> np.ndarray:
+    """Normalised autocorrelation C(t) = <dx_i dx_{i+t}>_{i < N-t} / var, t = 0 .. N-1 (FFT, zero padded)."""
+    n = x.size
+    dx = x - x.mean()
+    var = float(dx @ dx) / n
+    size = 1 << int(2 * n - 1).bit_length()
+    f = np.fft.rfft(dx, size)
+    acov = np.fft.irfft(f * np.conj(f), size)[:n] / np.arange(n, 0, -1)
+    return acov / var
+
+
+def statistical_inefficiency(x, mintime: int = 3) -> float:
+    """Statistical inefficiency g of a stationary series (Chodera 2016, eq. 7; pymbar.timeseries):
+
+        g = 1 + 2 sum_{t=1}^{N-1} (1 - t/N) C(t),
+
+    the sum truncated at the first t > ``mintime`` with C(t) <= 0 (beyond it C(t) is noise), g >= 1. The number
+    of effectively uncorrelated samples is N/g and the integrated autocorrelation time (tau = (g - 1)/2) in
+    sample intervals. A constant series (zero variance) has g = 1.
+    """
+    x = np.asarray(x, float).ravel()
+    n = x.size
+    if n < 2:
+        return 1.0
+    if not float(np.ptp(x)) > 0.0:
+        return 1.0
+    c = _autocorrelation(x)
+    t = np.arange(1, n - 1)
+    stop = np.flatnonzero((c[1:n - 1] <= 0.0) & (t > mintime))
+    end = int(stop[0]) if stop.size else t.size
+    g = 1.0 + 2.0 * float(np.sum((1.0 - t[:end] / n) * c[1:end + 1]))
+    return max(1.0, g)
+
+
+def detect_equilibration(x, nskip: int | None = None, min_samples: int = 10) -> dict:
+    """Automated equilibration detection (Chodera 2016, pymbar.timeseries.detectEquilibration): the start t0
+    that maximises the effective number of uncorrelated samples N_eff(t0) = (N - t0) / g(t0) of the production
+    part x[t0:]. ``nskip``: candidate starts every nskip samples (default: about 100 candidates); at least
+    ``min_samples`` are kept. Returns ``t0``, ``g`` (of x[t0:]) and ``n_eff``."""
+    x = np.asarray(x, float).ravel()
+    n = x.size
+    if n < 2:
+        return {"t0": 0, "g": 1.0, "n_eff": float(n)}
+    step = max(1, n // 100) if nskip is None else max(1, int(nskip))
+    best = (0, 1.0, -1.0)
+    for t0 in range(0, max(1, n - max(2, min_samples) + 1), step):
+        g = statistical_inefficiency(x[t0:])
+        ne = (n - t0) / g
+        if ne > best[2]:
+            best = (t0, g, ne)
+    return {"t0": int(best[0]), "g": float(best[1]), "n_eff": float(best[2])}
+
+
+def timeseries_stats(x, *, equilibrate: bool = True, mintime: int = 3) -> dict:
+    """Mean of a correlated series and its standard error from the statistical inefficiency (Chodera 2016).
+
+    With ``equilibrate`` the start is chosen by :func:`detect_equilibration` (the samples before t0 are discarded
+    as not yet equilibrated); then ``stderr = sqrt(var(x[t0:], ddof=1) g / (N - t0))``. Returns ``mean``,
+    ``stderr``, ``g`` (statistical inefficiency), ``tau`` ((g - 1)/2, sample intervals), ``t0`` (first sample
+    used), ``n`` (samples used), ``n_eff`` and ``std``. A series of one sample has an undefined (nan) stderr.
+    """
+    x = np.asarray(x, float).ravel()
+    if x.size == 0:
+        raise ValueError("empty series")
+    t0 = detect_equilibration(x)["t0"] if equilibrate and x.size >= 4 else 0
+    y = x[t0:]
+    n = y.size
+    g = statistical_inefficiency(y, mintime)
+    if n < 2:
+        return {"mean": float(y.mean()), "stderr": float("nan"), "g": 1.0, "tau": 0.0, "t0": t0, "n": n,
+                "n_eff": float(n), "std": float("nan")}
+    sd = float(y.std(ddof=1))
+    return {"mean": float(y.mean()), "stderr": sd * math.sqrt(g / n), "g": g, "tau": 0.5 * (g - 1.0), "t0": t0,
+            "n": n, "n_eff": n / g, "std": sd}
+
+
 # ------------------------------------------------------------------------------------ works of adhesion
 
 _ENERGY_NOTE = ("interaction energy per area, not a free energy (entropic contribution neglected)")
 
 
-def energy_separation_work(e_contact_kcal, e_separated_kcal, area_A2: float, n_blocks: int = 5) -> dict:
+def energy_separation_work(e_contact_kcal, e_separated_kcal, area_A2: float, n_blocks: int | None = None) -> dict:
     """Work of separation from two equilibrium runs: W = (<E_sep> - <E_contact>) / A (J/m^2).
 
     ``e_contact_kcal`` and ``e_separated_kcal`` are time series of the potential energy (kcal/mol) of the
     same system in contact and pulled apart; ``area_A2`` is the contact area in A^2 (both interfaces'
-    area if the cell has two).  The two block errors (:func:`block_average`) are combined in quadrature.
+    area if the cell has two). Each mean and its stderr come from :func:`timeseries_stats` (automated
+    equilibration detection and the statistical inefficiency, Chodera 2016); the two are combined in quadrature.
+    ``n_blocks`` (optional) adds the old fixed-block estimate as ``stderr_blocks`` for comparison only.
     This is an energy, not a free energy: the entropic part of the work of adhesion is neglected.
     """
     area = float(area_A2)
     if not area > 0:
         raise ValueError(f"area_A2 must be positive, got {area_A2}")
-    mc, sc = block_average(e_contact_kcal, n_blocks)
-    ms, ss = block_average(e_separated_kcal, n_blocks)
+    c, s_ = timeseries_stats(e_contact_kcal), timeseries_stats(e_separated_kcal)
+    mc, sc, ms, ss = c["mean"], c["stderr"], s_["mean"], s_["stderr"]
     f = KCALMOL_PER_A2_TO_J_PER_M2 / area
-    return {"value": (ms - mc) * f, "stderr": math.hypot(sc, ss) * f, "units": "J/m^2",
-            "note": _ENERGY_NOTE, "e_contact_kcal": mc, "e_separated_kcal": ms,
-            "e_contact_stderr_kcal": sc, "e_separated_stderr_kcal": ss, "area_A2": area}
+    out = {"value": (ms - mc) * f, "stderr": math.hypot(sc, ss) * f, "units": "J/m^2",
+           "note": _ENERGY_NOTE, "e_contact_kcal": mc, "e_separated_kcal": ms,
+           "e_contact_stderr_kcal": sc, "e_separated_stderr_kcal": ss, "area_A2": area,
+           "contact_stats": {k: c[k] for k in ("g", "t0", "n", "n_eff")},
+           "separated_stats": {k: s_[k] for k in ("g", "t0", "n", "n_eff")}}
+    if n_blocks:
+        out["stderr_blocks"] = math.hypot(block_average(e_contact_kcal, n_blocks)[1],
+                                          block_average(e_separated_kcal, n_blocks)[1]) * f
+    return out
+
+
+def _zero_crossing(d: np.ndarray, f: np.ndarray) -> int | None:
+    """Index j of the repulsive-to-attractive crossing that bounds the adhesive well: f[j] >= 0 > f[j+1], the
+    last such crossing before the most attractive window; None if no window before the well is repulsive."""
+    i_min = int(np.argmin(f))
+    js = np.flatnonzero((f[:-1] >= 0.0) & (f[1:] < 0.0))
+    js = js[js < i_min] if i_min > 0 else js[:0]
+    return int(js[-1]) if js.size else None
+
+
+def _trapezoid_from(d: np.ndarray, f: np.ndarray, j: int | None) -> tuple[float, float]:
+    """(-integral of f from the zero crossing of segment j -- or from d[0] if j is None -- to d[-1], start)."""
+    if j is None:
+        return -float(np.sum(0.5 * np.diff(d) * (f[1:] + f[:-1]))), float(d[0])
+    den = f[j] - f[j + 1]
+    start = float(d[j] + (d[j + 1] - d[j]) * (f[j] / den if den != 0 else 0.0))
+    area = 0.5 * (d[j + 1] - start) * f[j + 1]
+    k = slice(j + 1, None)
+    area += float(np.sum(0.5 * np.diff(d[k]) * (f[k][1:] + f[k][:-1])))
+    return -area, start
 
 
 def force_integration_work(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA,
-                           area_A2: float) -> dict:
+                           area_A2: float, from_zero_crossing: bool = True) -> dict:
     """Free energy of separation by thermodynamic integration of the mean force over separation (J/m^2).
 
-    W_F = -(1/A) integral <F_z> dd from the first to the last window, with ``mean_force`` the force on the upper
-    body along +z (attraction negative) at each held separation ``separation_A`` (A, any order). ``value`` uses
-    the trapezoid rule and ``stderr`` propagates the windows' statistical errors through its weights.
-    ``value_pchip`` integrates the shape-preserving cubic (PCHIP, Fritsch & Carlson, SIAM J. Numer. Anal. 17
-    (1980) 238) through the same points; ``discretisation_error`` = |trapezoid - PCHIP| estimates what the window
-    grid misses (two quadratures of different order agree when the grid resolves the force curve).
+    W_F = -(1/A) integral <F_z> dd from the bottom of the adhesive well to the last window, with ``mean_force``
+    the force on the upper body along +z (repulsion positive, attraction negative) at each held separation
+    ``separation_A`` (A, any order). The bottom of the well is where the mean force changes sign from repulsive
+    to attractive (linear interpolation between the two windows around it: the PMF's minimum, the equilibrium
+    contact at zero load). The grid must therefore reach into compression: ``repulsive_end`` is False when no
+    window before the most attractive one is repulsive -- then the integral starts at the first window and
+    misses part of the well (a lower bound); ``from_zero_crossing=False`` always integrates the whole grid.
+
+    ``value`` uses the trapezoid rule and ``stderr`` propagates the windows' statistical errors through it
+    (linearised: the start point moves with the forces, at zero force). ``value_pchip`` integrates the
+    shape-preserving cubic (PCHIP, Fritsch & Carlson, SIAM J. Numer. Anal. 17 (1980) 238) over the same range;
+    ``discretisation_error`` = |trapezoid - PCHIP| estimates what the window grid misses (two quadratures of
+    different order agree when the grid resolves the force curve). ``pmf_J_per_m2``: the PMF at each window
+    relative to the well's bottom; ``cumulative_J_per_m2``: -integral from the first window.
     """
     from scipy.interpolate import PchipInterpolator
 
@@ -156,16 +278,193 @@ def force_integration_work(separation_A, mean_force_kcal_per_molA, force_stderr_
     d, f, e = d[order], f[order], e[order]
     if np.any(np.diff(d) <= 0):
         raise ValueError("two windows at the same separation")
-    w = np.zeros_like(d)
-    w[:-1] += 0.5 * np.diff(d)
-    w[1:] += 0.5 * np.diff(d)
+    j = _zero_crossing(d, f) if from_zero_crossing else None
     conv = KCALMOL_PER_A2_TO_J_PER_M2 / area
-    trap = -float(np.sum(w * f)) * conv
-    err = float(np.sqrt(np.sum((w * e) ** 2))) * conv
-    pchip = -float(PchipInterpolator(d, f).integrate(d[0], d[-1])) * conv if d.size >= 3 else trap
+    w_kcal, start = _trapezoid_from(d, f, j)
+    # linear error propagation: dW/df_k by central differences (exact for the piecewise-linear rule)
+    grad = np.zeros_like(f)
+    for k in range(f.size):
+        h = 1e-6 * max(abs(f[k]), float(np.max(np.abs(f))), 1e-12)
+        fp, fm = f.copy(), f.copy()
+        fp[k] += h
+        fm[k] -= h
+        grad[k] = (_trapezoid_from(d, fp, j)[0] - _trapezoid_from(d, fm, j)[0]) / (2 * h)
+    err = float(np.sqrt(np.sum((grad * e) ** 2))) * conv
+    trap = w_kcal * conv
+    pchip = -float(PchipInterpolator(d, f).integrate(start, d[-1])) * conv if d.size >= 3 else trap
     cumulative = -np.concatenate([[0.0], np.cumsum(0.5 * np.diff(d) * (f[1:] + f[:-1]))]) * conv
+    # PMF relative to the well's bottom: cumulative minus its (interpolated) value at the start
+    # (the trapezoid value at the crossing, where f = 0; the first window without a crossing)
+    c_start = float(cumulative[j]) - 0.5 * (start - d[j]) * f[j] * conv if j is not None else 0.0
     return {"value": trap, "stderr": err, "value_pchip": pchip, "discretisation_error": abs(trap - pchip),
-            "units": "J/m^2", "separation_A": d, "cumulative_J_per_m2": cumulative}
+            "units": "J/m^2", "separation_A": d, "cumulative_J_per_m2": cumulative,
+            "pmf_J_per_m2": cumulative - c_start, "repulsive_end": j is not None,
+            "zero_force_separation_A": start if j is not None else float("nan"), "start_A": start}
+
+
+# ------------------------------------------------------------------------ flat-slab force curves: z0, sigma0
+
+#: Maugis (1992) for the LJ 9-3 traction law: sigma0 = (16 / (9 sqrt 3)) w / z0 = 1.0264 w / z0
+MAUGIS_LJ93 = 16.0 / (9.0 * math.sqrt(3.0))
+
+
+def registry_average(values, stderrs) -> dict:
+    """Average over lateral registries of quantities measured at the same points.
+
+    ``values``, ``stderrs``: shape (n_registries,) for one quantity or (n_registries, n_points) for a curve.
+    The registries sample the lateral offset of two crystalline faces; an incommensurate contact averages over
+    all of them, so the mean over registries is the estimate and their spread is part of its error:
+    ``stderr = max(std over registries / sqrt(n), sqrt(sum stderr^2) / n)`` -- the first is the random-effects
+    error (it carries the registries' own statistical noise too), the second guards it when two or three
+    registries agree by chance. One registry: its own stderr.
+    Returns ``mean``, ``stderr``, ``stderr_statistical``, ``registry_spread`` (std, ddof 1) and ``n``.
+    """
+    scalar = np.ndim(values) == 1
+    v = np.asarray(values, float).reshape(len(values), -1)
+    e = np.asarray(stderrs, float).reshape(v.shape)
+    n = v.shape[0]
+    mean = v.mean(axis=0)
+    stat = np.sqrt(np.sum(e ** 2, axis=0)) / n
+    spread = v.std(axis=0, ddof=1) if n >= 2 else np.zeros_like(mean)
+    err = np.maximum(spread / math.sqrt(n), stat)
+    pick = (lambda a: float(a[0])) if scalar else (lambda a: a)
+    return {"mean": pick(mean), "stderr": pick(err), "stderr_statistical": pick(stat),
+            "registry_spread": pick(spread), "n": int(n)}
+
+
+def traction_peak(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA, area_A2: float) -> dict:
+    """Peak tensile traction sigma0 (Pa) of a flat-slab mean-force curve, with its standard error.
+
+    A quadratic through the three windows around the most attractive one gives the peak (its vertex); its stderr
+    follows from the windows' stderrs by the delta method (the fit is exact, so the covariance is the noise's
+    alone). ``discretisation_error`` = |3-point - 5-point (weighted least squares) vertex| estimates what the grid
+    misses, as the trapezoid-PCHIP difference does for W. If the parabola opens downwards or its vertex lies outside
+    the windows used, the most attractive window itself is taken (``method = 'window'``: on a coarse grid that
+    underestimates the peak). Returns ``sigma0`` (Pa, > 0 for tension), ``stderr``, ``discretisation_error``,
+    ``separation_A`` (of the peak) and ``method``.
+    """
+    d = np.asarray(separation_A, float).ravel()
+    f = np.asarray(mean_force_kcal_per_molA, float).ravel()
+    e = np.asarray(force_stderr_kcal_per_molA, float).ravel()
+    order = np.argsort(d)
+    d, f, e = d[order], f[order], e[order]
+    area = float(area_A2)
+    i = int(np.argmin(f))
+    if not f[i] < 0:
+        raise ValueError("no attractive window: the curve has no tensile peak")
+    to_pa = lambda x: float(_units.kcal_per_mol_A3_to_Pa(x / area))
+
+    def vertex(m):
+        if d.size < m:
+            return None
+        lo = min(max(0, i - m // 2), d.size - m)
+        sel = slice(lo, lo + m)
+        x, y = d[sel] - d[i], f[sel]
+        s = np.where(e[sel] > 0, e[sel], 1.0)
+        a = np.column_stack([np.ones_like(x), x, x * x]) / s[:, None]
+        coef, *_ = np.linalg.lstsq(a, y / s, rcond=None)
+        c0, c1, c2 = coef
+        if not c2 > 0 or not (x.min() <= -c1 / (2 * c2) <= x.max()):
+            return None
+        cov = np.linalg.inv(a.T @ a)
+        g = np.array([1.0, -c1 / (2 * c2), c1 * c1 / (4 * c2 * c2)])
+        return c0 - c1 * c1 / (4 * c2), math.sqrt(max(float(g @ cov @ g), 0.0)), float(d[i] - c1 / (2 * c2))
+
+    v3, v5 = vertex(3), vertex(5)
+    if v3 is None:
+        return {"sigma0": to_pa(-f[i]), "stderr": to_pa(e[i]), "discretisation_error": float("nan"),
+                "separation_A": float(d[i]), "method": "window"}
+    disc = to_pa(abs(v3[0] - v5[0])) if v5 is not None else float("nan")
+    return {"sigma0": to_pa(-v3[0]), "stderr": to_pa(v3[1]), "discretisation_error": disc,
+            "separation_A": v3[2], "method": "quadratic"}
+
+
+def flat_slab_range(work_J_per_m2: float, work_stderr: float, sigma0_Pa: float, sigma0_stderr: float) -> dict:
+    """Interaction range z0 (m) that makes the LJ 9-3 law carry the measured work W and peak traction sigma0
+    (Maugis, J. Colloid Interface Sci. 150 (1992) 243): z0 = (16 / (9 sqrt 3)) W / sigma0 = 1.0264 W / sigma0, and
+    the Dugdale range h0 = W / sigma0. The stderr combines the two relative errors in quadrature (their
+    correlation -- both come from the same windows -- is neglected, which overstates the error)."""
+    w, s = float(work_J_per_m2), float(sigma0_Pa)
+    if not (w > 0 and s > 0):
+        raise ValueError(f"need W > 0 and sigma0 > 0, got W = {w:g} J/m^2, sigma0 = {s:g} Pa")
+    z0 = MAUGIS_LJ93 * w / s
+    rel = math.hypot((work_stderr or 0.0) / w, (sigma0_stderr or 0.0) / s)
+    return {"z0": z0, "stderr": z0 * rel, "h0": w / s, "h0_stderr": w / s * rel}
+
+
+# ------------------------------------------------------------------------ dispersion beyond the cutoff
+
+def lj_tail_between(pos_a, types_a, pos_b, types_b, epsilon, sigma, include, cell_xy, r_cut_A: float,
+                    r_max_A: float = 30.0, smeared_beyond: bool = True) -> dict:
+    """Lennard-Jones interaction beyond the cutoff between two groups of atoms, A below and B above (kcal/mol).
+
+    The dynamics truncate LJ at ``r_cut_A`` (``lj/cut``: not shifted); what a full sum adds is
+    U_tail = sum over pairs with r > r_cut of 4 eps [(s/r)^12 - (s/r)^6]. Pairs with r_cut < r <= ``r_max_A`` are
+    summed explicitly, over every periodic image in x and y (``cell_xy``; z is not periodic); beyond r_max the
+    images are smeared into a uniform layer per pair (density 1 / cell area), which gives the closed form
+    -pi C6 / (2 A max(r_max, |dz|)^4) per pair with C6 = 4 eps s^6 (and its z-derivative for the force).
+    ``types_*`` are integer indices into the (T, T) arrays ``epsilon``, ``sigma`` (kcal/mol, A) and the boolean
+    ``include`` (the pairs to count). Positions in A, any wrapping in x, y.
+
+    Returns ``energy`` (kcal/mol), ``force_z`` (on B along +z, kcal/mol/A; negative = attraction), the explicit
+    and smeared parts of both, and ``pairs`` (explicit pair count).
+    """
+    from scipy.spatial import cKDTree
+
+    pa, pb = np.asarray(pos_a, float).reshape(-1, 3), np.asarray(pos_b, float).reshape(-1, 3)
+    ta, tb = np.asarray(types_a, int).ravel(), np.asarray(types_b, int).ravel()
+    eps, sig, inc = np.asarray(epsilon, float), np.asarray(sigma, float), np.asarray(include, bool)
+    lx, ly = float(cell_xy[0]), float(cell_xy[1])
+    rc, rm = float(r_cut_A), float(r_max_A)
+    if not rm > rc:
+        raise ValueError(f"r_max_A ({rm}) must exceed r_cut_A ({rc})")
+    # only atoms that have an included partner type on the other side
+    ka = np.isin(ta, np.flatnonzero(inc[:, np.unique(tb)].any(axis=1))) if tb.size else np.zeros(ta.size, bool)
+    kb = np.isin(tb, np.flatnonzero(inc[np.unique(ta), :].any(axis=0))) if ta.size else np.zeros(tb.size, bool)
+    pa, ta, pb, tb = pa[ka], ta[ka], pb[kb], tb[kb]
+    out = {"energy": 0.0, "force_z": 0.0, "energy_explicit": 0.0, "force_z_explicit": 0.0,
+           "energy_smeared": 0.0, "force_z_smeared": 0.0, "pairs": 0}
+    if not (pa.size and pb.size):
+        return out
+    pa = pa.copy()
+    pb = pb.copy()
+    pa[:, 0] %= lx
+    pa[:, 1] %= ly
+    pb[:, 0] %= lx
+    pb[:, 1] %= ly
+    nx, ny = int(math.ceil(rm / lx)) + 1, int(math.ceil(rm / ly)) + 1
+    shifts = np.array([(i * lx, j * ly, 0.0) for i in range(-nx, nx + 1) for j in range(-ny, ny + 1)])
+    # every image of B within r_max of the primary cell (laterally), in one tree
+    img = (pb[None, :, :] + shifts[:, None, :]).reshape(-1, 3)
+    src = np.tile(np.arange(pb.shape[0]), len(shifts))
+    near = (img[:, 0] > -rm) & (img[:, 0] < lx + rm) & (img[:, 1] > -rm) & (img[:, 1] < ly + rm)
+    img, src = img[near], src[near]
+    res = cKDTree(pa).sparse_distance_matrix(cKDTree(img), rm, output_type="ndarray")
+    i, j, r = res["i"], src[res["j"]], res["v"]
+    keep = (r > rc) & inc[ta[i], tb[j]]
+    i, jj, j, r = i[keep], res["j"][keep], j[keep], r[keep]
+    e_ij, s_ij = eps[ta[i], tb[j]], sig[ta[i], tb[j]]
+    sr6 = (s_ij / r) ** 6
+    e_exp = float(np.sum(4.0 * e_ij * (sr6 * sr6 - sr6)))
+    # force on b along z: -dU/dr * (z_b - z_a) / r
+    dudr = 4.0 * e_ij * (-12.0 * sr6 * sr6 + 6.0 * sr6) / r
+    f_exp = float(np.sum(-dudr * (img[jj, 2] - pa[i, 2]) / r))
+    n_pairs = int(r.size)
+    e_sm = f_sm = 0.0
+    if smeared_beyond:
+        area = lx * ly
+        c6 = 4.0 * eps * sig ** 6 * inc
+        for k in range(0, pa.shape[0], 2048):
+            dz = pb[None, :, 2] - pa[k:k + 2048, None, 2]
+            c = c6[ta[k:k + 2048, None], tb[None, :]]
+            h = np.maximum(np.abs(dz), rm)
+            e_sm += float(np.sum(-math.pi * c / (2.0 * area * h ** 4)))
+            # d/d(dz) of -pi C6 / (2 A dz^4) for |dz| > r_max; force on b = -dU/d(dz)
+            far = np.abs(dz) > rm
+            f_sm += float(np.sum(np.where(far, -2.0 * math.pi * c * np.sign(dz) / (area * h ** 5), 0.0)))
+    out.update(energy=e_exp + e_sm, force_z=f_exp + f_sm, energy_explicit=e_exp, force_z_explicit=f_exp,
+               energy_smeared=e_sm, force_z_smeared=f_sm, pairs=n_pairs)
+    return out
 
 
 def _refined_min(x, y, i):
@@ -697,12 +996,14 @@ else:  # pragma: no cover
 # ------------------------------------------------------------------------------------ surface tension
 
 def surface_tension(pxx_atm, pyy_atm, pzz_atm, lz_A, tail_correction_N_per_m: float = 0.0,
-                    n_blocks: int = 5) -> dict:
+                    n_blocks: int | None = None) -> dict:
     """Liquid-vapour surface tension of a slab with two interfaces normal to z (Kirkwood-Buff 1949).
 
     gamma = (Lz / 2) (<Pzz> - (<Pxx> + <Pyy>) / 2), pressures in atm (LAMMPS real), ``lz_A`` in A (a
-    number or a series like the pressures).  The instantaneous gamma(t) is block-averaged, so
-    correlations between the components enter the error.  ``tail_correction_N_per_m`` (e.g. from
+    number or a series like the pressures).  The mean of the instantaneous gamma(t) and its stderr come from
+    :func:`timeseries_stats` (automated equilibration detection and the statistical inefficiency, Chodera
+    2016), so correlations between the components enter the error; ``n_blocks`` (optional) adds the old
+    fixed-block estimate as ``stderr_blocks`` for comparison only.  ``tail_correction_N_per_m`` (e.g. from
     :func:`lj_tail_correction`) is added to ``value``; ``value_uncorrected`` omits it.
     """
     pxx, pyy, pzz = (np.asarray(p, float).ravel() for p in (pxx_atm, pyy_atm, pzz_atm))
@@ -710,10 +1011,14 @@ def surface_tension(pxx_atm, pyy_atm, pzz_atm, lz_A, tail_correction_N_per_m: fl
         raise ValueError("pressure series must have the same length")
     lz = np.broadcast_to(np.asarray(lz_A, float), pxx.shape)
     g = 0.5 * lz * (pzz - 0.5 * (pxx + pyy)) * ATM_A_TO_N_PER_M
-    mean, err = block_average(g, n_blocks)
+    st = timeseries_stats(g)
+    mean, err = st["mean"], st["stderr"]
     tail = float(tail_correction_N_per_m)
-    return {"value": mean + tail, "stderr": err, "tail_correction": tail, "value_uncorrected": mean,
-            "units": "N/m"}
+    out = {"value": mean + tail, "stderr": err, "tail_correction": tail, "value_uncorrected": mean,
+           "units": "N/m", "statistical_inefficiency": st["g"], "t0": st["t0"], "n_eff": st["n_eff"]}
+    if n_blocks:
+        out["stderr_blocks"] = block_average(g, n_blocks)[1]
+    return out
 
 
 def lj_tail_correction(epsilon_kcal: float, sigma_A: float, rho_liquid_per_A3: float, r_cut_A: float,
@@ -847,7 +1152,7 @@ def _law(kind):
     raise ValueError(f"unknown traction law {kind!r}: use 'lj93' or 'sphere_lj93'")
 
 
-def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> dict:
+def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False, force_stderr=None) -> dict:
     """Fit an LJ-type force-separation law (positive = repulsive) to (sep, force) in consistent units.
 
     ``kind="lj93"``: the LJ 9-3 traction law (Maugis 1992)
@@ -862,8 +1167,12 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
     between atom centres, not from the law's origin).  Points with F > 3 |F_min| (the stiff repulsive
     wall) are left out so they do not dominate the least squares.
 
+    ``force_stderr`` (per point) weights the least squares by 1/stderr.
+
     Returns ``kind``, ``params`` (w or Fc, z0, offset), ``z0``, ``w`` (None for sphere_lj93), ``peak``
-    (magnitude of the most tensile force of the law), ``sep_at_peak``, ``h0_maugis`` (lj93), ``rms``.
+    (magnitude of the most tensile force of the law), ``sep_at_peak``, ``h0_maugis`` (lj93), ``rms`` and
+    ``stderr`` (of ``params``, ``z0`` and ``peak``) from the fit's covariance inv(J^T J), scaled by the residual
+    variance (unweighted) or by max(1, reduced chi^2) (weighted); nan when the fit has no degrees of freedom.
     """
     from scipy.optimize import least_squares
 
@@ -871,6 +1180,7 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
     f = np.asarray(force, float).ravel()
     order = np.argsort(d)
     d, f = d[order], f[order]
+    sd = None if force_stderr is None else np.asarray(force_stderr, float).ravel()[order]
     shape = _law(kind)
     i = int(np.argmin(f))
     fmin, dmin = float(f[i]), float(d[i])
@@ -890,6 +1200,7 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
             raise ValueError("separations must be positive when the law's origin is not fitted (offset=False)")
         d0, scale = 0.0, dmin
     ds, fs = (d[use] - d0) / scale, f[use] / abs(fmin)
+    ws = np.ones_like(fs) if sd is None else abs(fmin) / np.maximum(sd[use], 1e-300)
     peak_x = _LJ93_PEAK if kind == "lj93" else 1.0
     peak_val = -float(shape(np.array(peak_x)))       # |shape| at its minimum
 
@@ -899,7 +1210,7 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
         return amp * shape(h / z0)
 
     def res(p):
-        return model(p, ds) - fs
+        return (model(p, ds) - fs) * ws
 
     best = None
     offs = (-0.2, -0.5, -1.0, -2.0) if offset else (0.0,)
@@ -919,15 +1230,31 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False) -> di
         raise RuntimeError("traction-law fit failed")
     amp, z0 = best.x[0] * abs(fmin), best.x[1] * scale
     off = d0 + best.x[2] * scale if offset else 0.0
-    rms = float(np.sqrt(np.mean(best.fun ** 2))) * abs(fmin)
+    rms = float(np.sqrt(np.mean((best.fun / ws) ** 2))) * abs(fmin)
+    # covariance of (amp, z0[, offset]) in physical units
+    npar, m = len(best.x), int(ds.size)
+    dof = m - npar
+    try:
+        cov = np.linalg.inv(best.jac.T @ best.jac)
+        chi2 = float(np.sum(best.fun ** 2)) / dof if dof > 0 else float("nan")
+        cov = cov * (chi2 if sd is None else max(1.0, chi2))
+        cov = cov * np.outer(*(2 * [np.array([abs(fmin), scale, scale][:npar])]))
+    except np.linalg.LinAlgError:
+        cov = np.full((npar, npar), np.nan)
+    se = lambda g: float(math.sqrt(g @ cov @ g)) if np.all(np.isfinite(cov)) and g @ cov @ g >= 0 else float("nan")
+    g_amp, g_z0 = np.eye(npar)[0], np.eye(npar)[1]
     out = {"kind": kind, "z0": float(z0), "offset": float(off), "rms": rms,
-           "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0)}
+           "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0), "dof": dof}
+    stderr = {"z0": se(g_z0), "offset": se(np.eye(npar)[2]) if offset else 0.0, "peak": se(g_amp) * peak_val}
     if kind == "lj93":
         w = amp * 3.0 * z0 / 8.0
+        stderr["w"] = se(3.0 / 8.0 * (z0 * g_amp + amp * g_z0))
         out.update(w=float(w), params={"w": float(w), "z0": float(z0), "offset": float(off)},
                    h0_maugis=float(w / (amp * peak_val)))
     else:
+        stderr["Fc"] = se(g_amp)
         out.update(w=None, params={"Fc": float(amp), "z0": float(z0), "offset": float(off)})
+    out["stderr"] = stderr
     return out
 
 
@@ -981,6 +1308,7 @@ def pull_off_analysis(separation_A, force_kcal_per_molA, smooth: int | None = No
         fit = {"error": str(exc), "z0": float("nan")}
     out["traction_fit"] = fit
     out["z0"] = fit["z0"]
+    out["z0_stderr"] = fit.get("stderr", {}).get("z0", float("nan"))
     if radius_m is not None:
         fmag = out["max_tensile_force"]
         out["eff_work_jkr"] = fmag / (1.5 * math.pi * float(radius_m))

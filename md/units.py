@@ -24,6 +24,8 @@ LAMMPS real             SI                                    function
 kcal/mol                J (per system)                        :func:`kcal_per_mol_to_J`
 kcal/(mol A)            N                                     :func:`kcal_per_mol_A_to_N`
 kcal/(mol A^2)          J/m^2 (energy per area)               :func:`kcal_per_mol_A2_to_J_per_m2`
+kcal/(mol A^3)          Pa (force per area: traction)         :func:`kcal_per_mol_A3_to_Pa`
+(g/mol) A/fs^2          kcal/(mol A) (mass x acceleration)    :func:`g_per_mol_A_per_fs2_to_kcal_per_mol_A`
 A                       m                                     :func:`angstrom_to_m`
 fs                      s                                     :func:`fs_to_s`
 atm                     Pa                                    :func:`atm_to_Pa`
@@ -42,7 +44,8 @@ import math
 
 __all__ = ["AVOGADRO", "BOLTZMANN", "ELEMENTARY_CHARGE", "KCAL", "ATM", "ANGSTROM", "FEMTOSECOND",
            "KCAL_PER_MOL", "kcal_per_mol_to_J", "J_to_kcal_per_mol", "kcal_per_mol_A_to_N", "N_to_kcal_per_mol_A",
-           "kcal_per_mol_A2_to_J_per_m2", "angstrom_to_m", "m_to_angstrom", "fs_to_s", "s_to_fs", "atm_to_Pa",
+           "kcal_per_mol_A2_to_J_per_m2", "kcal_per_mol_A3_to_Pa", "g_per_mol_A_per_fs2_to_kcal_per_mol_A",
+           "angstrom_to_m", "m_to_angstrom", "fs_to_s", "s_to_fs", "atm_to_Pa",
            "atm_A_to_N_per_m", "g_per_cm3_to_kg_per_m3", "kg_per_m3_to_g_per_cm3", "angstrom_per_fs_to_m_per_s",
            "m_per_s_to_angstrom_per_fs", "g_per_mol_to_kg", "amu_per_A3_to_kg_per_m3", "kT_kcal_per_mol",
            "ns_per_day", "convert", "CONVERSIONS"]
@@ -79,6 +82,18 @@ def N_to_kcal_per_mol_A(x):
 def kcal_per_mol_A2_to_J_per_m2(x):
     """Energy per area: kcal/(mol A^2) -> J/m^2 (1 kcal/(mol A^2) = 0.69477 J/m^2)."""
     return x * (KCAL_PER_MOL / ANGSTROM ** 2)
+
+
+def kcal_per_mol_A3_to_Pa(x):
+    """Force per area (a traction, e.g. a mean force between slabs divided by their area): kcal/(mol A^3) -> Pa
+    (1 kcal/(mol A^3) = 6.9477e9 Pa)."""
+    return x * KCAL_PER_MOL / ANGSTROM ** 3
+
+
+def g_per_mol_A_per_fs2_to_kcal_per_mol_A(x):
+    """Mass x acceleration in LAMMPS real units ((g/mol) A/fs^2, e.g. a momentum change per time) -> the real
+    force unit kcal/(mol A): 1 (g/mol) A/fs^2 = 1e7/4184 = 2390.06 kcal/(mol A) (LAMMPS: 1/ftm2v)."""
+    return x * (1e-3 * ANGSTROM / FEMTOSECOND ** 2) / (KCAL / ANGSTROM)
 
 
 def angstrom_to_m(x):
@@ -150,6 +165,7 @@ CONVERSIONS: dict[str, tuple[str, str, float]] = {
     "energy": ("kcal/mol", "J", KCAL_PER_MOL),
     "force": ("kcal/mol/A", "N", KCAL_PER_MOL / ANGSTROM),
     "energy_per_area": ("kcal/mol/A^2", "J/m^2", KCAL_PER_MOL / ANGSTROM ** 2),
+    "stress": ("kcal/mol/A^3", "Pa", KCAL_PER_MOL / ANGSTROM ** 3),
     "length": ("A", "m", ANGSTROM),
     "time": ("fs", "s", FEMTOSECOND),
     "pressure": ("atm", "Pa", ATM),

@@ -15,7 +15,8 @@ import pytest
 from md.analysis import (ATM_A_TO_N_PER_M, KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ContactAngle,
                          block_analysis, block_average, density_profile, energy_separation_work,
                          fit_contact_angle, fit_traction_law, lj_tail_correction, pull_off_analysis,
-                         rate_extrapolation, slab_density, surface_tension, work_from_energy_curve)
+                         rate_extrapolation, slab_density, surface_tension, work_from_energy_curve,
+                         statistical_inefficiency, detect_equilibration, timeseries_stats)
 
 N_A = 6.02214076e23          # CODATA 2018 / SI 2019, exact
 KCAL = 4184.0                # J, thermochemical
@@ -83,6 +84,69 @@ def test_block_analysis_levels_off_at_the_exact_stderr():
     assert exact / 1.5 < res["stderr_plateau"] < 1.5 * exact
 
 
+# ------------------------------------------------------------------------- statistical inefficiency (Chodera)
+
+def test_statistical_inefficiency_of_ar1_is_1_plus_phi_over_1_minus_phi():
+    rng = np.random.default_rng(21)
+    for phi in (0.0, 0.5, 0.9):
+        x = ar1(phi, 200_000, rng)
+        assert statistical_inefficiency(x) == rel((1 + phi) / (1 - phi), 0.05)
+    assert statistical_inefficiency(np.full(50, 3.0)) == 1.0          # no variance: no correlation
+    assert statistical_inefficiency([1.0]) == 1.0
+
+
+def test_stderr_from_statistical_inefficiency_covers_the_true_mean_on_100_ar1_series():
+    """100 seeded AR(1) series (phi = 0.9: g = 19, ~105 effective samples in 2000): the stderr of the mean is
+    the exact one within the spread that an estimated g must have at this length, and the 95 % intervals cover
+    the true mean (0) about 95 % of the time. The spread: g is a sum over ~M lags of C(t), M about 3
+    exponential times (where C(t) first drops into its noise), so var(g)/g^2 ~ 2 (2M + 1)/N (Sokal) and the
+    stderr, which goes as sqrt(g), scatters by sqrt((2M + 1)/(2N))."""
+    rng = np.random.default_rng(1799)
+    phi, n = 0.9, 2000
+    exact = ar1_exact_stderr(phi, n)
+    m_lags = 3 * (-1.0 / math.log(phi))                       # 3 exponential correlation times
+    spread = math.sqrt((2 * m_lags + 1) / (2 * n))            # ~0.12
+    ratios, covered = [], 0
+    for _ in range(100):
+        st = timeseries_stats(ar1(phi, n, rng), equilibrate=False)
+        ratios.append(st["stderr"] / exact)
+        covered += abs(st["mean"]) < 1.96 * st["stderr"]
+    lo, med, hi = np.percentile(ratios, [5, 50, 95])
+    assert 1 - spread < med < 1 + spread / 2                   # a slight downward bias (truncated sum), no more
+    assert 1 - 2.5 * spread < lo and hi < 1 + 2.5 * spread
+    assert 88 <= covered <= 99
+    # five fixed blocks (the old estimator) scatter about twice as much on the same kind of series
+    five = [block_average(ar1(phi, n, rng), 5)[1] / exact for _ in range(100)]
+    f_lo, f_hi = np.percentile(five, [5, 95])
+    assert f_hi - f_lo > 1.5 * (hi - lo)
+
+
+def test_equilibration_detection_drops_the_transient():
+    """A relaxing start (an exponential decay of 18 sd, time constant 200 samples) on AR(1) noise: the detected
+    start lies past the transient's bulk, and the mean of what is kept is unbiased within its stderr; using every
+    sample would be biased by many stderrs."""
+    rng = np.random.default_rng(16)
+    n, tau = 4000, 200.0
+    x = ar1(0.8, n, rng) + 30.0 * np.exp(-np.arange(n) / tau)
+    det = detect_equilibration(x)
+    assert 2 * tau < det["t0"] < 0.5 * n
+    st = timeseries_stats(x)
+    assert st["t0"] == det["t0"] and abs(st["mean"]) < 3 * st["stderr"]
+    naive = timeseries_stats(x, equilibrate=False)
+    assert naive["mean"] > 5 * st["stderr"]
+    assert st["g"] == rel(9.0, 0.35) and st["n_eff"] == pytest.approx((n - st["t0"]) / st["g"])
+
+
+def test_surface_tension_stderr_uses_the_statistical_inefficiency():
+    rng = np.random.default_rng(4)
+    n, lz = 20000, 60.0
+    c = ar1(0.9, n, rng) * 100.0                               # correlated Pzz fluctuation (atm)
+    out = surface_tension(np.zeros(n), np.zeros(n), c, lz, n_blocks=5)
+    exact = 0.5 * lz * 100.0 * ar1_exact_stderr(0.9, n) * ATM * 1e-10
+    assert out["stderr"] == rel(exact, 0.25)
+    assert out["statistical_inefficiency"] == rel(19.0, 0.25) and "stderr_blocks" in out
+
+
 # ------------------------------------------------------------------------------------ works of adhesion
 
 def test_energy_separation_work_is_the_energy_difference_per_area():
@@ -91,9 +155,9 @@ def test_energy_separation_work_is_the_energy_difference_per_area():
     e_c, e_s = -1000.0 + noise, -800.0 + noise[::-1]       # same noise, exact means
     out = energy_separation_work(e_c, e_s, area_A2=400.0)
     assert out["value"] == rel(200.0 / 400.0 * KCAL / (N_A * 1e-20), 1e-12)
-    _, sc = block_average(e_c)
-    _, ss = block_average(e_s)
+    sc, ss = timeseries_stats(e_c)["stderr"], timeseries_stats(e_s)["stderr"]     # statistical inefficiency
     assert out["stderr"] == rel(math.hypot(sc, ss) / 400.0 * KCAL / (N_A * 1e-20), 1e-12)
+    assert math.hypot(sc, ss) == rel(5.0 * math.sqrt(2 / 1000), 0.15)               # white noise: g = 1
     assert out["units"] == "J/m^2"
     assert "not a free energy" in out["note"] and "entropic" in out["note"]
 
@@ -128,6 +192,123 @@ def test_force_integration_of_a_lj93_traction_law_gives_its_work():
     assert r["stderr"] == pytest.approx(math.sqrt(0.5 ** 2 + 3.0 ** 2 + 3.0 ** 2) * KCALMOL_PER_A2_TO_J_PER_M2)
     with pytest.raises(ValueError, match="same separation"):
         force_integration_work([0.0, 0.0, 1.0], [1, 2, 3], [1, 1, 1], 1.0)
+
+
+def _lj93_window_curve(W, z0, area, d):
+    """Mean force on the upper slab (kcal/mol/A, repulsion positive) for the 9-3 traction law whose zero-force
+    point (the contact at zero load) is at d = 0: separations d are measured from the contact, as in the MD."""
+    g = d + z0
+    return area * 8 * W / (3 * z0) * ((z0 / g) ** 9 - (z0 / g) ** 3)
+
+
+def test_force_integration_starts_at_the_zero_force_point_of_a_grid_reaching_into_compression():
+    """Compressive windows (d < 0, repulsive) and the quadratic outward grid: W_F is integrated from the
+    interpolated zero crossing, so the repulsive windows do not cut into it (the old rule, from the first window,
+    subtracts their positive force: W too small); a grid that never turns repulsive is flagged."""
+    from md.analysis import force_integration_work
+    W, z0, area = 0.06, 2.5, 600.0                            # kcal/mol/A^2, A, A^2
+    exact = W * (1 - 4 / 3 * (z0 / (20 + z0)) ** 2 + (z0 / (20 + z0)) ** 8 / 3) * KCALMOL_PER_A2_TO_J_PER_M2
+    d = np.concatenate([-np.linspace(0.8, 0.1, 8), 20.0 * (np.arange(300) / 299) ** 2])
+    f = _lj93_window_curve(W, z0, area, d)
+    r = force_integration_work(d, f, np.full(d.size, 0.5), area)
+    assert r["repulsive_end"] and r["zero_force_separation_A"] == pytest.approx(0.0, abs=2e-3)
+    assert r["value"] == rel(exact, 2e-3) and r["value_pchip"] == rel(exact, 2e-3)
+    assert r["pmf_J_per_m2"].min() == pytest.approx(0.0, abs=1e-4 * exact)      # the PMF's minimum: the contact
+    old = force_integration_work(d, f, np.full(d.size, 0.5), area, from_zero_crossing=False)
+    assert old["value"] < 0.9 * exact                           # integrated through the repulsive wall
+    # outward windows only, starting inside the well (d = 0.3 A): no repulsive window, flagged, a lower bound
+    out = d[d >= 0.3]
+    r2 = force_integration_work(out, _lj93_window_curve(W, z0, area, out), np.full(out.size, 0.5), area)
+    assert not r2["repulsive_end"] and math.isnan(r2["zero_force_separation_A"])
+    assert r2["value"] < exact
+
+
+def test_registry_average_carries_the_spread_between_registries():
+    from md.analysis import registry_average
+    one = registry_average([[1.0, 2.0]], [[0.1, 0.2]])
+    assert np.allclose(one["mean"], [1, 2]) and np.allclose(one["stderr"], [0.1, 0.2])
+    three = registry_average([1.0, 2.0, 3.0], [0.01, 0.01, 0.01])       # spread dominates
+    assert three["mean"] == 2.0 and three["stderr"] == rel(1.0 / math.sqrt(3), 1e-12)
+    agree = registry_average([2.0, 2.0, 2.0], [0.3, 0.3, 0.3])          # agreement by chance: statistics remain
+    assert agree["stderr"] == rel(0.3 / math.sqrt(3), 1e-12) and agree["registry_spread"] == 0.0
+
+
+def test_z0_and_sigma0_from_a_coarse_noisy_flat_slab_curve():
+    """sigma0 from the quadratic through the three windows around the peak, z0 = 1.026 W / sigma0: on the 9-3
+    law (seeded noise, 30 draws) both come back within their stated errors, the stated noise error is the scatter's
+    size, and the 3- vs 5-point difference (the grid's discretisation error) covers the bias."""
+    from md.analysis import MAUGIS_LJ93, flat_slab_range, traction_peak
+    from md import units as U
+    W, z0, area = 0.06, 2.5, 600.0
+    W_si = W * KCALMOL_PER_A2_TO_J_PER_M2
+    sigma0_pa = float(U.kcal_per_mol_A3_to_Pa(MAUGIS_LJ93 * W / z0))
+    d = np.concatenate([-np.linspace(1.0, 0.25, 4), 20.0 * (np.arange(14) / 13) ** 2])
+    f0 = _lj93_window_curve(W, z0, area, d)
+    noise = 0.5                                                  # kcal/mol/A per window
+    rng = np.random.default_rng(8)
+    peaks = [traction_peak(d, f0 + rng.normal(0, noise, d.size), np.full(d.size, noise), area) for _ in range(30)]
+    assert all(p["method"] == "quadratic" for p in peaks)
+    sg = np.array([p["sigma0"] for p in peaks])
+    se = np.array([p["stderr"] for p in peaks])
+    disc = np.median([p["discretisation_error"] for p in peaks])
+    assert 0.5 < np.median(se) / sg.std() < 2.0                  # the stated noise error is the scatter's size
+    assert abs(sg.mean() - sigma0_pa) < 2 * math.hypot(sg.std() / math.sqrt(30), disc)
+    best_window = float(U.kcal_per_mol_A3_to_Pa(-f0.min() / area))
+    assert best_window < sg.mean()                               # the vertex, not the coarse grid's best window
+    z = [flat_slab_range(W_si, 0.0, p["sigma0"], math.hypot(p["stderr"], p["discretisation_error"])) for p in peaks]
+    z_mean = np.mean([r["z0"] for r in z])
+    assert abs(z_mean - z0 * 1e-10) < 2 * np.median([r["stderr"] for r in z])
+    assert flat_slab_range(0.1, 0.01, 1e8, 1e7)["stderr"] == rel(MAUGIS_LJ93 * 1e-9 * math.sqrt(0.02), 1e-12)
+    with pytest.raises(ValueError, match="no attractive window"):
+        traction_peak(d, np.abs(f0), np.ones(d.size), area)
+
+
+def test_traction_law_fit_stderr_matches_the_scatter_of_repeated_fits():
+    rng = np.random.default_rng(12)
+    amp, z0, off = 1.5, 2.8, 4.0
+    d = np.linspace(off + 2.4, off + 14.0, 120)
+    clean = lj93_force(d - off, amp, z0)
+    fits = [fit_traction_law(d, clean + rng.normal(0, 0.05, d.size), offset=True) for _ in range(40)]
+    zs = np.array([f["z0"] for f in fits])
+    es = np.array([f["stderr"]["z0"] for f in fits])
+    assert 0.6 < np.median(es) / zs.std() < 1.6
+    w = fit_traction_law(d, clean + rng.normal(0, 0.05, d.size), offset=True, force_stderr=np.full(d.size, 0.05))
+    assert abs(w["z0"] - z0) < 4 * w["stderr"]["z0"] and w["stderr"]["w"] > 0
+
+
+def _lattice_slab(n_side, nz, a, z0):
+    g = np.arange(n_side) * a
+    x, y, z = np.meshgrid(g, g, np.arange(nz) * a, indexing="ij")
+    return np.column_stack([x.ravel(), y.ravel(), z.ravel() + z0])
+
+
+def test_dispersion_tail_between_two_slabs_has_the_sign_size_and_force_expected():
+    """Two simple-cubic LJ slabs (CH2-like: eps 0.0914 kcal/mol, sigma 3.95 A, 0.034 sites/A^3) 3.5 A apart, cut
+    at 12 A: the interaction beyond the cutoff is attractive, converges with the explicit radius (the smeared
+    images take over beyond it), is within 10 % of two laterally smeared stacks of planes (about 7 mJ/m^2 here:
+    the size of the review's 12-vs-40 A estimate for OTS-OTS), and its force is minus the energy's derivative."""
+    from md.analysis import lj_tail_between
+    a, n_side, nz, gap = 3.1, 8, 10, 3.5
+    L = n_side * a
+    lo, up = _lattice_slab(n_side, nz, a, 0.0), _lattice_slab(n_side, nz, a, (nz - 1) * a + gap)
+    E, S, I = np.array([[0.0914]]), np.array([[3.95]]), np.array([[True]])
+    z_lo, z_up = np.zeros(len(lo), int), np.zeros(len(up), int)
+    tail = {rm: lj_tail_between(lo, z_lo, up, z_up, E, S, I, (L, L), 12.0, rm) for rm in (20.0, 30.0)}
+    e20, e30 = tail[20.0]["energy"], tail[30.0]["energy"]
+    assert e20 < 0 and e20 == rel(e30, 0.02)
+    ns = 1 / a ** 2
+    planes = sum(ns * ns * 2 * math.pi * 4 * 0.0914 * (3.95 ** 12 / (10 * x ** 10) - 3.95 ** 6 / (4 * x ** 4))
+                 for x in (max(gap + a * (k1 + k2), 12.0) for k1 in range(nz) for k2 in range(nz))) * L * L
+    assert e30 == rel(planes, 0.10)
+    w_tail = -e30 / (L * L) * KCALMOL_PER_A2_TO_J_PER_M2
+    assert 0.004 < w_tail < 0.012                                # J/m^2
+    h = 1e-3
+    ep = lj_tail_between(lo, z_lo, up + [0, 0, h], z_up, E, S, I, (L, L), 12.0, 30.0)["energy"]
+    em = lj_tail_between(lo, z_lo, up - [0, 0, h], z_up, E, S, I, (L, L), 12.0, 30.0)["energy"]
+    assert tail[30.0]["force_z"] == rel(-(ep - em) / (2 * h), 1e-4) and tail[30.0]["force_z"] < 0
+    # pairs left out count nothing; the partner types decide
+    none = lj_tail_between(lo, z_lo, up, z_up, E, S, np.array([[False]]), (L, L), 12.0, 20.0)
+    assert none["energy"] == 0.0 and none["pairs"] == 0
 
 
 def test_work_from_lj93_wall_energy_curve_long_tail():
