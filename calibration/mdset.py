@@ -15,6 +15,15 @@ the set's sources and the report then name as "not a free energy". (The adhesion
 2 started its windows outside the adhesive well and gave W_F 20x too small; those runs no longer match
 the run hash and are not read.)
 
+Interaction range z0: from the flat-slab mean-force curve of the adhesion workflow (version 3):
+z0 = 1.026 W_F / sigma0 (Maugis 1992, the LJ 9-3 law), with sigma0 the curve's peak tensile traction, so that
+the continuum's Maugis-Dugdale stress 1.03 dgamma / z0 reproduces the measured sigma0 with the W_F used for
+dgamma; its stderr (from the peak fit's covariance and W_F's error) goes into the uncertainty bands like every
+other. An adhesion result without a flat-slab z0 (before version 3) falls back to the pull-off z0 (a 9-3 fit
+against the rigid holder's travel: it absorbs the asperity's compliance and overstates z0), and the sources
+say so. The pull-off results are otherwise a validation: F / (2 pi R) (DMT, the limit an MD-scale asperity is
+in) is compared with W_F in [meta.validation].
+
 A value outside the scene schema's range, or not finite, or a contact angle the analysis could not
 measure (0 deg: a film, 180 deg: no contact yet -- what smoke runs give) is not used: the base set's
 value is kept for that key, and [meta.rejected] and the report name the MD run and the value.
@@ -38,12 +47,19 @@ RESULTS_DIR = data.shipped_root() / "md" / "results"
 
 @dataclass(frozen=True)
 class Source:
-    """Scene key <- MD recipe, quantities in order of preference."""
+    """Scene key <- MD recipe, quantities in order of preference; ``fallback`` (another recipe) is used only
+    when this recipe's result has none of the quantities (``note`` says what the fallback value is)."""
 
     key: str
     recipe: str
     quantities: tuple[str, ...]
+    fallback: "Source | None" = None
+    note: str = ""
 
+
+_PULLOFF_Z0 = ("fallback: the adhesion result has no flat-slab z0; this z0 is a 9-3 fit with a free offset to the "
+               "pull-off curve against the rigid holder's travel, so it absorbs the asperity's compliance (an "
+               "overestimate)")
 
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),
@@ -52,14 +68,23 @@ MAPPING: tuple[Source, ...] = (
     Source("surfaces.substrate.contact_angle", "contact_angle_silica", ("contact_angle",)),
     Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",)),
     Source("menisci.surface_tension", "surface_tension_spce", ("surface_tension",)),
-    Source("surfaces.interaction_range", "pulloff_silica", ("interaction_range_z0",)),
-    Source("surfaces.sam.interaction_range", "pulloff_ots", ("interaction_range_z0",)),
+    Source("surfaces.interaction_range", "adhesion_silica", ("interaction_range_z0",),
+           fallback=Source("surfaces.interaction_range", "pulloff_silica", ("interaction_range_z0",),
+                           note=_PULLOFF_Z0)),
+    Source("surfaces.sam.interaction_range", "adhesion_ots", ("interaction_range_z0",),
+           fallback=Source("surfaces.sam.interaction_range", "pulloff_ots", ("interaction_range_z0",),
+                           note=_PULLOFF_Z0)),
 )
+
+#: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
+VALIDATION = (("pulloff_silica", "adhesion_silica"), ("pulloff_ots", "adhesion_ots"))
 
 
 def recipes_needed(mapping=MAPPING) -> list[str]:
-    """MD recipes a calibration needs, in mapping order, each once."""
-    return list(dict.fromkeys(s.recipe for s in mapping))
+    """MD recipes a calibration needs, in mapping order, each once (fallback recipes -- the pull-offs, also the
+    validation runs -- after the first ones)."""
+    first = [s.recipe for s in mapping]
+    return list(dict.fromkeys(first + [s.fallback.recipe for s in mapping if s.fallback is not None]))
 
 
 def _pick(result: dict, source: Source):
@@ -118,6 +143,9 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
     sources = dict(meta.get("sources", {}))
     rows, calib, rejected = [], {}, {}
     for src in mapping:
+        if src.fallback is not None and not any(q in (results.get(src.recipe) or {}).get("quantities", {})
+                                                for q in src.quantities):
+            src = src.fallback                  # the preferred result has no such quantity (an older protocol)
         res = results.get(src.recipe)
         row = {"key": src.key, "recipe": src.recipe, "base_value": _get_nested(table, src.key)}
         if res is None:
@@ -146,6 +174,17 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             if stderr is not None:
                 entry["stderr"] = stderr
             qs = res.get("quantities", {})
+            if qname == "interaction_range_z0":
+                q = qs[qname]
+                if src.note:
+                    entry["note"] = src.note
+                if "peak_traction_sigma0" in qs:
+                    sg = qs["peak_traction_sigma0"]
+                    entry["sigma0"] = {"value": sg.get("value"), "stderr": sg.get("stderr"), "units": "Pa",
+                                       "note": "peak tensile traction of the flat-slab curve; the continuum's "
+                                               "Maugis-Dugdale stress is 1.03 dgamma / z0"}
+                if q.get("dugdale_range_h0_m") is not None:
+                    entry["dugdale_range_h0"] = q["dugdale_range_h0_m"]
             if qname == "work_of_adhesion_free_energy":
                 entry["stderr_statistical"] = qs[qname].get("stderr")
                 entry["discretisation_error"] = qs[qname].get("discretisation_error")
@@ -157,18 +196,49 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             calib[src.key] = entry
             kind = {"work_of_adhesion": "potential-energy difference dE/A (not a free energy)",
                     "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
-                                                    "incl. the window grid's discretisation error"}.get(qname, qname)
+                                                    "incl. the window grid's discretisation error",
+                    "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
+                                             if src.recipe.startswith("adhesion") else
+                                             "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
             err = f"+- {stderr:.3g}" if stderr is not None else "(no stderr)"
             sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}, "
                                 f"run {str(res.get('run_hash'))[:16]}")
         rows.append(row)
     out_meta = {"description": description or f"MD-calibrated set '{name}' on base '{Path(base).stem}'",
                 "base": Path(base).stem, "sources": sources, "calibration": calib}
+    validation = pulloff_validation(results)
+    if validation:
+        out_meta["validation"] = validation
     if rejected:
         out_meta["rejected"] = rejected
     if extra_meta:
         out_meta.update(extra_meta)
     return {"meta": out_meta, **table}, rows
+
+
+def pulloff_validation(results: dict[str, dict]) -> dict:
+    """F / (2 pi R) of each pull-off (DMT: an MD-scale asperity is far in the DMT limit, Tabor mu ~ 0.06)
+    against the flat-slab W_F of the same surfaces: the ratio and the difference in units of the combined
+    stderr. Validation only: nothing here enters the set."""
+    out = {}
+    for pull, adh in VALIDATION:
+        rp, ra = results.get(pull), results.get(adh)
+        if not rp or not ra:
+            continue
+        qp, qa = rp.get("quantities", {}), ra.get("quantities", {})
+        dmt = qp.get("work_of_adhesion_eff_dmt", {})
+        wf = qa.get("work_of_adhesion_free_energy") or qa.get("work_of_adhesion") or {}
+        v1, v2 = dmt.get("value"), wf.get("value")
+        if v1 is None or v2 is None or not (math.isfinite(v1) and math.isfinite(v2)) or v2 == 0:
+            continue
+        e1, e2 = dmt.get("stderr") or 0.0, wf.get("stderr") or 0.0
+        err = math.hypot(e1, e2)
+        drag = qp.get("residual_drag_force", {})
+        out[pull] = {"F_over_2piR": v1, "F_over_2piR_stderr": e1 or None, "W_F": v2, "W_F_stderr": e2 or None,
+                     "ratio": v1 / v2, "difference_in_stderr": (v1 - v2) / err if err > 0 else None,
+                     "adhesion_recipe": adh, "residual_drag_N": drag.get("value"),
+                     "note": "pull-off F / (2 pi R) (DMT) against the flat-slab work of adhesion; validation only"}
+    return out
 
 
 # ----------------------------------------------------------------------------- TOML writing
