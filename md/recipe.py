@@ -117,6 +117,12 @@ FIELDS: tuple[Field, ...] = (
           "separated state; must exceed the cutoff.", 20.0, low=5.0, high=60.0, workflows=_ADH),
     Field("contact_gap_A", "system", float, "A", "Adhesion: initial gap between the two slabs before "
           "minimisation.", 3.0, low=1.0, high=6.0, workflows=_ADH),
+    Field("dispersion_tail", "system", str, "", "Adhesion: Lennard-Jones dispersion beyond the cutoff for TraPPE "
+          "pairs (every pair with a CH2/CH3 united atom: OTS-OTS, silica-OTS, water-OTS), which TraPPE was fitted "
+          "with (14 A + analytic tails). 'trappe' adds it as a static correction measured on the run's own "
+          "configurations (explicit sum to 20 A over all periodic images, smeared beyond) to W and to every "
+          "window's mean force; IFF pairs keep IFF's plain 12 A cutoff. 'none' leaves it out.", "trappe",
+          choices=("trappe", "none"), workflows=_ADH),
     Field("asperity_radius_A", "both", float, "A", "Pull-off: radius R of the hemispherical asperity.",
           REQUIRED, low=5.0, high=100.0, workflows=_PULL),
     Field("graft_max_polar_deg", "system", float, "deg", "Pull-off with OTS: chains are grafted on dome "
@@ -154,7 +160,9 @@ FIELDS: tuple[Field, ...] = (
           high=20.0),
     Field("kspace_accuracy", "fidelity", float, "1", "PPPM relative force accuracy.", 1e-5, low=1e-8,
           high=1e-3),
-    Field("n_blocks", "fidelity", int, "1", "Blocks for block-averaged standard errors.", 5, low=2, high=1000),
+    Field("n_blocks", "fidelity", int, "1", "Blocks of the block-wise fits (contact-angle maps, density "
+          "profiles); time-series errors use the statistical inefficiency instead (md.analysis.timeseries_stats).",
+          5, low=2, high=1000),
     # ---------------------------------------------------------------- fidelity: adhesion
     Field("nx", "fidelity", int, "cells", "Surface cells along x (cristobalite (001): 7.16 A; (111): 5.06 A).",
           REQUIRED, low=1, high=200, workflows=_ADH + _CA),
@@ -165,8 +173,18 @@ FIELDS: tuple[Field, ...] = (
     Field("free_energy", "fidelity", str, "", "Adhesion: 'pmf' also integrates the mean force between the "
           "slabs over separation (free energy of separation, hence T dS); 'none' reports the energy only.",
           "none", choices=("none", "pmf"), workflows=_ADH),
-    Field("pmf_windows", "fidelity", int, "1", "Adhesion, free_energy = 'pmf': separations sampled "
-          "(quadratically spaced from contact to separation_A).", 12, low=2, high=200, workflows=_ADH),
+    Field("pmf_windows", "fidelity", int, "1", "Adhesion, free_energy = 'pmf': windows from contact outwards "
+          "(quadratically spaced from contact to separation_A, dense near contact); each starts from its "
+          "inner neighbour's last state (a chain).", 12, low=2, high=200, workflows=_ADH),
+    Field("pmf_compress_windows", "fidelity", int, "1", "Adhesion PMF: windows pressed into the contact "
+          "(uniformly spaced down to -pmf_compress_A, a chain from the contact window inwards), so the mean "
+          "force turns repulsive and the bottom of the adhesive well lies inside the grid.", 4, low=0, high=100,
+          workflows=_ADH),
+    Field("pmf_compress_A", "fidelity", float, "A", "Adhesion PMF: how far the innermost window is pressed "
+          "into the contact.", 2.0, low=0.1, high=10.0, workflows=_ADH),
+    Field("lateral_registries", "fidelity", int, "1", "Adhesion PMF: lateral offsets of the upper slab (a "
+          "rank-1 lattice over one surface cell, the first at zero); each has its own chain of windows; the "
+          "force curves are averaged and their spread enters the error.", 1, low=1, high=16, workflows=_ADH),
     Field("pmf_equilibrate_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window discarded.", 1000,
           low=0, high=100_000_000, workflows=_ADH),
     Field("pmf_sample_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window sampled.", 5000, low=1,
@@ -195,6 +213,14 @@ FIELDS: tuple[Field, ...] = (
     Field("retract_speeds_m_s", "fidelity", list, "m/s", "Pull-off: holder speeds on retraction; more than one "
           "(a rate scan, extrapolated to low rate) only at production.", REQUIRED, low=0.01, high=2000.0,
           workflows=_PULL, item=float),
+    Field("retract_repeats", "fidelity", int, "1", "Pull-off: independent retractions per speed, each from the "
+          "held contact with fresh velocities and hold_steps more of holding; the pull-off force is their mean, "
+          "its stderr their spread.", 1, low=1, high=20, workflows=_PULL),
+    Field("tip_thermostat", "fidelity", str, "", "Pull-off: how the moving asperity is thermostatted. "
+          "'comoving': its thermal motion only (compute temp/com bias: no drag on the asperity's motion); "
+          "'none': the asperity runs NVE (only the flat is thermostatted); 'lab': the old lab-frame thermostat "
+          "on every mobile atom (drags the asperity: ~gamma M v).", "comoving",
+          choices=("comoving", "none", "lab"), workflows=_PULL),
     # ---------------------------------------------------------------- fidelity: contact angle
     Field("substrate_equilibrate_steps", "fidelity", int, "steps", "Contact angle: NVT steps of the substrate "
           "alone (minimised with nothing held, then its deep Si and bridging O held) before the droplet is "

@@ -180,25 +180,6 @@ def test_a_finished_run_is_reused_not_repeated(needs_lammps, cache, tmp_path):
     assert json.loads((tmp_path / "c" / "result.json").read_text())["run_hash"] == first.result["run_hash"]
 
 
-@pytest.mark.md
-def test_force_windows_start_from_the_contact_legs_last_state(needs_lammps, cache, tmp_path):
-    """Protocol of the free-energy route (Adhesion version 2): window 0 holds the upper back where the 300 K
-    contact leg ended, and separations are measured from the contact leg's mean back height."""
-    from md.analysis import block_average
-    from md.runner import read_samples
-    outcome, _ = _run("adhesion_silica", cache, tmp_path / "a")        # cached by the parametrised test
-    legs = outcome.run_dir / "legs"
-    contact, w0 = read_samples(legs / "contact" / "samples.csv"), read_samples(legs / "pmf_00" / "samples.csv")
-    assert np.ptp(w0["z_back"]) < 1e-6                                   # the back is held in a window
-    assert w0["z_back"][0] == pytest.approx(contact["z_back"][-1], abs=1e-4)
-    sampled = contact["z_back"][contact["stage"] == contact["stage"].max()]
-    windows = outcome.result["details"]["pmf_windows"]
-    zc = block_average(sampled, outcome.result["settings"]["n_blocks"])[0]     # as the analysis averages it
-    assert windows["separation_A"][0] == pytest.approx(w0["z_back"][0] - zc, abs=1e-6)
-    w1 = read_samples(legs / "pmf_01" / "samples.csv")
-    assert w1["z_back"][0] - w0["z_back"][0] == pytest.approx(windows["shift_from_contact_end_A"][1], abs=1e-4)
-
-
 def test_a_changed_workflow_protocol_changes_the_run_hash(monkeypatch):
     """Raising a workflow's version invalidates its cached and committed runs; version 1 leaves hashes alone."""
     from md import workflows

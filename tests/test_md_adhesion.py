@@ -1,0 +1,268 @@
+"""Adhesion and pull-off protocols (issue 11, points 4-7): dispersion beyond the cutoff, chained force-integration
+windows reaching into compression and averaged over lateral registries, z0 and sigma0 from the flat-slab curve,
+the pull-off thermostat and its residual drag, the OTS asperity's grafting density, and the calibration's use of
+the flat-slab z0.
+
+Tests marked ``md`` run LAMMPS at smoke fidelity (seconds each); the rest need no LAMMPS.
+"""
+from __future__ import annotations
+
+import io
+import json
+import math
+from contextlib import redirect_stdout
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from md import units as U
+from md.recipe import load_recipe, parse_recipe
+
+
+def _settings(name, fidelity="smoke", **override):
+    s = dict(load_recipe(name).settings(fidelity))
+    s.update(override)
+    return s
+
+
+def _recipe(name, fidelity="smoke", new_name=None, **override):
+    t = json.loads(json.dumps(dict(load_recipe(name).raw), default=dict))
+    t["fidelity"][fidelity].update(override)
+    return parse_recipe(t, name=new_name or name)
+
+
+def _run(recipe, cache, fidelity="smoke"):
+    from md.runner import run_recipe
+    with redirect_stdout(io.StringIO()):
+        return run_recipe(recipe, fidelity, cache=cache, out=None, progress=False)
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("md-adhesion-cache")
+
+
+# ------------------------------------------------------------------------------------ protocol (no LAMMPS)
+
+def test_protocol_versions_enter_the_run_hash():
+    from md import workflows
+    assert workflows.Adhesion.version == 3 and workflows.PullOff.version == 2
+
+
+def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path):
+    """The generated commands: window 0 of every registry starts from the contact leg's last restart, moved
+    laterally to the registry's offset; each further window reads its neighbour's last restart and moves the upper
+    slab by the difference of the nominal separations -- inwards (compression) and outwards."""
+    from md.workflows import Adhesion, _registry_offsets
+    s = _settings("adhesion_silica", "quick")
+    wf = Adhesion()
+    plan = wf.plan(s, tmp_path)
+    legs = {l.name: l for l in plan.legs}
+    n_out, n_in, n_reg = s["pmf_windows"], s["pmf_compress_windows"], s["lateral_registries"]
+    assert n_in >= 1 and n_reg >= 2
+    assert sum(n.startswith("pmf_") for n in legs) == n_reg * (n_out + n_in)
+    offsets = plan.system_info["registry_offsets_A"]
+    assert offsets[0] == [0.0, 0.0] and len({tuple(o) for o in offsets}) == n_reg
+    cell = (plan.system_info["box_A"][0] / s["nx"], plan.system_info["box_A"][1] / s["ny"])
+    assert [list(o) for o in _registry_offsets(n_reg, cell)] == offsets
+    nominal = dict((suf, d) for suf, d, _ in wf.chains(s))
+    assert min(nominal.values()) == pytest.approx(-s["pmf_compress_A"])
+    assert max(nominal.values()) == pytest.approx(s["separation_A"])
+    for r, (dx, dy) in enumerate(offsets):
+        for suf, d, prev in wf.chains(s):
+            cmds = legs[f"pmf_r{r}_{suf}"].fresh(tmp_path / "x")
+            head = cmds[0]
+            move = [c for c in cmds if c.startswith("displace_atoms upper move")]
+            if prev is None:
+                assert "legs/contact/restart." in head
+                if r == 0:
+                    assert not move
+                else:
+                    assert move == [f"displace_atoms upper move {dx:.6f} {dy:.6f} 0.000000 units box"]
+            else:
+                assert f"legs/pmf_r{r}_{prev}/restart." in head
+                assert move == [f"displace_atoms upper move 0.000000 0.000000 {d - nominal[prev]:.6f} units box"]
+            assert not any(c.startswith("velocity") for st in legs[f"pmf_r{r}_{suf}"].stages for c in st.begin)
+    # the chain order: every leg runs after the one it continues from
+    order = [l.name for l in plan.legs]
+    for l in plan.legs:
+        src = l.info.get("continues")
+        if src:
+            assert order.index(src) < order.index(l.name)
+
+
+def test_dispersion_tail_applies_to_trappe_pairs_only():
+    """'trappe': every pair with a CH2/CH3 united atom (OTS-OTS, silica-OTS, water-OTS), never an IFF-IFF pair;
+    the OTS head Si (IFF LJ) pairs with silica keep the cutoff."""
+    from md.workflows import TRAPPE_UA, _ff, _tail_pair_table
+    ff = _ff(["silica_interface", "ots_trappe_ua", "water_spce"])
+    names, eps, sig, inc = _tail_pair_table(ff, "trappe")
+    i = {n: k for k, n in enumerate(names)}
+    assert inc[i["CH2"], i["CH3"]] and inc[i["CH2"], i["OC24"]] and inc[i["OW"], i["CH3"]]
+    assert not inc[i["OC24"], i["OW"]] and not inc[i["SC4"], i["OC23"]] and not inc[i["SIH"], i["OC24"]]
+    assert set(TRAPPE_UA) == {"CH2", "CH3"}
+    p = ff.pair("CH2", "OW")
+    assert eps[i["CH2"], i["OW"]] == p.epsilon and sig[i["CH2"], i["OW"]] == p.sigma
+    assert _tail_pair_table(ff, "all")[3][i["OC24"], i["OW"]]
+
+
+def test_ots_asperity_is_grafted_at_sam_density():
+    """Version 1 drew dome sites in random order at 4.4 A and stopped at 9 chains (2.65 per nm^2 of projected cap)
+    on the quick R = 1.2 nm dome; now a largest set of sites at >= 4.3 A lateral spacing, >= 4 chains/nm^2."""
+    from md.builders import silica_asperity
+    from md.workflows import _graft_dome
+    s = _settings("pulloff_ots", "quick")
+    asp = silica_asperity(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
+                          margin=s["asperity_margin_A"], silanol_density=4.5, face="111", seed=int(s["seed"]))
+    sam, g = _graft_dome(asp, s, int(s["seed"]) + 30)
+    assert g["chains_per_projected_nm2"] >= 4.0 and g["chains"] == g["requested_chains"]
+    assert g["min_spacing_A"] >= 4.3
+    anchors = sam.positions[sam.group("sam_anchor_O"), :2]
+    dxy = anchors[:, None, :] - anchors[None, :, :]
+    dxy -= sam.cell[:2] * np.round(dxy / sam.cell[:2])
+    dist = np.hypot(dxy[..., 0], dxy[..., 1]) + np.eye(len(anchors)) * 99
+    assert dist.min() >= g["min_spacing_A"] - 1e-6
+
+
+def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
+    from calibration.mdset import build_parameter_set, recipes_needed
+
+    def res(recipe, q):
+        return {"recipe": recipe, "fidelity": "quick", "run_hash": f"{recipe:0<64}"[:64],
+                "quantities": {k: dict(v) for k, v in q.items()}}
+    adh_si = res("adhesion_silica", {
+        "work_of_adhesion": {"value": 0.12, "stderr": 0.002, "units": "J/m^2"},
+        "work_of_adhesion_free_energy": {"value": 0.075, "stderr": 0.002, "units": "J/m^2",
+                                         "discretisation_error": 0.001},
+        "interaction_range_z0": {"value": 0.17e-9, "stderr": 0.02e-9, "units": "m", "dugdale_range_h0_m": 0.16e-9},
+        "peak_traction_sigma0": {"value": 0.45e9, "stderr": 0.04e9, "units": "Pa"}})
+    adh_ots = res("adhesion_ots", {"work_of_adhesion_free_energy": {"value": 0.04, "stderr": 0.004,
+                                                                     "units": "J/m^2"}})
+    pull = {n: res(n, {"interaction_range_z0": {"value": z, "stderr": None, "units": "m"},
+                       "work_of_adhesion_eff_dmt": {"value": w, "stderr": 0.01, "units": "J/m^2"},
+                       "residual_drag_force": {"value": 1e-12, "stderr": 5e-11, "units": "N"}})
+            for n, z, w in (("pulloff_silica", 0.49e-9, 0.054), ("pulloff_ots", 0.94e-9, 0.03))}
+    table, rows = build_parameter_set({"adhesion_silica": adh_si, "adhesion_ots": adh_ots, **pull}, "paper", "cal")
+    s = table["surfaces"]
+    assert s["interaction_range"] == 0.17e-9                   # flat slab, not the pull-off's 0.49 nm
+    cal = table["meta"]["calibration"]["surfaces.interaction_range"]
+    assert cal["recipe"] == "adhesion_silica" and cal["stderr"] == 0.02e-9
+    assert cal["sigma0"]["value"] == 0.45e9 and cal["dugdale_range_h0"] == 0.16e-9
+    # the OTS adhesion result predates the flat-slab z0: the pull-off's z0 is used and named as such
+    assert s["sam"]["interaction_range"] == 0.94e-9
+    sam = table["meta"]["calibration"]["surfaces.sam.interaction_range"]
+    assert sam["recipe"] == "pulloff_ots" and "compliance" in sam["note"]
+    assert "pull-off" in table["meta"]["sources"]["surfaces.sam.interaction_range"]
+    val = table["meta"]["validation"]["pulloff_silica"]
+    assert val["ratio"] == pytest.approx(0.054 / 0.075) and val["adhesion_recipe"] == "adhesion_silica"
+    assert "pulloff_silica" in recipes_needed() and recipes_needed()[0] == "adhesion_silica"
+
+
+# ------------------------------------------------------------------------------------ LAMMPS (smoke)
+
+@pytest.mark.md
+def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_path):
+    """The Python tail (explicit pairs between 12 A and 30 A over all periodic images, TraPPE pairs only) is what
+    LAMMPS gives for the two slabs' LJ interaction with lj/cut 30 minus lj/cut 12 (compute group/group, run 0),
+    energy and force, on the smoke OTS/OTS system; and it is attractive."""
+    from md.analysis import lj_tail_between
+    from md.builders import flip_upside_down, place_on
+    from md.forcefield import lammps_pair_coeffs
+    from md.lammps_data import lammps_setup_commands, write_data
+    from md.lammps_loader import new_lammps
+    from md.runner import id_ranges
+    from md.workflows import _ff, _read_data_types, _surface_slab, _tail_pair_table
+    s = _settings("adhesion_ots")
+    ff = _ff(["silica_interface", "ots_trappe_ua"])
+    lower = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, "111")
+    upper = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 11, "111")
+    system = place_on(lower, flip_upside_down(upper), gap=3.0, vacuum=40.0)
+    data = write_data(system, ff, tmp_path / "ots.data")
+    names, eps, sig, inc = _tail_pair_table(ff, "trappe")
+    n_low = len(system.group("substrate"))
+    res = {}
+    for rc in (12.0, 30.0):
+        lmp = new_lammps(["-nocite", "-screen", "none", "-log", "none"])
+        try:
+            cmds = lammps_setup_commands(ff, data, pair="cut", cutoff=rc)
+            cmds += [f"pair_style lj/cut {rc:g}", "neigh_modify one 20000 page 200000"]
+            for line in lammps_pair_coeffs(ff, comments=False):
+                _, i, j, e, sg = line.split()
+                i, j = int(i), int(j)
+                cmds.append(f"pair_coeff {i} {j} {float(e) if inc[i - 1, j - 1] else 0.0:.6f} {sg}")
+            cmds += [f"group lower id {id_ranges(np.arange(n_low))}", "group upper subtract all lower",
+                     "compute gg upper group/group lower", "thermo_style custom step c_gg c_gg[3]", "run 0"]
+            for c in cmds:
+                lmp.command(c)
+            res[rc] = (lmp.extract_compute("gg", 0, 0), lmp.extract_compute("gg", 0, 1)[2])
+        finally:
+            lmp.close()
+    ids, types = _read_data_types(data)
+    low = ids <= n_low
+    tail = lj_tail_between(system.positions[low], types[low] - 1, system.positions[~low], types[~low] - 1, eps, sig,
+                           inc, system.cell[:2], 12.0, 30.0, smeared_beyond=False)
+    assert tail["energy"] == pytest.approx(res[30.0][0] - res[12.0][0], rel=1e-6)
+    assert tail["force_z"] == pytest.approx(res[30.0][1] - res[12.0][1], rel=1e-5)
+    assert tail["energy"] < 0 and tail["force_z"] < 0
+
+
+@pytest.mark.md
+def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(needs_lammps, cache):
+    """adhesion_ots at smoke: the chain is continuous (each held back starts where its neighbour's was, moved by
+    the nominal step), the inward chain is pressed into the contact, the dispersion tail is attractive (W grows)
+    and of the size the review estimated (OTS-OTS 9-11 mJ/m^2), z0 and sigma0 carry stderrs, and the flag for a
+    curve without a repulsive end is reported."""
+    from md.runner import read_samples
+    from md.workflows import Adhesion
+    outcome = _run(load_recipe("adhesion_ots"), cache)
+    r = outcome.result
+    s = r["settings"]
+    legs = outcome.run_dir / "legs"
+    nominal = {suf: d for suf, d, _ in Adhesion.chains(s)}
+    contact = read_samples(legs / "contact" / "samples.csv")
+    for suf, d, prev in Adhesion.chains(s):
+        w = read_samples(legs / f"pmf_r0_{suf}" / "samples.csv")
+        assert np.ptp(w["z_back"]) < 1e-6                       # held
+        start = contact["z_back"][-1] if prev is None else \
+            read_samples(legs / f"pmf_r0_{prev}" / "samples.csv")["z_back"][-1]
+        step = 0.0 if prev is None else d - nominal[prev]
+        assert w["z_back"][0] == pytest.approx(start + step, abs=1e-4)
+    win = r["details"]["pmf_windows"]
+    assert min(win["separation_A"]) < -0.5 * s["pmf_compress_A"]
+    assert isinstance(win["repulsive_end"], bool) and len(win["n_eff"][0]) == len(win["separation_A"])
+    q = r["quantities"]
+    for k, unit in (("peak_traction_sigma0", "Pa"), ("interaction_range_z0", "m"),
+                    ("work_of_adhesion_free_energy", "J/m^2"), ("dispersion_tail_work", "J/m^2")):
+        assert q[k]["units"] == unit and math.isfinite(q[k]["value"]), k
+    assert q["interaction_range_z0"]["stderr"] > 0 and q["peak_traction_sigma0"]["stderr"] > 0
+    tail = r["details"]["dispersion_tail"]
+    assert tail["applied"] and 0.004 < tail["static_work_J_m2"] < 0.02        # J/m^2, attractive
+    assert q["dispersion_tail_work"]["value"] > 0
+    assert q["work_of_adhesion"]["value"] == pytest.approx(r["details"]["energy"]["cutoff_only_J_m2"]
+                                                           + tail["static_work_J_m2"], rel=1e-9)
+    study = tail["cutoff_study_last_contact_frame"]
+    assert study["trappe_20A_J_m2"] == pytest.approx(study["trappe_40A_J_m2"], rel=0.02)
+    assert study["all_20A_J_m2"] >= study["trappe_20A_J_m2"] - 1e-9        # IFF pairs reported, not applied
+    assert abs(tail["fep_minus_mean_J_m2"]) < 0.05 * tail["static_work_J_m2"]   # first order suffices
+
+
+@pytest.mark.md
+def test_pulloff_drag_and_repeats(needs_lammps, cache):
+    """The old lab-frame thermostat drags the moving asperity by about gamma M v (measured here from the holder's
+    reaction and the asperity's momentum); the comoving thermostat leaves no drag beyond noise. Two repeated pulls
+    give the pull-off force its spread."""
+    new = _run(_recipe("pulloff_silica", retract_repeats=2, new_name="pulloff_silica_repeats"), cache).result
+    old = _run(_recipe("pulloff_silica", tip_thermostat="lab", retract_repeats=1, new_name="pulloff_silica_lab"),
+               cache).result
+    lab = old["quantities"]["residual_drag_force"]
+    assert lab["lab_frame_drag_N"] < 0
+    assert 0.5 < lab["value"] / lab["lab_frame_drag_N"] < 1.3
+    d = new["quantities"]["residual_drag_force"]
+    assert abs(d["value"]) < 0.15 * abs(d["lab_frame_drag_N"]) and abs(d["value"]) < 4 * d["stderr"] + 1e-11
+    pulls = new["details"]["pulls"]
+    assert len(pulls) == new["settings"]["retract_repeats"] == 2
+    f = [p["max_tensile_force_N"] for p in pulls]
+    assert new["quantities"]["pull_off_force"]["value"] == pytest.approx(np.mean(f))
+    assert new["quantities"]["pull_off_force"]["stderr"] == pytest.approx(np.std(f, ddof=1) / math.sqrt(2))
+    assert new["quantities"]["interaction_range_z0"]["stderr"] is not None
