@@ -29,12 +29,12 @@ Fast evaluation (dimensionless: h = d/sigma, t = z/sigma, x = delta/delta_c, lam
 -----------------------------------------------------------------------------------------------
 q(x) is the per-summit law in JKR units (P/P_c, U/(P_c delta_c), a^2/(beta delta_c)), q_H its Hertz
 part, x0 = 1.2114 the approach where P_JKR changes sign, x_r = Delta/delta_c,
-xi = (zeta_eff - d)/delta_c in [-x_r, 0]. With A(h, xi) = int_xi^{x0} q(x) phi(h + lambda x) lambda dx,
+xi = (zeta_eff - d)/delta_c in [-x_r, 0]. With A(h, xi) = int_xi^0 q(x) phi(h + lambda x) lambda dx,
 exactly (per unit area, for d <= z_max)::
 
     X = n [Hertz(h) + S G(h)] + n S * { 0                      approach   (zeta_eff = d)
                                         Wr(h)                  release    (zeta_eff = d - Delta)
-                                        A(h, xi) - A0(h)       threshold inside the window }
+                                        A(h, xi)               threshold inside the window }
 
 * Hertz(h) = (4/3) E* beta^{1/2} sigma^{3/2} F_{3/2}(h) (energy F_{5/2}, area F_1),
   F_nu(h) = Gamma(nu+1)/sqrt(2 pi) e^{-h^2/4} D_{-nu-1}(h) (parabolic-cylinder function,
@@ -43,11 +43,17 @@ exactly (per unit area, for d <= z_max)::
   the table holds log[int_h^{z_max} (t-h)^nu phi dt / u^{nu+1}] in r = sqrt(u), u = t_max - h: full
   relative accuracy up to z_max, where "untruncated minus the part above z_max" cancels.
 * G(h) = int_0^{x_top} (q - q_H) phi(h + lambda x) lambda dx (x_top = (z_max - d)/delta_c),
-  Wr(h) = int_{-x_r}^0 q phi lambda dx, A0(h) = A(h, 0): one 1-D table (in h, or in r).
-* A(h, xi): 2-D table in (h, w), w = sqrt((xi + x_r)/(x0 + x_r)), which removes the square-root
-  singularity of P_JKR at the fold.
+  Wr(h) = int_{-x_r}^0 q phi lambda dx, A0(h) = int_0^{x0} q phi lambda dx (the compressed summits
+  with P < 0, for the tensile part): one 1-D table (in h, or in r).
+* A(h, xi): 2-D table in (h, w) over the window only, w = sqrt((xi + x_r)/x_r), which removes the
+  square-root singularity of P_JKR at the fold. A(h, 0) = 0 is a node column, so the window meets the
+  approach branch exactly; at xi = -x_r the table is corrected by s (Wr - A(h, -x_r)), s = -xi/x_r
+  (linear, of the size of the table error) so that it meets the release branch exactly too: the law
+  is continuous wherever a threshold changes branch (a jump there stalls the coupled
+  pressure-deflection solve; docs/halfspace.md).
 * Above z_max only stretched summits remain: X = n S int_{xi}^{xi_top} q phi lam dx, from a 1-D
-  band table (release thresholds) or A(h, xi) - A(h, xi_top) (threshold inside the window).
+  band table (release thresholds) or A(h, xi) - A(h, xi_top) (threshold inside the window, corrected
+  linearly in xi to meet the band table at xi = -x_r).
   (For the compressive/tensile split, within x0 delta_c of z_max every summit is tensile.)
 All tables are piecewise-cubic Hermite with exact node derivatives, built by Gauss-Legendre
 quadrature in the JKR variable s = sqrt(a/a0) (x = (s^4 - s)/d_c is explicit: no root finding, no
@@ -83,6 +89,7 @@ __all__ = [
     "quadrature_contact_fraction",
     "RESOLUTIONS",
     "TENSILE_ONSET",
+    "table_size",
 ]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
@@ -103,6 +110,7 @@ _T_CUT = 8.5        # untruncated: adhesive tables neglect summits above 8.5 sig
 _H_ZERO = 30.0      # F_nu(h) < 1e-195 beyond h = 30: taken as 0
 _H_DEEP = -10.0     # tables cover h >= -10; deeper states use on-the-fly quadrature
 _DT_PANEL = 0.25    # largest t-span (sigma) of one Gauss-Legendre panel in the build quadratures
+_BUILD_BLOCK = 2_000_000   # most floats in one block of the window table's build quadrature
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _GH_X, _GH_W = np.polynomial.hermite_e.hermegauss(60)   # weight exp(-t^2/2)
 _HERTZ_NU = (1.5, 2.5, 1.0)            # pressure, energy, contact area
@@ -241,6 +249,69 @@ def _gl_nodes(bounds):
     return x.ravel(), w.ravel(), pid.ravel()
 
 
+def _window_shape(lam, xr, ttop, scale):
+    """(h-cells, w-cells, sub-panels per w-cell, band cells) of the window tables (`_build_window`)."""
+    dh = _DH * scale
+    h0, h1 = -_T_CUT, ttop + lam * xr
+    nh = max(4, int(math.ceil((h1 - h0) / dh)))
+    # w-cells: the resolution of a table in sqrt((xi + x_r)/(x_r + x0)) with max(24, 2 (x_r + x0) lam / 0.15)
+    # cells over [-x_r, x0] (the earlier layout, measured in docs/rough-gw.md), of which the window
+    # [-x_r, 0] is the fraction sqrt(x_r/(x_r + x0)) of the cells
+    span = xr + TENSILE_ONSET
+    nw = int(math.ceil(max(_NW_MIN, 2.0 * span * lam / _DT_W) * math.sqrt(xr / span) / scale))
+    # largest xi-step between w-nodes: the last cell (xi = -x_r (1 - w^2) is steepest at w = 1)
+    dxi = xr * (1.0 - (1.0 - 1.0 / nw) ** 2)
+    nsub = max(1, int(math.ceil(dxi * lam / _DT_PANEL)))
+    # along the band h moves by up to 2 lam x_r per unit w: keep its h-steps <= dh
+    nband = max(nw, int(math.ceil(2.0 * xr * lam / dh)))
+    return nh, nw, nsub, nband
+
+
+#: Peak bytes per node of the 2-D window table while it is built: node values and derivatives of three
+#: quantities (4 x 3 x 8 B), the Gaussian at the w-nodes (2 x 8 B), one quantity's Hermite blocks and
+#: monomial coefficients (2 x 16 x 8 B) and the coefficients already kept (2 x 16 x 8 B): 624 B, rounded up
+#: after measuring with tracemalloc (tests/test_extremes.py checks the estimate bounds the measured peak).
+_BYTES_PER_NODE = 800
+#: Fixed part of the build's peak: quadrature blocks of `_BUILD_BLOCK` floats (about six arrays of them).
+_BUILD_FIXED_BYTES = 6 * 8 * 2_000_000
+
+
+def table_size(stats, work_of_adhesion: float, e_star: float, z_max=None, detachment: str = "displacement",
+               resolution="standard") -> dict:
+    """What `GWJKRSurface(...)` with these arguments would allocate and compute, without building it.
+
+    Returns ``nodes`` (2-D window table), ``shape`` (h-cells, w-cells), ``band_cells``,
+    ``quadrature_points`` (integrand evaluations of the build), ``peak_bytes`` (an upper estimate of
+    the build's peak allocation) and ``lambda`` = delta_c/sigma. The window table spans the release
+    stretch Delta = x_r delta_c in steps of ~0.15 sigma and h from -8.5 sigma to z_max + Delta in steps
+    of 0.05 sigma (x the resolution multiplier), so its size grows like (delta_c/sigma)^2: with sigma
+    well below delta_c (soft, strongly adhesive summits on a very smooth surface) it outgrows any
+    memory. Hertz summits (work of adhesion 0) have no adhesive tables.
+    """
+    scale = RESOLUTIONS.get(resolution, resolution) if isinstance(resolution, str) else float(resolution)
+    scale = float(scale)
+    sigma = stats.sigma
+    out = {"nodes": 0, "shape": (0, 0), "band_cells": 0, "quadrature_points": 0,
+           "peak_bytes": 1_000_000, "lambda": 0.0}
+    if not work_of_adhesion > 0.0:
+        return out
+    delta_c = float(_jkr.critical_approach(stats.radius, work_of_adhesion, e_star))
+    lam = delta_c / sigma
+    xr = 1.0 if detachment == "displacement" else -_jkr.LOAD_DETACH_APPROACH_RATIO
+    tmax = math.inf if z_max is None or not math.isfinite(z_max) else float(z_max)
+    ttop = min(tmax, _T_CUT)
+    nh, nw, nsub, nband = _window_shape(lam, xr, ttop, scale)
+    nodes = (nh + 1) * (nw + 1)
+    band = nband if math.isfinite(tmax) else 0
+    # band: node i integrates up to its own s_i over panels of <= 0.25 sigma in t (about 4 lam x_r of them)
+    band_points = band * 8 * max(50, int(4.0 * lam * xr / _DT_PANEL)) // 2
+    out.update(nodes=nodes, shape=(nh, nw), band_cells=band, lambda_=lam,
+               quadrature_points=int((nh + 1) * nw * nsub * 8 + band_points),
+               peak_bytes=int(nodes * _BYTES_PER_NODE + _BUILD_FIXED_BYTES))
+    out["lambda"] = out.pop("lambda_")
+    return out
+
+
 # ==============================================================================================
 # Piecewise-cubic Hermite tables on uniform grids
 # ==============================================================================================
@@ -272,8 +343,11 @@ class _Hermite2D:
             for ib, (sb, kb) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
                 src = (F, Fb, Fa, Fab)[2 * ka + kb]
                 D[:, :, ia, ib] = src[sa:na - 1 + sa, sb:nb - 1 + sb]
-        C = np.einsum("mt,abtu,lu->ablm", _M, D, _M)       # monomial coefficients of b^l a^m
-        self.coef = np.ascontiguousarray(C.reshape((na - 1) * (nb - 1), 16))
+        # monomial coefficients of b^l a^m: C[., ., l, m] = sum_tu M[m, t] D[., ., t, u] M[l, u], as batched
+        # 4x4 products (a 4-index einsum here cost ~7 us per cell)
+        C = np.swapaxes(_M @ D @ _M.T, -1, -2)
+        del D
+        self.coef = np.ascontiguousarray(C).reshape((na - 1) * (nb - 1), 16)
         self.a0, self.inv_da, self.b0, self.inv_db = float(a0), 1.0 / da, float(b0), 1.0 / db
         self.na, self.nb = na - 1, nb - 1
 
@@ -387,7 +461,7 @@ class GWJKRSurface:
                              n * math.pi * beta * self.delta_c])
         self._ttop = min(self._tmax, _T_CUT)
         self._hlo = _H_DEEP
-        self._hlo2 = -(_T_CUT + self._lam * TENSILE_ONSET)     # window tables: no summits below
+        self._hlo2 = -_T_CUT          # window table (t = h + lam x <= h): no summits below
         self._hband = self._tmax - self._lam * TENSILE_ONSET
         self._inv_sigma = 1.0 / sigma
         #: separations (m) covered by the tables; below d_min fixed quadrature is used
@@ -461,53 +535,65 @@ class GWJKRSurface:
         return np.array(vals), np.array(ders)
 
     def _build_window(self, dh):
-        """2-D tables A_k(h, w) = int_xi^{x0} q_k(x) phi(h + lam x) lam dx, xi = -x_r + L w^2.
+        """2-D tables A_k(h, w) = int_xi^0 q_k(x) phi(h + lam x) lam dx over the stretched window,
+        xi = -x_r + x_r w^2 (w = 0: release, xi = -x_r; w = 1: approach, xi = 0, where A = 0 exactly).
 
         Cumulative Gauss-Legendre sums in s between the w-nodes; node derivatives exact:
-        dA/dh = int q phi' lam dx, dA/dw = -lam q(xi) phi(h + lam xi) dxi/dw.
+        dA/dh = int q phi' lam dx, dA/dw = -lam q(xi) phi(h + lam xi) dxi/dw. Built in blocks of h
+        rows so that the quadrature's temporaries stay below `_BUILD_BLOCK` floats (`table_size`).
         """
-        lam, xr, x0 = self._lam, self._xr, TENSILE_ONSET
-        L = xr + x0
+        lam, xr = self._lam, self._xr
+        L = xr
         self._L = L
         h0, h1 = self._hlo2, self._ttop + lam * xr
-        nh = max(4, int(math.ceil((h1 - h0) / dh)))
+        nh, nw, nsub, nband = _window_shape(lam, xr, self._ttop, self._scale)
         h = np.linspace(h0, h1, nh + 1)
-        nw = int(math.ceil(max(_NW_MIN, 2.0 * L * lam / _DT_W) / self._scale))
         wn = np.linspace(0.0, 1.0, nw + 1)
         s = _s_of_x(-xr + L * wn * wn)
         s[0] = _S_FOLD if self.detachment == "displacement" else _S_LOAD
-        s[-1] = _S_ZERO
+        s[-1] = 1.0
         xi = _x_of_s(s)
-        nsub = max(1, int(math.ceil(np.max(np.diff(xi)) * lam / _DT_PANEL)))
         sb = s[:-1, None] + np.diff(s)[:, None] * np.linspace(0.0, 1.0, nsub + 1)[None, :]
         lo, hi = sb[:, :-1].ravel(), sb[:, 1:].ravel()
         half = 0.5 * (hi - lo)
         sn = (((lo + hi) * 0.5)[:, None] + half[:, None] * _GL_X[None, :]).ravel()
         wt = (half[:, None] * _GL_W[None, :]).ravel()
         ker = _q_of_s(sn) * (lam * _dx_ds(sn) * wt)[None, :]        # (3, nodes)
-        t = h[:, None] + lam * _x_of_s(sn)[None, :]
-        ph = _phi(t)
-        pht = -ph * t
+        xs = lam * _x_of_s(sn)
         per = nsub * 8
         A = np.zeros((3, nh + 1, nw + 1))
         Ah = np.zeros_like(A)
-        for k in range(3):
-            pan = (ph * ker[k]).reshape(nh + 1, nw, per).sum(-1)
-            panh = (pht * ker[k]).reshape(nh + 1, nw, per).sum(-1)
-            A[k, :, :-1] = np.cumsum(pan[:, ::-1], axis=1)[:, ::-1]
-            Ah[k, :, :-1] = np.cumsum(panh[:, ::-1], axis=1)[:, ::-1]
+        rows = max(1, _BUILD_BLOCK // max(sn.size, 1))
+        for r0 in range(0, nh + 1, rows):
+            r1 = min(nh + 1, r0 + rows)
+            t = h[r0:r1, None] + xs[None, :]
+            ph = _phi(t)
+            pht = -ph * t
+            for k in range(3):
+                pan = (ph * ker[k]).reshape(r1 - r0, nw, per).sum(-1)
+                panh = (pht * ker[k]).reshape(r1 - r0, nw, per).sum(-1)
+                A[k, r0:r1, :-1] = np.cumsum(pan[:, ::-1], axis=1)[:, ::-1]
+                Ah[k, r0:r1, :-1] = np.cumsum(panh[:, ::-1], axis=1)[:, ::-1]
+            del t, ph, pht
         tj = h[:, None] + lam * xi[None, :]
         phj = _phi(tj)
         qj = _q_of_s(s)
         dxi_dw = 2.0 * L * wn
         Aw = -lam * qj[:, None, :] * phj[None] * dxi_dw[None, None, :]
         Ahw = lam * qj[:, None, :] * (phj * tj)[None] * dxi_dw[None, None, :]
+        del phj, tj
         self._t2 = [_Hermite2D(h0, (h1 - h0) / nh, 0.0, 1.0 / nw, A[k], Ah[k], Aw[k], Ahw[k]) for k in range(3)]
         self._t2_range = (h0, h1)
         self._nw = nw
+        # The bicubic restricted to the release end (w = 0, xi = -x_r) is exactly the cubic Hermite in h
+        # through its node values and h-derivatives there: E1(h) = A(h, -x_r), which `_integral` uses to
+        # make the window branch meet the release column Wr exactly (`_window_end`).
+        te = _Cubic1D(h0, (h1 - h0) / nh, A[:, :, 0], Ah[:, :, 0])
+        self._end = [np.ascontiguousarray(te.coef[:, j].T) for j in range(3)]          # (4, ncell)
+        self._end_x0, self._end_inv_dx, self._end_n = h0, nh / (h1 - h0), nh
+        del A, Ah, Aw, Ahw
         if self.truncated:
-            # along the band h moves by up to 2 lam x_r per unit w: keep its h-steps <= dh
-            self._build_band(max(nw, int(math.ceil(2.0 * xr * lam / dh))))
+            self._build_band(nband)
 
     def _build_band(self, nw):
         """Truncated surface, z_max < d < z_max + Delta, all stretched summits attached (release).
@@ -719,7 +805,7 @@ class GWJKRSurface:
             beyond = above & ~app
             if np.count_nonzero(beyond):
                 k = np.flatnonzero(beyond)
-                vk, dk, m = self._beyond_top(j, h[k], zt[k], deriv)
+                vk, dk, m, band_b, dband_b = self._beyond_top(j, h[k], zt[k], deriv)
                 val[k] = vk
                 if deriv:
                     dval[k] = dk
@@ -734,17 +820,35 @@ class GWJKRSurface:
                                                       (zt[kb] - hb) / lam if kb is not None else hb,
                                                       (self._tmax - hb) / lam]), deriv)
             n1, n2 = hf.size, hf.size + hb.size
+            E, dE = self._window_end(j, np.concatenate([hf, hb]), deriv)
+            xr = self._xr
             if kf is not None:
-                val[kf] += As * (A[:n1] - A0[kf])
+                # int_xi^0 = A(h, xi), corrected to meet the release column Wr exactly at xi = -x_r:
+                # + s (Wr - E1), s = -xi/x_r (`_window_end`); at xi = 0 both vanish (approach branch)
+                s = np.clip((hf - zt[kf]) / (lam * xr), 0.0, 1.0)
+                Af = A[:n1] + s * (Wr[kf] - E[:n1])
+                val[kf] += As * Af
                 if deriv:
-                    dval[kf] += As * (Ah[:n1] - Axi[:n1] / lam - dV[kf, 3])
+                    dval[kf] += As * (Ah[:n1] - Axi[:n1] / lam + s * (dV[kf, 2] - dE[:n1])
+                                      + (Wr[kf] - E[:n1]) / (lam * xr))
                 if parts:
-                    tens[kf] = As * A[:n1]
+                    tens[kf] = As * (A0[kf] + Af)
             if kb is not None:
+                # int_{xi_eff}^{xi_top} = A(h, xi_eff) - A(h, xi_top), corrected linearly in xi_eff to meet
+                # the band column T_rel at xi_eff = -x_r (it is 0 at xi_eff = xi_top either way):
+                # + c M, c = (xi_top - xi_eff)/(xi_top + x_r), M = T_rel - (E1 - A(h, xi_top)).
+                # M and its first w-derivative vanish at the band's end (xi_top = -x_r), so M/(xi_top + x_r)
+                # stays bounded.
                 on = zt[kb] < self._tmax                    # else every summit has let go
-                val[kb] = As * (A[n1:n2] - A[n2:]) * on
+                span = (self._tmax - hb) / lam + xr         # xi_top + x_r > 0 (live band points)
+                c = np.clip((self._tmax - zt[kb]) / (lam * np.maximum(span, 1e-300)), 0.0, 1.0)
+                M = band_b - (E[n1:] - A[n2:])
+                val[kb] = As * (A[n1:n2] - A[n2:] + c * M) * on
                 if deriv:
-                    dval[kb] = As * ((Ah[n1:n2] - Axi[n1:n2] / lam) - (Ah[n2:] - Axi[n2:] / lam)) * on
+                    dtop = Ah[n2:] - Axi[n2:] / lam
+                    dM = dband_b - dE[n1:] + dtop
+                    dc = np.where(span > 1e-9 * xr, c / (lam * np.maximum(span, 1e-300)), 0.0)
+                    dval[kb] = As * ((Ah[n1:n2] - Axi[n1:n2] / lam) - dtop + c * dM + dc * M) * on
         if parts and self.truncated:       # within x0 delta_c of z_max no summit is compressive
             tens = np.where(h > self._hband, val, tens)
         if parts:
@@ -762,12 +866,36 @@ class GWJKRSurface:
             return A, None, None
         return A, Ah, Aw / (2.0 * self._L * np.maximum(w, 1e-150))
 
+    def _window_end(self, j, h, deriv):
+        """The 2-D table at the window's release end, E1 = A_j(h, -x_r), and dE1/dh (or None).
+
+        Inside the window the table gives A(h, xi) = int_xi^0 q phi lam dx. At xi = 0 it is exactly 0
+        (a node column), as on the approach branch; at xi = -x_r it should equal the release column
+        Wr(h), but the 2-D and 1-D tables carry independent interpolation errors (~ the table error,
+        1e-9 - 1e-6 n P_c), so the law would jump by that much wherever a threshold switches between
+        the window and the release branch. The correction s (Wr - E1), s = -xi/x_r, linear in xi and
+        of the size of the table error, removes the mismatch: the law is continuous in d and zeta
+        (the coupled pressure-deflection solve needs it: a jump is a residual no iteration can
+        reduce; docs/halfspace.md).
+        """
+        a = (h - self._end_x0) * self._end_inv_dx
+        np.minimum(a, self._end_n * (1.0 - 1e-15), out=a)
+        np.maximum(a, 0.0, out=a)
+        i = a.astype(np.intp)
+        t = a - i
+        c0, c1, c2, c3 = np.take(self._end[j], i, axis=1)
+        E = ((c3 * t + c2) * t + c1) * t + c0
+        if not deriv:
+            return E, None
+        return E, ((3.0 * c3 * t + 2.0 * c2) * t + c1) * self._end_inv_dx
+
     def _beyond_top(self, j, h, zt, deriv):
         """Truncated surface, d > z_max, threshold below d: only stretched summits remain.
 
         Release thresholds: the 1-D band table T_rel (zero beyond z_max + Delta). Returns
-        (value, d/dh, m) where m indexes the points whose threshold lies inside the window and that
-        still hold summits: the caller adds A(h, xi_eff) - A(h, xi_top) for them (2-D table).
+        (value, d/dh, m, T_rel[m], dT_rel/dh[m]) where m indexes the points whose threshold lies inside
+        the window and that still hold summits: the caller adds A(h, xi_eff) - A(h, xi_top) for them
+        (2-D table), corrected to meet T_rel at xi_eff = -x_r.
         """
         lam, xr = self._lam, self._xr
         val = np.zeros(h.size)
@@ -775,7 +903,7 @@ class GWJKRSurface:
         w2 = ((self._tmax - h) / lam + xr) * (1.0 / xr)         # band coordinate squared
         live = w2 > 0.0
         if not np.count_nonzero(live):
-            return val, dval, np.zeros(0, np.intp)
+            return val, dval, np.zeros(0, np.intp), np.zeros(0), np.zeros(0) if deriv else None
         k = np.flatnonzero(live)
         hk, ztk = h[k], zt[k]
         wb = np.sqrt(w2[k])
@@ -786,11 +914,15 @@ class GWJKRSurface:
         c0, c1, c2, c3 = np.take(self._band[j], i, axis=1)
         rel = ztk <= hk - self._dn
         As = self._as[j]
-        val[k] = As * (((c3 * t + c2) * t + c1) * t + c0) * rel
+        band = ((c3 * t + c2) * t + c1) * t + c0
+        val[k] = As * band * rel
+        dband = None
         if deriv:
             dwdh = -0.5 / (lam * xr * np.maximum(wb, 1e-150))      # h = z_max + lam x_r (1 - w^2)
-            dval[k] = As * ((3.0 * c3 * t + 2.0 * c2) * t + c1) * (self._band_n * dwdh) * rel
-        return val, dval, k[~rel]
+            dband = ((3.0 * c3 * t + 2.0 * c2) * t + c1) * (self._band_n * dwdh)
+            dval[k] = As * dband * rel
+        win = ~rel
+        return val, dval, k[win], band[win], dband[win] if deriv else None
 
     # ------------------------------------------------------------------------------ public API
     def pressure(self, d, zeta):
