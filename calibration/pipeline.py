@@ -8,7 +8,7 @@ Steps (each timed in the report):
 2. The set: calibration.mdset.build_parameter_set on the recipe's base set, written atomically to
    inputs/params/<name>.toml (or --params-out), every value with its MD run hash in [meta].
 3. The paper's dry, wet and SAM cases for the base set, the literature `silicon` set and the new set
-   (continuum.paper.report.make_paper), into OUT/paper.
+   (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper.
 4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr) and the
    user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
    scene, giving first rebound heights, rebound counts and the escape velocity as median and
@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .executors import executor
+from nanoimpact.executors import Failure, executor
+
 from .mdset import MAPPING, build_parameter_set, committed_result, recipes_needed, write_parameter_set
 
 from nanoimpact import data
@@ -247,7 +248,9 @@ def md_job(task: tuple) -> dict:
     from md.recipe import load_recipe
     from md.runner import run_recipe
 
-    outcome = run_recipe(load_recipe(recipe_name), fidelity, cache=cache, progress=False, echo=None)
+    # resume: a run this job (or a worker that died, or an earlier calibration) left unfinished goes on from its
+    # last restart instead of starting again; with nothing to resume it is a fresh run
+    outcome = run_recipe(load_recipe(recipe_name), fidelity, cache=cache, resume=True, progress=False, echo=None)
     note = "md cache" if outcome.reused else "ran"
     if committed is not None:
         note += f" (committed result's hash {str(committed.get('run_hash'))[:16]} is not current {digest[:16]})"
@@ -381,16 +384,17 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         from continuum.paper.report import make_paper
 
         sets = [cal["base"], *[s for s in paper_sets if s != cal["base"]], str(set_path)]
-        paper = make_paper(sets, out / "paper", workers=workers, progress=lambda m: None)
+        paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None)   # the user's executor
         timings["paper_s"] = time.perf_counter() - t
         # 4. uncertainty
         t = time.perf_counter()
         unc = cal["uncertainty"]
         keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc["ranges"], unc["samples"], unc["seed"])
         sample_out = [None] * len(samples)
-        for i, s in ex.map(uncertainty_sample, [(unc["scene"], str(set_path), {**unc["overrides"], **smp},
-                                                  unc["max_bounces"]) for smp in samples]):
-            sample_out[i] = s
+        tasks = [(unc["scene"], str(set_path), {**unc["overrides"], **smp}, unc["max_bounces"]) for smp in samples]
+        for i, s in ex.map(uncertainty_sample, tasks, on_error="collect"):
+            # a sample whose job failed (a crash, a lost worker) is counted and reported like a refused one
+            sample_out[i] = {"overrides": tasks[i][2], "error": s.reason} if isinstance(s, Failure) else s
         timings["uncertainty_s"] = time.perf_counter() - t
     finally:
         ex.close()

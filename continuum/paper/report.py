@@ -123,11 +123,16 @@ def wet_lines(set_name: str, wet: dict, impacts: dict) -> list[str]:
 
 
 def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
+               executor_name: str = "processes", scheduler: str | None = None, executor=None,
                progress: Callable[[str], None] = print) -> dict:
-    """Run every case for every set into `out`; returns {"checks": [...], "wall_s": ...}."""
+    """Run every case for every set into `out`; returns {"checks": [...], "wall_s": ...}.
+
+    Where the runs go: `executor` (an open nanoimpact.executors object, e.g. the calibration's), else a new
+    `executor_name` executor with `workers` and `scheduler` (default: a local pool of CPU-count processes)."""
     out = Path(out)
     start = time.perf_counter()
-    collected = run_paper(sets, out, fidelity=fidelity, workers=workers, progress=progress)
+    collected = run_paper(sets, out, fidelity=fidelity, workers=workers, executor_name=executor_name,
+                          scheduler=scheduler, executor=executor, progress=progress)
     all_checks, summary = [], ["# nanoimpact paper: dry, wet and SAM cases", "",
                                f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
                                "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]

@@ -6,18 +6,21 @@ Layout of `--out DIR`:
     data/fig*.csv                                                                  the data behind them
     summary.md                                                                     per case and set
     checks.json                                                                    the paper's claims
-Independent runs go to a local process pool (no server; `workers` defaults to the CPU count).
+Independent runs go to an executor (nanoimpact.executors): by default a local process pool (no
+server; `workers` defaults to the CPU count); `executor_name`/`scheduler` pick another, or the
+caller passes its own executor (calibration passes the one the user chose).
 """
 from __future__ import annotations
 
 import math
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
+
+from nanoimpact.executors import executor as make_executor
 
 from ..escape import escape_velocity, single_impact
 from ..impact import first_impact_speed, run_impact, write_impact
@@ -134,24 +137,42 @@ def fig8_cases() -> list[Case]:
 
 
 def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
+              executor_name: str = "processes", scheduler: str | None = None, executor=None,
               progress: Callable[[str], None] = print) -> dict:
-    """Run every dry case and sweep for every parameter set; returns the collected outputs."""
+    """Run every dry case and sweep for every parameter set; returns the collected outputs.
+
+    Runs go to `executor` (an object from nanoimpact.executors, left open: its owner closes it) or, without one,
+    to a new `executor_name` executor (default: a local process pool of `workers`, default the CPU count).
+    The first run that fails stops the rest and its error propagates.
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     # longest first (the wet near-escape sweeps, then the Fig 8a sweeps), so no long run starts last
     tasks = [("wet", (case, s, fidelity)) for s in sets for case in wet_cases()]
     tasks += [("sweep", (case, s, fidelity)) for s in sets for case in fig8_cases()]
-    tasks += [("impact", (case, s, fidelity, str(out))) for s in sets for case in dry_cases() + wet_cases()]
-    workers = workers or os.cpu_count() or 1
+    # absolute: the runs write there from the workers, whose working directory may differ (a Dask cluster)
+    tasks += [("impact", (case, s, fidelity, str(out.resolve()))) for s in sets for case in dry_cases() + wet_cases()]
     collected = {"impacts": {}, "sweeps": {}, "wet": {}, "wall_s": {}}
     start = time.perf_counter()
-    progress(f"paper: {len(tasks)} runs on {workers} worker(s) for set(s) {', '.join(sets)}")
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        for done, item in enumerate(pool.map(_run, tasks), 1):
+    own = executor is None
+    if own:
+        if executor_name == "processes" and workers is None:
+            workers = os.cpu_count() or 1
+        executor = make_executor(executor_name, workers, scheduler)
+    try:
+        progress(f"paper: {len(tasks)} runs for set(s) {', '.join(sets)} on {executor.describe()}")
+        for done, (_, item) in enumerate(executor.map(_run, tasks), 1):
             key = (item["case"], item["set"])
             collected[{"impact": "impacts", "sweep": "sweeps", "wet": "wet"}[item["kind"]]][key] = item
             collected["wall_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["wall_s"]
             progress(f"  [{done}/{len(tasks)}] {item['kind']} {item['case']} ({item['set']}): {item['wall_s']:.1f} s")
+    except BaseException:
+        if own:
+            executor.close(cancel=True)
+        raise
+    else:
+        if own:
+            executor.close()
     collected["total_wall_s"] = time.perf_counter() - start
     return collected
 
