@@ -224,6 +224,9 @@ class Local(_Base):
 
 
 def _init_pool_worker(parent_pid: int) -> None:
+    # a forked worker inherits its parent's Python SIGTERM handler, if any: one the GIL-holding job would
+    # delay; the default action ends the worker at once (the parent-death signal and terminate() send SIGTERM)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     guard_parent(parent_pid)
 
 

@@ -175,3 +175,22 @@ def test_workers_end_when_their_parent_is_killed(tmp_path, kind):
             if not _gone(p):
                 os.kill(p, signal.SIGKILL)
         log.close()
+
+
+@pytest.mark.parametrize("name", ["local", "processes"])
+def test_the_paper_runner_runs_on_the_executor_it_is_given_and_leaves_it_open(tmp_path, monkeypatch, name):
+    """What calibrate does with the user's executor (the paper's case lists cut to one cheap case here)."""
+    from continuum.paper import run
+    from continuum.paper.cases import Case
+
+    hertz = Case("hertz", "hertz_roller.toml", {"numerics.max_bounces": 1}, ("8a",))
+    monkeypatch.setattr(run, "dry_cases", lambda: [hertz])
+    monkeypatch.setattr(run, "wet_cases", lambda: [])
+    monkeypatch.setattr(run, "fig8_cases", lambda: [hertz])
+    lines = []
+    with executor(name, workers=2) as ex:
+        got = run.run_paper(["paper"], tmp_path / "paper", executor=ex, progress=lines.append)
+        assert dict(ex.map(square_or_fail, [2])) == {0: 4}          # still open: its owner closes it
+    assert set(got["impacts"]) == {("hertz", "paper")} and set(got["sweeps"]) == {("hertz", "paper")}
+    assert (tmp_path / "paper" / "cases" / "hertz" / "paper" / "result.json").is_file()
+    assert lines[0].startswith("paper: 2 runs for set(s) paper on " + ex.describe())
