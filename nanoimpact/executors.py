@@ -211,7 +211,7 @@ class Local(_Base):
                 except Exception as exc:        # noqa: BLE001 -- collected or re-raised below
                     if on_error == "raise":
                         raise
-                    log.warning("job %d failed: %s", i, one_line(exc))
+                    log.debug("job %d failed: %s", i, one_line(exc))   # collected: the caller reports it
                     out = Failure.of(i, exc)
                 yield i, out
         return run()
@@ -272,7 +272,7 @@ class Processes(_Base):
                     if exc is None:
                         yield i, fut.result()
                     elif on_error == "collect":
-                        log.warning("job %d failed: %s", i, one_line(exc))
+                        log.debug("job %d failed: %s", i, one_line(exc))   # collected: the caller reports it
                         yield i, Failure.of(i, exc)
                     else:
                         self._aborted = True
@@ -324,6 +324,7 @@ class Dask(_Base):
         self.cluster = None
         self._futures: list = []
         self._aborted = False
+        self._quieted = None
         if scheduler:
             if workers is not None:
                 log.info("dask: --workers %s ignored: the cluster at %s has its own workers", workers, scheduler)
@@ -337,12 +338,24 @@ class Dask(_Base):
         else:
             self.workers = workers or 2
             has_bokeh = importlib.util.find_spec("bokeh") is not None
+            # the scheduler and nannies run in this process and log every start and stop at INFO (dask's own
+            # logger level, which its silence_logs does not touch): quiet them unless everything was asked for
+            dask_log = logging.getLogger("distributed")
+            if logging.getLogger().getEffectiveLevel() >= logging.WARNING > dask_log.getEffectiveLevel():
+                self._quieted = (dask_log, dask_log.level)
+                dask_log.setLevel(logging.WARNING)
             # ":0": a free port (the scheduler's HTTP server runs even without bokeh's dashboard);
             # the preload makes every worker end with this process (guard_parent)
-            self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                        dashboard_address=":0", silence_logs=logging.ERROR,
-                                        preload=["nanoimpact.executors"])
-            self.client = Client(self.cluster)
+            try:
+                self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
+                                            dashboard_address=":0", silence_logs=logging.ERROR,
+                                            preload=["nanoimpact.executors"])
+                self.client = Client(self.cluster)
+            except BaseException:
+                self._restore_logging()
+                if self.cluster is not None:
+                    self.cluster.close()
+                raise
             self.where = f"a LocalCluster of {self.workers} worker process(es) at {self.cluster.scheduler_address}"
             if not has_bokeh:
                 self.dashboard = "unavailable: bokeh is not installed (pip install 'bokeh>=3.1' for it)"
@@ -375,7 +388,7 @@ class Dask(_Base):
                     if exc is None:
                         exc = CancelledError(f"the job's future is {fut.status}")
                     if on_error == "collect":
-                        log.warning("job %d failed: %s", i, one_line(exc))
+                        log.debug("job %d failed: %s", i, one_line(exc))   # collected: the caller reports it
                         yield i, Failure.of(i, exc)
                     else:
                         self._aborted = True
@@ -407,6 +420,13 @@ class Dask(_Base):
         finally:
             if self.cluster is not None:
                 self.cluster.close()
+            self._restore_logging()
+
+    def _restore_logging(self) -> None:
+        if self._quieted is not None:
+            logger, level = self._quieted
+            logger.setLevel(level)
+            self._quieted = None
 
 
 def _check_workers(workers) -> None:
