@@ -9,6 +9,15 @@ pressure profile at that depth, the plane-strain half-space (FFT influence coeff
 `continuum.halfspace.LineHalfSpace`, referenced at x_ref = l) gives the deflection across the
 footprint; its span (largest minus smallest over the loaded cells) is what changes the summits'
 gaps relative to the rigid geometry. Cost: ~10-50 ms.
+
+Bounded cost (`check_table_cost`): before any table is built, the memory the averaged model's
+GW tables would take is estimated from the scene (the window table grows like (delta_c/sigma)^2,
+`continuum.rough.gw.table_size`) and so is the time of the rigid-substrate footprint tables (nodes
+over the range of gaps, `RigidRoughRoller.table_shape`, times a measured cost per surface state).
+A scene beyond `MEMORY_BOUND_BYTES` or `continuum.laws.rough_rigid.MAX_BUILD_SECONDS` is refused
+with a one-line `SceneError` naming the key, the value, the estimate and the way out (discrete
+summits, a larger sigma, tabulated JKR summits, the half-space grid law). docs/model.md, "Bounded
+cost".
 """
 from __future__ import annotations
 
@@ -19,6 +28,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .halfspace import LineHalfSpace
+
+#: Most memory (bytes) the averaged rough model's tables may take while they are built (issue 12).
+MEMORY_BOUND_BYTES = 2 * 2**30
 
 
 @dataclass(frozen=True)
@@ -74,3 +86,53 @@ def rough_impact_estimate(stats, summit_e_star: float, e_star: float, radius: fl
     loaded = p > 0.0
     span = float(np.max(u[loaded]) - np.min(u[loaded])) if np.count_nonzero(loaded) > 1 else 0.0
     return RoughImpactEstimate(energy, depth, contacts, force, half, span, time.perf_counter() - start)
+
+
+def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_max_sigma: float,
+                     detachment: str, resolution: str, gw_tables: bool, rigid: bool, rigid_resolution: str,
+                     release_stretch: float, end_gap: float, depth_estimate: float | None, sigma_key_value: float,
+                     origin: str = "") -> dict:
+    """Refuse a rough scene whose tables would outgrow the bounds, before anything is built.
+
+    gw_tables: the JKR summits' GW tables will be built (`GWJKRSurface` with adhesion); rigid: the
+    rigid-substrate footprint tables will be (`RigidRoughRoller`), for a first design depth of at
+    least 1.5 x `depth_estimate` (the Hertz summits' quasi-static depth; adhesion only pulls deeper,
+    which coarsens those tables' spacing). Returns the estimates (recorded in the result).
+    Raises `continuum.scene.SceneError` (key surfaces.roughness.sigma) with a one-line reason.
+    """
+    from .laws.rough_rigid import MAX_BUILD_SECONDS, SECONDS_PER_STATE, RigidRoughRoller, table_cost_refusal
+    from .rough.gw import table_size
+    from .scene import SceneError
+
+    sigma = stats.sigma
+    rec: dict = {"memory_bound_bytes": MEMORY_BOUND_BYTES}
+    if gw_tables and work_of_adhesion > 0.0:
+        size = table_size(stats, work_of_adhesion, summit_e_star, z_max=z_max_sigma, detachment=detachment,
+                          resolution=resolution)
+        rec["gw_table"] = {"nodes": size["nodes"], "shape": list(size["shape"]), "peak_bytes": size["peak_bytes"],
+                           "resolution": resolution, "sigma_over_delta_c": 1.0 / size["lambda"]}
+        if size["peak_bytes"] > MEMORY_BOUND_BYTES:
+            lam = size["lambda"]
+            # the table grows like lambda^2: the sigma that would fit, by that scaling (an estimate)
+            fit = sigma * math.sqrt(size["peak_bytes"] / MEMORY_BOUND_BYTES)
+            raise SceneError(
+                "surfaces.roughness.sigma", sigma_key_value,
+                f"sigma/delta_c = {1.0 / lam:.3g} (delta_c = {lam * sigma:.3g} m from the summits' radius, work of "
+                f"adhesion and modulus): the averaged model's GW tables would take ~{size['peak_bytes'] / 2**30:.3g} GiB "
+                f"({size['nodes']:.3g} nodes at '{resolution}'), above the {MEMORY_BOUND_BYTES / 2**30:g} GiB bound; "
+                f"use surfaces.roughness.mode = 'discrete' (individual summits, no tables) or sigma >= ~{fit:.2g} m "
+                f"(or stiffer summits / less adhesion)", origin)
+    if rigid and depth_estimate is not None and depth_estimate > 0.0:
+        # the first design depth is at least 1.5 x the Hertz estimate (adhesion only pulls deeper); the
+        # tables are checked again against the same bound with the real design depth before each build
+        depth = 1.5 * depth_estimate
+        shape = RigidRoughRoller.table_shape(sigma, release_stretch, end_gap, depth, rigid_resolution)
+        kind = "tabulated" if gw_tables else "generic"
+        rec["rigid_table"] = {"nodes": shape["nodes"], "states": shape["states"], "design_depth_at_least": depth,
+                              "resolution": rigid_resolution, "surface": kind,
+                              "estimated_seconds": shape["states"] * SECONDS_PER_STATE[kind],
+                              "max_build_seconds": MAX_BUILD_SECONDS}
+        refusal = table_cost_refusal(sigma_key_value, shape, kind, release_stretch, depth)
+        if refusal is not None:
+            raise refusal
+    return rec

@@ -28,7 +28,7 @@ import math
 
 from . import menisci as men
 from . import regimes
-from .estimates import rough_impact_estimate
+from .estimates import check_table_cost, rough_impact_estimate
 from .laws.base import ContactLaw
 from .laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
 from .laws.jkr import JKRSphere
@@ -221,18 +221,20 @@ def _estimate(scene: Scene, speed: float):
 
     body, rough = scene.body, scene.surfaces.roughness
     datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
+    # beyond the averaged model's range the depth search refuses the scene (SceneError, continuum.laws.rough_roller)
     return rough_impact_estimate(SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius),
                                  summit_e_star(scene), scene.surfaces.e_star, body.radius, body.length,
                                  datum["z_max"], body.mass, speed, scene.environment.gravity)
 
 
 def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None = None,
-              with_menisci: bool = False, speed: float | None = None) -> tuple[ContactLaw, dict]:
+              with_menisci: bool = False, speed: float | None = None, estimate=None) -> tuple[ContactLaw, dict]:
     """GW rough roller for `scene` and the record of its datum and regime numbers.
 
     `adhesion` (a law name) and `half_space` default to the scene's choices; where the scene says
     'auto' they are decided as `select_law` does (with the estimate at `speed`, m/s, if given, else
-    at the scene's first impact).
+    at the scene's first impact). Before any table is built the tables' size is estimated and a
+    scene beyond the bounds is refused with a `SceneError` (`continuum.estimates.check_table_cost`).
     """
     from .laws.rough_roller import RoughRoller
     from .rough.datum import tallest_summit
@@ -240,11 +242,13 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
 
     body, surf, phys = scene.body, scene.surfaces, scene.physics
     rough = surf.roughness
+    if speed is None:
+        speed = (math.sqrt(2.0 * scene.environment.gravity * scene.release_height)
+                 if scene.release_height is not None else scene.impact_velocity)
+    est = estimate
     if adhesion is None or half_space is None:
-        if speed is None:
-            speed = (math.sqrt(2.0 * scene.environment.gravity * scene.release_height)
-                     if scene.release_height is not None else scene.impact_velocity)
-        est = _estimate(scene, speed) if "auto" in (phys.adhesion_law, phys.half_space) else None
+        if est is None and "auto" in (phys.adhesion_law, phys.half_space):
+            est = _estimate(scene, speed)
         if adhesion is None:
             adhesion = decide_adhesion(scene, est)[0]
         if half_space is None:
@@ -255,6 +259,25 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     e_s = summit_e_star(scene)
     table = scene.numerics.table
     generic = adhesion in ("dmt", "maugis_dugdale") or sam_layer(scene) is not None
+    cost = None
+    if rough.mode != "discrete":
+        if not generic and table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
+                jkr_ref.critical_approach(rough.summit_radius, w, e_s)):
+            table = "standard"      # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
+        if not half_space and est is None:
+            est = _estimate(scene, speed)
+        if generic:
+            slaw = summit_law(adhesion, scene)
+            release_stretch, end_gap = max(-slaw.delta_out, 0.0), max(-slaw.delta_out, slaw.reach, 0.0)
+        else:
+            release_stretch = end_gap = (float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) *
+                                         (1.0 if phys.detachment == "displacement"
+                                          else -jkr_ref.LOAD_DETACH_APPROACH_RATIO) if w > 0 else 0.0)
+        cost = check_table_cost(stats=stats, work_of_adhesion=w, summit_e_star=e_s, z_max_sigma=datum["z_max"],
+                                detachment=phys.detachment, resolution=table, gw_tables=not generic,
+                                rigid=not half_space, rigid_resolution=scene.numerics.table,
+                                release_stretch=release_stretch, end_gap=end_gap,
+                                depth_estimate=est.depth if est else None, sigma_key_value=rough.sigma)
     if rough.mode == "discrete":
         # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
         from .laws.discrete_roller import DiscreteRoughRoller
@@ -266,11 +289,8 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     else:
         if generic:
             from .rough.gw_branches import GWBranchSurface
-            surface = GWBranchSurface(stats, summit_law(adhesion, scene), z_max=datum["z_max"], resolution=table)
+            surface = GWBranchSurface(stats, slaw, z_max=datum["z_max"], resolution=table)
         else:
-            if table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
-                    jkr_ref.critical_approach(rough.summit_radius, w, e_s)):
-                table = "standard"      # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
             surface = GWJKRSurface(stats, w, e_s, z_max=datum["z_max"], detachment=phys.detachment,
                                    resolution=table)
         if half_space:
@@ -292,6 +312,8 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     record = {"datum": {**datum, "z_max_m": datum["z_max"] * rough.sigma, "release_from": rough.datum},
               "regime": regime, "table": {"resolution": getattr(surface, "resolution", scene.numerics.table),
                                           "build_seconds": getattr(surface, "build_seconds", None)}}
+    if cost is not None:
+        record["table"]["cost_estimate"] = cost
     if rough.mode != "discrete" and table != scene.numerics.table:
         record["table"]["why"] = (f"the '{scene.numerics.table}' preset asked for '{scene.numerics.table}' tables, "
                                   f"but sigma/delta_c < {FAST_TABLE_MIN_SIGMA_OVER_DELTA_C:g}, where they miss their "
@@ -337,7 +359,7 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
             adhesion = "jkr"
         use_hs, hs_rec = decide_half_space(scene, estimate)
         wet = menisci if menisci is not None else (m_choice == "on")
-        law, record = rough_law(scene, adhesion, use_hs, with_menisci=wet)
+        law, record = rough_law(scene, adhesion, use_hs, with_menisci=wet, estimate=estimate)
         models["estimate"] = {**estimate.to_json(), "what": "quasi-static first approach of Hertz summits on a "
                               "rigid substrate absorbing the first impact's energy (continuum.estimates)"}
         models["contact_law"] = {**law.describe(), **record,

@@ -38,10 +38,37 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 from ..rough.gw import GWJKRSurface
 from .base import ContactLaw
+from .rough_roller import SECONDS_PER_STATE as _SECONDS_PER_STATE, beyond_range
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
 #: Table resolution per fidelity: (points per release stretch in h, points per sigma in h, w-nodes, Gauss nodes).
 RESOLUTION = {"fast": (8, 40, 9, 16), "standard": (16, 80, 17, 24), "reference": (32, 160, 33, 40)}
+#: Most surface states evaluated at once while the tables are built (bounds the build's temporaries).
+_BLOCK_STATES = 200_000
+#: Cost of one surface state (pressure or energy) in the table build (`rough_roller.SECONDS_PER_STATE`:
+#: 2.0 us tabulated JKR summits, 19 us generic laws, measured on a busy 2-core machine). Used to bound
+#: the build's time before it starts.
+SECONDS_PER_STATE = _SECONDS_PER_STATE
+#: Most estimated seconds one build of the tables may take; beyond it the scene is refused (issue 12).
+MAX_BUILD_SECONDS = 30.0
+
+
+def table_cost_refusal(sigma: float, shape: dict, surface_kind: str, release_stretch: float, depth: float):
+    """A SceneError if tables of `shape` (`RigidRoughRoller.table_shape`) would take longer than
+    MAX_BUILD_SECONDS to build on `surface_kind` summits, else None."""
+    from ..scene import SceneError
+
+    seconds = shape["states"] * SECONDS_PER_STATE[surface_kind]
+    if seconds <= MAX_BUILD_SECONDS:
+        return None
+    way = ("physics.adhesion_law = 'jkr' (tabulated summits, ~10x cheaper per state), " if surface_kind == "generic"
+           else "")
+    return SceneError(
+        "surfaces.roughness.sigma", sigma,
+        f"the rigid-substrate footprint tables would evaluate {shape['states']:.3g} {surface_kind} surface states "
+        f"(~{seconds:.3g} s: {shape['nodes']:.3g} nodes spaced {shape['step']:.3g} m over an impact depth of "
+        f"~{depth:.3g} m and a release stretch of {release_stretch:.3g} m), above the {MAX_BUILD_SECONDS:g} s bound; "
+        f"use {way}physics.half_space = 'on' (grid law, no footprint table) or surfaces.roughness.mode = 'discrete'")
 
 
 class RigidRoughRoller(ContactLaw):
@@ -73,6 +100,8 @@ class RigidRoughRoller(ContactLaw):
         self.max_pressure = 0.0
         self.edge_touched = False
         self.depth_history: list[dict] = []
+        #: "tabulated" (GW tables of JKR or Hertz summits) or "generic" (quadrature of any summit law)
+        self.surface_kind = "tabulated" if isinstance(surface, GWJKRSurface) else "generic"
         self.reset()
 
     # ------------------------------------------------------------------ tables
@@ -90,17 +119,48 @@ class RigidRoughRoller(ContactLaw):
         return s, w
 
     def _integrate(self, what: str, h: np.ndarray, r: np.ndarray) -> np.ndarray:
-        """2 l sqrt(2R) int_0^{sqrt(r-h)} q(z_max + h + s^2, threshold d - r) ds for q = pressure/energy/contacts."""
-        s, w = self._gauss(h, r)
-        d = self.z_top + h[..., None] + s * s
-        zeta = d - r[..., None]
-        q = getattr(self.surface, what)(d.ravel(), zeta.ravel()).reshape(d.shape)
-        return 2.0 * self.length * math.sqrt(2.0 * self.radius) * np.sum(q * w, axis=-1)
+        """2 l sqrt(2R) int_0^{sqrt(r-h)} q(z_max + h + s^2, threshold d - r) ds for q = pressure/energy/contacts.
+
+        Evaluated in blocks of at most `_BLOCK_STATES` surface states, so that the surface's own
+        temporaries (a few dozen arrays per state) stay bounded whatever the table size."""
+        h, r = np.broadcast_arrays(np.asarray(h, float), np.asarray(r, float))
+        shape = h.shape
+        hf, rf = h.reshape(-1), r.reshape(-1)
+        out = np.empty(hf.size)
+        per = 2 * self.res[3]
+        step = max(1, _BLOCK_STATES // per)
+        fun = getattr(self.surface, what)
+        for i in range(0, hf.size, step):
+            hb, rb = hf[i:i + step], rf[i:i + step]
+            s, w = self._gauss(hb, rb)
+            d = self.z_top + hb[:, None] + s * s
+            zeta = d - rb[:, None]
+            q = fun(d.ravel(), zeta.ravel()).reshape(d.shape)
+            out[i:i + step] = np.sum(q * w, axis=-1)
+        return 2.0 * self.length * math.sqrt(2.0 * self.radius) * out.reshape(shape)
+
+    @staticmethod
+    def table_shape(sigma: float, release_stretch: float, end_gap: float, depth: float,
+                    resolution: str = "standard") -> dict:
+        """Nodes of the (gap, window) tables `_build` makes for a design `depth` (m), and the surface
+        states their quadrature evaluates (2 x Gauss nodes per node, for the force and the energy)."""
+        per_delta, per_sigma, n_w, n_gauss = RESOLUTION[resolution]
+        step = min(sigma / per_sigma, depth / (4 * per_sigma))
+        if release_stretch > 0.0:
+            step = min(step, release_stretch / per_delta)
+        n_h = int(math.floor((end_gap + 2 * step + depth) / step)) + 1
+        return {"gap_nodes": n_h, "window_nodes": n_w, "nodes": n_h * n_w,
+                "states": 2 * n_h * n_w * 2 * n_gauss + n_h * 2 * n_gauss, "step": step}
 
     def _build(self, depth: float) -> None:
         import time
 
         start = time.perf_counter()
+        refusal = table_cost_refusal(self.sigma, self.table_shape(self.sigma, self.release_stretch, self.end_gap, depth,
+                                                                  self.resolution),
+                                     self.surface_kind, self.release_stretch, depth)
+        if refusal is not None:
+            raise refusal
         per_delta, per_sigma, n_w, _ = self.res
         # the spacing follows the smallest length in play: sigma, the release stretch, and the
         # depth this impact can reach (a 1 nm drop on sigma = 100 nm penetrates picometres)
@@ -131,11 +191,12 @@ class RigidRoughRoller(ContactLaw):
             self._build(depth)
 
     def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
-        """Depth below the datum (m) at which the approach branch has absorbed `energy` (J)."""
+        """Depth below the datum (m) at which the approach branch has absorbed `energy` (J); beyond the
+        averaged model's range the scene is refused (`SceneError`)."""
         first = min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
-        return absorbing_depth(lambda ds: self._integrate("pressure", -ds, np.zeros_like(ds)), energy,
-                               first_step=first, weight=weight,
-                               max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma)
+        return beyond_range(lambda: absorbing_depth(lambda ds: self._integrate("pressure", -ds, np.zeros_like(ds)),
+                                                    energy, first_step=first, weight=weight,
+                                                    max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma), self.sigma)
 
     # ------------------------------------------------------------------ state
     def reset(self) -> None:

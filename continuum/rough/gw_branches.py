@@ -33,7 +33,7 @@ from .gw import SummitStatistics, _gauss_mass
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
-_CHUNK = 4096
+_CHUNK = 512
 
 
 class GWBranchSurface:
@@ -93,8 +93,13 @@ class GWBranchSurface:
         shape = d.shape
         d, zeta = d.ravel(), zeta.ravel()
         out = np.empty(d.size)
+        # a chunk integrates every state over the panels up to its deepest state's compression:
+        # states sorted by separation make the chunks' panel counts follow their own depths
+        # (3-5x cheaper on a table's spread of states than chunks in input order; same sums)
+        order = np.argsort(d, kind="stable") if d.size > _CHUNK else None
         for i in range(0, d.size, _CHUNK):
-            out[i:i + _CHUNK] = self._chunk(what, d[i:i + _CHUNK], zeta[i:i + _CHUNK], part)
+            k = order[i:i + _CHUNK] if order is not None else slice(i, i + _CHUNK)
+            out[k] = self._chunk(what, d[k], zeta[k], part)
         out = out.reshape(shape)
         return out[()] if out.ndim == 0 else out
 
