@@ -18,7 +18,8 @@ from pathlib import Path
 
 from nanoimpact.cli import ArgumentParser, add_verbosity, check_out_dir, positive_int, setup_logging
 from nanoimpact import __version__, data
-from nanoimpact.errors import (EXIT_PARTIAL, BackendUnavailable, InputError, NanoimpactError, UsageError,
+from nanoimpact.executors import check_executor
+from nanoimpact.errors import (EXIT_PARTIAL, InputError, NanoimpactError, UsageError,
                                run_command)
 
 log = logging.getLogger("calibration.cli")      # not __name__: it is __main__ under python -m
@@ -44,16 +45,6 @@ def bounce_table(bounces: list[dict]) -> str:
 
 
 # ----------------------------------------------------------------------------- up-front checks
-def check_executor(executor: str, scheduler: str | None) -> None:
-    """--scheduler only with --executor dask; --executor dask only with dask.distributed installed."""
-    if scheduler and executor != "dask":
-        raise InputError("--scheduler", scheduler, f"goes with --executor dask, not --executor {executor}")
-    if executor == "dask" and (importlib.util.find_spec("dask") is None
-                               or importlib.util.find_spec("distributed") is None):
-        raise BackendUnavailable("--executor dask needs dask.distributed, which is not installed: "
-                                 "pip install \"nanoimpact[dist]\"")
-
-
 def check_params_set(spec: str) -> Path:
     """A parameter set (name or file) that exists, parses and whose every value passes the scene checks."""
     from continuum.scene import FIELD_BY_PATH, check_value, find_params, flatten, read_toml
@@ -113,7 +104,9 @@ def cmd_paper(args) -> int:
         raise InputError("--params", args.params, "one or more parameter set names or files, comma-separated")
     for s in sets:
         check_params_set(s)
-    record = make_paper(sets, args.out, fidelity=args.fidelity, workers=args.workers, progress=log.info)
+    check_executor(args.executor, args.workers, args.scheduler)
+    record = make_paper(sets, args.out, fidelity=args.fidelity, workers=args.workers, executor_name=args.executor,
+                        scheduler=args.scheduler, progress=log.info)
     failed = [c for c in record["checks"] if not c["pass"]]
     print(f"checks: {len(record['checks']) - len(failed)} pass, {len(failed)} fail "
           f"(see {args.out}/summary.md and checks.json); wall {record['wall_s']:.1f} s")
@@ -127,7 +120,7 @@ def cmd_calibrate(args) -> int:
     check_out_dir(args.md_cache, "--md-cache")
     if args.params_out is not None and Path(args.params_out).is_dir():
         raise InputError("--params-out", args.params_out, "is an existing folder; give the set's file path")
-    check_executor(args.executor, args.scheduler)
+    check_executor(args.executor, args.workers, args.scheduler)
     from calibration.pipeline import calibrate      # after the option checks: they need none of the physics
     # calibrate checks the whole recipe (pipeline.load_calibration) before any MD or paper run starts
     calibrate(args.recipe, args.out, md_fidelity=args.md_fidelity, executor_name=args.executor,
@@ -138,13 +131,16 @@ def cmd_calibrate(args) -> int:
 
 def cmd_sweep(args) -> int:
     check_out_dir(args.out)
-    check_executor(args.executor, args.scheduler)
+    check_executor(args.executor, args.workers, args.scheduler)
     from calibration.sweep import parse_vary, run_sweep
     vary = parse_vary(args.vary)             # run_sweep validates every point before anything runs or is written
     record = run_sweep(args.scene, vary, args.out, params=args.params, executor_name=args.executor,
                        workers=args.workers, scheduler=args.scheduler, progress=log.info)
     print(f"sweep: {record['computed']} points run, {record['reused']} reused; wrote {args.out}/sweep.csv and "
           f"sweep.png ({record['wall_s']:.1f} s)")
+    if record.get("failed"):
+        print(f"sweep: {len(record['failed'])} of {len(record['rows'])} points failed; their one-line reasons are in "
+              f"the error column of sweep.csv and in {args.out}/failures.json", file=sys.stderr)
     return record.get("exit_code", 0)          # EXIT_PARTIAL when some points failed (calibration.sweep)
 
 
@@ -188,6 +184,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--out", default="out/paper", help="output folder (default: out/paper)")
     q.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset for every case")
     q.add_argument("--workers", type=positive_int, help="parallel processes, >= 1 (default: CPU count)")
+    q.add_argument("--executor", choices=("local", "processes", "dask"), default="processes",
+                   help="where the cases run (default: processes, a local pool of --workers)")
+    q.add_argument("--scheduler", help="dask scheduler address (tcp://host:port) of an existing cluster")
     q.add_argument("--strict", action="store_true",
                    help=f"exit {EXIT_PARTIAL} when any of the paper's claims fails (everything is still written)")
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from nanoimpact.executors import Failure, executor
 
-from .mdset import MAPPING, build_parameter_set, committed_result, recipes_needed, write_parameter_set
+from .mdset import build_parameter_set, committed_result, recipes_needed, write_parameter_set
 
 from nanoimpact import data
 from nanoimpact.errors import InputError
@@ -206,7 +206,7 @@ def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, wor
     from continuum.scene import SceneError, find_params
     from md.recipe import FIDELITIES
 
-    from .executors import NAMES
+    from nanoimpact.executors import NAMES
 
     if Path(out).exists() and not Path(out).is_dir():
         raise CalibrationError("out", str(out), "is an existing file; give a folder (new or existing)")

@@ -437,12 +437,17 @@ def _check_workers(workers) -> None:
 
 
 def check_executor(name: str = "local", workers: int | None = None, scheduler: str | None = None) -> None:
-    """Refuse a bad choice before anything starts: InputError (a ValueError) naming the value."""
+    """Refuse a bad choice before anything starts: InputError (a ValueError) naming the value, BackendUnavailable
+    when dask is asked for and not installed."""
     if name not in NAMES:
         raise InputError("executor", name, "one of " + ", ".join(NAMES))
     _check_workers(workers)
     if scheduler and name != "dask":
-        raise InputError("--scheduler", scheduler, "goes with --executor dask only")
+        raise InputError("--scheduler", scheduler, f"goes with --executor dask, not --executor {name}")
+    if name == "dask" and (importlib.util.find_spec("dask") is None
+                           or importlib.util.find_spec("distributed") is None):
+        raise BackendUnavailable("--executor dask needs dask.distributed, which is not installed: "
+                                 "pip install \"nanoimpact[dist]\"")
 
 
 def executor(name: str = "local", workers: int | None = None, scheduler: str | None = None):
