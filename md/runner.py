@@ -68,6 +68,7 @@ import numpy as np
 from md import units
 from md.forcefield import FORCEFIELD_DIR
 from nanoimpact.errors import RunFailed
+from nanoimpact.provenance import git_commit
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_text
 from nanoimpact.lock import run_lock
 from md.recipe import Recipe
@@ -573,13 +574,8 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
 def _provenance(recipe: Recipe, plan: Plan, legs_state: Mapping[str, Any], np_: int) -> dict[str, Any]:
     from md.lammps_loader import mpich_version   # noqa: PLC0415
     versions = {s.get("lammps_version_string") for s in legs_state.values() if s.get("lammps_version_string")}
-    git = None
-    with contextlib.suppress(OSError, subprocess.SubprocessError):
-        root = Path(__file__).resolve().parent.parent
-        r = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5)
-        git = r.stdout.strip() or None
     return {
-        "package": "nanoimpact", "package_version": package_version(), "git_commit": git,
+        "package": "nanoimpact", "package_version": package_version(), "git_commit": git_commit(),
         "lammps_version": lammps_version(), "lammps_version_string": sorted(versions)[0] if versions else None,
         "mpich_version": mpich_version(),
         "engine": "in-process lammps module" if np_ <= 1 else f"mpirun -np {np_} lmp",

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import importlib.resources
 import os
-import sysconfig
 from pathlib import Path
 
 from .errors import DataNotFound
+from .provenance import source_checkout
 
 __all__ = ["DataNotFound", "KINDS", "ENV_VAR", "find", "names", "roots", "shipped_root", "user_root",
            "set_user_root", "writable_root", "md_results_dirs", "is_path_spec"]
@@ -59,23 +59,20 @@ def roots() -> list[Path]:
     return ([user] if user is not None else []) + [shipped_root()]
 
 
-def _in_site_packages(path: Path) -> bool:
-    sites = {sysconfig.get_paths()[k] for k in ("purelib", "platlib")}
-    return any(path.resolve().is_relative_to(Path(s).resolve()) for s in sites if s)
-
-
 def writable_root() -> Path:
     """Where new data (a calibrated parameter set) is written by default.
 
     The user folder when one is set; else the shipped folder when it is a source checkout (an
     editable install writes `inputs/params/NAME.toml` in the repository, where it is committed);
-    else `$XDG_DATA_HOME/nanoimpact` (`~/.local/share/nanoimpact`), never an installed package.
+    else `$XDG_DATA_HOME/nanoimpact` (`~/.local/share/nanoimpact`), never an installed package (a wheel in
+    site-packages, a `pip install --target` folder or a `--user` install alike).
     """
     user = user_root()
     if user is not None:
         return user
     shipped = shipped_root()
-    if shipped.is_dir() and not _in_site_packages(shipped) and os.access(shipped, os.W_OK):
+    checkout = source_checkout()
+    if checkout is not None and shipped.resolve() == (checkout / "inputs").resolve() and os.access(shipped, os.W_OK):
         return shipped
     base = os.environ.get("XDG_DATA_HOME", "").strip() or "~/.local/share"
     return Path(base).expanduser() / "nanoimpact"

@@ -1,0 +1,39 @@
+"""Where the running code came from: the source checkout (if this is one) and its git commit.
+
+An installed package that happens to sit inside some other git checkout (a venv inside a
+repository) must not record that repository's commit, so git is asked only when the folder above
+the packages is nanoimpact's own source tree (its pyproject.toml and inputs/ beside the packages).
+"""
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+_ROOT = Path(__file__).resolve().parent.parent
+
+
+def source_checkout() -> Path | None:
+    """The repository root when the code runs from nanoimpact's source tree, else None (an installed wheel)."""
+    pyproject = _ROOT / "pyproject.toml"
+    try:
+        ours = pyproject.is_file() and 'name = "nanoimpact"' in pyproject.read_text()
+    except OSError:
+        return None
+    return _ROOT if ours and (_ROOT / "inputs").is_dir() else None
+
+
+def git_commit() -> str | None:
+    """HEAD of the source checkout (with '+dirty' if tracked files have uncommitted changes), or None."""
+    root = source_checkout()
+    if root is None:
+        return None
+    try:
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
+                              timeout=5)
+        if head.returncode != 0:
+            return None
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=5).stdout.strip()
+        return head.stdout.strip() + ("+dirty" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        return None
