@@ -17,6 +17,7 @@ import pytest
 
 from nanoimpact.errors import InputError
 from nanoimpact.executors import Failure, executor, one_line
+from conftest import require_backend
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -143,7 +144,7 @@ def test_workers_end_when_their_parent_is_killed(tmp_path, kind):
     (a thread) cannot run then, the parent-death signal still ends them. `watchdog`: the fallback thread alone,
     without the parent-death signal (as off Linux), in a worker that sleeps."""
     if kind == "dask":
-        pytest.importorskip("dask.distributed")
+        require_backend("distributed", "dask.distributed")
     script = tmp_path / "child.py"
     script.write_text(CHILD)
     markers = tmp_path / "started"

@@ -11,6 +11,7 @@ import pytest
 
 from calibration.sweep import parse_vary, run_sweep
 from nanoimpact.errors import EXIT_OK, EXIT_PARTIAL
+from conftest import require_backend
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "inputs" / "scenes" / "rough_silica.toml"
@@ -61,7 +62,8 @@ def test_on_a_process_pool(tmp_path):
 def test_on_a_real_dask_scheduler(tmp_path, caplog):
     """A cluster started apart from the sweep, reached by its address (as `--scheduler` does): the failing
     point's exception travels back from the worker and is recorded; the sweep does not go down."""
-    distributed = pytest.importorskip("dask.distributed")
+    require_backend("distributed", "dask.distributed")
+    import distributed
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cl:
         with caplog.at_level(logging.INFO, logger="nanoimpact.executors"):
             record = run_sweep(SCENE, parse_vary(VARY), tmp_path / "sw", executor_name="dask",
