@@ -100,6 +100,8 @@ class RigidRoughRoller(ContactLaw):
         self.max_pressure = 0.0
         self.edge_touched = False
         self.depth_history: list[dict] = []
+        #: accepted states deeper than the tables (evaluated by the integral itself)
+        self.beyond_tables = 0
         #: "tabulated" (GW tables of JKR or Hertz summits) or "generic" (quadrature of any summit law)
         self.surface_kind = "tabulated" if isinstance(surface, GWJKRSurface) else "generic"
         self.reset()
@@ -149,8 +151,13 @@ class RigidRoughRoller(ContactLaw):
         if release_stretch > 0.0:
             step = min(step, release_stretch / per_delta)
         n_h = int(math.floor((end_gap + 2 * step + depth) / step)) + 1
-        return {"gap_nodes": n_h, "window_nodes": n_w, "nodes": n_h * n_w,
-                "states": 2 * n_h * n_w * 2 * n_gauss + n_h * 2 * n_gauss, "step": step}
+        nodes = n_h * n_w
+        return {"gap_nodes": n_h, "window_nodes": n_w, "nodes": nodes,
+                "states": 2 * nodes * 2 * n_gauss + n_h * 2 * n_gauss, "step": step,
+                # the build holds one block of states (nodes, weights, separations, thresholds and the surface's
+                # own temporaries: 75 floats each measured with tracemalloc, 100 taken) and the tables (grids,
+                # values, spline coefficients: ~16 floats per node)
+                "peak_bytes": 8 * (100 * min(_BLOCK_STATES, nodes * 2 * n_gauss) + 16 * nodes)}
 
     def _build(self, depth: float) -> None:
         import time
@@ -215,35 +222,48 @@ class RigidRoughRoller(ContactLaw):
         span = self.release_stretch - self._r_in
         return math.sqrt(min(max((self.release_stretch - r) / span, 0.0), 1.0)) if span > 0 else 0.0
 
-    def _check(self, gap: float) -> None:
-        if gap < self._h_lo:
-            self.edge_touched = True
-            raise RuntimeError(f"rough contact: gap {gap:.3e} m is deeper than the tables ({self._h_lo:.3e} m); "
-                               "the impact went deeper than its quasi-static estimate")
+    def _exact(self, what: str, gap: float, r: float) -> float:
+        """The footprint integral at one state by its Gauss-Legendre quadrature (what the tables hold)."""
+        return float(self._integrate(what, np.array([gap]), np.array([r]))[0])
 
     def force(self, gap):
         if gap >= self.end_gap:
             return 0.0
-        self._check(gap)
-        return float(self._force.ev(gap, self._w(self._window(gap))))
+        r = self._window(gap)
+        if gap < self._h_lo:
+            # deeper than the tables (an integrator's trial stage, or an impact deeper than its estimate):
+            # the same integral, evaluated directly
+            return self._exact("pressure", gap, r)
+        return float(self._force.ev(gap, self._w(r)))
 
     def stiffness(self, gap):
         if gap >= self.end_gap:
             return 0.0
         r = self._window(gap)
+        if gap < self._h_lo:
+            e = 1e-6 * self.sigma
+            return -(self._exact("pressure", gap + e, r) - self._exact("pressure", gap - e, r)) / (2.0 * e)
         dh = float(self._force.ev(gap, self._w(r), dx=1))
         return -dh
 
     def stored_energy(self, gap):
         if gap >= self.end_gap or self.h_min == math.inf and gap >= self.reach:
             return 0.0
-        self._check(gap)
-        return float(self._energy.ev(gap, self._w(self._window(gap))))
+        r = self._window(gap)
+        if gap < self._h_lo:
+            return self._exact("energy", gap, r)
+        return float(self._energy.ev(gap, self._w(r)))
+
+    def _first_approach_count(self, a: float) -> float:
+        """Summits attached on a first approach to `a` (table, or the integral itself beyond it)."""
+        if a < self._h_lo:
+            return self._exact("contacts", a, self.attach_stretch)
+        return float(self._count(a))
 
     def _attached(self, gap: float) -> float:
         """Summits attached at `gap` on the current path."""
         a = gap - self._window(gap) + self.attach_stretch
-        return float(self._count(a)) if a < self.attach_stretch else 0.0
+        return self._first_approach_count(a) if a < self.attach_stretch else 0.0
 
     def dissipated(self, gap):
         if self.h_min == math.inf:
@@ -251,9 +271,11 @@ class RigidRoughRoller(ContactLaw):
         return self.surface.loop_energy * max(self.count_min - self._attached(gap), 0.0)
 
     def accept(self, gap):
+        if gap < self._h_lo:
+            self.beyond_tables += 1           # the impact went deeper than the tables (exact integral used; recorded)
         if gap < self.h_min:
             self.h_min = gap
-            self.count_min = float(self._count(gap)) if gap < self.attach_stretch else 0.0
+            self.count_min = self._first_approach_count(gap) if gap < self.attach_stretch else 0.0
         self.max_contacts = max(self.max_contacts, self._attached(gap))
 
     def release_gap(self):
@@ -282,7 +304,7 @@ class RigidRoughRoller(ContactLaw):
         return {"max_contacts": self.max_contacts, "edge_touched": self.edge_touched,
                 "max_nominal_pressure": self.max_pressure, "table_depth": self.table_depth,
                 "table_points": getattr(self, "table_points", 0), "table_build_seconds": self.build_seconds,
-                "contacts_seen": len(self.depth_history)}
+                "contacts_seen": len(self.depth_history), "accepted_states_beyond_tables": self.beyond_tables}
 
     def describe(self):
         s = self.surface

@@ -59,7 +59,7 @@ All tables are piecewise-cubic Hermite with exact node derivatives, built by Gau
 quadrature in the JKR variable s = sqrt(a/a0) (x = (s^4 - s)/d_c is explicit: no root finding, no
 singularity at the fold; y = sqrt(s - 1) for q - q_H, whose x^{3/2} term is analytic in y). Their
 error is measured by ``table_error`` against scipy.integrate.quad of the defining integrals
-(``quadrature_pressure`` etc.). States deeper than the tables (d < -10 sigma) are integrated on
+(``quadrature_pressure`` etc.). States deeper than the tables (d < -20 sigma) are integrated on
 the fly with fixed Gauss-Legendre nodes.
 
 Sources: J. A. Greenwood & J. B. P. Williamson, Proc. R. Soc. Lond. A 295 (1966) 300-319;
@@ -108,7 +108,7 @@ _DT_W = 0.15        # largest t-step (sigma) between w-nodes of the 2-D table at
 _NW_MIN = 24        # fewest w-cells at resolution 1
 _T_CUT = 8.5        # untruncated: adhesive tables neglect summits above 8.5 sigma (mass 9.5e-18)
 _H_ZERO = 30.0      # F_nu(h) < 1e-195 beyond h = 30: taken as 0
-_H_DEEP = -10.0     # tables cover h >= -10; deeper states use on-the-fly quadrature
+_H_DEEP = -20.0     # tables cover h >= -20; deeper states use on-the-fly quadrature
 _DT_PANEL = 0.25    # largest t-span (sigma) of one Gauss-Legendre panel in the build quadratures
 _BUILD_BLOCK = 2_000_000   # most floats in one block of the window table's build quadrature
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
@@ -402,9 +402,10 @@ class GWJKRSurface:
 
     All methods take separations d and thresholds zeta in metres (arrays broadcast; zeta may be
     +inf = nothing attached yet) and are vectorised. Results are per unit nominal area.
-    The tables cover d >= -10 sigma (``table_range``); deeper states (summits compressed by more
-    than 10 sigma) are evaluated by fixed Gauss-Legendre quadrature of the defining integrals on the
-    fly (exact, slower; not expected in practice).
+    The tables cover d >= -20 sigma (``table_range``; the rough model refuses impacts deeper than
+    10 sigma below the mean plane, and the rigid law's footprint tables reach 1.5 x that); deeper
+    states (summits compressed by more than 20 sigma) are evaluated by fixed Gauss-Legendre
+    quadrature of the defining integrals on the fly (exact, ~50 us per state; not expected).
     """
 
     def __init__(self, stats: SummitStatistics, work_of_adhesion: float, e_star: float, z_max=None,
@@ -501,7 +502,8 @@ class GWJKRSurface:
                                           .transpose(2, 0, 1)) for j in range(3)]        # (4, ncell, K)
         self._k1 = 4 if self.adhesive else 1
         # fixed Gauss-Legendre nodes in t on [-9.5, t_top] for states deeper than the tables
-        tb = np.linspace(_H_DEEP + 0.5, self._ttop, int(math.ceil((self._ttop - _H_DEEP - 0.5) / _DT_PANEL)) + 1)
+        t_lo = -(_T_CUT + 1.0)               # no summit mass below (9.5 sigma: < 1e-20)
+        tb = np.linspace(t_lo, self._ttop, int(math.ceil((self._ttop - t_lo) / _DT_PANEL)) + 1)
         tn, tw, _ = _gl_nodes(tb)
         self._deep_nodes = (tn, tw * _phi(tn))
 
@@ -701,6 +703,7 @@ class GWJKRSurface:
             np.maximum(u, 0.0, out=u)
             r = np.sqrt(u)
             a = r * self._inv_dx1
+            np.minimum(a, self._n1, out=a)      # deeper than the tables: replaced by `_deep` (no overflow)
         else:
             u = r = None
             a = (np.minimum(h, _H_ZERO) - self._x10) * self._inv_dx1
