@@ -31,6 +31,9 @@ from .halfspace import LineHalfSpace
 
 #: Most memory (bytes) the averaged rough model's tables may take while they are built (issue 12).
 MEMORY_BOUND_BYTES = 2 * 2**30
+#: Build time of the GW window table per node (s), measured on a busy 2-core machine (load ~10):
+#: 20-23 us at 9e4-6e5 nodes, the band table's build included (docs/rough-gw.md).
+GW_SECONDS_PER_NODE = 2.5e-5
 
 
 @dataclass(frozen=True)
@@ -109,19 +112,23 @@ def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_
     if gw_tables and work_of_adhesion > 0.0:
         size = table_size(stats, work_of_adhesion, summit_e_star, z_max=z_max_sigma, detachment=detachment,
                           resolution=resolution)
+        seconds = size["nodes"] * GW_SECONDS_PER_NODE
         rec["gw_table"] = {"nodes": size["nodes"], "shape": list(size["shape"]), "peak_bytes": size["peak_bytes"],
-                           "resolution": resolution, "sigma_over_delta_c": 1.0 / size["lambda"]}
-        if size["peak_bytes"] > MEMORY_BOUND_BYTES:
+                           "estimated_seconds": seconds, "resolution": resolution,
+                           "sigma_over_delta_c": 1.0 / size["lambda"]}
+        over = max(size["peak_bytes"] / MEMORY_BOUND_BYTES, seconds / MAX_BUILD_SECONDS)
+        if over > 1.0:
             lam = size["lambda"]
             # the table grows like lambda^2: the sigma that would fit, by that scaling (an estimate)
-            fit = sigma * math.sqrt(size["peak_bytes"] / MEMORY_BOUND_BYTES)
+            fit = sigma * math.sqrt(over)
             raise SceneError(
                 "surfaces.roughness.sigma", sigma_key_value,
                 f"sigma/delta_c = {1.0 / lam:.3g} (delta_c = {lam * sigma:.3g} m from the summits' radius, work of "
                 f"adhesion and modulus): the averaged model's GW tables would take ~{size['peak_bytes'] / 2**30:.3g} GiB "
-                f"({size['nodes']:.3g} nodes at '{resolution}'), above the {MEMORY_BOUND_BYTES / 2**30:g} GiB bound; "
-                f"use surfaces.roughness.mode = 'discrete' (individual summits, no tables) or sigma >= ~{fit:.2g} m "
-                f"(or stiffer summits / less adhesion)", origin)
+                f"and ~{seconds:.3g} s to build ({size['nodes']:.3g} nodes at '{resolution}'), above the "
+                f"{MEMORY_BOUND_BYTES / 2**30:g} GiB / {MAX_BUILD_SECONDS:g} s bounds; use surfaces.roughness.mode = "
+                f"'discrete' (individual summits, no tables) or sigma >= ~{fit:.2g} m (or stiffer summits, less "
+                "adhesion)", origin)
     if rigid and depth_estimate is not None and depth_estimate > 0.0:
         # the first design depth is at least 1.5 x the Hertz estimate (adhesion only pulls deeper); the
         # tables are checked again against the same bound with the real design depth before each build
