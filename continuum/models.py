@@ -33,7 +33,7 @@ from .laws.base import ContactLaw
 from .laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
 from .laws.jkr import JKRSphere
 from .reference import jkr as jkr_ref
-from .scene import Scene
+from .scene import Scene, SceneError
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
@@ -227,6 +227,18 @@ def _estimate(scene: Scene, speed: float):
                                  datum["z_max"], body.mass, speed, scene.environment.gravity)
 
 
+def _adhesive_range_check(scene: Scene, stats, z_max_sigma: float, speed: float) -> None:
+    """Refuse (SceneError, continuum.laws.rough_roller.beyond_range) if the first impact's adhesive JKR
+    approach, integrated by quadrature over the footprint on a rigid substrate, would press the roller
+    beyond the averaged model's range; return otherwise."""
+    from .laws.rough_rigid import RigidRoughRoller
+    from .rough.gw_branches import GWBranchSurface
+
+    surface = GWBranchSurface(stats, summit_law("jkr", scene), z_max=z_max_sigma)
+    law = RigidRoughRoller(surface, scene.body.radius, scene.body.length, resolution="fast")
+    law.quasi_static_depth(0.5 * scene.body.mass * speed * speed, scene.body.mass * scene.environment.gravity)
+
+
 def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None = None,
               with_menisci: bool = False, speed: float | None = None, estimate=None) -> tuple[ContactLaw, dict]:
     """GW rough roller for `scene` and the record of its datum and regime numbers.
@@ -273,11 +285,19 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
             release_stretch = end_gap = (float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) *
                                          (1.0 if phys.detachment == "displacement"
                                           else -jkr_ref.LOAD_DETACH_APPROACH_RATIO) if w > 0 else 0.0)
-        cost = check_table_cost(stats=stats, work_of_adhesion=w, summit_e_star=e_s, z_max_sigma=datum["z_max"],
-                                detachment=phys.detachment, resolution=table, gw_tables=not generic,
-                                rigid=not half_space, rigid_resolution=scene.numerics.table,
-                                release_stretch=release_stretch, end_gap=end_gap,
-                                depth_estimate=est.depth if est else None, sigma_key_value=rough.sigma)
+        try:
+            cost = check_table_cost(stats=stats, work_of_adhesion=w, summit_e_star=e_s, z_max_sigma=datum["z_max"],
+                                    detachment=phys.detachment, resolution=table, gw_tables=not generic,
+                                    rigid=not half_space, rigid_resolution=scene.numerics.table,
+                                    release_stretch=release_stretch, end_gap=end_gap,
+                                    depth_estimate=est.depth if est else None, sigma_key_value=rough.sigma)
+        except SceneError:
+            # Refused for size. The Hertz estimate leaves adhesion out, and an adhesive approach can pull the
+            # roller beyond the averaged model's range, where every way out of the size refusal would be refused
+            # too: say so instead (the approach branch by quadrature, no tables; < 1 s).
+            if w > 0 and not generic:
+                _adhesive_range_check(scene, stats, datum["z_max"], speed)
+            raise
     if rough.mode == "discrete":
         # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
         from .laws.discrete_roller import DiscreteRoughRoller

@@ -39,7 +39,7 @@ TIME_BOUND_S = 90.0
 
 CORNERS = [(s, e, w, r) for s in (0.1e-9, 100e-9) for e in (1e6, 1e12) for w in (0.0, 1.0) for r in (1e-9, 10e-6)]
 REPORTED = [
-    (0.1e-9, 1e6, 1.0, 1e-9),       # the 6.7 TiB GW table
+    (0.1e-9, 1e6, 1.0, 1e-9),       # the 6.7 TiB GW table (now: beyond the model's range, no table)
     (0.1e-9, 1e10, 0.01, 1e-9),     # Maugis-Dugdale footprint tables: the run still going after 60 s
     (0.3e-9, 1e8, 1.0, 1e-6),       # a GW table built for minutes
     (0.3e-9, 1e10, 0.01, 1e-9),     # Maugis-Dugdale footprint tables
@@ -105,10 +105,31 @@ def test_extreme_point_runs_within_bounds_or_is_refused_in_one_line(built, sigma
 
 
 def test_the_reported_memory_case_is_refused_before_any_table(built):
-    with pytest.raises(SceneError, match="GiB") as info:
+    """The 6.7 TiB case: its adhesive approach would pull the roller beyond the averaged model's range, so
+    that is what the refusal says (the size refusal's ways out would all be refused too); no table built."""
+    with pytest.raises(SceneError) as info:
         run_point(0.1e-9, 1e6, 1.0, 1e-9)
-    assert "surfaces.roughness.mode = 'discrete'" in str(info.value)
-    assert not [b for b in built if b[0] == "gw"]
+    message = str(info.value)
+    assert "\n" not in message and "more than 10 sigma below the summits' mean plane" in message
+    assert not built
+
+
+def test_an_oversized_gw_table_is_refused_in_one_line_with_the_way_out():
+    stats = gw.SummitStatistics(0.1e-9, 1e13, 2e-7)
+    with pytest.raises(SceneError) as info:
+        estimates.check_table_cost(stats=stats, work_of_adhesion=1.0, summit_e_star=1e6, z_max_sigma=4.1,
+                                   detachment="displacement", resolution="standard", gw_tables=True, rigid=False,
+                                   rigid_resolution="standard", release_stretch=0.0, end_gap=0.0,
+                                   depth_estimate=None, sigma_key_value=0.1e-9)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith("surfaces.roughness.sigma = 1e-10: ")
+    assert "GiB" in message and "surfaces.roughness.mode = 'discrete'" in message
+    # within the bounds: no refusal, and the estimate is recorded
+    ok = estimates.check_table_cost(stats=gw.SummitStatistics(6e-9, 1e13, 2e-7), work_of_adhesion=0.12,
+                                    summit_e_star=10e9, z_max_sigma=4.1, detachment="displacement",
+                                    resolution="standard", gw_tables=True, rigid=False, rigid_resolution="standard",
+                                    release_stretch=0.0, end_gap=0.0, depth_estimate=None, sigma_key_value=6e-9)
+    assert ok["gw_table"]["peak_bytes"] < estimates.MEMORY_BOUND_BYTES
 
 
 def test_table_size_bounds_the_measured_build():

@@ -17,7 +17,9 @@ threshold rises: n * loop * [Phi_t(zeta_new) - Phi_t(zeta_old)].
 
 Evaluation: fixed Gauss-Legendre panels in delta = z - d (8 nodes), with edges at the law's jump
 points, at 0 and at -reach, geometric from there (first width a tenth of the adhesive length scale,
-at most sigma/4), split per state at the threshold and cut at z_max; ~1 us per state and quantity.
+at most sigma/4), split per state at the threshold and cut at z_max. States are sorted by
+separation and integrated in chunks of 512 over the panels their deepest member needs: 15-20 us per
+state and quantity on a busy 2-core machine for a footprint table's spread of states (65 us unsorted).
 No tables: the rigid-substrate law tabulates the footprint integral of this surface once per set.
 Accuracy against adaptive quadrature is measured in tests/test_gw_branches.py.
 """
