@@ -37,6 +37,9 @@ from .scene import Scene, SceneError
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
+#: GW tables estimated to take longer than this (s) are built only after the adhesive approach has been
+#: checked against the averaged model's range (`_adhesive_range_check`, < 1 s).
+LARGE_TABLE_SECONDS = 2.0
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
 TABOR_JKR, TABOR_DMT = 5.0, 0.1
 #: Adhesion is negligible below these estimated fractions: loss per impact / impact energy, and
@@ -298,6 +301,9 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
             if w > 0 and not generic:
                 _adhesive_range_check(scene, stats, datum["z_max"], speed)
             raise
+        if w > 0 and not generic and cost.get("gw_table", {}).get("estimated_seconds", 0.0) > LARGE_TABLE_SECONDS:
+            # a large table (seconds, hundreds of MB) is worth building only if the impact stays in range
+            _adhesive_range_check(scene, stats, datum["z_max"], speed)
     if rough.mode == "discrete":
         # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
         from .laws.discrete_roller import DiscreteRoughRoller
