@@ -21,7 +21,7 @@ file takes about a minute (docs/halfspace.md).
 
 Audit tolerance: 1e-3 of the run's energy turnover (kinetic + |stored| + dissipated), the bound
 docs/model.md states for rough runs and tests/test_rough_stability.py uses at `standard`; at
-`fast` (rtol 1e-6, tables within 2e-6 of n P_c) this sweep measured at most 2e-4.
+`fast` (rtol 1e-6, tables within 2e-6 of n P_c) this sweep measured at most 1.5e-4 (wet_silica, 3 nm).
 """
 import math
 import tomllib
