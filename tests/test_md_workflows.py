@@ -10,7 +10,6 @@ from __future__ import annotations
 import io
 import json
 import math
-import time
 from contextlib import redirect_stdout
 from pathlib import Path
 
@@ -34,8 +33,8 @@ EXPECTED = {
 }
 FIGURES = {"adhesion": "energy_timeseries.png", "pulloff": "pulloff_curve.png", "contact_angle": "density_map.png",
            "surface_tension": "density_profile.png"}
-SMOKE_BUDGET_S = 60.0            # per recipe, 2 cores; all together must stay well under 5 minutes
-WALL: dict[str, float] = {}
+# Smoke wall times are measured by benchmarks/md_cost.py --measure, never asserted here: a timed test fails
+# on a loaded or slower machine while the code is right.
 
 
 # ------------------------------------------------------------------------------------ no LAMMPS needed
@@ -124,9 +123,7 @@ def _total_charge(data_file: Path) -> float:
 @pytest.mark.md
 @pytest.mark.parametrize("name", RECIPES)
 def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(needs_lammps, name, cache, tmp_path):
-    t0 = time.perf_counter()
     outcome, text = _run(name, cache, tmp_path / "out")
-    WALL[name] = time.perf_counter() - t0
     assert not outcome.reused
     r = outcome.result
     wf = r["workflow"]
@@ -162,7 +159,6 @@ def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(needs_lammps, n
         assert any("not a free energy" in n or "not the free energy" in n for n in r["notes"])
     assert (tmp_path / "out" / FIGURES[wf]).stat().st_size > 1000
     assert list((tmp_path / "out").glob("*.csv"))
-    assert WALL[name] < SMOKE_BUDGET_S, f"{name} smoke took {WALL[name]:.1f} s"
 
 
 @pytest.mark.md
@@ -251,11 +247,3 @@ def test_mpirun_two_ranks_runs_a_recipe(needs_lammps, tmp_path):
     assert "Loop time of" in (outcome.run_dir / "legs" / "contact" / "log.lammps").read_text()
     assert "on 2 procs" in (outcome.run_dir / "legs" / "contact" / "log.lammps").read_text()
     assert math.isfinite(r["quantities"]["work_of_adhesion"]["value"])
-
-
-def test_zz_report_smoke_wall_times():
-    """Prints the measured smoke wall times (pytest -s); fails if all of them together exceed 5 minutes."""
-    if WALL:
-        print("\nsmoke wall times: " + ", ".join(f"{k} {v:.1f} s" for k, v in WALL.items())
-              + f"; total {sum(WALL.values()):.1f} s")
-        assert sum(WALL.values()) < 300.0
