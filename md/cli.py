@@ -18,11 +18,12 @@ import math
 import sys
 from pathlib import Path
 
-from nanoimpact.cli import ArgumentParser, add_verbosity, check_out_dir, logging_ready, positive_int, setup_logging
+from nanoimpact.cli import (ArgumentParser, Command, add_verbosity, check_out_dir, logging_ready, positive_int,
+                            setup_logging)
 from nanoimpact.errors import (EXIT_BACKEND, EXIT_FAILED, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, InputError,
                                RunInterrupted, UsageError, run_command)
 
-__all__ = ["main", "run", "build_parser", "format_quantities"]
+__all__ = ["COMMANDS", "main", "run", "build_parser", "format_quantities"]
 
 #: Kept for callers of the old names; the codes are nanoimpact.errors'.
 EXIT_OK, EXIT_LAMMPS, EXIT_INVALID, EXIT_UNAVAILABLE, EXIT_INTERRUPTED = (EXIT_OK, EXIT_FAILED, EXIT_INPUT,
@@ -114,6 +115,13 @@ def run(argv: list[str]) -> int:
         print(f"note: {note}")
     print(f"result: {outcome.out_dir}/result.json (run directory {outcome.run_dir})")
     return EXIT_OK
+
+
+#: md's contribution to the `nanoimpact` command (both parse their own arguments: `nanoimpact md --help`).
+COMMANDS = (
+    Command("md", "run an MD recipe (work of adhesion, pull-off, contact angle, surface tension)", "md.cli", "run"),
+    Command("doctor", "check the LAMMPS installation (in-process and mpirun -np 2)", "md.doctor", "run"),
+)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -6,13 +6,39 @@ checks that run before any work. Leaf module: imports none of continuum, md, cal
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from .errors import InputError, UsageError
 
-__all__ = ["ArgumentParser", "positive_int", "check_out_dir", "add_verbosity", "setup_logging", "logging_ready"]
+__all__ = ["ArgumentParser", "Command", "positive_int", "check_out_dir", "add_verbosity", "setup_logging",
+           "logging_ready"]
+
+
+@dataclass(frozen=True)
+class Command:
+    """One `nanoimpact` subcommand, contributed by the package that owns the job (its `cli.COMMANDS`).
+
+    `module`/`function` name the runner, looked up when the command runs (so importing a package's command
+    list costs no physics imports, and a test may replace the function). With `configure` the top-level parser
+    gets a subparser that `configure(parser)` fills and the runner receives the parsed `argparse.Namespace`;
+    without it the command parses its own arguments and the runner receives the list of strings after the
+    command's name (`nanoimpact md`, `nanoimpact doctor`).
+    """
+
+    name: str
+    help: str
+    module: str
+    function: str
+    configure: Callable[[argparse.ArgumentParser], None] | None = None
+    description: str = ""
+
+    def runner(self) -> Callable:
+        return getattr(importlib.import_module(self.module), self.function)
 
 
 class ArgumentParser(argparse.ArgumentParser):

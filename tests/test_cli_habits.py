@@ -16,6 +16,7 @@ import pytest
 
 import nanoimpact
 from calibration import cli
+import continuum.cli as continuum_cli
 from calibration.cli import main
 from nanoimpact import data
 from nanoimpact.errors import EXIT_BACKEND, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_PARTIAL, BackendUnavailable
@@ -104,7 +105,7 @@ def _fake_command(args):
     (["SUB", "-v"], {"debug", "info", "warning"}),
 ])
 def test_verbosity_sets_the_logging_levels_and_results_stay_on_stdout(monkeypatch, capsys, argv, levels):
-    monkeypatch.setattr(cli, "cmd_impact", _fake_command)
+    monkeypatch.setattr(continuum_cli, "cmd_impact", _fake_command)
     glob = [a for a in argv if a != "SUB"] if "SUB" not in argv else []
     sub = argv[argv.index("SUB") + 1:] if "SUB" in argv else []
     assert main([*glob, "impact", "whatever", *sub]) == 0
@@ -174,7 +175,7 @@ def test_ctrl_c_exits_130_without_a_traceback(monkeypatch, capsys):
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "cmd_impact", interrupted)
+    monkeypatch.setattr(continuum_cli, "cmd_impact", interrupted)
     assert main(["impact", "hertz_roller"]) == EXIT_INTERRUPTED
     captured = capsys.readouterr()
     assert _one_line(captured.err) == "nanoimpact impact: interrupted" and captured.out == ""
@@ -262,3 +263,29 @@ def test_console_script_version_and_one_line_usage_error(tmp_path):
                           capture_output=True, text=True, cwd=tmp_path)
     assert proc.returncode == EXIT_INPUT and "--workers" in _one_line(proc.stderr)
     assert not (tmp_path / "p").exists()
+
+
+# ----------------------------------------------------------------------------- the command registry
+def test_every_package_contributes_its_commands_and_each_resolves():
+    """`nanoimpact` is assembled from the packages' COMMANDS: continuum (impact, paper), calibration
+    (calibrate, sweep), md (md, doctor); every entry names a runner that exists, and the help lists them."""
+    import md.cli
+
+    commands = cli.registry()
+    assert {c.name: c.module.split(".")[0] for c in commands.values()} == {
+        "impact": "continuum", "paper": "continuum", "calibrate": "calibration", "sweep": "calibration",
+        "md": "md", "doctor": "md"}
+    for cmd in commands.values():
+        assert callable(cmd.runner()), cmd.name
+    assert {c.name for c in md.cli.COMMANDS} == {"md", "doctor"}
+    text = cli.build_parser().format_help()
+    for name in commands:
+        assert f"    {name} " in text, name
+
+
+def test_a_command_name_given_twice_is_refused(monkeypatch):
+    from nanoimpact.cli import Command
+
+    monkeypatch.setattr(cli, "COMMANDS", cli.COMMANDS + (Command("impact", "again", "calibration.cli", "main"),))
+    with pytest.raises(RuntimeError, match="'impact' is contributed by both continuum.cli and calibration.cli"):
+        cli.registry()

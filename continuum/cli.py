@@ -1,0 +1,138 @@
+"""The continuum's `nanoimpact` commands: `impact` (one scene) and `paper` (the founding paper's cases).
+
+Contributed to the top-level command through `COMMANDS` (the registry is assembled in calibration.cli, where
+the layers meet). Runners check their inputs before any work and print results to stdout; diagnostics go
+through `logging`. Physics modules are imported inside the runners, so listing the commands costs nothing.
+"""
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from nanoimpact import data
+from nanoimpact.cli import Command, check_out_dir, positive_int
+from nanoimpact.errors import EXIT_PARTIAL, InputError, UsageError
+from nanoimpact.executors import check_executor
+
+log = logging.getLogger("continuum.cli")
+
+__all__ = ["COMMANDS", "bounce_table", "check_params_set", "cmd_impact", "cmd_paper"]
+
+
+def _fmt(x, scale=1.0, spec=".4g"):
+    return "-" if x is None else format(x * scale, spec)
+
+
+def bounce_table(bounces: list[dict]) -> str:
+    """A short fixed-width table of the bounces (display units)."""
+    head = f"{'#':>3} {'v_in mm/s':>10} {'t_c ns':>10} {'F_peak uN':>10} {'pen pm':>9} {'e':>9} {'rebound nm':>11}"
+    rows = [head, "-" * len(head)]
+    for b in bounces:
+        rows.append(f"{b['index'] + 1:>3} {_fmt(b['v_impact'], 1e3):>10} {_fmt(b['duration'], 1e9):>10} "
+                    f"{_fmt(b['peak_force'], 1e6):>10} {_fmt(b['max_penetration'], 1e12):>9} "
+                    f"{_fmt(b['restitution'], 1, '.6f'):>9} {_fmt(b['rebound_height'], 1e9):>11}")
+    return "\n".join(rows)
+
+
+def check_params_set(spec: str) -> Path:
+    """A parameter set (name or file) that exists, parses and whose every value passes the scene checks."""
+    from continuum.scene import FIELD_BY_PATH, check_value, find_params, flatten, read_toml
+
+    path = find_params(spec)
+    flat = flatten(read_toml(path, "params"), str(path), skip=("meta",))
+    for key, value in flat.items():
+        check_value(FIELD_BY_PATH[key], value, str(path))
+    return path
+
+
+# ----------------------------------------------------------------------------- impact
+def configure_impact(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scene", help="scene name (hertz_roller) or file (inputs/scenes/hertz_roller.toml)")
+    p.add_argument("--out", help="output folder (default: out/<scene name>)")
+    p.add_argument("--params", help="parameter set NAME (inputs/params/NAME.toml) or FILE; replaces the scene's")
+    p.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset")
+
+
+def cmd_impact(args) -> int:
+    from continuum.impact import run_impact, write_impact
+    from continuum.scene import SceneError, resolve_scene
+
+    check_out_dir(args.out)
+    overrides = {"numerics.fidelity": args.fidelity} if args.fidelity else None
+    resolved = resolve_scene(args.scene, params=args.params, overrides=overrides, override_label="command line")
+    out = Path(args.out) if args.out else Path("out") / resolved.scene.name
+    check_out_dir(out)
+    sc = resolved.scene
+    print(f"scene {sc.name}: {sc.body.shape}, contact {sc.contact}, adhesion {sc.physics.adhesion_law}, "
+          f"params {resolved.params_file or 'none'}")
+
+    def progress(b):
+        if b.index < 5 or (b.index + 1) % 10 == 0:
+            log.info("  impact %d: e = %.6f", b.index + 1, b.restitution)
+        else:
+            log.debug("  impact %d: e = %.6f", b.index + 1, b.restitution)
+
+    try:
+        result, trace = run_impact(resolved, progress=progress)
+    except SceneError:
+        raise
+    except ValueError as exc:            # refusals that need the model (datum, depth range): nothing written
+        raise UsageError(f"refused: {exc}") from exc
+    write_impact(out, result, trace)
+    print(bounce_table(result["bounces"]))
+    audit = result["energy_audit"]["max_relative_error"]
+    print(f"status: {result['status']} after {result['n_bounces']} impacts; energy audit max error {audit:.2e}; "
+          f"wall {result['timing']['wall_s']:.3f} s")
+    for w in result["warnings"]:
+        print(f"warning: {w}")
+    print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png")
+    return 0
+
+
+# ----------------------------------------------------------------------------- paper
+def configure_paper(q: argparse.ArgumentParser) -> None:
+    q.add_argument("--params", default=None, help="parameter sets, comma-separated (default: paper,silicon and, "
+                                                    "when a `calibrated` set exists, calibrated)")
+    q.add_argument("--out", default="out/paper", help="output folder (default: out/paper)")
+    q.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset for every case")
+    q.add_argument("--workers", type=positive_int, help="parallel processes, >= 1 (default: CPU count)")
+    q.add_argument("--executor", choices=("local", "processes", "dask"), default="processes",
+                   help="where the cases run (default: processes, a local pool of --workers)")
+    q.add_argument("--scheduler", help="dask scheduler address (tcp://host:port) of an existing cluster")
+    q.add_argument("--strict", action="store_true",
+                   help=f"exit {EXIT_PARTIAL} when any of the paper's claims fails (everything is still written)")
+
+
+def cmd_paper(args) -> int:
+    from continuum.paper.report import make_paper
+
+    check_out_dir(args.out)
+    if args.params is None:
+        args.params = "paper,silicon" + (",calibrated" if "calibrated" in data.names("params") else "")
+    sets = [s.strip() for s in args.params.split(",") if s.strip()]
+    if not sets:
+        raise InputError("--params", args.params, "one or more parameter set names or files, comma-separated")
+    for s in sets:
+        check_params_set(s)
+    check_executor(args.executor, args.workers, args.scheduler)
+    record = make_paper(sets, args.out, fidelity=args.fidelity, workers=args.workers, executor_name=args.executor,
+                        scheduler=args.scheduler, progress=log.info)
+    failed = [c for c in record["checks"] if not c["pass"]]
+    print(f"checks: {len(record['checks']) - len(failed)} pass, {len(failed)} fail "
+          f"(see {args.out}/summary.md and checks.json); wall {record['wall_s']:.1f} s")
+    for c in failed:
+        print(f"  FAIL [{c['set']}] {c['name']}: {c['threshold']}")
+    return EXIT_PARTIAL if failed and args.strict else 0
+
+
+COMMANDS = (
+    Command("impact", "run one impact scene", "continuum.cli", "cmd_impact", configure_impact, description=(
+        "Simulate a body released onto a surface described by a scene (a shipped name such as hertz_roller, "
+        "or a TOML file, SI units); writes result.json, timeseries.csv and figures to --out.")),
+    Command("paper", "reproduce the founding paper's cases for each parameter set", "continuum.cli", "cmd_paper",
+            configure_paper, description=(
+                "Run every case of the paper (Hertz roller, rough silica, OTS, roughness and velocity sweeps) for "
+                "each parameter set; write figures, data, summary.md and checks.json to --out. Exit 0 whatever "
+                "the claims give, unless --strict.")),
+)
