@@ -7,7 +7,8 @@ Steps (each timed in the report):
    files, package and LAMMPS versions); otherwise md's own engine runs it, reusing its hashed cache.
 2. The set: calibration.mdset.build_parameter_set on the recipe's base set, written atomically to
    inputs/params/<name>.toml (or --params-out), every value with its MD run hash in [meta].
-3. The paper's dry, wet and SAM cases for the base set, the literature `silicon` set and the new set
+3. The paper's dry, wet and SAM cases for the base set, the recipe's `compare_sets` (default: the literature
+   `silicon` set) and the new set
    (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper.
 4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr) and the
    user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
@@ -42,7 +43,9 @@ class CalibrationError(InputError):
 
 
 #: Keys of a calibration recipe: top level, and its [uncertainty] table.
-RECIPE_KEYS = ("name", "base", "description", "uncertainty")
+RECIPE_KEYS = ("name", "base", "description", "compare_sets", "uncertainty")
+#: Sets whose paper cases a calibration runs beside its base and the new set, unless the recipe says otherwise.
+DEFAULT_COMPARE_SETS = ("silicon",)
 UNCERTAINTY_KEYS = ("samples", "seed", "scene", "max_bounces", "ranges", "overrides")
 DEFAULT_UNCERTAINTY_SCENE = "rough_silica"
 _SET_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
@@ -128,6 +131,20 @@ def load_calibration(spec: str | Path) -> dict:
     except SceneError as exc:
         raise CalibrationError("base", base, exc.allowed if exc.key == "params" else str(exc), origin) from None
 
+    compare = raw.get("compare_sets", list(DEFAULT_COMPARE_SETS))
+    if not (isinstance(compare, list) and all(isinstance(c, str) and c for c in compare)):
+        raise CalibrationError("compare_sets", _short(compare), "must be a list of parameter set names or files "
+                               "(may be empty)", origin)
+    compare_files = []
+    for c in compare:
+        try:
+            found = _locate(find_params, c, path)
+            read_toml(found, "params")
+        except SceneError as exc:
+            raise CalibrationError("compare_sets", c, exc.allowed if exc.key == "params" else str(exc),
+                                   origin) from None
+        compare_files.append(str(found) if data.is_path_spec(c) else c)
+
     unc = raw.get("uncertainty", {})
     if not isinstance(unc, dict):
         raise CalibrationError("uncertainty", unc, f"must be a table with keys {', '.join(UNCERTAINTY_KEYS)}", origin)
@@ -195,7 +212,7 @@ def load_calibration(spec: str | Path) -> dict:
                                    + (f" ({exc.origin})" if getattr(exc, "origin", "") else "")) from None
     # a base set given as a path is kept as the file found (it may have been found from the recipe's folder)
     return {**raw, "path": str(path), "description": description,
-            "base": str(base_file) if data.is_path_spec(base) else base,
+            "base": str(base_file) if data.is_path_spec(base) else base, "compare_sets": compare_files,
             "uncertainty": {"samples": samples, "seed": seed, "scene": str(scene_file), "max_bounces": max_bounces,
                             "ranges": ranges, "overrides": overrides}}
 
@@ -341,11 +358,15 @@ def _band(values) -> dict:
 # ----------------------------------------------------------------------------- pipeline
 def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "quick", executor_name: str = "local",
               workers: int | None = None, scheduler: str | None = None, params_out: str | Path | None = None,
-              md_cache: str | None = None, results_dir: str | Path | None = None, paper_sets: tuple = ("silicon",),
-              progress=print) -> dict:
-    """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json)."""
+              md_cache: str | None = None, results_dir: str | Path | None = None,
+              paper_sets: tuple | None = None, progress=print) -> dict:
+    """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json).
+
+    `paper_sets`: the sets whose paper cases run beside the base and the new set (default: the recipe's
+    `compare_sets`)."""
     t_all = time.perf_counter()
     cal = load_calibration(recipe_path)             # the whole recipe and the options, before anything runs
+    paper_sets = cal["compare_sets"] if paper_sets is None else paper_sets
     check_run_options(out, md_fidelity, executor_name, workers, scheduler, paper_sets)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
