@@ -87,10 +87,41 @@ def recipes_needed(mapping=MAPPING) -> list[str]:
     return list(dict.fromkeys(first + [s.fallback.recipe for s in mapping if s.fallback is not None]))
 
 
+#: Recipes whose result depends on the water model (settings.water_model); one model throughout a calibration.
+WATER_RECIPES = ("contact_angle_silica", "contact_angle_ots", "surface_tension_spce")
+
+
+def water_model_mismatch(results: dict[str, dict]) -> str | None:
+    """Why the water-derived values cannot be combined, or None. Young-Dupre and the meniscus force use
+    gamma_lv cos(theta): an angle measured with one water model and gamma_lv of another describe no liquid
+    (SPC/E's gamma_lv is 63.6 mN/m, TIP4P/2005's 69.3, at 300 K; Vega & de Miguel, J. Chem. Phys. 126 (2007)
+    154707), so a calibration mixing them keeps the base set's values for all of them."""
+    models = {r: (results[r].get("settings") or {}).get("water_model") for r in WATER_RECIPES if results.get(r)}
+    if len({m for m in models.values() if m}) > 1:
+        return "water models differ (" + ", ".join(f"{r}: {m}" for r, m in models.items()) + \
+            "): an angle and gamma_lv of different models cannot be combined; use one model throughout"
+    return None
+
+
+def _wets(q: dict, name: str):
+    """A droplet that wets (status 'wets') gives only an upper bound: theta in [0, bound]. It enters as the
+    uniform distribution on that interval, mean bound/2 and stderr bound/sqrt(12), so the uncertainty bands
+    cover every angle the run allows (quantity `contact_angle_upper_bound`)."""
+    if name != "contact_angle" or q.get(name, {}).get("status") != "wets":
+        return None
+    bound = (q.get("contact_angle_upper_bound") or {}).get("value")
+    if bound is None or not math.isfinite(bound) or bound <= 0.0:
+        return None
+    return "contact_angle_upper_bound", 0.5 * float(bound), float(bound) / math.sqrt(12.0), "deg"
+
+
 def _pick(result: dict, source: Source):
     """(quantity name, value, stderr, units) chosen from a result, or (None, reason)."""
     q = result.get("quantities", {})
     for name in source.quantities:
+        wets = _wets(q, name)
+        if wets is not None:
+            return wets
         if name not in q:
             continue
         v, e = q[name].get("value"), q[name].get("stderr")
@@ -142,6 +173,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
     meta = table.pop("meta", {}) or {}
     sources = dict(meta.get("sources", {}))
     rows, calib, rejected = [], {}, {}
+    water_mismatch = water_model_mismatch(results)
     for src in mapping:
         if src.fallback is not None and not any(q in (results.get(src.recipe) or {}).get("quantities", {})
                                                 for q in src.quantities):
@@ -161,7 +193,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
         qname, value, stderr, units = picked
         row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
                    fidelity=res.get("fidelity"))
-        why = _rejection(src.key, value, qname)
+        why = water_mismatch if water_mismatch and src.recipe in WATER_RECIPES else _rejection(src.key, value, qname)
         if why:
             row.update(status="rejected", why=why)
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "quantity": qname,
@@ -174,6 +206,12 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             if stderr is not None:
                 entry["stderr"] = stderr
             qs = res.get("quantities", {})
+            if qname == "contact_angle_upper_bound":
+                entry["note"] = (f"MD: the water wets (theta < {2 * value:.3g} deg, no angle measurable); entered as "
+                                 f"uniform on [0, {2 * value:.3g}] deg: mean and stderr of that interval")
+            if qname == "contact_angle" and (qs.get("contact_angle_drift") or {}).get("drifting"):
+                entry["drifting"] = True
+                entry["note"] = "the block angles still drift (see the MD result's notes): not equilibrated"
             if qname == "interaction_range_z0":
                 q = qs[qname]
                 if src.note:
@@ -197,6 +235,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             kind = {"work_of_adhesion": "potential-energy difference dE/A (not a free energy)",
                     "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
                                                     "incl. the window grid's discretisation error",
+                    "contact_angle_upper_bound": "the water wets: uniform on [0, the run's upper bound]",
                     "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
                                              if src.recipe.startswith("adhesion") else
                                              "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)

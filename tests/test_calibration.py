@@ -89,6 +89,42 @@ def test_unusable_md_values_keep_the_base_value_and_say_so():
     assert "surfaces.sam.interaction_range" not in table["surfaces"]["sam"]
 
 
+def test_a_wetting_droplet_enters_as_the_uniform_interval_below_its_bound():
+    """status 'wets' (the MD contact_angle is a 0 mark) with an upper bound of 12 deg: theta ~ U[0, 12],
+    mean 6 deg and stderr 12/sqrt(12) = 3.4641 deg, named as the bound's quantity."""
+    wet = _result("contact_angle_silica", {"contact_angle": (0.0, None, "deg"),
+                                           "contact_angle_upper_bound": (12.0, None, "deg")})
+    wet["quantities"]["contact_angle"]["status"] = "wets"
+    table, rows = build_parameter_set(_results(contact_angle_silica=wet), "paper", "cal")
+    assert table["surfaces"]["body"]["contact_angle"] == table["surfaces"]["substrate"]["contact_angle"] == 6.0
+    cal = table["meta"]["calibration"]["surfaces.body.contact_angle"]
+    assert cal["quantity"] == "contact_angle_upper_bound"
+    assert cal["stderr"] == pytest.approx(12.0 / math.sqrt(12.0), rel=1e-12)
+    assert "wets" in cal["note"] and "[0, 12]" in cal["note"]
+    assert {r["key"]: r["status"] for r in rows}["surfaces.body.contact_angle"] == "used"
+    # without a bound the 0 mark is refused as before
+    del wet["quantities"]["contact_angle_upper_bound"]
+    table, _ = build_parameter_set(_results(contact_angle_silica=wet), "paper", "cal")
+    assert "surfaces.body.contact_angle" in table["meta"]["rejected"]
+
+
+def test_angles_and_gamma_of_different_water_models_are_not_combined():
+    res = _results()
+    for r, model in (("contact_angle_silica", "tip4p2005"), ("contact_angle_ots", "tip4p2005"),
+                     ("surface_tension_spce", "spce")):
+        res[r]["settings"] = {"water_model": model}
+    table, rows = build_parameter_set(res, "paper", "cal")
+    base = tomllib.loads((ROOT / "inputs" / "params" / "paper.toml").read_text())
+    rej = table["meta"]["rejected"]
+    for key in ("surfaces.body.contact_angle", "surfaces.sam.contact_angle", "menisci.surface_tension"):
+        assert "water models differ" in rej[key]["why"] and "tip4p2005" in rej[key]["why"], key
+    assert table["surfaces"]["sam"]["contact_angle"] == base["surfaces"]["sam"]["contact_angle"]
+    assert table["surfaces"]["work_of_adhesion"] == 0.18          # not water-derived: still used
+    res["surface_tension_spce"]["settings"] = {"water_model": "tip4p2005"}     # one model: all used
+    table, rows = build_parameter_set(res, "paper", "cal")
+    assert "rejected" not in table["meta"] and all(r["status"] == "used" for r in rows)
+
+
 def test_recipes_needed_are_the_seven_mapped_ones():
     assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "contact_angle_silica", "contact_angle_ots",
                                 "surface_tension_spce", "pulloff_silica", "pulloff_ots"]
