@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import csv
 import json
+import logging
 import math
 import os
 import platform
@@ -36,6 +37,8 @@ from .mdset import build_parameter_set, committed_result, recipes_needed, write_
 
 from nanoimpact import data
 from nanoimpact.errors import InputError
+
+log = logging.getLogger(__name__)
 
 
 class CalibrationError(InputError):
@@ -359,11 +362,12 @@ def _band(values) -> dict:
 def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "quick", executor_name: str = "local",
               workers: int | None = None, scheduler: str | None = None, params_out: str | Path | None = None,
               md_cache: str | None = None, results_dir: str | Path | None = None,
-              paper_sets: tuple | None = None, progress=print) -> dict:
+              paper_sets: tuple | None = None, progress=None) -> dict:
     """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json).
 
     `paper_sets`: the sets whose paper cases run beside the base and the new set (default: the recipe's
     `compare_sets`)."""
+    progress = progress or log.info                 # library code logs; the CLI decides what is shown
     t_all = time.perf_counter()
     cal = load_calibration(recipe_path)             # the whole recipe and the options, before anything runs
     paper_sets = cal["compare_sets"] if paper_sets is None else paper_sets

@@ -104,7 +104,7 @@ def _absolute(spec):
 
 def run_sweep(scene: str, vary: dict[str, list], out: str | Path, *, params: str | None = None,
               executor_name: str = "local", workers: int | None = None, scheduler: str | None = None,
-              progress=print) -> dict:
+              progress=log.info) -> dict:
     """Run (or resume) the sweep; a point that fails is recorded and the others go on.
 
     Returns {"rows", "computed", "reused", "failed": [{overrides, input_hash, error}], "exit_code", "wall_s"};
