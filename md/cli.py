@@ -1,7 +1,7 @@
 """``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N]``.
 
 Runs one MD recipe (``inputs/md/*.toml``, or a recipe name such as ``adhesion_silica``) through
-:func:`md.runner.run_recipe`, prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
+:func:`md.workflows.run_recipe` (looked up through :mod:`md.runner`), prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
 into ``--out``. Exit codes (``nanoimpact.errors``): 0 done (or reused from the cache), 1 LAMMPS failed (message
 and the last lines of its log on stderr; no result.json is written), 2 invalid recipe or arguments (one line),
 3 LAMMPS not installed (one line), 75 the same run is in progress in another process and ``--no-wait`` was

@@ -24,7 +24,7 @@ import numpy as np
 from md.forcefield import ForceField, combine, lammps_pair_coeffs, lammps_type_ids, load_forcefield
 from md.topology import System
 
-__all__ = ["write_data", "read_back_check", "ReadBack", "lammps_setup_commands", "style_of"]
+__all__ = ["write_data", "read_atoms", "read_back_check", "ReadBack", "lammps_setup_commands", "style_of"]
 
 _HEADER_TAG = "nanoimpact data file"
 
@@ -135,6 +135,26 @@ def write_data(system: System, forcefield: ForceField, path: str | Path, *, titl
         lines.append("")
     path.write_text("\n".join(lines))
     return path
+
+
+def read_atoms(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(ids, LAMMPS type numbers, positions (N, 3) in A) from the Atoms section of an ``atom_style full`` data
+    file (ours, or LAMMPS's ``write_data``), sorted by id."""
+    lines = Path(path).read_text().splitlines()
+    start = next(i for i, l in enumerate(lines) if l.strip().startswith("Atoms"))
+    ids, types, xyz = [], [], []
+    for l in lines[start + 2:]:
+        s = l.split("#")[0].split()
+        if not s:
+            if ids:
+                break
+            continue
+        ids.append(int(s[0]))
+        types.append(int(s[2]))
+        xyz.append((float(s[4]), float(s[5]), float(s[6])))
+    ids_a = np.array(ids, int)
+    order = np.argsort(ids_a)
+    return ids_a[order], np.array(types, int)[order], np.array(xyz, float).reshape(-1, 3)[order]
 
 
 # ------------------------------------------------------------------------------------------------ read back

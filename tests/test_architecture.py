@@ -2,6 +2,8 @@
 
 - `nanoimpact` (the shared leaf) imports none of `continuum`, `md`, `calibration`, not even lazily;
 - `continuum` and `md` never import each other, and neither imports `calibration`;
+- inside md, the engine (`md.engine`) never imports a workflow (`md.workflows`) or the recipe (`md.recipe`);
+- no module of the project imports another in a circle (function-level imports included);
 - no library module switches matplotlib's backend (`matplotlib.use`) or draws through pyplot.
 """
 from __future__ import annotations
@@ -65,4 +67,100 @@ def test_library_code_never_switches_the_matplotlib_backend(package):
                         isinstance(node, ast.ImportFrom) and node.module == "matplotlib"
                         and any(a.name == "pyplot" for a in node.names)):
                     bad.append(f"{path.relative_to(ROOT)}:{node.lineno} imports pyplot (use matplotlib.figure.Figure)")
+    assert not bad, "\n".join(bad)
+
+
+# ------------------------------------------------------------------------------------------ module graph
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _all_modules() -> dict[str, Path]:
+    return {_module_name(p): p for package in PACKAGES for p in _modules(package)}
+
+
+def _imported_modules(path: Path, known: set[str]) -> set[tuple[str, int]]:
+    """Project modules a module imports anywhere (function level included): ``from a import b`` counts as
+    ``a.b`` when that is a module, else ``a``; relative imports are resolved."""
+    name = _module_name(path)
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            found.update((a.name, node.lineno) for a in node.names if a.name in known)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module or ""
+            for a in node.names:
+                full = f"{module}.{a.name}"
+                if full in known:
+                    found.add((full, node.lineno))
+                elif module in known:
+                    found.add((module, node.lineno))
+    # a module's own ancestor packages are loaded before it whatever it imports: a name taken from one of them
+    # (``from . import __version__``) is no edge of the graph
+    ancestors = {".".join(name.split(".")[:k]) for k in range(1, name.count(".") + 1)}
+    return {(m, line) for m, line in found if m != name and m not in ancestors}
+
+
+def _graph() -> dict[str, set[str]]:
+    modules = _all_modules()
+    known = set(modules)
+    return {m: {t for t, _ in _imported_modules(p, known)} for m, p in modules.items()}
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan), each sorted."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_module_imports_another_in_a_circle():
+    cycles = _cycles(_graph())
+    assert not cycles, "import cycles (function-level imports included):\n" + "\n".join(" <-> ".join(c) for c in cycles)
+
+
+def test_the_cycle_scan_sees_a_lazy_cycle():
+    """Two modules that import each other, one of them inside a function (how md.runner and md.workflows did)."""
+    assert _cycles({"md.a": {"md.b"}, "md.b": {"md.a"}, "md.c": {"md.a"}}) == [["md.a", "md.b"]]
+    assert _cycles({"md.a": {"md.b"}, "md.b": set()}) == []
+
+
+def test_the_md_engine_never_imports_a_workflow_or_the_recipe():
+    modules = _all_modules()
+    known = set(modules)
+    bad = [f"{p.relative_to(ROOT)}:{line} imports {m}"
+           for name, p in modules.items() if name == "md.engine" or name.startswith("md.engine.")
+           for m, line in _imported_modules(p, known)
+           if m in ("md.recipe", "md.workflows") or m.startswith(("md.workflows.", "md.recipe."))]
     assert not bad, "\n".join(bad)

@@ -33,7 +33,7 @@ def _recipe(name, fidelity="smoke", new_name=None, **override):
 
 
 def _run(recipe, cache, fidelity="smoke"):
-    from md.runner import run_recipe
+    from md.workflows import run_recipe
     with redirect_stdout(io.StringIO()):
         return run_recipe(recipe, fidelity, cache=cache, out=None, progress=False)
 
@@ -47,14 +47,14 @@ def cache(tmp_path_factory):
 
 def test_protocol_versions_enter_the_run_hash():
     from md import workflows
-    assert workflows.Adhesion.version == 3 and workflows.PullOff.version == 2
+    assert workflows.WORKFLOWS["adhesion"].version == 3 and workflows.WORKFLOWS["pulloff"].version == 2
 
 
 def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path):
     """The generated commands: window 0 of every registry starts from the contact leg's last restart, moved
     laterally to the registry's offset; each further window reads its neighbour's last restart and moves the upper
     slab by the difference of the nominal separations -- inwards (compression) and outwards."""
-    from md.workflows import Adhesion, _registry_offsets
+    from md.workflows.adhesion import Adhesion, _registry_offsets
     s = _settings("adhesion_silica", "quick")
     wf = Adhesion()
     plan = wf.plan(s, tmp_path)
@@ -95,7 +95,8 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
 def test_dispersion_tail_applies_to_trappe_pairs_only():
     """'trappe': every pair with a CH2/CH3 united atom (OTS-OTS, silica-OTS, water-OTS), never an IFF-IFF pair;
     the OTS head Si (IFF LJ) pairs with silica keep the cutoff."""
-    from md.workflows import TRAPPE_UA, _ff, _tail_pair_table
+    from md.workflows.adhesion import TRAPPE_UA, _tail_pair_table
+    from md.workflows.common import _ff
     ff = _ff(["silica_interface", "ots_trappe_ua", "water_spce"])
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")
     i = {n: k for k, n in enumerate(names)}
@@ -111,7 +112,7 @@ def test_ots_asperity_is_grafted_at_sam_density():
     """Version 1 drew dome sites in random order at 4.4 A and stopped at 9 chains (2.65 per nm^2 of projected cap)
     on the quick R = 1.2 nm dome; now a largest set of sites at >= 4.3 A lateral spacing, >= 4 chains/nm^2."""
     from md.builders import silica_asperity
-    from md.workflows import _graft_dome
+    from md.workflows.pulloff import _graft_dome
     s = _settings("pulloff_ots", "quick")
     asp = silica_asperity(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
                           margin=s["asperity_margin_A"], silanol_density=4.5, face="111", seed=int(s["seed"]))
@@ -171,8 +172,10 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     from md.forcefield import lammps_pair_coeffs
     from md.lammps_data import lammps_setup_commands, write_data
     from md.lammps_loader import new_lammps
-    from md.runner import id_ranges
-    from md.workflows import _ff, _read_data_types, _surface_slab, _tail_pair_table
+    from md.engine.plan import id_ranges
+    from md.lammps_data import read_atoms
+    from md.workflows.adhesion import _tail_pair_table
+    from md.workflows.common import _ff, _surface_slab
     s = _settings("adhesion_ots")
     ff = _ff(["silica_interface", "ots_trappe_ua"])
     lower = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, "111")
@@ -198,7 +201,7 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
             res[rc] = (lmp.extract_compute("gg", 0, 0), lmp.extract_compute("gg", 0, 1)[2])
         finally:
             lmp.close()
-    ids, types = _read_data_types(data)
+    ids, types, _ = read_atoms(data)
     low = ids <= n_low
     tail = lj_tail_between(system.positions[low], types[low] - 1, system.positions[~low], types[~low] - 1, eps, sig,
                            inc, system.cell[:2], 12.0, 30.0, smeared_beyond=False)
@@ -213,8 +216,8 @@ def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(needs
     the nominal step), the inward chain is pressed into the contact, the dispersion tail is attractive (W grows)
     and of the size the review estimated (OTS-OTS 9-11 mJ/m^2), z0 and sigma0 carry stderrs, and the flag for a
     curve without a repulsive end is reported."""
-    from md.runner import read_samples
-    from md.workflows import Adhesion
+    from md.engine.store import read_samples
+    from md.workflows.adhesion import Adhesion
     outcome = _run(load_recipe("adhesion_ots"), cache)
     r = outcome.result
     s = r["settings"]

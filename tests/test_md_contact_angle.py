@@ -1,4 +1,4 @@
-"""Contact-angle protocol (md.workflows.ContactAngleWorkflow version 2) and its analysis (md.analysis).
+"""Contact-angle protocol (md.workflows.contact_angle.ContactAngleWorkflow version 2) and its analysis (md.analysis).
 
 What the review of the first quick results found wrong, each with a test that fails on the old code:
 
@@ -297,7 +297,7 @@ def test_only_deep_si_and_bridging_o_are_held_and_silanols_are_constrained_not_f
     n_sub = len(types)
     assert 0 < len(_ids(frozen)) < 0.6 * n_sub
     # the silanol O-H bond is constrained (SHAKE), not held
-    from md.workflows import _ff
+    from md.workflows.common import _ff
     ff = _ff(wf.forcefield_files(s))
     oh = next(k for k, t in enumerate(ff.bond_types, 1) if sorted(t.types) == ["HOY", "OC24"])
     shake = next(c for c in leg.define(0) if " shake " in c)
@@ -325,7 +325,9 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
     """Review item 1: contact angle, adhesion and pull-off share one IFF surface, cristobalite (111) with isolated
     Q3 silanols: no two top silanol O closer than 4 A (minimum image; the (001) face has pairs at 2.53 A)."""
     from md.topology import minimum_image
-    from md.workflows import PullOff, _silica_face, _surface_slab, get_workflow
+    from md.workflows import get_workflow
+    from md.workflows.common import _silica_face, _surface_slab
+    from md.workflows.pulloff import PullOff
 
     def min_oo(system, group):
         o = np.asarray(group, int)
@@ -351,8 +353,8 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
 
 
 def test_contact_angle_protocol_change_raised_the_workflow_version():
-    from md.runner import run_hash
-    from md.workflows import ContactAngleWorkflow
+    from md.workflows import run_hash
+    from md.workflows.contact_angle import ContactAngleWorkflow
     assert ContactAngleWorkflow.version >= 2
     rec = load_recipe("contact_angle_ots")
     _, doc = run_hash(rec, "quick", ContactAngleWorkflow().forcefield_files(rec.settings("quick")))
@@ -368,8 +370,9 @@ def test_silica_smoke_run_reports_the_angle_at_the_waters_plane_with_w_sl_and_dr
     import io
     from contextlib import redirect_stdout
 
-    from md.runner import read_samples, run_recipe
-    from md.workflows import _read_data_positions
+    from md.engine.store import read_samples
+    from md.workflows import run_recipe
+    from md.lammps_data import read_atoms
     buf = io.StringIO()
     with redirect_stdout(buf):
         out = run_recipe(load_recipe("contact_angle_silica"), "smoke", cache=tmp_path / "c", progress=False)
@@ -387,8 +390,8 @@ def test_silica_smoke_run_reports_the_angle_at_the_waters_plane_with_w_sl_and_dr
     assert d["reference_z_A"] >= d["surface_z_A"] - 3.0
     # the silanol H moved during the unconstrained minimisation (they are not frozen)
     run = out.run_dir
-    ids0, p0 = _read_data_positions(run / "substrate.data")
-    ids1, p1 = _read_data_positions(run / "legs" / "substrate" / "minimized.data")
+    ids0, _, p0 = read_atoms(run / "substrate.data")
+    ids1, _, p1 = read_atoms(run / "legs" / "substrate" / "minimized.data")
     types = _data_types(run / "substrate.data")
     hoy = r["system"]["type_ids"]["HOY"]
     h = np.array([types[i] == hoy for i in ids0])

@@ -2,7 +2,8 @@
 
 Reported: two ``nanoimpact md surface_tension_spce --fidelity smoke`` started together on one cache both exited 0
 with gamma_lv = 0.086 and 0.036 N/m, while one run alone gives 0.0709 every time: both wrote into the same run
-directory. Now :func:`md.runner.run_recipe` holds :func:`nanoimpact.lock.run_lock` on it; the second waits and
+directory. Now the engine (:func:`md.engine.runner.run_job`, under :func:`md.workflows.run_recipe`) holds
+:func:`nanoimpact.lock.run_lock` on it; the second waits and
 reuses the first's result, or stops with RunBusy (exit 75) under ``--no-wait``.
 
 The lock tests need no LAMMPS (a child process holds the lock); the two ``md`` tests run smoke MD.
@@ -135,7 +136,8 @@ def test_md_no_wait_exits_75_with_one_line_when_the_run_is_busy(tmp_path, capsys
     """``nanoimpact md --no-wait`` on a run directory another process holds: exit 75, one line, nothing run."""
     from md.cli import main
     from md.recipe import load_recipe
-    from md.runner import cache_root, run_hash
+    from md.engine import cache_root
+    from md.workflows import run_hash
     from md.workflows import get_workflow
     recipe = load_recipe(RECIPE)
     digest, _ = run_hash(recipe, "smoke", get_workflow(recipe.workflow).forcefield_files(recipe.settings("smoke")))
@@ -185,10 +187,11 @@ def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(needs
     wall = time.monotonic() - t0
     for k, (p, out, err) in res.items():
         assert p.returncode == 0, f"{k}: exit {p.returncode}\n{out}\n{err[-3000:]}"
-    reused = [k for k in ("a", "b") if "reusing cached result" in res[k][1]]
+    # what the engine did is logged on stderr (INFO); the printed summary (stdout) says "(cached)"
+    reused = [k for k in ("a", "b") if "reusing cached result" in res[k][2]]
     assert len(reused) == 1, "exactly one of the two must have waited and reused the other's run"
     waiter, runner = reused[0], ({"a", "b"} - set(reused)).pop()
-    assert "(cached)" in res[waiter][1] and "wrote " in res[runner][1]
+    assert "(cached)" in res[waiter][1] and "wrote " in res[runner][2]
     run_dir = next(p for p in (tmp_path / "shared").iterdir())
     assert f"waiting for PID {procs[runner].pid} on {HOST} to finish {run_dir}" in res[waiter][2]
     assert sorted(p.name for p in (tmp_path / "shared").iterdir()) == [run_dir.name]     # no lock file left
@@ -209,15 +212,16 @@ def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(needs
 
 _KILLED_AFTER = """
 import os, signal, sys
-import md.runner as R
+import md.engine.runner as E
+from md.workflows import run_recipe
 from md.recipe import load_recipe
 
 class SigKill(Exception):                # raised where the test hook would stop the run: die like kill -9
     def __init__(self, *args):
         os.kill(os.getpid(), signal.SIGKILL)
 
-R.Interrupted = SigKill
-R.run_recipe(load_recipe(sys.argv[1]), "smoke", cache=sys.argv[2], progress=False, echo=None,
+E.Interrupted = SigKill
+run_recipe(load_recipe(sys.argv[1]), "smoke", cache=sys.argv[2], progress=False, echo=None,
              stop_after_chunks=int(sys.argv[3]))
 """
 
@@ -228,7 +232,7 @@ def test_a_run_killed_with_sigkill_is_resumed_by_another_process(needs_lammps, t
     and ``--resume --no-wait`` in another process continues it from step 400 to a complete result."""
     from md.cli import main
     from md.recipe import load_recipe
-    from md.runner import read_samples
+    from md.engine import read_samples
     cache = tmp_path / "cache"
     child = subprocess.Popen([sys.executable, "-c", _KILLED_AFTER, RECIPE, str(cache), "4"], cwd=REPO,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -8,7 +8,7 @@ strain (Si-O 1.55 A against IFF's 1.68 A, straight Si-O-Si against 149 deg; 4.8 
 timestep, and the recipe's 2 fs (chosen for SHAKE, which is not on while minimising) let it reach 20 fs, two
 periods of the free silanol O-H; in 4320 atoms FIRE's global power test did not see one H diverging, and the H
 collapsed onto its O (0.03 A at step 47) and was shot away. In the 780-atom smoke slab the same 2 fs FIRE only
-shows force spikes it recovers from, so smoke passed. FIRE now runs at 1 fs (``md.workflows.FIRE_TIMESTEP_FS``):
+shows force spikes it recovers from, so smoke passed. FIRE now runs at 1 fs (``md.workflows.common.FIRE_TIMESTEP_FS``):
 the quick minimisation then runs its 500 iterations to -301 018 kcal/mol (final step changes it by 1e-4).
 
 The build-level checks below (every silica recipe, every fidelity) guard the other suspects: each bond's
@@ -83,7 +83,7 @@ def test_the_substrate_is_minimised_by_fire_at_1_fs_and_run_at_the_recipes_times
 def test_no_recipe_minimises_with_fire_above_1_fs(fidelity):
     """Every recipe at every fidelity, through the helper every workflow minimises with (FIRE for the solids,
     cg for rigid water): FIRE never above 1 fs, the recipe's timestep restored after it."""
-    from md.workflows import _minimize
+    from md.workflows.common import _minimize
     for name in RECIPES:
         s = load_recipe(name).settings(fidelity)
         at_fire, dt = _fire_timesteps(_minimize(s), dt=s["timestep_fs"])
@@ -98,7 +98,8 @@ def test_quick_silica_substrate_survives_fire(needs_lammps, tmp_path):
     Version 2 (FIRE at 2 fs) raised "Bond atoms 3501 3502 missing" at step 48; now 60 steps leave every silanol
     O-H at its length and the energy lower."""
     from md.lammps_loader import new_lammps
-    from md.workflows import _ff, get_workflow
+    from md.workflows import get_workflow
+    from md.workflows.common import _ff
     s = dict(load_recipe("contact_angle_silica").settings("quick"))
     s["minimize_steps"] = 60
     wf = get_workflow("contact_angle")
@@ -132,7 +133,8 @@ def test_quick_silica_substrate_survives_fire(needs_lammps, tmp_path):
 
 def _substrates(name: str, fidelity: str):
     """The periodic silica (with its SAM) the recipe's workflow builds, and the cell counts it asked for."""
-    from md.workflows import PullOff, _silica_face, _surface_slab
+    from md.workflows.common import _silica_face, _surface_slab
+    from md.workflows.pulloff import PullOff
     s = load_recipe(name).settings(fidelity)
     seed = int(s["seed"])
     if name.startswith("pulloff"):
@@ -145,7 +147,7 @@ def _substrates(name: str, fidelity: str):
 
 
 def _forcefield_r0(system) -> np.ndarray:
-    from md.workflows import _ff
+    from md.workflows.common import _ff
     names = ["silica_interface"] + (["ots_trappe_ua"] if "CH3" in set(system.types.tolist()) else []) \
         + (["water_spce"] if "OW" in set(system.types.tolist()) else [])
     r0 = {t.name: float(t.coeffs[1]) for t in _ff(names).bond_types}

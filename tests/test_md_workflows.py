@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import json
+import logging
 import math
 from contextlib import redirect_stdout
 from pathlib import Path
@@ -101,12 +102,28 @@ def cache(tmp_path_factory):
     return tmp_path_factory.mktemp("md-cache")
 
 
+class _Lines(logging.Handler):
+    def __init__(self):
+        super().__init__(logging.INFO)
+        self.lines: list[str] = []
+
+    def emit(self, record):
+        self.lines.append(record.getMessage())
+
+
 def _run(name, cache, out, **kw):
-    from md.runner import run_recipe
-    buf = io.StringIO()
-    with redirect_stdout(buf):
+    """Run a recipe at smoke; returns the result and what the engine logged (INFO on md.engine.runner)."""
+    from md.workflows import run_recipe
+    engine_log, handler = logging.getLogger("md.engine.runner"), _Lines()
+    level = engine_log.level
+    engine_log.addHandler(handler)
+    engine_log.setLevel(logging.INFO)
+    try:
         outcome = run_recipe(load_recipe(name), "smoke", cache=cache, out=out, progress=False, **kw)
-    return outcome, buf.getvalue()
+    finally:
+        engine_log.removeHandler(handler)
+        engine_log.setLevel(level)
+    return outcome, "\n".join(handler.lines)
 
 
 def _total_charge(data_file: Path) -> float:
@@ -172,19 +189,20 @@ def test_a_finished_run_is_reused_not_repeated(needs_lammps, cache, tmp_path):
     with redirect_stdout(buf):
         code = main(["adhesion_silica", "--fidelity", "smoke", "--cache", str(cache), "--out", str(tmp_path / "c"),
                      "--quiet"])
-    assert code == 0 and "reusing cached result" in buf.getvalue() and "work_of_adhesion" in buf.getvalue()
+    # the reuse is logged (INFO, hidden by --quiet); the printed summary says "(cached)"
+    assert code == 0 and "(cached)" in buf.getvalue() and "work_of_adhesion" in buf.getvalue()
     assert json.loads((tmp_path / "c" / "result.json").read_text())["run_hash"] == first.result["run_hash"]
 
 
 def test_a_changed_workflow_protocol_changes_the_run_hash(monkeypatch):
     """Raising a workflow's version invalidates its cached and committed runs; version 1 leaves hashes alone."""
     from md import workflows
-    from md.runner import run_hash
+    from md.workflows import run_hash
     rec = load_recipe("adhesion_silica")
     ff = workflows.get_workflow("adhesion").forcefield_files(rec.settings("quick"))
     h2, doc2 = run_hash(rec, "quick", ff)
-    assert doc2["workflow_version"] == workflows.Adhesion.version >= 2
-    monkeypatch.setattr(workflows.Adhesion, "version", 1)
+    assert doc2["workflow_version"] == workflows.adhesion.Adhesion.version >= 2
+    monkeypatch.setattr(workflows.adhesion.Adhesion, "version", 1)
     h1, doc1 = run_hash(rec, "quick", ff)
     assert "workflow_version" not in doc1 and h1 != h2
 
@@ -193,7 +211,7 @@ def test_a_changed_workflow_protocol_changes_the_run_hash(monkeypatch):
 def test_resume_after_an_interruption_loses_and_duplicates_no_sample(needs_lammps, tmp_path):
     """Run 3 of 6 chunks, leave a sample past the restart (a crash between appending samples and committing
     the restart), resume: the samples are exactly one per sample_interval over the whole run."""
-    from md.runner import Interrupted, read_frames, read_samples
+    from md.engine import Interrupted, read_frames, read_samples
     name = "surface_tension_spce"
     with pytest.raises(Interrupted):
         _run(name, tmp_path / "cache", None, stop_after_chunks=3)
@@ -227,7 +245,7 @@ def test_resume_after_an_interruption_loses_and_duplicates_no_sample(needs_lammp
 
 @pytest.mark.md
 def test_a_lammps_error_leaves_no_result_and_shows_the_log_tail(needs_lammps, tmp_path):
-    from md.runner import LOG_TAIL_LINES, MDRunError
+    from md.engine.lammps import LOG_TAIL_LINES, MDRunError
     with pytest.raises(MDRunError) as info:
         _run("adhesion_silica_ots", tmp_path / "cache", tmp_path / "out", extra_commands=["fix broken all nve/bogus"])
     msg = str(info.value)

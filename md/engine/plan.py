@@ -1,0 +1,141 @@
+"""What a workflow hands the engine: the plan data model (a leaf: it imports nothing of md).
+
+Vocabulary
+    A *run* is one recipe at one fidelity (a :class:`Job`). It consists of *legs* (independent LAMMPS simulations
+    run one after the other: the contact and the separated slabs, one PMF window, one retraction speed, ...). A
+    leg is a list of *stages* (equilibrate, sample, approach, hold, retract) run in *chunks* of ``chunk_steps``.
+    A workflow is anything with ``plan(settings, run_dir) -> Plan`` and ``analyse(ctx) -> Analysis``
+    (:class:`Planner`); the engine never imports one.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping, Protocol, Sequence
+
+import numpy as np
+
+__all__ = ["Stage", "Frames", "Leg", "Plan", "Analysis", "Job", "Planner", "id_ranges"]
+
+
+@dataclass(frozen=True)
+class Stage:
+    """``steps`` MD steps; ``begin`` commands are issued once when the stage starts (never on resume: velocities
+    are in the restart); ``sampled`` marks the stages whose samples the analysis uses (all are stored)."""
+    name: str
+    steps: int
+    begin: tuple[str, ...] = ()
+    sampled: bool = True
+
+
+@dataclass(frozen=True)
+class Frames:
+    """Configurations of ``group`` (ids and x y z in A) stored every ``interval`` steps of sampled stages."""
+    group: str
+    interval: int
+
+
+@dataclass
+class Leg:
+    """One LAMMPS simulation.
+
+    ``fresh(leg_dir)``: commands that create the system (styles, ``read_data`` or ``read_restart`` of another
+    leg, pair coefficients, k-space, groups); ``define(step)``: computes, variables and fixes, issued after every
+    (re)start (``step`` is the absolute step, to vary Langevin seeds between restarts); ``prepare(leg_dir)``:
+    issued once after ``define`` on a fresh start (minimise, write the minimised structure, ``reset_timestep
+    0``); ``restart_head(path)``: what to issue instead of ``fresh`` when continuing from ``path`` (read_restart
+    plus the settings a restart file does not hold: k-space, neighbour lists).
+    ``columns``: sample name -> LAMMPS ``fix ave/time`` argument (``v_pe``, ``c_gg[3]``).
+    """
+    name: str
+    fresh: Callable[[Path], list[str]]
+    define: Callable[[int], list[str]]
+    prepare: Callable[[Path], list[str]]
+    restart_head: Callable[[Path], list[str]]
+    stages: list[Stage]
+    columns: dict[str, str]
+    sample_interval: int
+    chunk_steps: int
+    n_atoms: int
+    frames: Frames | None = None
+    info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def total_steps(self) -> int:
+        return int(sum(s.steps for s in self.stages))
+
+    def stage_at(self, step: int) -> tuple[int, int, int]:
+        """(stage index, stage start, stage end) of the stage that runs the step after ``step``."""
+        start = 0
+        for k, s in enumerate(self.stages):
+            if step < start + s.steps:
+                return k, start, start + s.steps
+            start += s.steps
+        return len(self.stages), start, start
+
+
+@dataclass
+class Plan:
+    """What a workflow wants run: its legs (in order), the LAMMPS timestep and facts for result.json."""
+    legs: list[Leg]
+    timestep_fs: float
+    n_atoms: int
+    seeds: dict[str, int]
+    forcefield_files: list[str]
+    system_info: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class Analysis:
+    """What a workflow returns: SI quantities ({name: {value, stderr, units}}), curves (CSV name -> (columns,
+    rows)), figures (PNG name -> function(path)), notes, and anything else worth keeping (``details``)."""
+    quantities: dict[str, dict[str, Any]]
+    curves: dict[str, tuple[list[str], np.ndarray]] = field(default_factory=dict)
+    figures: dict[str, Callable[[Path], None]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    details: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run as the engine sees it (:func:`md.workflows.job_for` makes it from a recipe): what names it, what
+    its hash covers, what ``result.json`` records.
+
+    ``canonical`` is the recipe's resolved content at ``fidelity`` (``Recipe.canonical``); ``source`` the recipe
+    file (or name), ``file_sha256`` its bytes' hash, ``content_sha256`` the hash of ``canonical``;
+    ``workflow_version`` enters the run hash once above 1."""
+    name: str
+    workflow: str
+    description: str
+    fidelity: str
+    settings: Mapping[str, Any]
+    canonical: Mapping[str, Any]
+    forcefield_files: tuple[str, ...]
+    workflow_version: int = 1
+    source: str = ""
+    file_sha256: str = ""
+    content_sha256: str = ""
+
+
+class Planner(Protocol):
+    """The engine's view of a workflow."""
+
+    def plan(self, settings: Mapping[str, Any], run_dir: Path) -> Plan: ...
+
+    def analyse(self, ctx: Any) -> Analysis: ...
+
+
+def id_ranges(indices: Sequence[int]) -> str:
+    """0-based atom indices -> LAMMPS ``group ID id`` arguments with ranges (1-based): '1:40 45 47:50'."""
+    ids = np.unique(np.asarray(indices, int)) + 1
+    if not len(ids):
+        return ""
+    out, start, prev = [], ids[0], ids[0]
+    for i in ids[1:]:
+        if i == prev + 1:
+            prev = i
+            continue
+        out.append(f"{start}:{prev}" if prev > start else f"{start}")
+        start = prev = i
+    out.append(f"{start}:{prev}" if prev > start else f"{start}")
+    return " ".join(out)

@@ -1,0 +1,268 @@
+"""What the four workflows share: LAMMPS set-up, thermostats, minimisation, SHAKE, stage sizes, the
+substrates a recipe names, result quantities and figures, the water models, and the :class:`Workflow`
+base class (a workflow plans legs for :mod:`md.engine` and analyses what they stored).
+
+Each workflow (1) builds its system with :mod:`md.builders` and writes it with :func:`md.lammps_data.write_data`,
+(2) plans LAMMPS legs for :mod:`md.engine` -- FIRE minimisation first (the builds start strained), NVT
+equilibration, sampling -- and (3) turns the stored samples into SI quantities with :mod:`md.analysis`, every
+conversion through :mod:`md.units`.
+
+Common LAMMPS set-up: ``units real``, ``atom_style full``, ``boundary p p f``, ``lj/cut/coul/long`` with PPPM
+and ``kspace_modify slab 3.0`` (the Yeh-Berkowitz correction: the empty space above the system is tripled
+for the Ewald sum, so periodic images along z do not interact), reflecting walls at the z faces of the box
+(an evaporated molecule is turned back instead of being lost), pair coefficients and ``special_bonds`` from
+the force-field files. Atoms held fixed (slab backs, whole substrates) are left out of the integrator, feel
+``setforce 0 0 0`` during minimisation, and their internal pairs are excluded from the neighbour list.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from md.builders import SILICA_FACE, ots_sam, silica_slab
+from md.forcefield import ForceField, combine, load_forcefield
+from md.lammps_data import lammps_setup_commands
+from md.engine.plan import Analysis, Plan, Stage, id_ranges
+from md.engine.store import RunContext
+from md.topology import System
+
+
+ENERGY_NOT_FREE_ENERGY = (
+    "work_of_adhesion is dE/A, the difference of mean potential energies (separated - contact) per area at "
+    "the thermostat temperature: an energy, not the free energy of adhesion (the Dupre work). It neglects "
+    "-T dS/A, the change of vibrational/conformational entropy on contact.")
+WATER_MASS = 15.9994 + 2 * 1.008          # g/mol, SPC/E (force-field masses)
+
+
+# ================================================================================================ LAMMPS helpers
+
+def _seed(base: int, *salt: int) -> int:
+    """A LAMMPS-valid seed (1 .. 900 000 000) derived from ``base`` and ``salt``."""
+    x = int(base)
+    for s in salt:
+        x = (x * 1_000_003 + int(s) * 7919 + 12345) % 899_999_989
+    return x + 1
+
+
+def _restart_head(settings: Mapping[str, Any]) -> Callable[[Path], list[str]]:
+    def head(path: Path) -> list[str]:
+        return [f"read_restart {Path(path).as_posix()}",
+                f"kspace_style pppm {settings['kspace_accuracy']:g}", "kspace_modify slab 3.0"] + _neighbor()
+    return head
+
+
+def _neighbor() -> list[str]:
+    return ["neighbor 2.0 bin", "neigh_modify delay 0 every 1 check yes"]
+
+
+def _fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], groups: Mapping[str, Any]) -> list[str]:
+    cmds = lammps_setup_commands(ff, data, boundary="p p f", pair="long", cutoff=settings["cutoff_A"],
+                                 kspace_accuracy=settings["kspace_accuracy"])
+    cmds += _neighbor()
+    cmds += [f"timestep {settings['timestep_fs']:g}"]
+    for name, idx in groups.items():
+        if len(idx):
+            cmds.append(f"group {name} id {id_ranges(idx)}")
+        else:
+            cmds.append(f"group {name} empty")
+    return cmds
+
+
+def _thermostat(group: str, settings: Mapping[str, Any], step: int, salt: int = 0) -> list[str]:
+    t = settings["temperature_K"]
+    damp = settings["thermostat_damping_fs"]
+    if settings["thermostat"] == "nose-hoover":
+        return [f"fix thermostat {group} nvt temp {t:g} {t:g} {damp:g}"]
+    return [f"fix thermostat {group} langevin {t:g} {t:g} {damp:g} {_seed(settings['seed'], 17, salt, step)} "
+            f"zero yes", f"fix integrate {group} nve"]
+
+
+def _common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
+    return ["fix zwalls all wall/reflect zlo EDGE zhi EDGE",
+            f"compute tmob {mobile} temp",
+            "variable pe equal pe", "variable temp equal c_tmob",
+            "thermo_style custom step temp c_tmob pe ke press",
+            f"thermo {max(settings['sample_interval'], settings['chunk_steps'] // 4)}",
+            "thermo_modify norm no flush yes lost error"]
+
+
+#: timestep (fs) FIRE runs at, whatever the MD timestep: FIRE grows its step to tmax (LAMMPS default 10) times the
+#: timestep, and nothing is constrained while it runs (SHAKE comes afterwards; FIRE breaks SHAKE's restraints, see
+#: :func:`_minimize_water`), so the silanol O-H bond (IFF 495 kcal/mol/A^2, H: period 9.5 fs) vibrates freely.
+#: At 1 fs (steps up to 10 fs, the timestep of every flexible-O-H recipe) the minimisations are stable; at the 2 fs
+#: of a SHAKE recipe (steps up to 20 fs, two O-H periods) the O-H integration diverges wherever FIRE's global power
+#: test does not see it -- the quick contact_angle_silica substrate (4320 atoms) lost a silanol H at FIRE step 46.
+FIRE_TIMESTEP_FS = 1.0
+
+
+def _minimize(settings: Mapping[str, Any], write: Path | None = None, style: str = "fire") -> list[str]:
+    """FIRE (or ``style``) minimisation of ``minimize_steps`` iterations; FIRE at :data:`FIRE_TIMESTEP_FS` when the
+    MD timestep is longer, the MD timestep restored afterwards."""
+    n = int(settings["minimize_steps"])
+    cmds = []
+    if n > 0:
+        dt = float(settings["timestep_fs"])
+        slow = style == "fire" and dt > FIRE_TIMESTEP_FS
+        cmds += ([f"timestep {FIRE_TIMESTEP_FS:g}"] if slow else []) + \
+            [f"min_style {style}", f"minimize 0.0 1.0e-3 {n} {10 * n}"] + ([f"timestep {dt:g}"] if slow else [])
+    if write is not None:
+        cmds.append(f"write_data {write.as_posix()}")
+    return cmds + ["reset_timestep 0"]
+
+
+def _minimize_water(settings: Mapping[str, Any], write: Path | None = None) -> list[str]:
+    """Minimisation of a system with rigid water: conjugate gradients (FIRE moves SHAKE clusters apart: LAMMPS
+    turns SHAKE into restraints while minimising, and FIRE's steps break them; cg does not)."""
+    return _minimize(settings, write, style="cg")
+
+
+#: silanol O-H bond (IFF OC24-HOY, 0.945 A): constrained where silanols are mobile at a 2 fs timestep
+SILANOL_OH = (("OC24", "HOY"),)
+
+
+def _shake(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[str]:
+    """``fix shake`` on every bond/angle type the force field marks rigid (SPC/E), and on the bond types
+    between the atom-type pairs in ``also`` (e.g. :data:`SILANOL_OH`); [] if none."""
+    pairs = {tuple(sorted(p)) for p in also}
+    b = [k for k, t in enumerate(ff.bond_types, start=1)
+         if t.constraint == "shake" or tuple(sorted(t.types)) in pairs]
+    a = [k for k, t in enumerate(ff.angle_types, start=1) if t.constraint == "shake"]
+    if not b and not a:
+        return []
+    args = (" b " + " ".join(map(str, b)) if b else "") + (" a " + " ".join(map(str, a)) if a else "")
+    return [f"fix rigidwater all shake 1.0e-5 50 0{args} kbond 2.0e5"]
+
+
+def _round_up(n: float, k: int) -> int:
+    return int(max(k, k * math.ceil(float(n) / k - 1e-9)))
+
+
+def _steps(settings: Mapping[str, Any], key: str) -> int:
+    n = int(settings[key])
+    return 0 if n == 0 else _round_up(n, settings["sample_interval"])
+
+
+def _equil(settings: Mapping[str, Any], group: str, salt: int = 0, extra: tuple[str, ...] = ()) -> Stage:
+    t = settings["temperature_K"]
+    return Stage("equilibrate", _steps(settings, "equilibrate_steps"),
+                 (f"velocity {group} create {t:g} {_seed(settings['seed'], 3, salt)} mom yes rot no dist gaussian",)
+                 + extra, sampled=False)
+
+
+def _stages(*stages: Stage) -> list[Stage]:
+    return [s for s in stages if s.steps > 0]
+
+
+def _read_data_positions(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(ids, positions (N, 3) in A) from the Atoms section of a LAMMPS data file (``atom_style full``)."""
+    lines = Path(path).read_text().splitlines()
+    start = next(i for i, l in enumerate(lines) if l.strip().startswith("Atoms"))
+    rows = []
+    for l in lines[start + 2:]:
+        s = l.split("#")[0].split()
+        if not s:
+            if rows:
+                break
+            continue
+        rows.append((int(s[0]), float(s[4]), float(s[5]), float(s[6])))
+    arr = np.array(rows)
+    order = np.argsort(arr[:, 0])
+    return arr[order, 0].astype(int), arr[order, 1:]
+
+
+def _ff(names: list[str]) -> ForceField:
+    return load_forcefield(names[0]) if len(names) == 1 else combine(*names)
+
+
+def _intersect(system: System, a: str, b: str) -> np.ndarray:
+    return np.intersect1d(system.group(a), system.group(b))
+
+
+def _q(value: float, stderr: float | None, units: str, **extra) -> dict[str, Any]:
+    d = {"value": float(value), "stderr": None if stderr is None or not np.isfinite(stderr) else float(stderr),
+         "units": units}
+    d.update(extra)
+    return d
+
+
+def _figure(draw: Callable) -> Callable[[Path], None]:
+    def save(path: Path) -> None:
+        from matplotlib.figure import Figure    # object API: no pyplot state, no backend switch
+        fig = Figure(figsize=(6.0, 4.2), dpi=110)
+        ax = fig.subplots()
+        draw(ax)
+        fig.tight_layout()
+        fig.savefig(path)
+    return save
+
+
+def _silica_face(settings: Mapping[str, Any]) -> str:
+    """The cristobalite face of a recipe's silica: the recipe's ``silica_face`` (default
+    :data:`md.builders.SILICA_FACE` = '111', isolated Q3 silanols) for bare silica; always (111) when an OTS SAM
+    is involved (it is grafted on (111), and the two slabs of a pair must share the lateral cell)."""
+    kinds = settings.get("surfaces") or [settings.get("surface")]
+    if "ots" in kinds:
+        return "111"
+    return settings.get("silica_face", SILICA_FACE)
+
+
+def _held_deep(system: System, group: str = "frozen") -> np.ndarray:
+    """Atoms of ``group`` (the builder's deep layer) that are Si or bridging O: only these are held; silanol O
+    and H stay mobile everywhere."""
+    idx = np.asarray(system.group(group), int)
+    return idx[np.isin(system.types[idx], ["SC4", "OC23"])]
+
+
+def _surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mapping[str, Any], seed: int,
+                  face: str) -> System:
+    if kind == "silica":
+        dens = settings["silanol_density"] if face == "001" else 4.5
+        return silica_slab(nx, ny, thickness=thickness, silanol_density=dens, face=face, seed=seed)
+    slab = silica_slab(nx, ny, thickness=thickness, face="111", silanol_density=4.5, seed=seed)
+    return ots_sam(slab, coverage=settings["sam_coverage"], chain_length=settings["chain_length"], seed=seed + 1)
+
+
+# ================================================================================================ base class
+
+class Workflow:
+    """``version`` counts changes of a workflow's simulation protocol; above 1 it enters the run hash.
+    ``yields``: the quantities every result of the workflow reports (name -> SI units); some report more."""
+    name = ""
+    version = 1
+    yields: dict[str, str] = {}
+
+    def forcefield_files(self, settings: Mapping[str, Any]) -> list[str]:
+        raise NotImplementedError
+
+    def plan(self, settings: Mapping[str, Any], run_dir: Path) -> Plan:
+        raise NotImplementedError
+
+    def analyse(self, ctx: RunContext) -> Analysis:
+        raise NotImplementedError
+
+
+
+def _summary(system: System) -> dict[str, Any]:
+    keep = ("builder", "polymorph", "face", "n_atoms", "silanol_density_top", "silanol_density_bottom", "chains",
+            "coverage_nm2", "thickness_A", "radius_requested_A", "silanol_density_dome", "total_charge")
+    return {k: system.info[k] for k in keep if k in system.info}
+
+
+
+# ================================================================================================ water
+
+#: Water models a recipe may name: their force-field files and the model's own liquid-vapour surface tension at
+#: 300 K (published), which turns every contact angle into W_SL = gamma_lv (1 + cos theta) and gamma_lv cos theta.
+#: One model throughout a calibration: the angles and gamma_lv of the menisci must describe the same water.
+WATER_MODELS: dict[str, dict[str, Any]] = {
+    "spce": {"name": "SPC/E", "forcefields": ["water_spce"], "gamma_lv_N_m": 0.0636, "gamma_T_K": 300.0,
+             "gamma_source": "SPC/E, 300 K, Ewald with LJ tail: Vega & de Miguel, J. Chem. Phys. 126 (2007) 154707 "
+                             "(this project's quick films: 60.7 +/- 3.0 mN/m at 25 A, 64.0 +/- 1.9 mN/m at 35 A)"},
+}
+
+
+def _water_ff_names(model: str) -> list[str]:
+    return list(WATER_MODELS[model]["forcefields"])

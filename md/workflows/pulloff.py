@@ -1,0 +1,501 @@
+"""Asperity pull-off (:class:`PullOff`).
+
+pulloff
+    A hemispherical asperity on a holder, flipped onto a flat. The flat's bottom layer is fixed; the
+    holder's back is moved rigidly (``velocity set`` + ``setforce 0 0 0``: constant speed) -- approach, hold,
+    retract (``retract_repeats`` times per speed, each with fresh velocities). The flat and the asperity have
+    separate thermostats, the asperity's in its own frame (no drag on its motion); the residual drag is measured
+    from the holder's reaction. The force on the asperity is ``compute group/group`` (asperity body vs flat,
+    ``kspace yes``); the separation is the rigid-holder gap (apex to the top of the flat at the minimised start,
+    plus the holder's travel). :func:`md.analysis.pull_off_analysis` gives the maximum tensile force, a 9-3 z0
+    (validation only: it absorbs the asperity's compliance) and Delta gamma_eff = F/(1.5 pi R) (JKR) and
+    F/(2 pi R) (DMT, the limit at MD scale). At production a rate scan branches several retractions from the same
+    held contact and extrapolates (:func:`md.analysis.rate_extrapolation`).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from md import analysis as A
+from md import units as U
+from md.builders import flip_upside_down, ots_sam, place_on, silica_asperity
+from md.lammps_data import read_atoms, write_data
+from md.engine.plan import Analysis, Leg, Plan, Stage
+from md.topology import System, with_groups
+
+from md.workflows.common import (Workflow, _common_define, _equil, _ff, _figure, _fresh_from_data, _intersect,
+                                 _minimize, _q, _restart_head, _round_up, _seed, _silica_face, _stages, _steps,
+                                 _summary, _surface_slab, _thermostat)
+
+# ================================================================================================ pull-off
+
+class PullOff(Workflow):
+    """Asperity approach-hold-retract against a flat at constant holder speed.
+
+    Version 2 (this protocol): the moving asperity is not dragged by the thermostat (``tip_thermostat``:
+    'comoving' thermostats only its thermal motion, a temp/com bias; the flat has its own thermostat), the residual
+    drag on the asperity is measured from the holder's reaction and reported; ``retract_repeats`` independent
+    retractions per speed give the pull-off force a spread; the OTS asperity carries >= 4 chains per nm^2 of
+    projected cap. Version 1 thermostatted every mobile atom in the lab frame: at 30-40 m/s a drag gamma M v of
+    10-13 nN on the asperity against pull-off forces of 0.2-0.5 nN."""
+    name = "pulloff"
+    version = 2
+    yields = {"pull_off_force": "N", "separation_at_max_tension": "m", "interaction_range_z0": "m",
+              "work_of_adhesion_eff_jkr": "J/m^2", "work_of_adhesion_eff_dmt": "J/m^2"}
+
+    def forcefield_files(self, s):
+        return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else [])
+
+    def build(self, s) -> tuple[System, dict[str, Any]]:
+        seed = int(s["seed"])
+        R = float(s["asperity_radius_A"])
+        face = _silica_face(s)
+        dens = s["silanol_density"] if face == "001" else 4.5
+        asp = silica_asperity(radius=R, holder_thickness=s["holder_thickness_A"], margin=s["asperity_margin_A"],
+                              silanol_density=dens, face=face, seed=seed)
+        nx, ny = asp.info["surface_cells"]
+        fnx, fny = (s["flat_nx"] or nx), (s["flat_ny"] or ny)
+        if (fnx, fny) != (nx, ny):
+            raise ValueError(f"flat_nx/flat_ny ({fnx}, {fny}) must match the asperity's holder cells ({nx}, {ny}) "
+                             f"(both are periodic in x and y); set them to 0")
+        flat = _surface_slab(s["surface"], nx, ny, s["flat_thickness_A"], s, seed + 20, face)
+        info: dict[str, Any] = {"radius_A": R, "face": face}
+        if s["surface"] == "ots":
+            asp, ginfo = _graft_dome(asp, s, seed + 30)
+            info["asperity_sam"] = ginfo
+        system = place_on(flat, flip_upside_down(asp), gap=s["initial_gap_A"],
+                          vacuum=s["retract_distance_A"] + 15.0)
+        info.update(asperity=_summary(asp), flat=_summary(flat), box_A=system.cell.tolist())
+        return system, info
+
+    def plan(self, s, run_dir):
+        ff = _ff(self.forcefield_files(s))
+        system, info = self.build(s)
+        data = run_dir / "system.data"
+        write_data(system, ff, data)
+        groups = {"flat": system.group("substrate"), "tip": system.group("adsorbate"),
+                  "flat_fixed": _intersect(system, "frozen", "substrate"),
+                  "holder_rigid": _intersect(system, "frozen", "adsorbate")}
+        tip_mobile = np.setdiff1d(groups["tip"], groups["holder_rigid"])
+        n = system.n_atoms
+        dt = s["timestep_fs"]
+        si = s["sample_interval"]
+        seed = int(s["seed"])
+        v_app = U.m_per_s_to_angstrom_per_fs(s["approach_speed_m_s"])
+        n_app = _round_up(s["approach_distance_A"] / (v_app * dt), si)
+        columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_holder": "v_zh", "tip_zmin": "v_tipmin",
+                   "flat_zmax": "v_flatmax", "f_holder": "f_hold_holder[3]", "p_tip": "v_ptip"}
+
+        def define(salt: int):
+            def d(step: int) -> list[str]:
+                return _common_define(s, "mobile") + [
+                    "neigh_modify exclude group flat_fixed flat_fixed",
+                    "neigh_modify exclude group holder_rigid holder_rigid",
+                    "fix hold_flat flat_fixed setforce 0.0 0.0 0.0",
+                    "fix hold_holder holder_rigid setforce 0.0 0.0 0.0",
+                    "fix move_holder holder_rigid nve",
+                    "compute gg tip group/group flat kspace yes",
+                    "variable zh equal xcm(holder_rigid,z)", "variable tipmin equal bound(tip,zmin)",
+                    "variable flatmax equal bound(flat,zmax)",
+                    "variable ptip equal mass(tip_mobile)*vcm(tip_mobile,z)"] + \
+                    _pulloff_thermostat(s, step, salt)
+            return d
+
+        def fresh(leg_dir: Path) -> list[str]:
+            return _fresh_from_data(ff, data, s, groups) + [
+                "group held union flat_fixed holder_rigid", "group mobile subtract all held",
+                "group flat_mobile subtract flat flat_fixed", "group tip_mobile subtract tip holder_rigid"]
+
+        vz = lambda v: f"velocity holder_rigid set 0.0 0.0 {v:.10g} units box"
+        approach = Leg(
+            name="approach", fresh=fresh, define=define(0), prepare=lambda d: _minimize(s, d / "minimized.data"),
+            restart_head=_restart_head(s),
+            stages=_stages(_equil(s, "mobile", 1, (vz(0.0),)), Stage("approach", n_app, (vz(-v_app),)),
+                           Stage("hold", _steps(s, "hold_steps"), (vz(0.0),))),
+            columns=columns, sample_interval=si, chunk_steps=s["chunk_steps"], n_atoms=n,
+            info={"v_approach_A_fs": v_app})
+        legs = [approach]
+        approach_dir = run_dir / "legs" / "approach"
+        repeats = int(s["retract_repeats"])
+        t = s["temperature_K"]
+        for k, v in enumerate(s["retract_speeds_m_s"]):
+            v_ret = U.m_per_s_to_angstrom_per_fs(v)
+            n_ret = _round_up(s["retract_distance_A"] / (v_ret * dt), si)
+            for j in range(repeats):
+                def fresh_retract(leg_dir: Path, _total=approach.total_steps) -> list[str]:
+                    return _restart_head(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
+                stages = [Stage("retract", n_ret, (vz(v_ret),))]
+                if repeats > 1:     # independent pulls: fresh velocities, then hold_steps more in contact
+                    stages = _stages(Stage("rehold", _steps(s, "hold_steps"), (
+                        f"velocity mobile create {t:g} {_seed(seed, 7, k, j)} mom yes rot no dist gaussian",
+                        vz(0.0)), sampled=False)) + stages
+                legs.append(Leg(name=f"retract_{k}" + (f"_{j}" if j else ""), fresh=fresh_retract,
+                                define=define(100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
+                                restart_head=_restart_head(s), stages=stages, columns=columns, sample_interval=si,
+                                chunk_steps=s["chunk_steps"], n_atoms=n,
+                                info={"speed_m_s": v, "v_A_fs": v_ret, "repeat": j}))
+        info.update(n_flat=int(len(groups["flat"])), n_tip=int(len(groups["tip"])),
+                    tip_mobile_mass_g_mol=float(system.masses[tip_mobile].sum()), tip_thermostat=s["tip_thermostat"])
+        return Plan(legs=legs, timestep_fs=dt, n_atoms=n,
+                    seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": _seed(seed, 3, 1),
+                           "thermostat_base": seed, **({"sam_asperity": seed + 30} if s["surface"] == "ots" else {})},
+                    forcefield_files=self.forcefield_files(s), system_info=info)
+
+    def analyse(self, ctx):
+        s = ctx.settings
+        info = ctx.plan.system_info
+        R_m = U.angstrom_to_m(s["asperity_radius_A"])
+        ids, _, pos = read_atoms(ctx.leg_dir("approach") / "minimized.data")
+        n_flat = info["n_flat"]
+        # ids 1..n_flat are the flat (place_on puts the substrate first)
+        flat_top = pos[:n_flat, 2].max()
+        tip_bottom = pos[n_flat:, 2].min()
+        s0 = tip_bottom - flat_top
+        app = ctx.samples("approach", False)
+        # the holder's height at the minimised start: it does not move before the approach stage, so the first
+        # sample of the equilibration has it exactly
+        zh0 = float(app["z_holder"][0])
+        sep = lambda d: s0 + (d["z_holder"] - zh0)
+        dt = ctx.plan.timestep_fs
+        curves, figures, pulls = {}, {}, []
+        retracts = [l for l in ctx.plan.legs if l.name.startswith("retract_")]
+        smooth = None
+        for l in retracts:
+            d = ctx.samples(l)
+            n = len(d["step"])
+            smooth = max(5, (n // 25) | 1) if n >= 15 else None
+            r = A.pull_off_analysis(sep(d), d["fz"], smooth=smooth, radius_m=R_m)
+            r["local_noise"] = _local_noise(r, smooth)
+            r["drag"] = _residual_drag(d, dt)
+            pulls.append((l.info["speed_m_s"], l.info.get("repeat", 0), l.name, r))
+            curves[f"pulloff_curve_{l.name}"] = (
+                ["separation_m", "force_N", "force_smoothed_N"],
+                np.column_stack([r["curve"]["separation"], r["curve"]["force"], r["curve"]["force_smoothed"]]))
+        d_app = ctx.samples("approach", False)
+        curves["approach_curve"] = (["step", "stage", "separation_m", "force_N"],
+                                    np.column_stack([d_app["step"], d_app["stage"], U.angstrom_to_m(sep(d_app)),
+                                                     U.kcal_per_mol_A_to_N(d_app["fz"])]))
+        speeds = sorted({v for v, *_ in pulls})
+        per_speed = []
+        for v in speeds:
+            rs = [r for vv, _, _, r in pulls if vv == v]
+            fs = np.array([r["max_tensile_force"] for r in rs])
+            if len(rs) >= 2:
+                f_err, how = float(fs.std(ddof=1) / math.sqrt(len(rs))), f"spread of {len(rs)} pulls"
+            else:
+                f_err, how = rs[0]["local_noise"], "force noise of one curve near its maximum"
+            per_speed.append({"speed_m_s": float(v), "force": float(fs.mean()), "stderr": f_err, "how": how,
+                              "forces": fs.tolist(), "results": rs})
+        slow = per_speed[0]
+        best = slow["results"][0]
+        F, f_err = slow["force"], slow["stderr"]
+        z0q = _z0_quantity(best) if len(slow["results"]) == 1 else _z0_mean([r for r in slow["results"]])
+        drag = np.array([r["drag"]["value"] for r in slow["results"]])
+        drag_err = np.array([r["drag"]["stderr"] for r in slow["results"]])
+        v_slow = U.m_per_s_to_angstrom_per_fs(slow["speed_m_s"])
+        gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(info["tip_mobile_mass_g_mol"] * v_slow /
+                                                           s["thermostat_damping_fs"])
+        err = lambda x: x / (2 * math.pi * R_m) if x else None
+        q = {"pull_off_force": _q(F, f_err, "N", speed_m_s=slow["speed_m_s"], repeats=len(slow["results"]),
+                                  kind=f"maximum tensile force on retraction (mean of {len(slow['results'])}; "
+                                       f"stderr: {slow['how']})"),
+             "separation_at_max_tension": _q(best["separation_at_max"], None, "m"),
+             "interaction_range_z0": z0q,
+             "work_of_adhesion_eff_jkr": _q(F / (1.5 * math.pi * R_m), f_err / (1.5 * math.pi * R_m) if f_err else None,
+                                            "J/m^2", kind="F / (1.5 pi R)"),
+             "work_of_adhesion_eff_dmt": _q(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
+                                            kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit; at MD "
+                                                 "scale the contact is DMT-like, Tabor mu ~ 0.06)"),
+             "residual_drag_force": _q(float(U.kcal_per_mol_A_to_N(drag.mean())),
+                                       float(U.kcal_per_mol_A_to_N(math.sqrt(np.sum(drag_err ** 2)) / len(drag))),
+                                       "N", kind="mean thermostat force on the moving asperity along the pulling "
+                                                 "axis on retraction (holder reaction - interaction + momentum change)",
+                                       lab_frame_drag_N=float(U.kcal_per_mol_A_to_N(-gamma_lab)))}
+        notes = [f"separation = gap between the lowest asperity atom and the highest flat atom at the minimised "
+                 f"start ({s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
+                 f"flat's deformation); force = compute group/group (asperity body vs flat, kspace yes), "
+                 f"positive = repulsive.",
+                 f"pull-off force: mean of {len(slow['results'])} retraction(s) at {slow['speed_m_s']:g} m/s; "
+                 f"stderr: {slow['how']}.",
+                 f"thermostat on the asperity: '{s['tip_thermostat']}'"
+                 + {"comoving": " (its thermal motion only: compute temp/com bias, so no drag on its motion; the flat "
+                                "has its own thermostat)",
+                    "none": " (the asperity runs NVE; only the flat is thermostatted)",
+                    "lab": " (lab frame, every mobile atom: the old protocol; it drags the moving asperity)"}[
+                     s["tip_thermostat"]]
+                 + f"; residual drag measured {q['residual_drag_force']['value'] * 1e9:+.3f} nN against "
+                   f"{-gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
+                   f"(gamma M v) would apply.",
+                 f"validation, not calibration: at MD scale (R = {s['asperity_radius_A']:g} A) the contact is "
+                 f"DMT-like (Tabor mu ~ 0.06), so F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the number "
+                 f"to compare with the flat-slab work of adhesion W_F (the calibration report does).",
+                 f"R = {s['asperity_radius_A']:g} A (the requested radius of the carved, faceted dome)."]
+        if s["surface"] == "ots":
+            g = info.get("asperity_sam", {})
+            notes.append(f"OTS chains on the asperity: {g.get('chains')} on dome silanols within "
+                         f"graft_max_polar_deg of the apex ({g.get('chains_per_projected_nm2', float('nan')):.2f} per "
+                         f"nm^2 of projected cap, lateral spacing >= {g.get('min_spacing_A', float('nan')):.2f} A); "
+                         "they point along the pulling axis, not along the local normal (the builder grafts along "
+                         "one axis); the chain-end surface is the dome translated by the chain vector, so its "
+                         "curvature radius is still R.")
+        details = {"per_speed": [{"speed_m_s": p["speed_m_s"], "max_tensile_force_N": p["force"],
+                                  "stderr_N": p["stderr"], "forces_N": p["forces"]} for p in per_speed],
+                   "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j,
+                              "max_tensile_force_N": r["max_tensile_force"],
+                              "separation_at_max_m": r["separation_at_max"], "z0_m": r["z0"],
+                              "z0_stderr_m": r["z0_stderr"], "z0_zero_to_min_m": r["z0_zero_to_min"],
+                              "zero_force_separation_m": r["zero_force_separation"],
+                              "local_noise_N": r["local_noise"],
+                              "residual_drag_N": float(U.kcal_per_mol_A_to_N(r["drag"]["value"])),
+                              "residual_drag_stderr_N": float(U.kcal_per_mol_A_to_N(r["drag"]["stderr"])),
+                              "traction_fit": {k: v for k, v in r["traction_fit"].items()
+                                               if isinstance(v, (int, float, str, dict))}}
+                             for v, j, name, r in pulls],
+                   "s0_A": float(s0), "holder_z0_A": zh0, "smoothing_window": smooth,
+                   "lab_frame_drag_estimate_N": float(U.kcal_per_mol_A_to_N(-gamma_lab)),
+                   "tip_mobile_mass_g_mol": info["tip_mobile_mass_g_mol"]}
+        if len(speeds) >= 2:
+            ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in per_speed]),
+                                       target_rate=float(min(speeds)) / 10.0, temperature_K=s["temperature_K"])
+            q["pull_off_force_extrapolated"] = _q(ext["F0"], ext["stderr"], "N",
+                                                  kind=f"F = a + b ln(v) fitted to {len(speeds)} speeds, "
+                                                       f"evaluated at {ext['target_rate']:g} m/s")
+            details["rate_extrapolation"] = ext
+            notes.append("rate scan: F = a + b ln(v) (Bell-Evans) extrapolated one decade below the slowest "
+                         "simulated speed; valid only while the Bell-Evans regime holds.")
+
+        def draw(ax):
+            for (v, j, name, r) in pulls:
+                c = r["curve"]
+                ax.plot(c["separation"] * 1e9, c["force"] * 1e9, lw=0.5, alpha=0.5)
+                ax.plot(c["separation"] * 1e9, c["force_smoothed"] * 1e9, lw=1.5, label=f"{name} {v:g} m/s")
+            ax.plot(U.angstrom_to_m(sep(d_app)) * 1e9, U.kcal_per_mol_A_to_N(d_app["fz"]) * 1e9, lw=0.5,
+                    color="grey", label="approach/hold")
+            ax.axhline(0, color="k", lw=0.5)
+            ax.set_xlabel("separation (nm)")
+            ax.set_ylabel("force on asperity (nN)")
+            ax.set_title(f"pull-off {F * 1e9:.3f} nN, R = {s['asperity_radius_A']:g} Å")
+            ax.legend(fontsize=7)
+        figures["pulloff_curve"] = _figure(draw)
+        return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
+
+
+def _thermostat_fix(name: str, group: str, settings: Mapping[str, Any], step: int, salt: int) -> list[str]:
+    """A named thermostat fix on ``group`` (Langevin + nve, or Nose-Hoover nvt)."""
+    t = settings["temperature_K"]
+    damp = settings["thermostat_damping_fs"]
+    if settings["thermostat"] == "nose-hoover":
+        return [f"fix {name} {group} nvt temp {t:g} {t:g} {damp:g}"]
+    return [f"fix {name} {group} langevin {t:g} {t:g} {damp:g} {_seed(settings['seed'], 17, salt, step)} zero yes",
+            f"fix {name}_nve {group} nve"]
+
+
+def _pulloff_thermostat(s: Mapping[str, Any], step: int, salt: int) -> list[str]:
+    """The pull-off thermostats (recipe ``tip_thermostat``): the flat's mobile atoms always; the asperity's mobile
+    atoms in its own frame ('comoving': a temp/com bias, so drag and noise act on the thermal velocities only and
+    sum to zero over the asperity), not at all ('none': NVE), or -- the version-1 protocol -- together with the
+    flat in the lab frame ('lab')."""
+    mode = s["tip_thermostat"]
+    if mode == "lab":
+        return _thermostat("mobile", s, step, salt)
+    cmds = _thermostat_fix("thermo_flat", "flat_mobile", s, step, 2 * salt)
+    if mode == "comoving":
+        cmds += ["compute tip_com tip_mobile temp/com"] + \
+            _thermostat_fix("thermo_tip", "tip_mobile", s, step, 2 * salt + 1) + ["fix_modify thermo_tip temp tip_com"]
+    else:
+        cmds += ["fix integrate_tip tip_mobile nve"]
+    return cmds
+
+
+def _local_noise(r: Mapping[str, Any], smooth: int | None) -> float | None:
+    """Force noise of one retraction curve near its maximum: std of raw minus smoothed force within two smoothing
+    windows of the maximum (under compression the force, and its noise, is many times larger)."""
+    if not smooth:
+        return None
+    c = r["curve"]
+    resid = c["force"] - c["force_smoothed"]
+    i_max = int(np.argmin(np.abs(c["separation"] - r["separation_at_max"])))
+    lo, hi = max(0, i_max - 2 * smooth), min(len(resid), i_max + 2 * smooth + 1)
+    return float(np.std(resid[lo:hi]))
+
+
+def _residual_drag(d: Mapping[str, np.ndarray], dt_fs: float, block: int = 10) -> dict[str, float]:
+    """Mean thermostat force on the moving asperity's mobile atoms along z over a retraction (kcal/mol/A).
+
+    Newton for the asperity: dP/dt = F_thermostat + F_flat->asperity + F_holder->asperity, and the holder's
+    setforce reports f_holder = F_asperity->holder + F_flat->holder; with F_gg = compute group/group of the whole
+    upper body (asperity + holder) against the flat, F_thermostat = dP/dt + f_holder - F_gg. Per block of
+    ``block`` samples: the time average of f_holder - F_gg (trapezoid) plus the block's momentum change over its
+    duration -- the momentum term cancels the asperity's vibrations, which would otherwise swamp the mean. The value
+    is the mean over blocks (= the whole leg's), the stderr from the blocks' statistical inefficiency."""
+    x = np.asarray(d["f_holder"], float) - np.asarray(d["fz"], float)
+    t = np.asarray(d["step"], float) * dt_fs
+    p = np.asarray(d["p_tip"], float)
+    if x.size < 3:
+        return {"value": float("nan"), "stderr": float("nan")}
+    edges = np.arange(0, x.size, block)
+    if edges[-1] != x.size - 1:
+        edges = np.append(edges, x.size - 1)
+    vals, w = [], []
+    for i0, i1 in zip(edges[:-1], edges[1:]):
+        span = t[i1] - t[i0]
+        if span <= 0:
+            continue
+        integral = float(np.sum(0.5 * np.diff(t[i0:i1 + 1]) * (x[i0 + 1:i1 + 1] + x[i0:i1])))
+        vals.append((integral + float(U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(p[i1] - p[i0]))) / span)
+        w.append(span)
+    vals, w = np.array(vals), np.array(w)
+    st = A.timeseries_stats(vals, equilibrate=False)
+    return {"value": float(np.sum(vals * w) / np.sum(w)), "stderr": st["stderr"], "blocks": int(vals.size)}
+
+
+def _z0_quantity(r: Mapping[str, Any]) -> dict[str, Any]:
+    """z0 of the fitted LJ 9-3 traction law, stderr from the fit's covariance; if the fit fails, from the
+    zero-to-minimum distance of the curve (for the 9-3 law that distance is (3^(1/6) - 1) z0), without a stderr.
+    A pull-off z0 is a validation number: it is fitted against the rigid holder's travel, so it absorbs the
+    asperity's compliance; the calibration takes z0 from the flat-slab force curve of the adhesion workflow."""
+    if r["z0"] is not None and np.isfinite(r["z0"]):
+        e = r.get("z0_stderr")
+        return _q(r["z0"], e if e is not None and np.isfinite(e) else None, "m",
+                  kind="z0 of the LJ 9-3 traction law fitted to the retraction curve (stderr from the fit's "
+                       "covariance; includes the asperity's compliance)")
+    zm = r["z0_zero_to_min"]
+    return _q(zm / (3 ** (1 / 6) - 1) if np.isfinite(zm) else float("nan"), None, "m",
+              kind="z0 = (zero-to-minimum distance) / (3^(1/6) - 1) (the 9-3 law fit failed: "
+                   f"{r['traction_fit'].get('error', '?')})")
+
+
+def _z0_mean(rs: list[Mapping[str, Any]]) -> dict[str, Any]:
+    """z0 over repeated pulls: the mean of the fitted z0, stderr max(spread / sqrt(n), fit stderrs / n)."""
+    z = np.array([r["z0"] for r in rs if r["z0"] is not None and np.isfinite(r["z0"])])
+    if not z.size:
+        return _z0_quantity(rs[0])
+    e = np.array([r.get("z0_stderr") or 0.0 for r in rs if r["z0"] is not None and np.isfinite(r["z0"])])
+    e = np.where(np.isfinite(e), e, 0.0)
+    avg = A.registry_average(z, e) if z.size >= 2 else {"mean": float(z[0]), "stderr": float(e[0]) or None}
+    return _q(avg["mean"], avg["stderr"], "m", kind=f"mean z0 of the LJ 9-3 law fitted to {z.size} retraction "
+                                                    f"curves (includes the asperity's compliance)")
+
+
+#: lateral spacing of grafted chains on the asperity: tried in this order until the cap holds the target coverage
+#: (a crystalline dome's silanols pair up at 4.3-4.4 A in projection; polyethylene's nearest chains are 4.46 A
+#: apart, TraPPE CH2 sigma 3.95 A); the builder's default for flat SAMs is 4.4 A
+GRAFT_SPACINGS_A = (4.4, 4.35, 4.3)
+#: the dome's chains stand along the pulling axis (the flat SAM's builder default is 15 deg off it)
+DOME_CHAIN_TILT_DEG = 0.0
+
+
+def _independent_sites(xy: np.ndarray, cell_xy, spacing: float, order: np.ndarray, exact_max: int = 60,
+                       restarts: int = 200, seed: int = 0) -> list[int]:
+    """A largest set of sites (indices into ``xy``) no two closer than ``spacing`` laterally (periodic): exact
+    branch and bound up to ``exact_max`` sites, else the best of ``restarts`` randomised min-degree greedy passes.
+    Ties prefer sites early in ``order`` (nearest the apex)."""
+    n = len(xy)
+    d = xy[:, None, :] - xy[None, :, :]
+    d -= np.asarray(cell_xy)[None, None, :] * np.round(d / np.asarray(cell_xy)[None, None, :])
+    close = (np.hypot(d[..., 0], d[..., 1]) < spacing) & ~np.eye(n, dtype=bool)
+    adj = [set(np.flatnonzero(close[i]).tolist()) for i in range(n)]
+    rank = {int(i): r for r, i in enumerate(order)}
+    if n <= exact_max:
+        best: list[list[int]] = [[]]
+
+        def rec(cand: set, chosen: list):
+            if len(chosen) + len(cand) <= len(best[0]):
+                return
+            if not cand:
+                best[0] = list(chosen)
+                return
+            v = max(cand, key=lambda u: (len(adj[u] & cand), -rank[u]))
+            if not adj[v] & cand:
+                rec(cand - {v}, chosen + [v])
+                return
+            rec(cand - adj[v] - {v}, chosen + [v])
+            rec(cand - {v}, chosen)
+        rec(set(range(n)), [])
+        return sorted(best[0], key=lambda i: rank[i])
+    rng = np.random.default_rng(seed)
+    best_set: list[int] = []
+    for it in range(restarts):
+        cand = set(range(n))
+        chosen = []
+        noise = rng.random(n) if it else np.zeros(n)
+        while cand:
+            v = min(cand, key=lambda u: (len(adj[u] & cand) + noise[u], rank[u]))
+            chosen.append(v)
+            cand -= adj[v] | {v}
+        if len(chosen) > len(best_set):
+            best_set = chosen
+    return sorted(best_set, key=lambda i: rank[i])
+
+
+def _chain_clearance(asp: System, sites: np.ndarray, chain_length: int, tilt_deg: float = 0.0,
+                     clearance_A: float = 2.6) -> np.ndarray:
+    """True for the sites whose chain -- straight, ``tilt_deg`` from +z towards +x, as :func:`md.builders.ots_sam`
+    grafts it -- keeps ``clearance_A`` from every heavy atom of the asperity from 4 A above the anchor O to the
+    chain's end. Near the rim of a stepped dome a chain along the pulling axis can run into the dome above its site
+    (an 80 deg cap at smoke without this check: an overlap the minimiser cannot undo)."""
+    from scipy.spatial import cKDTree
+
+    t = math.radians(tilt_deg)
+    axis = np.array([math.sin(t), 0.0, math.cos(t)])
+    heavy = np.flatnonzero(~np.isin(asp.types, ["HOY"]))
+    tree = cKDTree(asp.positions[heavy])
+    length = 1.54 * math.cos(math.radians(33.0)) * (chain_length + 1)     # all-trans axial length, A
+    ts = np.arange(4.0, length + 0.5, 0.7)
+    ok = np.ones(len(sites), bool)
+    for k, site in enumerate(sites):
+        pts = asp.positions[site] + ts[:, None] * axis[None, :]
+        hits = tree.query_ball_point(pts, clearance_A)
+        ok[k] = not any(heavy[h] != site for hs in hits for h in hs)
+    return ok
+
+
+def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, dict[str, Any]]:
+    """OTS chains on the dome silanols within ``graft_max_polar_deg`` of the apex (asperity tip up), at the SAM's
+    coverage ``sam_coverage`` per nm^2 of the cap's projected area (the chains point along the pulling axis, so
+    their lateral packing is what counts): the sites are a largest set no two closer than the spacing laterally
+    (:data:`GRAFT_SPACINGS_A`, tried in order until one holds the target), the ones nearest the apex kept.
+    Version 1 drew sites in random order at 4.4 A and reached 2.65 chains/nm^2 on the quick R = 1.2 nm dome."""
+    R = float(s["asperity_radius_A"])
+    centre = np.array(asp.info["centre_A"])
+    dome = np.asarray(asp.group("silanol_O_dome"), int)
+    p = asp.positions[dome] - centre
+    cosang = p[:, 2] / np.maximum(np.linalg.norm(p, axis=1), 1e-9)
+    keep = cosang >= math.cos(math.radians(s["graft_max_polar_deg"]))
+    sites, cos_k = dome[keep], cosang[keep]
+    clear = _chain_clearance(asp, sites, s["chain_length"], DOME_CHAIN_TILT_DEG)
+    n_blocked = int((~clear).sum())
+    sites, cos_k = sites[clear], cos_k[clear]
+    if not len(sites):
+        raise ValueError("no dome silanols within graft_max_polar_deg of the apex: nothing to graft on")
+    cap = math.pi * (R * math.sin(math.radians(s["graft_max_polar_deg"]))) ** 2      # projected area, A^2
+    cell_area = float(asp.cell[0] * asp.cell[1])
+    n_target = max(1, int(round(s["sam_coverage"] * cap / 100.0)))
+    order = np.argsort(-cos_k, kind="stable")               # apex first
+    xy = asp.positions[sites, :2]
+    chosen, spacing = [], GRAFT_SPACINGS_A[0]
+    for spacing in GRAFT_SPACINGS_A:
+        chosen = _independent_sites(xy, asp.cell[:2], spacing, order, seed=seed)
+        if len(chosen) >= n_target:
+            break
+    chosen = chosen[:n_target]
+    last = None
+    for n in range(len(chosen), 0, -1):
+        grp = sites[np.array(chosen[:n], int)]
+        try:
+            sam = ots_sam(with_groups(asp, graft_sites=grp), coverage=(n + 0.49) / (cell_area / 100.0),
+                          chain_length=s["chain_length"], seed=seed, site_group="graft_sites",
+                          min_spacing=spacing - 1e-6, tilt_deg=DOME_CHAIN_TILT_DEG)
+            break
+        except ValueError as exc:
+            last = exc
+    else:
+        raise ValueError(f"no OTS chain fits on the dome: {last}")
+    chains = int(sam.info["chains"])
+    return sam, {"chains": chains, "requested_chains": n_target, "cap_projected_area_nm2": cap / 100.0,
+                 "chains_per_projected_nm2": chains / (cap / 100.0), "sites": int(len(sites)),
+                 "sites_blocked_by_the_dome": n_blocked, "min_spacing_A": float(spacing)}
