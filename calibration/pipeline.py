@@ -35,8 +35,11 @@ from nanoimpact.executors import Failure, executor
 
 from .mdset import build_parameter_set, committed_result, recipes_needed, write_parameter_set
 
+from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
 from nanoimpact.errors import InputError
+from nanoimpact.fields import REQUIRED, Field
+from nanoimpact.fields import json_schema as json_schema_of
 
 log = logging.getLogger(__name__)
 
@@ -59,11 +62,47 @@ def _short(value) -> object:
     return "{...}" if isinstance(value, dict) else value
 
 
-def _integer(unc: dict, key: str, default: int, low: int, high: int, origin: str) -> int:
-    value = unc.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-        raise CalibrationError(f"uncertainty.{key}", _short(value), f"must be an integer in {low}..{high}", origin)
-    return value
+#: The calibration recipe's keys (ranges and overrides are tables of scene keys, checked with the scene's fields).
+FIELDS = (
+    Field("name", str, "", "Name of the calibrated set: letters, digits, '_' and '-' (it names "
+          "params/<name>.toml).", REQUIRED),
+    Field("base", str, "", "Parameter set (name or file) the MD values go into; every value MD does not measure "
+          "comes from it.", REQUIRED),
+    Field("description", str, "", "Free text written into the set.", ""),
+    Field("compare_sets", list, "", "Parameter sets (names or files) whose paper cases run beside the base and the "
+          "new set; may be empty.", list(DEFAULT_COMPARE_SETS), item=str, empty_ok=True),
+    Field("uncertainty.samples", int, "", "Latin-hypercube samples.", 16, low=2, high=10000),
+    Field("uncertainty.seed", int, "", "Seed of the sampling.", 0, low=0, high=2**63 - 1),
+    Field("uncertainty.scene", str, "", "Scene each sample reruns (name or file).", DEFAULT_UNCERTAINTY_SCENE),
+    Field("uncertainty.max_bounces", int, "", "Impacts per sample.", 6, low=1,
+          high=int(SCENE_FIELDS["numerics.max_bounces"].high)),
+)
+FIELD_BY_KEY = {f.key: f for f in FIELDS}
+
+
+def _get(table: dict, key: str, origin: str):
+    """The recipe's value of `key` (its default when absent), checked by its field."""
+    f = FIELD_BY_KEY[key]
+    value = table.get(key.rsplit(".", 1)[-1], f.default)
+    if value is REQUIRED:
+        raise CalibrationError(key, None, f"is required: {f.doc}", origin)
+    return f.check(value, origin, error=CalibrationError)
+
+
+def json_schema() -> dict:
+    """JSON Schema of a calibration recipe (inputs/calibration/*.toml)."""
+    doc = json_schema_of(((f.key, f) for f in FIELDS), title="nanoimpact calibration recipe",
+                         description="A calibration recipe: MD results -> parameter set -> the paper's cases, "
+                                     "with uncertainty bands. See docs/calibration.md.")
+    unc = doc["properties"]["uncertainty"]
+    unc["properties"]["ranges"] = {
+        "type": "object", "description": "{\"dotted.scene.key\" = [low, high]}: user ranges (uniform) of real-valued "
+                                         "scene keys", "additionalProperties": {"type": "array", "minItems": 2,
+                                                                               "maxItems": 2,
+                                                                               "items": {"type": "number"}}}
+    unc["properties"]["overrides"] = {"type": "object", "description": "{\"dotted.scene.key\" = value}: scene "
+                                      "overrides for every sample (scene keys and values, docs/scenes.md)"}
+    return doc
 
 
 def _dotted(table, key: str, origin: str, prefix: str = "") -> dict:
@@ -122,22 +161,19 @@ def load_calibration(spec: str | Path) -> dict:
                                    origin)
     name, base, description = raw.get("name"), raw.get("base"), raw.get("description", "")
     if not isinstance(name, str) or not _SET_NAME.fullmatch(name):
-        raise CalibrationError("name", _short(name), "is required: the set's name, letters, digits, '_' and '-' "
-                               "(it names params/<name>.toml)", origin)
+        raise CalibrationError("name", _short(name), f"is required: {FIELD_BY_KEY['name'].doc}", origin)
     if not isinstance(base, str) or not base:
         raise CalibrationError("base", _short(base), "must be given: a parameter set name or file", origin)
-    if not isinstance(description, str):
-        raise CalibrationError("description", _short(description), "must be a string", origin)
+    _get(raw, "description", origin)
     try:
         base_file = _locate(find_params, base, path)
         read_toml(base_file, "params")
     except SceneError as exc:
         raise CalibrationError("base", base, exc.allowed if exc.key == "params" else str(exc), origin) from None
 
-    compare = raw.get("compare_sets", list(DEFAULT_COMPARE_SETS))
-    if not (isinstance(compare, list) and all(isinstance(c, str) and c for c in compare)):
-        raise CalibrationError("compare_sets", _short(compare), "must be a list of parameter set names or files "
-                               "(may be empty)", origin)
+    compare = _get(raw, "compare_sets", origin)
+    if not all(compare):
+        raise CalibrationError("compare_sets", compare, "set names or files cannot be empty", origin)
     compare_files = []
     for c in compare:
         try:
@@ -155,9 +191,9 @@ def load_calibration(spec: str | Path) -> dict:
         if key not in UNCERTAINTY_KEYS:
             raise CalibrationError(f"uncertainty.{key}", _short(value),
                                    f"unknown key; keys allowed here: {', '.join(UNCERTAINTY_KEYS)}", origin)
-    samples = _integer(unc, "samples", 16, 2, 10000, origin)
-    seed = _integer(unc, "seed", 0, 0, 2**63 - 1, origin)
-    max_bounces = _integer(unc, "max_bounces", 6, 1, int(FIELD_BY_PATH["numerics.max_bounces"].high), origin)
+    samples = _get(unc, "uncertainty.samples", origin)
+    seed = _get(unc, "uncertainty.seed", origin)
+    max_bounces = _get(unc, "uncertainty.max_bounces", origin)
     scene_spec = unc.get("scene", DEFAULT_UNCERTAINTY_SCENE)
     if not isinstance(scene_spec, str) or not scene_spec:
         raise CalibrationError("uncertainty.scene", _short(scene_spec), "must be a scene name or file", origin)

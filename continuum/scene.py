@@ -281,28 +281,9 @@ def find_scene(spec: str | Path) -> Path:
 
 # ----------------------------------------------------------------------------- validation
 def check_value(f: Field, value, origin: str):
-    """Type and range check of one value in file units; returns it (ints widened to float)."""
-    if f.kind is str:
-        if not isinstance(value, str):
-            raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
-        if f.choices and value not in f.choices:
-            raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
-        return value
-    if f.kind is bool:
-        if not isinstance(value, bool):
-            raise SceneError(f.path, value, "must be true or false", origin)
-        return value
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
-    if f.kind is int and not isinstance(value, int):
-        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
-    if not math.isfinite(value):
-        raise SceneError(f.path, value, f"must be finite: {f.allowed()}", origin)
-    if f.low is not None and (value < f.low or (f.low_open and value == f.low)):
-        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
-    if f.high is not None and (value > f.high or (f.high_open and value == f.high)):
-        raise SceneError(f.path, value, f"must be {f.allowed()}", origin)
-    return float(value) if f.kind is float else value
+    """Type and range check of one value in file units; returns it (ints widened to float). The check is the
+    field's own (nanoimpact.fields.Field.check), raising SceneError."""
+    return f.check(value, origin, error=SceneError)
 
 
 def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = None,

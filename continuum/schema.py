@@ -10,45 +10,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-REQUIRED = object()
+from nanoimpact import fields
+from nanoimpact.fields import REQUIRED
 
 
 @dataclass(frozen=True)
-class Field:
-    """One scene key.
+class Field(fields.Field):
+    """One scene key (`nanoimpact.fields.Field`: type, unit, range, default, doc, the check and the JSON
+    Schema), plus `degrees`: an angle written in degrees in the file and stored in radians."""
 
-    `path` is the dotted key ("body.radius"); `kind` is float, int, str or bool; `low`/`high`
-    bound numbers (`low_open`/`high_open` make the bound strict); `choices` lists allowed
-    strings; `degrees` marks angles written in degrees and stored in radians.
-    """
-
-    path: str
-    kind: type
-    unit: str
-    doc: str
-    default: object = REQUIRED
-    low: float | None = None
-    high: float | None = None
-    low_open: bool = False
-    high_open: bool = False
-    choices: tuple[str, ...] = ()
     degrees: bool = False
 
-    def allowed(self) -> str:
-        """Human-readable statement of what the field accepts."""
-        if self.kind is str:
-            return "one of " + ", ".join(repr(c) for c in self.choices) if self.choices else "a string"
-        if self.kind is bool:
-            return "true or false"
-        name = "an integer" if self.kind is int else "a number"
-        parts = []
-        if self.low is not None:
-            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
-        if self.high is not None:
-            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
-        rng = " and ".join(parts)
-        unit = f" {self.unit}" if self.unit and self.unit != "1" else ""
-        return f"{name} {rng}{unit}".rstrip() if rng else f"{name}{unit}"
+    @property
+    def path(self) -> str:
+        """The dotted key ("body.radius")."""
+        return self.key
 
 
 _LEN = dict(kind=float, unit="m")
@@ -215,17 +191,19 @@ def to_internal(f: Field, value):
 
 def schema_markdown() -> str:
     """The schema as a markdown table, for docs/scenes.md (generated, so it cannot drift)."""
-    lines = ["| key | type | unit | allowed | default | meaning |", "|---|---|---|---|---|---|"]
-    for f in FIELDS:
-        if f.default is REQUIRED:
-            default = "required"
-        elif f.default is None:
-            default = "not set"
-        else:
-            default = f"`{f.default!r}`"
-        lines.append(f"| `{f.path}` | {f.kind.__name__} | {f.unit or ''} | {f.allowed()} | {default} | {f.doc} |")
-    return "\n".join(lines)
+    return fields.markdown_table(FIELDS, [("key", lambda f: f"`{f.path}`"), ("type", lambda f: f.kind.__name__),
+                                          ("unit", lambda f: f.unit or ""), ("allowed", Field.allowed),
+                                          ("default", Field.default_text), ("meaning", lambda f: f.doc)])
 
+
+def json_schema() -> dict:
+    """JSON Schema of a scene file (and of a parameter set, whose keys are scene keys; `[meta]` is free)."""
+    doc = fields.json_schema(((f.path, f) for f in FIELDS), title="nanoimpact scene", required=False,
+                             description="A scene file or parameter set (TOML, SI units; angles in degrees). "
+                                         "Required keys may come from the scene's parameter set, so none is "
+                                         "required here; the loader checks the merged scene. See docs/scenes.md.")
+    doc["properties"]["meta"] = {"type": "object", "description": "Parameter sets: sources and provenance."}
+    return doc
 
 
 if __name__ == "__main__":  # python -m continuum.schema  -> prints the table for docs/scenes.md

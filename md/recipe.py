@@ -18,17 +18,18 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
 
 from nanoimpact import data as shipped_data
+from nanoimpact import fields
+from nanoimpact.fields import REQUIRED
 from nanoimpact.errors import InputError
 
-__all__ = ["RecipeError", "Recipe", "Field", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES", "load_recipe",
+__all__ = ["RecipeError", "Recipe", "Field", "RecipeField", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES", "load_recipe",
            "parse_recipe", "schema_markdown", "RECIPE_DIR"]
 
 #: The shipped MD recipes (inputs/md, installed as package data); names are looked up in the user data
@@ -38,7 +39,6 @@ WORKFLOWS = ("adhesion", "pulloff", "contact_angle", "surface_tension")
 FIDELITIES = ("smoke", "quick", "production")
 SURFACES = ("silica", "ots")
 THERMOSTATS = ("nose-hoover", "langevin")
-REQUIRED = object()
 ALL = WORKFLOWS
 
 
@@ -47,45 +47,23 @@ class RecipeError(InputError):
 
 
 @dataclass(frozen=True)
-class Field:
-    """One recipe key.
+class RecipeField(fields.Field):
+    """One recipe key (`nanoimpact.fields.Field`: type, unit, range, default, doc, the check and the JSON
+    Schema), plus where it may be written and for which workflows.
 
     ``section``: 'top', 'system', 'fidelity' or 'both' (system value, overridable per fidelity).
-    ``kind``: float, int, str, bool, or list (then ``item`` is the element kind and ``length`` the allowed
-    lengths, if restricted). ``workflows``: the workflows the key belongs to.
+    ``workflows``: the workflows the key belongs to.
     """
-    key: str
-    section: str
-    kind: type
-    unit: str
-    doc: str
-    default: Any = REQUIRED
-    low: float | None = None
-    high: float | None = None
-    low_open: bool = False
-    choices: tuple[str, ...] = ()
+    section: str = "top"
     workflows: tuple[str, ...] = ALL
-    item: type | None = None
-    length: tuple[int, ...] = ()
 
-    def allowed(self) -> str:
-        if self.kind is list:
-            inner = Field(self.key, self.section, self.item or float, self.unit, "", low=self.low, high=self.high,
-                          low_open=self.low_open, choices=self.choices).allowed()
-            n = " or ".join(str(k) for k in self.length) if self.length else "one or more"
-            return f"a list of {n} items, each {inner}"
-        if self.kind is str:
-            return "one of " + ", ".join(repr(c) for c in self.choices) if self.choices else "a string"
-        if self.kind is bool:
-            return "true or false"
-        name = "an integer" if self.kind is int else "a number"
-        parts = []
-        if self.low is not None:
-            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
-        if self.high is not None:
-            parts.append(f"<= {self.high:g}")
-        unit = f" {self.unit}" if self.unit and self.unit != "1" else ""
-        return (f"{name} " + " and ".join(parts) + unit) if parts else f"{name}{unit}"
+
+def Field(key: str, section: str, kind: type, unit: str, doc: str, default: Any = REQUIRED, low: float | None = None,
+          high: float | None = None, low_open: bool = False, choices: tuple[str, ...] = (),
+          workflows: tuple[str, ...] = ALL, item: type | None = None, length: tuple[int, ...] = ()) -> RecipeField:
+    """A recipe key, declared as the table below reads: key, section, kind, unit, doc, default, then the range."""
+    return RecipeField(key, kind, unit, doc, default, low=low, high=high, low_open=low_open, choices=choices,
+                       item=item, length=length, section=section, workflows=workflows)
 
 
 _ADH, _PULL, _CA, _ST = ("adhesion",), ("pulloff",), ("contact_angle",), ("surface_tension",)
@@ -240,8 +218,8 @@ FIELDS: tuple[Field, ...] = (
 )
 
 
-def _fields(section: str, workflow: str) -> dict[str, Field]:
-    out: dict[str, Field] = {}
+def _fields(section: str, workflow: str) -> dict[str, RecipeField]:
+    out: dict[str, RecipeField] = {}
     for f in FIELDS:
         if workflow not in f.workflows:
             continue
@@ -250,35 +228,12 @@ def _fields(section: str, workflow: str) -> dict[str, Field]:
     if section == "fidelity":     # 'both' keys may be overridden per fidelity (their fidelity Field if any)
         for f in FIELDS:
             if f.section == "both" and workflow in f.workflows:
-                out.setdefault(f.key, Field(f.key, "fidelity", f.kind, f.unit, f.doc, None, f.low, f.high,
-                                            f.low_open, f.choices, f.workflows, f.item, f.length))
+                out.setdefault(f.key, replace(f, section="fidelity", default=None))
     return out
 
 
-def _check(f: Field, path: str, value: Any, origin: str) -> Any:
-    if f.kind is list:
-        if not isinstance(value, list) or not value or (f.length and len(value) not in f.length):
-            raise RecipeError(path, value, f"must be {f.allowed()}", origin)
-        item = Field(f.key, f.section, f.item or float, f.unit, "", low=f.low, high=f.high, low_open=f.low_open,
-                     choices=f.choices)
-        return [_check(item, f"{path}[{k}]", v, origin) for k, v in enumerate(value)]
-    if f.kind is str:
-        if not isinstance(value, str) or (f.choices and value not in f.choices):
-            raise RecipeError(path, value, f"must be {f.allowed()}", origin)
-        return value
-    if f.kind is bool:
-        if not isinstance(value, bool):
-            raise RecipeError(path, value, "must be true or false", origin)
-        return value
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or (f.kind is int and not isinstance(value, int)):
-        raise RecipeError(path, value, f"must be {f.allowed()}", origin)
-    if not math.isfinite(value):
-        raise RecipeError(path, value, f"must be finite: {f.allowed()}", origin)
-    if f.low is not None and (value < f.low or (f.low_open and value == f.low)):
-        raise RecipeError(path, value, f"must be {f.allowed()}", origin)
-    if f.high is not None and value > f.high:
-        raise RecipeError(path, value, f"must be {f.allowed()}", origin)
-    return float(value) if f.kind is float else int(value)
+def _check(f: RecipeField, path: str, value: Any, origin: str) -> Any:
+    return f.check(value, origin, error=RecipeError, name=path)
 
 
 def _unknown(path: str, allowed: Mapping[str, Field], workflow: str | None) -> str:
@@ -420,23 +375,37 @@ def load_recipe(spec: str | Path) -> Recipe:
                         file_sha256=hashlib.sha256(data).hexdigest())
 
 
+_WHERE = {"top": "top level", "system": "[system]", "fidelity": "[fidelity.*]", "both": "[system], [fidelity.*]"}
+
+
 def schema_markdown() -> str:
     """The schema as a markdown table (generated for docs/md.md, so it cannot drift)."""
-    lines = ["| key | where | workflows | type | unit | allowed | default | meaning |",
-             "|---|---|---|---|---|---|---|---|"]
-    for f in FIELDS:
-        if f.default is REQUIRED:
-            d = "required"
-        elif f.default is None:
-            d = "not set"
-        else:
-            d = f"`{f.default!r}`"
-        where = {"top": "top level", "system": "[system]", "fidelity": "[fidelity.*]",
-                 "both": "[system], [fidelity.*]"}[f.section]
-        wfs = "all" if f.workflows == ALL else ", ".join(f.workflows)
-        kind = f"list of {f.item.__name__}" if f.kind is list else f.kind.__name__
-        lines.append(f"| `{f.key}` | {where} | {wfs} | {kind} | {f.unit} | {f.allowed()} | {d} | {f.doc} |")
-    return "\n".join(lines)
+    return fields.markdown_table(FIELDS, [
+        ("key", lambda f: f"`{f.key}`"), ("where", lambda f: _WHERE[f.section]),
+        ("workflows", lambda f: "all" if f.workflows == ALL else ", ".join(f.workflows)),
+        ("type", RecipeField.type_name), ("unit", lambda f: f.unit), ("allowed", RecipeField.allowed),
+        ("default", RecipeField.default_text), ("meaning", lambda f: f.doc)])
+
+
+def json_schema() -> dict:
+    """JSON Schema of an MD recipe file: top-level keys, [system] and [fidelity.smoke|quick|production]. Keys of
+    every workflow are listed (each key's description names its workflows); the loader also refuses a key of
+    another workflow and checks the cross-key rules."""
+    def doc(f: RecipeField) -> RecipeField:
+        wfs = "all workflows" if f.workflows == ALL else "workflows: " + ", ".join(f.workflows)
+        return replace(f, doc=f"{f.doc} ({wfs})")
+
+    pairs = [(f.key, doc(f)) for f in FIELDS if f.section == "top"]
+    pairs += [(f"system.{f.key}", replace(doc(f), default=None)) for f in FIELDS if f.section in ("system", "both")]
+    for name in FIDELITIES:
+        seen = set()
+        for f in FIELDS:
+            if f.section in ("fidelity", "both") and f.key not in seen:
+                seen.add(f.key)
+                pairs.append((f"fidelity.{name}.{f.key}", replace(doc(f), default=None)))
+    return fields.json_schema(pairs, title="nanoimpact MD recipe",
+                              description="An MD recipe (inputs/md/*.toml; lengths in angstrom, times in fs or steps, "
+                                          "temperatures in K). See docs/md.md.")
 
 
 if __name__ == "__main__":  # python -m md.recipe -> the table for docs/md.md

@@ -5,7 +5,7 @@ g/cm^3, e, g/mol) up to the edge, and every number that leaves the layer (``resu
 calibration hand-off) is SI. Every conversion between the two goes through this module -- no other file
 multiplies by 4184 or 101325 (the model: ``ase/calculators/lammps/unitconvert.py``).
 
-Constants (exact since the 2019 SI redefinition, CODATA 2018):
+Constants (from :mod:`scipy.constants`; exact since the 2019 SI redefinition, CODATA 2018):
 
 * Avogadro constant N_A = 6.02214076e23 mol^-1 (exact)
 * Boltzmann constant k_B = 1.380649e-23 J/K (exact)
@@ -42,7 +42,11 @@ from __future__ import annotations
 
 import math
 
+import scipy.constants as _C
+
 __all__ = ["AVOGADRO", "BOLTZMANN", "ELEMENTARY_CHARGE", "KCAL", "ATM", "ANGSTROM", "FEMTOSECOND",
+           "SPCE_WATER_MOLAR_MASS", "WATER_MOLAR_MASS", "WATER_DENSITY", "R_KCAL_PER_MOL_K",
+           "KJ_PER_KCAL",
            "KCAL_PER_MOL", "kcal_per_mol_to_J", "J_to_kcal_per_mol", "kcal_per_mol_A_to_N", "N_to_kcal_per_mol_A",
            "kcal_per_mol_A2_to_J_per_m2", "kcal_per_mol_A3_to_Pa", "g_per_mol_A_per_fs2_to_kcal_per_mol_A",
            "angstrom_to_m", "m_to_angstrom", "fs_to_s", "s_to_fs", "atm_to_Pa",
@@ -50,15 +54,27 @@ __all__ = ["AVOGADRO", "BOLTZMANN", "ELEMENTARY_CHARGE", "KCAL", "ATM", "ANGSTRO
            "m_per_s_to_angstrom_per_fs", "g_per_mol_to_kg", "amu_per_A3_to_kg_per_m3", "kT_kcal_per_mol",
            "ns_per_day", "convert", "CONVERSIONS"]
 
-AVOGADRO = 6.02214076e23            #: 1/mol, exact (SI 2019)
-BOLTZMANN = 1.380649e-23            #: J/K, exact (SI 2019)
-ELEMENTARY_CHARGE = 1.602176634e-19  #: C, exact (SI 2019)
-KCAL = 4184.0                       #: J, thermochemical kilocalorie (exact; LAMMPS real)
-ATM = 101325.0                      #: Pa, standard atmosphere (exact)
-ANGSTROM = 1e-10                    #: m
-FEMTOSECOND = 1e-15                 #: s
+AVOGADRO = _C.Avogadro              #: 1/mol, exact (SI 2019): 6.02214076e23
+BOLTZMANN = _C.k                    #: J/K, exact (SI 2019): 1.380649e-23
+ELEMENTARY_CHARGE = _C.e            #: C, exact (SI 2019): 1.602176634e-19
+KCAL = _C.kilo * _C.calorie         #: J, thermochemical kilocalorie (exact; LAMMPS real): 4184.0
+ATM = _C.atm                        #: Pa, standard atmosphere (exact): 101325.0
+ANGSTROM = _C.angstrom              #: m
+FEMTOSECOND = _C.femto              #: s
 KCAL_PER_MOL = KCAL / AVOGADRO      #: J per system for 1 kcal/mol (6.9477e-21 J)
 GAS_CONSTANT_KCAL = BOLTZMANN * AVOGADRO / KCAL   #: kcal/(mol K), 1.98720e-3
+#: kcal/(mol K): R as CODATA 2018 prints it, 8.314462618 J/(mol K) (not k_B N_A = 8.31446261815...), over the
+#: thermochemical kcal; the force-field files' epsilon/k_B values (K) are converted with it, so it stays as is
+R_KCAL_PER_MOL_K = 8.314462618 / KCAL
+KJ_PER_KCAL = _C.calorie                 #: kJ per kcal (thermochemical): 4.184
+
+# water (the two values are kept apart: results computed with each must not move)
+#: g/mol, SPC/E water from its force-field masses (O 15.9994 + 2 H 1.008 = 18.0154): the surface-tension film
+SPCE_WATER_MOLAR_MASS = 15.9994 + 2 * 1.008
+#: g/mol, the molar mass the contact-angle density maps count each water oxygen with (18.015)
+WATER_MOLAR_MASS = 18.015
+#: g/cm^3, liquid water at 298 K: the density the water builders fill to
+WATER_DENSITY = 0.997
 
 
 def kcal_per_mol_to_J(x):

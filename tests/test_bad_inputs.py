@@ -240,7 +240,7 @@ def calibration_cases():
         ("compare-not-list", ("compare_sets",), "silicon", "compare_sets = 'silicon'"),
         ("compare-missing-set", ("compare_sets",), ["silicon", "no_such_set"], "compare_sets = 'no_such_set'"),
         ("compare-missing-file", ("compare_sets",), ["nowhere/set.toml"], "compare_sets = 'nowhere/set.toml'"),
-        ("compare-wrong-type", ("compare_sets",), [3], "compare_sets = [3]"),
+        ("compare-wrong-type", ("compare_sets",), [3], "compare_sets[0] = 3"),
         ("compare-empty-name", ("compare_sets",), [""], "compare_sets = ['']"),
         ("uncertainty-not-table", ("uncertainty",), 3, "uncertainty = 3"),
         ("unknown-uncertainty-key", ("uncertainty", "bogus"), 1, "uncertainty.bogus = 1"),

@@ -1,4 +1,4 @@
-"""Force-field parameter files (inputs/forcefields/*.toml) and md.forcefield. No LAMMPS needed."""
+"""Force-field parameter files (inputs/forcefields/*.toml) and md.system.forcefield. No LAMMPS needed."""
 from __future__ import annotations
 
 import math
@@ -6,7 +6,7 @@ import shutil
 
 import pytest
 
-from md.forcefield import (
+from md.system.forcefield import (
     FORCEFIELD_DIR, R_KCAL_PER_MOL_K, TWO_TO_ONE_SIXTH, ForceFieldError, PairCoeff, available_forcefields,
     combine, epsilon_from_published, lammps_pair_coeffs, lammps_type_ids, load_forcefield, mix,
     sigma_from_published,

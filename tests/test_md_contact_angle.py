@@ -26,7 +26,7 @@ import pytest
 
 from md.analysis import (ContactAngle, block_drift, cap_angle_for_base, cap_angle_for_height, dividing_plane,
                          fit_contact_angle, wetting_bound, work_of_adhesion_sl)
-from md.builders import cap_radius, water_cap
+from md.build import cap_radius, water_cap
 from md.recipe import load_recipe
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -285,7 +285,7 @@ def test_substrate_is_minimised_before_anything_is_held(name, tmp_path):
 
 @pytest.mark.parametrize("name", ["contact_angle_silica", "contact_angle_ots"])
 def test_only_deep_si_and_bridging_o_are_held_and_silanols_are_constrained_not_frozen(name, tmp_path):
-    from md.forcefield import lammps_type_ids
+    from md.system.forcefield import lammps_type_ids
     wf, plan, s = _plan(name, tmp_path)
     leg = plan.legs[0]
     cmds = leg.fresh(tmp_path / "legs" / leg.name)
@@ -324,7 +324,7 @@ def test_the_substrate_equilibrates_alone_before_the_water_is_added(name, tmp_pa
 def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
     """Review item 1: contact angle, adhesion and pull-off share one IFF surface, cristobalite (111) with isolated
     Q3 silanols: no two top silanol O closer than 4 A (minimum image; the (001) face has pairs at 2.53 A)."""
-    from md.topology import minimum_image
+    from md.system.topology import minimum_image
     from md.workflows import get_workflow
     from md.workflows.common import _silica_face, _surface_slab
     from md.workflows.pulloff import PullOff
@@ -372,7 +372,7 @@ def test_silica_smoke_run_reports_the_angle_at_the_waters_plane_with_w_sl_and_dr
 
     from md.engine.store import read_samples
     from md.workflows import run_recipe
-    from md.lammps_data import read_atoms
+    from md.system.lammps_data import read_atoms
     buf = io.StringIO()
     with redirect_stdout(buf):
         out = run_recipe(load_recipe("contact_angle_silica"), "smoke", cache=tmp_path / "c", progress=False)

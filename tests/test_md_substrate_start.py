@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from md.builders import CRISTOBALITE_A
+from md.build import CRISTOBALITE_A
 from md.recipe import load_recipe
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -164,7 +164,7 @@ def _condensed_bridges(info) -> int:
 def bond_defects(system) -> dict:
     """Minimum-image bond lengths of ``system`` (positions wrapped into the box, as the data file has them)
     against r0: the bonds off by more than BOND_TOL_A, and how many cross a periodic boundary."""
-    from md.topology import minimum_image
+    from md.system.topology import minimum_image
     p = system.wrapped_positions()
     b = np.asarray(system.bonds)
     d = p[b[:, 1]] - p[b[:, 0]]

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from md.forcefield import FORCEFIELD_DIR
+from md.system.forcefield import FORCEFIELD_DIR
 
 __all__ = ["run_hash", "forcefield_hashes", "package_version", "lammps_version"]
 

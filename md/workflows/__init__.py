@@ -6,7 +6,7 @@ One module per workflow (:mod:`~md.workflows.adhesion`, :mod:`~md.workflows.pull
 (``Workflow.yields``); what they share is :mod:`~md.workflows.common`, the names :mod:`~md.workflows.registry`, the
 front door :mod:`~md.workflows.facade`.
 
-Each workflow (1) builds its system with :mod:`md.builders` and writes it with :func:`md.lammps_data.write_data`,
+Each workflow (1) builds its system with :mod:`md.build` and writes it with :func:`md.system.lammps_data.write_data`,
 (2) plans LAMMPS legs for :mod:`md.engine` -- FIRE minimisation first (the builds start strained), NVT
 equilibration, sampling -- and (3) turns the stored samples into SI quantities with :mod:`md.analysis`, every
 conversion through :mod:`md.units`.

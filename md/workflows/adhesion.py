@@ -21,11 +21,11 @@ import numpy as np
 
 from md import analysis as A
 from md import units as U
-from md.builders import flip_upside_down, place_on
-from md.forcefield import ForceField
-from md.lammps_data import read_atoms, write_data
+from md.build import flip_upside_down, place_on
+from md.system.forcefield import ForceField
+from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
-from md.topology import System
+from md.system.topology import System
 
 from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, Workflow, _common_define, _equil, _ff, _figure,
                                  _fresh_from_data, _intersect, _minimize, _q, _restart_head, _round_up, _seed,

@@ -2,7 +2,7 @@
 substrates a recipe names, result quantities and figures, the water models, and the :class:`Workflow`
 base class (a workflow plans legs for :mod:`md.engine` and analyses what they stored).
 
-Each workflow (1) builds its system with :mod:`md.builders` and writes it with :func:`md.lammps_data.write_data`,
+Each workflow (1) builds its system with :mod:`md.build` and writes it with :func:`md.system.lammps_data.write_data`,
 (2) plans LAMMPS legs for :mod:`md.engine` -- FIRE minimisation first (the builds start strained), NVT
 equilibration, sampling -- and (3) turns the stored samples into SI quantities with :mod:`md.analysis`, every
 conversion through :mod:`md.units`.
@@ -22,19 +22,20 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from md.builders import SILICA_FACE, ots_sam, silica_slab
-from md.forcefield import ForceField, combine, load_forcefield
-from md.lammps_data import lammps_setup_commands
+from md.build import SILICA_FACE, ots_sam, silica_slab
+from md.system.forcefield import ForceField, combine, load_forcefield
+from md.system.lammps_data import lammps_setup_commands
+from md.units import SPCE_WATER_MOLAR_MASS
 from md.engine.plan import Analysis, Plan, Stage, id_ranges
 from md.engine.store import RunContext
-from md.topology import System
+from md.system.topology import System
 
 
 ENERGY_NOT_FREE_ENERGY = (
     "work_of_adhesion is dE/A, the difference of mean potential energies (separated - contact) per area at "
     "the thermostat temperature: an energy, not the free energy of adhesion (the Dupre work). It neglects "
     "-T dS/A, the change of vibrational/conformational entropy on contact.")
-WATER_MASS = 15.9994 + 2 * 1.008          # g/mol, SPC/E (force-field masses)
+WATER_MASS = SPCE_WATER_MOLAR_MASS       # g/mol, SPC/E (force-field masses), from md.units
 
 
 # ================================================================================================ LAMMPS helpers
@@ -201,7 +202,7 @@ def _figure(draw: Callable) -> Callable[[Path], None]:
 
 def _silica_face(settings: Mapping[str, Any]) -> str:
     """The cristobalite face of a recipe's silica: the recipe's ``silica_face`` (default
-    :data:`md.builders.SILICA_FACE` = '111', isolated Q3 silanols) for bare silica; always (111) when an OTS SAM
+    :data:`md.build.SILICA_FACE` = '111', isolated Q3 silanols) for bare silica; always (111) when an OTS SAM
     is involved (it is grafted on (111), and the two slabs of a pair must share the lateral cell)."""
     kinds = settings.get("surfaces") or [settings.get("surface")]
     if "ots" in kinds:

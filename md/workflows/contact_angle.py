@@ -17,11 +17,11 @@ import numpy as np
 
 from md import analysis as A
 from md import units as U
-from md.builders import place_on, water_cap
-from md.forcefield import lammps_type_ids
-from md.lammps_data import write_data
+from md.build import place_on, water_cap
+from md.system.forcefield import lammps_type_ids
+from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
-from md.topology import System, remove_atoms
+from md.system.topology import System, remove_atoms
 
 from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, _common_define, _equil, _ff, _figure,
                                  _fresh_from_data, _held_deep, _intersect, _minimize, _minimize_water, _q,

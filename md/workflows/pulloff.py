@@ -22,10 +22,10 @@ import numpy as np
 
 from md import analysis as A
 from md import units as U
-from md.builders import flip_upside_down, ots_sam, place_on, silica_asperity
-from md.lammps_data import read_atoms, write_data
+from md.build import flip_upside_down, ots_sam, place_on, silica_asperity
+from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
-from md.topology import System, with_groups
+from md.system.topology import System, with_groups
 
 from md.workflows.common import (Workflow, _common_define, _equil, _ff, _figure, _fresh_from_data, _intersect,
                                  _minimize, _q, _restart_head, _round_up, _seed, _silica_face, _stages, _steps,
@@ -434,7 +434,7 @@ def _independent_sites(xy: np.ndarray, cell_xy, spacing: float, order: np.ndarra
 
 def _chain_clearance(asp: System, sites: np.ndarray, chain_length: int, tilt_deg: float = 0.0,
                      clearance_A: float = 2.6) -> np.ndarray:
-    """True for the sites whose chain -- straight, ``tilt_deg`` from +z towards +x, as :func:`md.builders.ots_sam`
+    """True for the sites whose chain -- straight, ``tilt_deg`` from +z towards +x, as :func:`md.build.ots_sam`
     grafts it -- keeps ``clearance_A`` from every heavy atom of the asperity from 4 A above the anchor O to the
     chain's end. Near the rim of a stepped dome a chain along the pulling axis can run into the dome above its site
     (an 80 deg cap at smoke without this check: an overlap the minimiser cannot undo)."""

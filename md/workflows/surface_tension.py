@@ -13,8 +13,8 @@ import numpy as np
 
 from md import analysis as A
 from md import units as U
-from md.builders import water_slab
-from md.lammps_data import write_data
+from md.build import water_slab
+from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 
 from md.workflows.common import (WATER_MASS, Workflow, _common_define, _equil, _ff, _figure, _fresh_from_data,

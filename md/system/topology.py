@@ -5,7 +5,7 @@ Units are LAMMPS ``real`` (the MD layer's edge): positions and cell in angstrom,
 * :class:`System` -- frozen: positions, force-field type names, charges, masses, molecule ids, bonds/angles/
   dihedrals as index arrays with the force field's bonded-type names, an orthorhombic cell ``[0, L)`` per
   axis, periodicity flags, named index groups and a free ``info`` dict saying what a builder made.
-* :func:`from_types` -- a System whose charges and masses are looked up in a :class:`~md.forcefield.ForceField`.
+* :func:`from_types` -- a System whose charges and masses are looked up in a :class:`~md.system.forcefield.ForceField`.
 * :func:`with_bonded_terms` -- types every bond and generates every angle and dihedral from the bond graph,
   looking each up in the force field; a term without parameters raises :class:`MissingParameterError`
   naming it. Dihedrals whose parameters are all zero (IFF's Si-O torsions) are left out by default.
@@ -22,7 +22,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
-from md.forcefield import WILDCARD, ForceField
+from md.system.forcefield import WILDCARD, ForceField
 
 __all__ = ["System", "MissingParameterError", "from_types", "with_bonded_terms", "merge", "translate",
            "flip_upside_down", "with_cell", "with_groups", "with_info", "remove_atoms", "neighbors",
@@ -54,7 +54,7 @@ def _names(a: Iterable[str]) -> np.ndarray:
 class System:
     """An all-atom (or united-atom) system ready for a LAMMPS ``atom_style full`` data file.
 
-    Index arrays are 0-based into the atom arrays. Type names are :class:`~md.forcefield.ForceField` names
+    Index arrays are 0-based into the atom arrays. Type names are :class:`~md.system.forcefield.ForceField` names
     (atom types; bond/angle/dihedral type ``name`` fields). Arrays are read-only; every operation returns a
     new System.
     """

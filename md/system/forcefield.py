@@ -20,14 +20,12 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
+from md.units import KJ_PER_KCAL, R_KCAL_PER_MOL_K
 from nanoimpact import data
 
 #: The shipped force-field files (inputs/forcefields, installed as package data).
 FORCEFIELD_DIR = data.shipped_root() / "forcefields"
 
-#: Molar gas constant in kcal/(mol K): CODATA 2018 R = 8.314462618 J/(mol K), thermochemical kcal = 4184 J.
-R_KCAL_PER_MOL_K = 8.314462618 / 4184.0
-KJ_PER_KCAL = 4.184
 TWO_TO_ONE_SIXTH = 2.0 ** (1.0 / 6.0)
 
 SIGMA_TOLERANCE = 5e-4      # angstrom: stored sigma vs. sigma recomputed from the published value

@@ -1,13 +1,13 @@
-"""LAMMPS data files (``atom_style full``, ``units real``) for :class:`md.topology.System`, and a read-back check.
+"""LAMMPS data files (``atom_style full``, ``units real``) for :class:`md.system.topology.System`, and a read-back check.
 
 ASE's LAMMPS writer drops bonds, angles and dihedrals; this one writes them. Type numbering is the force
-field's own: atom types in the order of ``ForceField.atom_types`` (:func:`md.forcefield.lammps_type_ids`),
+field's own: atom types in the order of ``ForceField.atom_types`` (:func:`md.system.forcefield.lammps_type_ids`),
 bond/angle/dihedral types in the order of ``ForceField.bond_types`` etc., the numbering that
-:func:`md.forcefield.lammps_pair_coeffs`, :func:`~md.forcefield.lammps_bond_coeffs` and friends use -- so an
+:func:`md.system.forcefield.lammps_pair_coeffs`, :func:`~md.system.forcefield.lammps_bond_coeffs` and friends use -- so an
 input script built from the same force field matches the data file. Every type of the force field is declared
 (also those the system does not use). Sections written: Masses, Bond/Angle/Dihedral Coeffs (from the force
 field), Atoms (``id mol type q x y z``), Bonds, Angles, Dihedrals. Pair Coeffs are *not* written: the input
-script sets ``pair_coeff`` from :func:`md.forcefield.lammps_pair_coeffs`.
+script sets ``pair_coeff`` from :func:`md.system.forcefield.lammps_pair_coeffs`.
 
 Units at this edge: angstrom, kcal/mol, e, g/mol (LAMMPS ``real``), the units of :class:`System`.
 """
@@ -21,8 +21,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from md.forcefield import ForceField, combine, lammps_pair_coeffs, lammps_type_ids, load_forcefield
-from md.topology import System
+from md.system.forcefield import ForceField, combine, lammps_pair_coeffs, lammps_type_ids, load_forcefield
+from md.system.topology import System
 
 __all__ = ["write_data", "read_atoms", "read_back_check", "ReadBack", "lammps_setup_commands", "style_of"]
 
@@ -56,7 +56,7 @@ def write_data(system: System, forcefield: ForceField, path: str | Path, *, titl
     """Write ``system`` as a LAMMPS data file (atom_style full, units real); returns the path.
 
     Every atom type must be a force-field atom type and every bonded term must carry a force-field type name
-    (build systems with :func:`md.topology.with_bonded_terms`); otherwise KeyError names the missing one.
+    (build systems with :func:`md.system.topology.with_bonded_terms`); otherwise KeyError names the missing one.
     Periodic axes are wrapped into the box [0, L). The first line records the force-field name and the
     periodicity (``boundary p p f``), which :func:`read_back_check` reads.
 
@@ -79,7 +79,7 @@ def write_data(system: System, forcefield: ForceField, path: str | Path, *, titl
         table = {t.name: k for k, t in enumerate(fftypes, start=1)}
         term_ids[kind] = table
         if len(terms) and len(names) != len(terms):
-            raise KeyError(f"the system's {kind}s carry no type names; build it with md.topology.with_bonded_terms")
+            raise KeyError(f"the system's {kind}s carry no type names; build it with md.system.topology.with_bonded_terms")
         unknown = sorted(set(names.tolist()) - set(table))
         if unknown:
             raise KeyError(f"{kind} types {unknown} are not in force field {forcefield.name!r}")
@@ -224,7 +224,7 @@ def read_back_check(path: str | Path, forcefield: ForceField | None = None, *, p
     """Load a data file written by :func:`write_data` into LAMMPS (in process) and report what LAMMPS sees.
 
     The force field defaults to the one named in the file's first line (``combine`` of the '+'-joined names).
-    Styles come from the force field; ``pair_coeff`` lines from :func:`md.forcefield.lammps_pair_coeffs`;
+    Styles come from the force field; ``pair_coeff`` lines from :func:`md.system.forcefield.lammps_pair_coeffs`;
     ``special_bonds`` from the force field. With ``run0`` a ``run 0`` evaluates the energy terms.
     """
     from md.lammps_loader import new_lammps   # noqa: PLC0415  (LAMMPS only when asked for)
