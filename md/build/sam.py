@@ -1,0 +1,180 @@
+"""OTS monolayers grafted on a silica substrate (:func:`ots_sam`).
+
+OTS (``ots_trappe_ua.toml``): C18 united-atom chains CH3-(CH2)17- on a head Si (SIH) bonded to one surface O
+(silanol O retyped OC24 -> OC23, its H deleted) and carrying two OH; no lateral cross-linking.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from md.system.forcefield import ForceField
+from md.system.topology import System, from_types, merge, minimum_image, remove_atoms, with_bonded_terms
+from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, sam_forcefield
+
+# ================================================================================================ OTS monolayer
+
+def _xy_spacing_ok(p: np.ndarray, accepted: list[np.ndarray], cell: np.ndarray, dmin: float) -> bool:
+    if not accepted:
+        return True
+    d = minimum_image(np.array(accepted)[:, :2] - p[:2], cell[:2], (True, True))
+    return bool(np.min(np.hypot(d[:, 0], d[:, 1])) >= dmin)
+
+
+def _chain_template(ff: ForceField, chain_length: int, tilt_deg: float, azimuth_deg: float):
+    """Positions (relative to the anchor O at the origin) and types of SIH, 2 x (OC24, HOY), CH2 x (n-1), CH3.
+
+    All-trans zigzag: anchor O, head Si and the carbons lie in one plane containing the chain axis, which is
+    tilted ``tilt_deg`` from +z towards azimuth ``azimuth_deg``; every backbone angle is the TraPPE C-C-C
+    theta0 (114 deg), bond lengths are the force field's r0. The two head OH take the remaining tetrahedral
+    directions at the head Si, with Si-O-H = IFF theta0 and H tilted upwards.
+    """
+    t, phi = math.radians(tilt_deg), math.radians(azimuth_deg)
+    axis = np.array([math.sin(t) * math.cos(phi), math.sin(t) * math.sin(phi), math.cos(t)])
+    up = np.array([0.0, 0.0, 1.0])
+    w = up - np.dot(up, axis) * axis
+    if np.linalg.norm(w) < 1e-9:  # untilted: any perpendicular in the azimuth plane
+        w = np.array([math.cos(phi), math.sin(phi), 0.0])
+    w = _unit(w)
+    half = math.radians(0.5 * (180.0 - _angle_theta0(ff, "CH2", "CH2", "CH2")))
+    r = {"O-S": _bond_r0(ff, "SIH", "OC23"), "S-C": _bond_r0(ff, "CH2", "SIH"), "C-C": _bond_r0(ff, "CH2", "CH2"),
+         "C-C3": _bond_r0(ff, "CH3", "CH2"), "S-OH": _bond_r0(ff, "SIH", "OC24"), "O-H": _bond_r0(ff, "OC24", "HOY")}
+    lengths = [r["O-S"], r["S-C"]] + [r["C-C"]] * (chain_length - 2) + [r["C-C3"]]
+    backbone = [np.zeros(3)]
+    for k, length in enumerate(lengths):
+        sign = 1.0 if k % 2 == 0 else -1.0
+        backbone.append(backbone[-1] + length * (math.cos(half) * axis + sign * math.sin(half) * w))
+    backbone = np.array(backbone)            # 0: anchor O, 1: SIH, 2..: carbons
+    s = backbone[1]
+    a, b = _unit(backbone[0] - s), _unit(backbone[2] - s)
+    m, nrm = _unit(a + b), _unit(np.cross(a, b))
+    half_tet = math.acos(-1.0 / 3.0) / 2.0
+    bend = math.radians(180.0 - _angle_theta0(ff, "SIH", "OC24", "HOY"))
+    head = []
+    for sign in (1.0, -1.0):
+        d = -math.cos(half_tet) * m + sign * math.sin(half_tet) * nrm
+        o = s + r["S-OH"] * d
+        p = up - np.dot(up, d) * d
+        p = _unit(p) if np.linalg.norm(p) > 1e-6 else _unit(np.cross(d, axis))
+        head.append((o, o + r["O-H"] * (math.cos(bend) * d + math.sin(bend) * p)))
+    pos = [backbone[1], head[0][0], head[0][1], head[1][0], head[1][1], *backbone[2:]]
+    types = ["SIH", "OC24", "HOY", "OC24", "HOY"] + ["CH2"] * (chain_length - 1) + ["CH3"]
+    # local bonds (indices into pos); the anchor bond O-SIH is added by the caller
+    bonds = [(0, 1), (1, 2), (0, 3), (3, 4), (0, 5)] + [(5 + k, 6 + k) for k in range(chain_length - 1)]
+    return np.array(pos), types, bonds
+
+
+def ots_sam(substrate: System, coverage: float = 4.5, *, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
+            chain_length: int = 18, seed: int = 0, min_spacing: float = 4.4, site_group: str = "silanol_O_top",
+            vacuum: float = 10.0, forcefield: ForceField | None = None) -> System:
+    """Graft an OTS monolayer (C``chain_length`` united-atom chains on Si(OH)2 heads) onto a flat silica slab.
+
+    Grafting sites are drawn (seeded, random order) from the substrate's top silanol O (group ``site_group``)
+    with a lateral minimum spacing ``min_spacing`` (A) until ``coverage`` chains/nm^2 (of the x-y area) is
+    reached; if the sites cannot hold it, ValueError says how many fit (cristobalite (111), one Q3 silanol per
+    4.50 nm^-2 on a 5.06 A hexagonal lattice, holds 4.50 chains/nm^2; the (001) face at most 3.9).
+
+    Each graft is the condensation Si-OH + HO-Si(OH)2R -> Si-O-Si(OH)2R: the surface silanol H is deleted and
+    its O retyped OC24 -> OC23 (charge -0.675 -> -0.55); the head Si (SIH, +0.825) is bonded to that O, to two
+    OH (OC24/HOY) and to the alpha-CH2. Charge per graft: substrate -0.4 + 0.125 = -0.275, chain
+    0.825 + 2 (-0.675 + 0.4) = +0.275, net 0 (inputs/forcefields/README.md). No lateral Si-O-Si cross-links
+    between heads (simplification).
+    Chains start all-trans with their axis tilted ``tilt_deg`` towards ``tilt_azimuth_deg``.
+
+    Groups added: 'sam' (all chain atoms incl. head OH), 'sam_head_si', 'sam_ch3', 'sam_anchor_O'.
+    ``info``: chains, coverage (nm^-2), thickness (mean CH3 height above the mean anchor-O plane, A), sites.
+    """
+    ff = forcefield or sam_forcefield()
+    rng = np.random.default_rng(seed)
+    if chain_length < 2:
+        raise ValueError("chain_length must be >= 2")
+    sites = np.asarray(substrate.group(site_group), int)
+    if not len(sites):
+        raise ValueError(f"substrate group {site_group!r} is empty: nothing to graft on")
+    area = float(substrate.cell[0] * substrate.cell[1])
+    target = int(round(coverage * area / 100.0))
+    pos = substrate.positions
+    accepted: list[int] = []
+    acc_pos: list[np.ndarray] = []
+    for k in rng.permutation(len(sites)).tolist():
+        i = int(sites[k])
+        if len(accepted) == target:
+            break
+        if _xy_spacing_ok(pos[i], acc_pos, substrate.cell, min_spacing):
+            accepted.append(i)
+            acc_pos.append(pos[i])
+    if len(accepted) < target:
+        raise ValueError(
+            f"only {len(accepted)} of {target} grafting sites fit at {min_spacing} A spacing on this substrate "
+            f"({len(accepted) / area * 100:.2f} chains/nm^2 < requested {coverage}); cristobalite face='111' "
+            f"offers 4.50 sites/nm^2 on a 5.06 A lattice")
+    accepted.sort()
+    # delete the silanol H of each anchor O, retype the O
+    nb = [[] for _ in range(substrate.n_atoms)]
+    for i, j in substrate.bonds.tolist():
+        nb[i].append(j)
+        nb[j].append(i)
+    h_del = []
+    for o in accepted:
+        hs = [h for h in nb[o] if substrate.types[h] == "HOY"]
+        if len(hs) != 1 or substrate.types[o] != "OC24":
+            raise ValueError(f"site atom {o} is not a silanol O (type {substrate.types[o]}, H neighbours {hs})")
+        h_del.append(hs[0])
+    types = substrate.types.copy().astype(object)
+    charges = substrate.charges.copy()
+    oc23 = ff.atom_type("OC23")
+    types[accepted] = "OC23"
+    charges[accepted] = oc23.charge
+    # the anchor O stays but is no longer a silanol; record it through a group so that remove_atoms re-indexes it
+    groups = {k: (np.setdiff1d(v, accepted) if k.startswith("silanol_O") else v) for k, v in substrate.groups.items()}
+    groups["sam_anchor_O"] = np.array(accepted, int)
+    base = replace(substrate, types=types, charges=charges, groups=groups)
+    base = remove_atoms(base, h_del)
+    anchors = np.asarray(base.group("sam_anchor_O"), int)
+    # chains
+    tpos, ttypes, tbonds = _chain_template(ff, chain_length, tilt_deg, tilt_azimuth_deg)
+    n0 = base.n_atoms
+    per = len(ttypes)
+    mol0 = int(base.mol_ids.max())
+    all_pos, all_types, all_mol, bonds = [], [], [], []
+    for c, o in enumerate(anchors.tolist()):
+        off = n0 + c * per
+        all_pos.append(base.positions[o] + tpos)
+        all_types += ttypes
+        all_mol += [mol0 + 1 + c] * per
+        bonds += [(off + i, off + j) for i, j in tbonds]
+        bonds.append((o, off))                        # anchor O - head Si
+    chain_pos = np.concatenate(all_pos)
+    chains = from_types(chain_pos, all_types, ff, mol_ids=all_mol, cell=base.cell, pbc=base.pbc)
+    merged = merge([base, chains], cell=base.cell)
+    merged = replace(merged, bonds=np.concatenate([merged.bonds, np.array(bonds, int)]), bond_types=[])
+    zmax = merged.positions[:, 2].max()
+    cell = np.array([base.cell[0], base.cell[1], zmax + vacuum])
+    sam_idx = np.arange(n0, n0 + len(anchors) * per)
+    head_si = n0 + np.arange(len(anchors)) * per
+    ch3 = n0 + np.arange(len(anchors)) * per + per - 1
+    groups = {k: v for k, v in merged.groups.items()}
+    groups.update(sam=sam_idx, sam_head_si=head_si, sam_ch3=ch3, sam_anchor_O=anchors)
+    merged = replace(merged, cell=cell, groups=groups, info={})
+    merged = with_bonded_terms(merged, ff)
+    p = merged.positions
+    thickness = float(p[ch3, 2].mean() - p[anchors, 2].mean())
+    top_sil = merged.groups.get("silanol_O_top", np.array([], int))
+    sub_info = dict(substrate.info)
+    info = {
+        "builder": "ots_sam", "chains": int(len(anchors)), "chain_length": chain_length,
+        "coverage_requested_nm2": coverage, "coverage_nm2": len(anchors) / (area / 100.0),
+        "area_nm2": area / 100.0, "tilt_deg": tilt_deg, "tilt_azimuth_deg": tilt_azimuth_deg,
+        "min_spacing_A": min_spacing, "seed": seed,
+        "thickness_A": thickness,
+        "thickness_definition": "mean CH3 height minus mean anchor-O height (initial all-trans geometry)",
+        "unreacted_top_silanols": int(len(top_sil)),
+        "unreacted_top_silanol_density_nm2": len(top_sil) / (area / 100.0),
+        "cross_linking": "none: each head keeps two Si-OH (simplification)",
+        "n_atoms": merged.n_atoms, "counts": merged.type_counts(), "total_charge": merged.total_charge(),
+        "source": SOURCES["ots"], "substrate": sub_info,
+        "omitted_zero_dihedrals": merged.info.get("omitted_zero_dihedrals", 0),
+    }
+    return replace(merged, info=_plain(info))
