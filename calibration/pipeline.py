@@ -19,7 +19,6 @@ Steps (each timed in the report):
 from __future__ import annotations
 
 import csv
-import json
 import logging
 import math
 import os
@@ -34,6 +33,7 @@ import numpy as np
 from nanoimpact.executors import Failure, executor
 
 from .mdset import build_parameter_set, committed_result, recipes_needed, write_parameter_set
+from .report import CalibrationReport, ValueRow
 
 from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
@@ -398,8 +398,9 @@ def _band(values) -> dict:
 def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "quick", executor_name: str = "local",
               workers: int | None = None, scheduler: str | None = None, params_out: str | Path | None = None,
               md_cache: str | None = None, results_dir: str | Path | None = None,
-              paper_sets: tuple | None = None, progress=None) -> dict:
-    """Run the whole pipeline; returns a record of what was done (also written to OUT/calibration.json).
+              paper_sets: tuple | None = None, progress=None) -> CalibrationReport:
+    """Run the whole pipeline; returns the typed CalibrationReport (also written to OUT/calibration.json and
+    OUT/report.md).
 
     `paper_sets`: the sets whose paper cases run beside the base and the new set (default: the recipe's
     `compare_sets`)."""
@@ -471,13 +472,12 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
              "seed": unc["seed"], "scene": unc["scene"]}
     _write_uncertainty(out, keys, sample_out, bands)
     timings["total_s"] = time.perf_counter() - t_all
-    record = {"calibration": cal, "set": str(set_path), "rows": rows, "md_sources": sources, "bands": bands,
-              "md_compute_total_s": sum(md_compute.values()),
-              "timings": timings, "machine": machine, "paper_checks": paper["checks"]}
-    (out / "calibration.json").write_text(json.dumps(record, indent=1, default=str) + "\n")
-    _write_report(out, record)
-    progress(f"calibrate: report {out / 'report.md'}; total {timings['total_s']:.1f} s")
-    return record
+    report = CalibrationReport(name=cal["name"], set_path=Path(set_path), out=out, calibration=cal,
+                               rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources=sources, bands=bands,
+                               paper_checks=tuple(paper["checks"]), timings=timings, machine=machine,
+                               md_compute_total_s=sum(md_compute.values()))
+    progress(f"calibrate: report {report.write()}; total {timings['total_s']:.1f} s")
+    return report
 
 
 def _write_uncertainty(out: Path, keys, samples, bands) -> None:
@@ -514,78 +514,3 @@ def _write_uncertainty(out: Path, keys, samples, bands) -> None:
     fig.tight_layout()
     fig.savefig(out / "uncertainty.png.tmp.png", dpi=110)
     (out / "uncertainty.png.tmp.png").replace(out / "uncertainty.png")
-
-
-def _fmt(x, spec=".4g"):
-    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
-
-
-def _work_sentence(rows: list[dict]) -> str:
-    """What the work-of-adhesion values are: free energies (force integration) or energy differences."""
-    used = {r["key"]: r.get("quantity") for r in rows if "work_of_adhesion" in r["key"] and r["status"] == "used"}
-    fe = sorted(k for k, q in used.items() if q == "work_of_adhesion_free_energy")
-    de = sorted(k for k, q in used.items() if q == "work_of_adhesion")
-    parts = []
-    if fe:
-        parts.append(f"{', '.join(f'`{k}`' for k in fe)}: free energy of separation by force integration (the "
-                     "Dupre work JKR needs); its stderr includes the window grid's discretisation error, and dE/A "
-                     "is recorded beside it in [meta.calibration]")
-    if de:
-        parts.append(f"{', '.join(f'`{k}`' for k in de)}: the energy difference dE/A, not a free energy (the run "
-                     "has no force integration)")
-    return ("Work of adhesion: " + "; ".join(parts) + " (docs/calibration.md).") if parts else ""
-
-
-def _write_report(out: Path, rec: dict) -> None:
-    cal = rec["calibration"]
-    lines = [f"# Calibration `{cal['name']}` (base `{cal['base']}`)", "",
-             f"Recipe `{cal['path']}`; machine: {rec['machine']['cores']} cores, {rec['machine']['platform']}, "
-             f"Python {rec['machine']['python']}. MD compute (the runs themselves, from their results): "
-             f"{rec.get('md_compute_total_s', 0.0):.0f} s. Pipeline wall time: MD jobs {rec['timings']['md_s']:.1f} s "
-             "(cached or committed runs cost nothing), paper cases "
-             f"{rec['timings']['paper_s']:.1f} s, uncertainty {rec['timings']['uncertainty_s']:.1f} s, total "
-             f"{rec['timings']['total_s']:.1f} s. Set written to `{rec['set']}`.", "",
-             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | status | why / run |",
-             "|---|---|---|---|---|---|---|"]
-    for r in rec["rows"]:
-        lines.append(f"| `{r['key']}` | {r['recipe']} | {r.get('quantity', '-')} | {_fmt(r.get('value'))} "
-                     f"{r.get('units', '')} | {_fmt(r.get('stderr'))} | {r['status']} | "
-                     f"{r.get('why') or str(r.get('run_hash', ''))[:16]} |")
-    lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec["md_sources"].items()), "",
-              "A rejected or missing value keeps the base set's value (its [meta.sources] entry says so).",
-              _work_sentence(rec["rows"]),
-              "", "## The paper's claims per set", "",
-              "| claim | " + " | ".join(sorted({c['set'] for c in rec['paper_checks']})) + " |",
-              "|---|" + "---|" * len({c['set'] for c in rec['paper_checks']})]
-    sets = sorted({c["set"] for c in rec["paper_checks"]})
-    by = {}
-    for c in rec["paper_checks"]:
-        by.setdefault(c["name"], {})[c["set"]] = "pass" if c["pass"] else "**fail**"
-    for name, res in by.items():
-        lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
-    name = Path(rec["set"]).stem
-    mine = [c for c in rec["paper_checks"] if c["set"] == name]
-    agree = [c["name"] for c in mine if c["pass"]]
-    differ = [c for c in mine if not c["pass"]]
-    lines += ["", f"**Where the calibrated physics agrees with the paper:** {len(agree)} of {len(mine)} claims hold "
-              f"with the `{name}` set.", ""]
-    if differ:
-        lines += [f"**Where it does not** ({len(differ)}):", ""]
-        lines += [f"- `{c['name']}`: needs {c['threshold']}; got {json.dumps(c['values'], default=str)[:300]}"
-                  for c in differ]
-    b = rec["bands"]
-    lines += ["", "## Uncertainty", "",
-              f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "
-              f"{', '.join(b['covers'])}; failed samples: {b['failed_samples']}.", "",
-              "| output | median | 5 % | 95 % | n |", "|---|---|---|---|---|"]
-    for key in ("first_rebound_over_h0", "rebound_count", "escape_velocity_m_per_s"):
-        v = b[key]
-        lines.append(f"| {key} | {_fmt(v['median'])} | {_fmt(v['p05'])} | {_fmt(v['p95'])} | {v['n']} |")
-    if b.get("rebound_count_capped"):
-        lines += ["", f"**rebound_count is a lower bound:** {b['rebound_count_capped']} of {b['rebound_count']['n']} "
-                      f"samples reached the `max_bounces` cap ({b['max_bounces']}) without sticking; raise "
-                      "`[uncertainty] max_bounces` for the full count."]
-    lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`; data: `uncertainty.csv`, "
-              "`calibration.json`, `paper/checks.json`.", ""]
-    (out / "report.md.tmp").write_text("\n".join(lines))
-    (out / "report.md.tmp").replace(out / "report.md")

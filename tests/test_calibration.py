@@ -125,6 +125,34 @@ def test_angles_and_gamma_of_different_water_models_are_not_combined():
     assert "rejected" not in table["meta"] and all(r["status"] == "used" for r in rows)
 
 
+def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
+    from calibration.report import CalibrationReport, ValueRow
+
+    table, rows = build_parameter_set(_results(), "paper", "cal")
+    band = {"median": 0.5, "p05": 0.4, "p95": 0.6, "n": 4}
+    report = CalibrationReport(
+        name="cal", set_path=tmp_path / "cal.toml", out=tmp_path / "out",
+        calibration={"name": "cal", "base": "paper", "path": "recipe.toml"},
+        rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources={"adhesion_silica": {"source": "committed"}},
+        bands={"first_rebound_over_h0": band, "rebound_count": band, "escape_velocity_m_per_s": band,
+               "covers": ["x"], "samples": 4, "failed_samples": 0, "seed": 0, "scene": "s", "max_bounces": 3},
+        paper_checks=({"set": "cal", "name": "claim_a", "pass": True, "threshold": "t", "values": {}},
+                      {"set": "cal", "name": "claim_b", "pass": False, "threshold": "t2", "values": {"v": 1}},
+                      {"set": "paper", "name": "claim_a", "pass": True, "threshold": "t", "values": {}}),
+        timings={"md_s": 1.0, "paper_s": 2.0, "uncertainty_s": 3.0, "total_s": 6.0},
+        machine={"cores": 2, "platform": "p", "python": "3.11"}, md_compute_total_s=10.0)
+    assert len(report.used) == 8 and report.not_used == ()
+    assert [c["name"] for c in report.claims()] == ["claim_a", "claim_b"]
+    md = report.write()
+    text = md.read_text()
+    assert "1 of 2 claims hold" in text and "`claim_b`: needs t2" in text
+    assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 |" in text
+    saved = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    assert saved["rows"][0] == rows[0] | {k: None for k in ValueRow.__dataclass_fields__ if k not in rows[0]}
+    assert saved["versions"]["numpy"] == np.__version__
+    assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
+
+
 def test_recipes_needed_are_the_seven_mapped_ones():
     assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "contact_angle_silica", "contact_angle_ots",
                                 "surface_tension_spce", "pulloff_silica", "pulloff_ots"]
@@ -177,16 +205,21 @@ def test_sweep_validates_first_then_resumes_without_rerunning(tmp_path):
 
 @pytest.mark.md
 def test_smoke_pipeline_on_two_dask_workers(tmp_path):
-    from calibration.pipeline import calibrate
+    from calibration import CalibrationReport, calibrate
 
     out = tmp_path / "cal"
-    record = calibrate(ROOT / "inputs" / "calibration" / "smoke.toml", out, md_fidelity="smoke", executor_name="dask",
+    report = calibrate(ROOT / "inputs" / "calibration" / "smoke.toml", out, md_fidelity="smoke", executor_name="dask",
                        workers=2, params_out=tmp_path / "calibrated_smoke.toml", md_cache=str(tmp_path / "md"),
                        progress=lambda m: None)
+    assert isinstance(report, CalibrationReport) and report.name == "calibrated_smoke"
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
-    assert len(record["md_sources"]) == 7
+    assert len(report.md_sources) == 7 and len(report.rows) == 8
+    assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
+    assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
+    assert len(report.used) + len(report.not_used) == 8
     scene = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params=str(tmp_path / "calibrated_smoke.toml"))
     assert scene.scene.surfaces.roughness.summit_modulus == 10e9
     saved = json.loads((out / "calibration.json").read_text())
-    assert saved["bands"]["samples"] == 4
+    assert saved["bands"]["samples"] == 4 and saved == json.loads(json.dumps(report.to_dict(), default=str))
+    assert saved["versions"]["nanoimpact"] and saved["rows"][0]["key"] == report.rows[0].key

@@ -1,0 +1,182 @@
+"""What a calibration returns and writes: a typed `CalibrationReport` (`calibration.calibrate(...)`), its
+`calibration.json` (the same record as before, plus versions) and `report.md`.
+
+One place for the calibration's output files: `CalibrationReport.write(out)` writes both atomically.
+"""
+from __future__ import annotations
+
+import json
+import math
+import platform
+import sys
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from typing import Any, Mapping
+
+from nanoimpact import __version__
+from nanoimpact.fileio import atomic_write_text
+
+__all__ = ["ValueRow", "CalibrationReport", "versions"]
+
+
+@dataclass(frozen=True)
+class ValueRow:
+    """One scene key the calibration maps: where its value came from and whether it was used.
+
+    `status`: 'used' (the MD value is in the set), 'rejected' (the base set's value is kept; `why` says why)
+    or 'missing' (no result of `recipe`)."""
+
+    key: str
+    recipe: str
+    status: str
+    base_value: Any = None
+    quantity: str | None = None
+    value: float | None = None
+    stderr: float | None = None
+    units: str = ""
+    run_hash: str | None = None
+    fidelity: str | None = None
+    why: str | None = None
+
+    @classmethod
+    def from_dict(cls, row: Mapping) -> "ValueRow":
+        known = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in row.items() if k in known})
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def versions() -> dict:
+    """Versions a calibration's numbers depend on (the MD results carry their own, with their run hashes)."""
+    import numpy
+    import scipy
+
+    return {"nanoimpact": __version__, "python": platform.python_version(), "numpy": numpy.__version__,
+            "scipy": scipy.__version__, "platform": sys.platform}
+
+
+@dataclass(frozen=True)
+class CalibrationReport:
+    """The result of `calibration.calibrate(...)`.
+
+    `set_path` is the parameter set written; `rows` say for each mapped scene key whether the MD value was used;
+    `md_sources` where each MD result came from (committed, md cache, ran); `paper_checks` the founding paper's
+    claims for every set run; `bands` the uncertainty bands (median, 5 %, 95 %, n); `timings` wall seconds per
+    step. `to_dict()` is `calibration.json`.
+    """
+
+    name: str
+    set_path: Path
+    out: Path
+    calibration: Mapping[str, Any]
+    rows: tuple[ValueRow, ...]
+    md_sources: Mapping[str, Mapping[str, Any]]
+    bands: Mapping[str, Any]
+    paper_checks: tuple[Mapping[str, Any], ...]
+    timings: Mapping[str, float]
+    machine: Mapping[str, Any]
+    md_compute_total_s: float
+    versions: Mapping[str, str] = field(default_factory=versions)
+
+    @property
+    def used(self) -> tuple[ValueRow, ...]:
+        return tuple(r for r in self.rows if r.status == "used")
+
+    @property
+    def not_used(self) -> tuple[ValueRow, ...]:
+        return tuple(r for r in self.rows if r.status != "used")
+
+    def claims(self, set_name: str | None = None) -> tuple[Mapping[str, Any], ...]:
+        """The paper's claims for `set_name` (default: the calibrated set)."""
+        name = set_name or Path(self.set_path).stem
+        return tuple(c for c in self.paper_checks if c["set"] == name)
+
+    def to_dict(self) -> dict:
+        return {"calibration": dict(self.calibration), "set": str(self.set_path),
+                "rows": [r.to_dict() for r in self.rows], "md_sources": dict(self.md_sources),
+                "bands": dict(self.bands), "md_compute_total_s": self.md_compute_total_s,
+                "timings": dict(self.timings), "machine": dict(self.machine), "versions": dict(self.versions),
+                "paper_checks": list(self.paper_checks)}
+
+    def write(self, out: str | Path | None = None) -> Path:
+        """calibration.json and report.md in `out` (default: the run's folder), each written atomically."""
+        out = Path(out or self.out)
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(out / "calibration.json", json.dumps(self.to_dict(), indent=1, default=str) + "\n")
+        atomic_write_text(out / "report.md", report_markdown(self))
+        return out / "report.md"
+
+
+# ----------------------------------------------------------------------------- report.md
+def _fmt(x, spec=".4g"):
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def _work_sentence(rows: tuple[ValueRow, ...]) -> str:
+    """What the work-of-adhesion values are: free energies (force integration) or energy differences."""
+    used = {r.key: r.quantity for r in rows if "work_of_adhesion" in r.key and r.status == "used"}
+    fe = sorted(k for k, q in used.items() if q == "work_of_adhesion_free_energy")
+    de = sorted(k for k, q in used.items() if q == "work_of_adhesion")
+    parts = []
+    if fe:
+        parts.append(f"{', '.join(f'`{k}`' for k in fe)}: free energy of separation by force integration (the "
+                     "Dupre work JKR needs); its stderr includes the window grid's discretisation error, and dE/A "
+                     "is recorded beside it in [meta.calibration]")
+    if de:
+        parts.append(f"{', '.join(f'`{k}`' for k in de)}: the energy difference dE/A, not a free energy (the run "
+                     "has no force integration)")
+    return ("Work of adhesion: " + "; ".join(parts) + " (docs/calibration.md).") if parts else ""
+
+
+def report_markdown(rec: CalibrationReport) -> str:
+    cal, t, m = rec.calibration, rec.timings, rec.machine
+    lines = [f"# Calibration `{cal['name']}` (base `{cal['base']}`)", "",
+             f"Recipe `{cal['path']}`; machine: {m['cores']} cores, {m['platform']}, Python {m['python']}; "
+             f"nanoimpact {rec.versions.get('nanoimpact')}, NumPy {rec.versions.get('numpy')}, SciPy "
+             f"{rec.versions.get('scipy')}. MD compute (the runs themselves, from their results): "
+             f"{rec.md_compute_total_s:.0f} s. Pipeline wall time: MD jobs {t['md_s']:.1f} s "
+             "(cached or committed runs cost nothing), paper cases "
+             f"{t['paper_s']:.1f} s, uncertainty {t['uncertainty_s']:.1f} s, total "
+             f"{t['total_s']:.1f} s. Set written to `{rec.set_path}`.", "",
+             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | status | why / run |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rec.rows:
+        lines.append(f"| `{r.key}` | {r.recipe} | {r.quantity or '-'} | {_fmt(r.value)} "
+                     f"{r.units} | {_fmt(r.stderr)} | {r.status} | {r.why or str(r.run_hash or '')[:16]} |")
+    sets = sorted({c["set"] for c in rec.paper_checks})
+    lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec.md_sources.items()), "",
+              "A rejected or missing value keeps the base set's value (its [meta.sources] entry says so).",
+              _work_sentence(rec.rows),
+              "", "## The paper's claims per set", "",
+              "| claim | " + " | ".join(sets) + " |", "|---|" + "---|" * len(sets)]
+    by: dict[str, dict] = {}
+    for c in rec.paper_checks:
+        by.setdefault(c["name"], {})[c["set"]] = "pass" if c["pass"] else "**fail**"
+    for name, res in by.items():
+        lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
+    name = Path(rec.set_path).stem
+    mine = rec.claims()
+    agree = [c["name"] for c in mine if c["pass"]]
+    differ = [c for c in mine if not c["pass"]]
+    lines += ["", f"**Where the calibrated physics agrees with the paper:** {len(agree)} of {len(mine)} claims hold "
+              f"with the `{name}` set.", ""]
+    if differ:
+        lines += [f"**Where it does not** ({len(differ)}):", ""]
+        lines += [f"- `{c['name']}`: needs {c['threshold']}; got {json.dumps(c['values'], default=str)[:300]}"
+                  for c in differ]
+    b = rec.bands
+    lines += ["", "## Uncertainty", "",
+              f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "
+              f"{', '.join(b['covers'])}; failed samples: {b['failed_samples']}.", "",
+              "| output | median | 5 % | 95 % | n |", "|---|---|---|---|---|"]
+    for key in ("first_rebound_over_h0", "rebound_count", "escape_velocity_m_per_s"):
+        v = b[key]
+        lines.append(f"| {key} | {_fmt(v['median'])} | {_fmt(v['p05'])} | {_fmt(v['p95'])} | {v['n']} |")
+    if b.get("rebound_count_capped"):
+        lines += ["", f"**rebound_count is a lower bound:** {b['rebound_count_capped']} of {b['rebound_count']['n']} "
+                      f"samples reached the `max_bounces` cap ({b['max_bounces']}) without sticking; raise "
+                      "`[uncertainty] max_bounces` for the full count."]
+    lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`; data: `uncertainty.csv`, "
+              "`calibration.json`, `paper/checks.json`.", ""]
+    return "\n".join(lines)
