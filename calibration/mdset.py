@@ -40,6 +40,7 @@ from continuum.scene import SceneError, check_value, find_params
 from continuum.schema import FIELD_BY_PATH
 
 from nanoimpact import data
+from nanoimpact.fileio import atomic_write_text
 
 #: Committed MD results shipped with the package (inputs/md/results, installed as package data).
 RESULTS_DIR = data.shipped_root() / "md" / "results"
@@ -330,9 +331,7 @@ def write_parameter_set(table: dict, path: Path, header: str = "") -> Path:
     parsed = tomllib.loads(text)
     if parsed.get("surfaces") != table.get("surfaces"):
         raise RuntimeError("parameter set did not round-trip through TOML")
-    tmp = path.with_suffix(".toml.tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
+    atomic_write_text(path, text)
     return path
 
 

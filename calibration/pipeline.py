@@ -19,6 +19,7 @@ Steps (each timed in the report):
 from __future__ import annotations
 
 import csv
+import io
 import logging
 import math
 import os
@@ -31,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from nanoimpact.executors import Failure, executor
+from nanoimpact.fileio import atomic_save_figure, atomic_write_text
 
 from .mdset import build_parameter_set, committed_result, recipes_needed, write_parameter_set
 from .report import CalibrationReport, ValueRow
@@ -483,14 +485,15 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
 def _write_uncertainty(out: Path, keys, samples, bands) -> None:
     from matplotlib.figure import Figure
 
-    with open(out / "uncertainty.csv", "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(keys + ["rebound1_over_h0", "rebound2_over_h0", "rebound3_over_h0", "rebound_count",
-                           "escape_velocity_m_per_s", "error"])
-        for s in samples:
-            r = (s.get("rebounds_over_h0") or []) + [None] * 3
-            w.writerow([s["overrides"].get(k) for k in keys] + r[:3] +
-                       [s.get("rebound_count"), s.get("escape_velocity"), s.get("error", "")])
+    fh = io.StringIO(newline="")
+    w = csv.writer(fh)
+    w.writerow(keys + ["rebound1_over_h0", "rebound2_over_h0", "rebound3_over_h0", "rebound_count",
+                       "escape_velocity_m_per_s", "error"])
+    for s in samples:
+        r = (s.get("rebounds_over_h0") or []) + [None] * 3
+        w.writerow([s["overrides"].get(k) for k in keys] + r[:3] +
+                   [s.get("rebound_count"), s.get("escape_velocity"), s.get("error", "")])
+    atomic_write_text(out / "uncertainty.csv", fh.getvalue())
     fig = Figure(figsize=(6, 4))
     ax = fig.subplots()
     ok = [s for s in samples if "error" not in s]
@@ -512,5 +515,4 @@ def _write_uncertainty(out: Path, keys, samples, bands) -> None:
                                           ", ".join(bands["covers"]), 95)), fontsize=7)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "uncertainty.png.tmp.png", dpi=110)
-    (out / "uncertainty.png.tmp.png").replace(out / "uncertainty.png")
+    atomic_save_figure(fig, out / "uncertainty.png", dpi=110)

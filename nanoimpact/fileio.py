@@ -49,3 +49,14 @@ def atomic_write_json(path: str | Path, obj: Any, *, indent: int | None = 2, def
     """Write `obj` as JSON (keys sorted) to `path` atomically; returns the path."""
     text = json.dumps(obj, indent=indent, sort_keys=True, default=default)
     return atomic_write_text(path, text + "\n")
+
+
+def atomic_save_figure(fig, path: str | Path, **savefig_kw) -> Path:
+    """Save a matplotlib Figure to `path` atomically (the format from the suffix); returns the path.
+    Rendered to memory first, so a failed render leaves no file at all."""
+    import io
+
+    path = Path(path)
+    buf = io.BytesIO()
+    fig.savefig(buf, format=path.suffix.lstrip(".") or "png", **savefig_kw)
+    return atomic_write_bytes(path, buf.getvalue())

@@ -35,3 +35,17 @@ def test_failed_write_keeps_the_old_file_and_cleans_up(tmp_path):
         atomic_write_json(target, {"not serialisable": object()})
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["r.json"]
+
+
+def test_a_figure_is_saved_whole_or_not_at_all(tmp_path):
+    from matplotlib.figure import Figure
+
+    from nanoimpact.fileio import atomic_save_figure
+
+    fig = Figure(figsize=(2, 2))
+    fig.subplots().plot([0, 1], [0, 1])
+    path = atomic_save_figure(fig, tmp_path / "f.png", dpi=50)
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ValueError):
+        atomic_save_figure(fig, tmp_path / "g.nosuchformat")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png"]      # no partial file, no temporary left
