@@ -95,13 +95,17 @@ class _StderrHandler(logging.StreamHandler):
 
 _handler: logging.Handler | None = None
 _PACKAGES = ("nanoimpact", "continuum", "md", "calibration")
+#: Libraries whose import-time warnings say nothing about a run (MDAnalysis: "netCDF4 is not available.
+#: Writing AMBER ncdf files will be slow.", at every import): shown from -v on.
+_CHATTY = ("MDAnalysis",)
 
 
 def setup_logging(verbosity: int = 0) -> None:
     """Install the command line's stderr handler (replacing an earlier one) and set the levels.
 
-    verbosity 0: INFO from nanoimpact's packages, WARNING from everything else; each -v one step more
-    (-vv: DEBUG everywhere), each -q one step less (-q: WARNING, -qq: ERROR).
+    verbosity 0: INFO from nanoimpact's packages, WARNING from everything else (ERROR from the chatty
+    libraries in _CHATTY); each -v one step more (-vv: DEBUG everywhere), each -q one step less (-q: WARNING,
+    -qq: ERROR).
     """
     global _handler
     root = logging.getLogger()
@@ -113,6 +117,8 @@ def setup_logging(verbosity: int = 0) -> None:
     ours = min(max(logging.INFO - 10 * verbosity, logging.DEBUG), logging.CRITICAL)
     for name in _PACKAGES:
         logging.getLogger(name).setLevel(ours)
+    for name in _CHATTY:
+        logging.getLogger(name).setLevel(logging.ERROR if verbosity < 1 else logging.NOTSET)
     root.setLevel(logging.DEBUG if verbosity >= 2 else max(ours, logging.WARNING))
 
 

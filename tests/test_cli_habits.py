@@ -289,3 +289,19 @@ def test_a_command_name_given_twice_is_refused(monkeypatch):
     monkeypatch.setattr(cli, "COMMANDS", cli.COMMANDS + (Command("impact", "again", "calibration.cli", "main"),))
     with pytest.raises(RuntimeError, match="'impact' is contributed by both continuum.cli and calibration.cli"):
         cli.registry()
+
+
+def test_library_chatter_is_hidden_unless_verbose(monkeypatch, capsys):
+    """MDAnalysis warns at import that netCDF4 is missing; that line is noise for a run (and broke the
+    one-line errors of `nanoimpact md`): hidden by default, shown with -v."""
+    def chatty(args):
+        logging.getLogger("MDAnalysis.coordinates.AMBER").warning("netCDF4 is not available.")
+        logging.getLogger("MDAnalysis.coordinates.AMBER").error("a real MDAnalysis error")
+        return 0
+
+    monkeypatch.setattr(continuum_cli, "cmd_impact", chatty)
+    assert main(["impact", "x"]) == 0
+    err = capsys.readouterr().err
+    assert "netCDF4" not in err and "a real MDAnalysis error" in err
+    assert main(["-v", "impact", "x"]) == 0
+    assert "netCDF4" in capsys.readouterr().err
