@@ -236,6 +236,74 @@ def test_quartz_cell_matches_ase_spacegroup():
         assert np.all(d.min(axis=1) < 1e-9)
 
 
+def _ase_bulk(polymorph: str, face: str, n: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The builder's orthorhombic bulk supercell made with ASE alone: the cell from ``ase.spacegroup.crystal``,
+    the face's orthorhombic cell with ``ase.build.cut`` / ``make_supercell``, repeated; (positions as the builder
+    places them -- rotated into the box and shifted by its 0.05 A -- Si mask, box)."""
+    import ase.build
+    import ase.spacegroup as ase_sg
+    from md.build import CRISTOBALITE_A, QUARTZ
+    if polymorph == "cristobalite":
+        a = CRISTOBALITE_A
+        cell = ase_sg.crystal(["Si", "O"], basis=[(0, 0, 0), (1 / 8, 1 / 8, 1 / 8)], spacegroup=227, setting=1,
+                              cellpar=[a, a, a, 90, 90, 90])
+        axes = {"001": ((1, 0, 0), (0, 1, 0), (0, 0, 1)), "111": ((.5, -.5, 0), (.5, .5, -1), (1, 1, 1))}[face]
+        ortho = ase.build.cut(cell, a=axes[0], b=axes[1], c=axes[2])
+    else:
+        cell = ase_sg.crystal(["Si", "O"], basis=[QUARTZ["si"], QUARTZ["o"]], spacegroup=QUARTZ["spacegroup"],
+                              cellpar=[QUARTZ["a"], QUARTZ["a"], QUARTZ["c"], 90, 90, 120])
+        ortho = ase.build.make_supercell(cell, [[1, 0, 0], [1, 2, 0], [0, 0, 1]])
+    sup = ortho.repeat(n)
+    vectors = sup.cell.array
+    rot = vectors / np.linalg.norm(vectors, axis=1)[:, None]          # rows: the box axes in the crystal frame
+    box = np.linalg.norm(vectors, axis=1)
+    assert np.allclose(rot @ rot.T, np.eye(3), atol=1e-12)                # orthorhombic
+    pos = np.mod(sup.positions @ rot.T + 0.05, box)
+    return pos, np.array(sup.get_chemical_symbols()) == "Si", box
+
+
+def _sorted_rows(p: np.ndarray) -> np.ndarray:
+    return p[np.lexsort(np.round(p, 4).T[::-1])]
+
+
+@pytest.mark.parametrize("polymorph, face, n", [("cristobalite", "001", (2, 2, 2)), ("cristobalite", "111", (2, 1, 1)),
+                                                ("quartz", "0001", (2, 1, 2))])
+def test_bulk_crystals_are_the_atoms_ase_builds(polymorph, face, n):
+    """The builder's bulk supercells hold exactly the atoms ASE builds (ase.spacegroup.crystal for the cell,
+    ase.build.cut / make_supercell for the face's orthorhombic cell): same count, same Si and O positions to
+    1e-6 A once sorted. The builder keeps its own basis order, because atom ids and the seeded condensation and
+    grafting choices follow it (every built system and committed result would change with ASE's order)."""
+    require_backend("ase", "ASE")
+    from md.build.silica import _bulk
+    bulk = _bulk(polymorph, face, *n)
+    ref, ref_si, box = _ase_bulk(polymorph, face, n)
+    assert np.allclose(bulk.cell, box, rtol=0, atol=1e-9)
+    for ours, theirs in ((bulk.si_pos, ref[ref_si]), (bulk.o_pos, ref[~ref_si])):
+        assert ours.shape == theirs.shape
+        assert np.abs(_sorted_rows(ours) - _sorted_rows(theirs)).max() < 1e-6
+
+
+def test_a_built_system_is_an_ase_atoms_and_back(tmp_path):
+    """md.system.atoms: types, charges, masses and molecule ids as Atoms arrays; the topology and groups in
+    atoms.info; back to the same System, whose data file is byte-identical; ase.io writes and reads it."""
+    require_backend("ase", "ASE")
+    import ase.io
+    from md.system.atoms import from_atoms, to_atoms
+    ff = sam_forcefield()
+    s = ots_sam(silica_slab(3, 2, thickness=10.0, face="111", silanol_density=4.5, seed=2), seed=3)
+    atoms = to_atoms(s)
+    assert atoms.get_chemical_formula() == "C216H36O228Si108"
+    assert list(atoms.arrays["ff_types"]) == list(s.types) and np.array_equal(atoms.arrays["mol-id"], s.mol_ids)
+    assert np.array_equal(atoms.get_initial_charges(), s.charges) and np.array_equal(atoms.get_masses(), s.masses)
+    back = from_atoms(atoms)
+    write_data(s, ff, tmp_path / "a.data")
+    write_data(back, ff, tmp_path / "b.data")
+    assert (tmp_path / "a.data").read_bytes() == (tmp_path / "b.data").read_bytes()
+    ase.io.write(tmp_path / "s.extxyz", atoms)
+    again = ase.io.read(tmp_path / "s.extxyz")
+    assert list(again.arrays["ff_types"]) == list(s.types) and np.allclose(again.positions, s.positions, atol=1e-6)
+
+
 def test_unreachable_silanol_density_fails_with_the_achievable_range():
     with pytest.raises(ValueError, match=r"achievable 4\.50\.\.4\.50"):
         silica_slab(2, 2, face="111", thickness=6.0, silanol_density=7.0)

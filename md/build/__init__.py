@@ -12,7 +12,8 @@ One module per kind of structure: :mod:`~md.build.silica` (slabs, asperities), :
 from md.build.common import sam_forcefield, silica_forcefield, water_forcefield
 from md.build.place import place_on
 from md.build.sam import ots_sam
-from md.build.silica import CRISTOBALITE_A, DEFAULT_FACE, QUARTZ, SILICA_FACE, quartz_basis, silica_asperity, silica_slab
+from md.build.silica import (CRISTOBALITE_A, DEFAULT_FACE, QUARTZ, SILICA_FACE, quartz_basis, silica_asperity,
+                             silica_slab)
 from md.build.water import cap_radius, water_cap, water_cylinder, water_slab
 from md.system.topology import flip_upside_down
 

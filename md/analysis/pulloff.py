@@ -1,0 +1,234 @@
+"""Asperity pull-off: the maximum tensile force, traction-law fits and rate extrapolation.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from md import units as _units
+
+from md.analysis.common import KCALMOL_PER_A_TO_N, refined_min
+
+
+# ------------------------------------------------------------------------------------------ pull-off
+
+_LJ93_PEAK = 3.0 ** (1.0 / 6.0)   # peak traction of the LJ 9-3 law at h = 3^(1/6) z0
+
+
+def _law(kind):
+    """Shape f(h/z0) of a law F = amplitude * f; amplitude = 8w/(3 z0) (lj93) or Fc (sphere_lj93)."""
+    if kind == "lj93":
+        return lambda x: x ** -9 - x ** -3
+    if kind == "sphere_lj93":
+        return lambda x: x ** -8 / 3.0 - 4.0 * x ** -2 / 3.0
+    raise ValueError(f"unknown traction law {kind!r}: use 'lj93' or 'sphere_lj93'")
+
+
+def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False, force_stderr=None) -> dict:
+    """Fit an LJ-type force-separation law (positive = repulsive) to (sep, force) in consistent units.
+
+    ``kind="lj93"``: the LJ 9-3 traction law (Maugis 1992)
+        F(D) = (8 w / (3 z0)) [(z0/h)^9 - (z0/h)^3],  h = D - D_off,
+    with equilibrium separation z0 and work w = -int_z0^inf F dh (force x length units of the input;
+    J/m^2 if the input is a traction in Pa vs m).  Peak tension 16 w / (9 sqrt 3 z0) = 1.026 w/z0 at
+    h = 3^(1/6) z0; Maugis' Dugdale range h0 = w / sigma0 = 0.974 z0.
+    ``kind="sphere_lj93"``: a rigid sphere against a flat with the same surface law in the Derjaguin
+    approximation, F(D) = Fc [(z0/h)^8 / 3 - 4 (z0/h)^2 / 3]; Fc = 2 pi R w is the pull-off force,
+    reached at h = z0.
+    With ``offset=True`` the origin D_off of the separation is fitted too (MD separations are measured
+    between atom centres, not from the law's origin).  Points with F > 3 |F_min| (the stiff repulsive
+    wall) are left out so they do not dominate the least squares.
+
+    ``force_stderr`` (per point) weights the least squares by 1/stderr.
+
+    Returns ``kind``, ``params`` (w or Fc, z0, offset), ``z0``, ``w`` (None for sphere_lj93), ``peak``
+    (magnitude of the most tensile force of the law), ``sep_at_peak``, ``h0_maugis`` (lj93), ``rms`` and
+    ``stderr`` (of ``params``, ``z0`` and ``peak``) from the fit's covariance inv(J^T J), scaled by the residual
+    variance (unweighted) or by max(1, reduced chi^2) (weighted); nan when the fit has no degrees of freedom.
+    """
+    from scipy.optimize import least_squares
+
+    d = np.asarray(sep, float).ravel()
+    f = np.asarray(force, float).ravel()
+    order = np.argsort(d)
+    d, f = d[order], f[order]
+    sd = None if force_stderr is None else np.asarray(force_stderr, float).ravel()[order]
+    shape = _law(kind)
+    i = int(np.argmin(f))
+    fmin, dmin = float(f[i]), float(d[i])
+    if not fmin < 0:
+        raise ValueError("the force curve has no tensile (negative) part to fit")
+    use = f <= 3.0 * abs(fmin)
+    # scaled: the minimum at (1, -1). Without an offset the law's origin is d = 0, so d is scaled by dmin
+    # (> 0 required). With an offset, d is measured from the first point used, d0, in units of dmin - d0, so
+    # MD separations that start at or below zero (a compressed contact) scale the same way.
+    if offset:
+        d0 = float(d[use].min())
+        scale = dmin - d0
+        if not scale > 0:
+            raise ValueError("the most tensile point is the first one used: no attractive branch to fit")
+    else:
+        if not dmin > 0:
+            raise ValueError("separations must be positive when the law's origin is not fitted (offset=False)")
+        d0, scale = 0.0, dmin
+    ds, fs = (d[use] - d0) / scale, f[use] / abs(fmin)
+    ws = np.ones_like(fs) if sd is None else abs(fmin) / np.maximum(sd[use], 1e-300)
+    peak_x = _LJ93_PEAK if kind == "lj93" else 1.0
+    peak_val = -float(shape(np.array(peak_x)))       # |shape| at its minimum
+
+    def model(p, dd):
+        amp, z0, off = p[0], p[1], (p[2] if offset else 0.0)
+        h = np.maximum(dd - off, 1e-6)
+        return amp * shape(h / z0)
+
+    def res(p):
+        return (model(p, ds) - fs) * ws
+
+    best = None
+    offs = (-0.2, -0.5, -1.0, -2.0) if offset else (0.0,)
+    for off0 in offs:
+        z00 = (1.0 - off0) / peak_x
+        p0 = [1.0 / peak_val, z00] + ([off0] if offset else [])
+        lo = [0.0, 1e-6] + ([-np.inf] if offset else [])
+        hi = [np.inf, np.inf] + ([float(ds.min()) - 1e-9] if offset else [])
+        try:
+            sol = least_squares(res, p0, bounds=(lo, hi), xtol=1e-14, ftol=1e-14, gtol=1e-14,
+                                max_nfev=20000)
+        except ValueError:
+            continue
+        if best is None or sol.cost < best.cost:
+            best = sol
+    if best is None:
+        raise RuntimeError("traction-law fit failed")
+    amp, z0 = best.x[0] * abs(fmin), best.x[1] * scale
+    off = d0 + best.x[2] * scale if offset else 0.0
+    rms = float(np.sqrt(np.mean((best.fun / ws) ** 2))) * abs(fmin)
+    # covariance of (amp, z0[, offset]) in physical units
+    npar, m = len(best.x), int(ds.size)
+    dof = m - npar
+    try:
+        cov = np.linalg.inv(best.jac.T @ best.jac)
+        chi2 = float(np.sum(best.fun ** 2)) / dof if dof > 0 else float("nan")
+        cov = cov * (chi2 if sd is None else max(1.0, chi2))
+        cov = cov * np.outer(*(2 * [np.array([abs(fmin), scale, scale][:npar])]))
+    except np.linalg.LinAlgError:
+        cov = np.full((npar, npar), np.nan)
+    se = lambda g: float(math.sqrt(g @ cov @ g)) if np.all(np.isfinite(cov)) and g @ cov @ g >= 0 else float("nan")
+    g_amp, g_z0 = np.eye(npar)[0], np.eye(npar)[1]
+    out = {"kind": kind, "z0": float(z0), "offset": float(off), "rms": rms,
+           "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0), "dof": dof}
+    stderr = {"z0": se(g_z0), "offset": se(np.eye(npar)[2]) if offset else 0.0, "peak": se(g_amp) * peak_val}
+    if kind == "lj93":
+        w = amp * 3.0 * z0 / 8.0
+        stderr["w"] = se(3.0 / 8.0 * (z0 * g_amp + amp * g_z0))
+        out.update(w=float(w), params={"w": float(w), "z0": float(z0), "offset": float(off)},
+                   h0_maugis=float(w / (amp * peak_val)))
+    else:
+        stderr["Fc"] = se(g_amp)
+        out.update(w=None, params={"Fc": float(amp), "z0": float(z0), "offset": float(off)})
+    out["stderr"] = stderr
+    return out
+
+
+def pull_off_analysis(separation_A, force_kcal_per_molA, smooth: int | None = None,
+                      radius_m: float | None = None, law: str = "lj93", fit_offset: bool = True) -> dict:
+    """Pull-off force and interaction range from an asperity force-separation curve (SI out).
+
+    Convention: ``force_kcal_per_molA`` is the force on the asperity along the pulling direction,
+    positive = repulsive (pushing the surfaces apart); ``separation_A`` grows as the asperity is pulled
+    off.  ``smooth`` (odd window, in points) applies a cubic Savitzky-Golay filter before the minimum is
+    searched.
+
+    Returns (SI):
+    ``max_tensile_force`` (N, the magnitude of the most tensile force, spline-refined),
+    ``separation_at_max`` (m), ``zero_force_separation`` (m, the last repulsive-to-tensile crossing
+    before the maximum tension), ``z0_zero_to_min`` (m, the distance from that crossing to the maximum
+    tension -- a model-free range), ``traction_fit`` (:func:`fit_traction_law` with ``law``, in SI) and
+    ``z0`` (m): the equilibrium separation z0 of the fitted law, the length in Tabor's parameter and
+    Maugis' lambda (for ``lj93`` the zero-to-min distance is (3^(1/6) - 1) z0 = 0.201 z0).  With
+    ``radius_m``: ``eff_work_jkr`` = F / (1.5 pi R) and ``eff_work_dmt`` = F / (2 pi R) (J/m^2).
+    ``curve``: ``separation`` (m), ``force`` (N) and ``force_smoothed`` (N) sorted by separation.
+    """
+    d = np.asarray(separation_A, float).ravel()
+    f = np.asarray(force_kcal_per_molA, float).ravel()
+    if d.shape != f.shape or d.size < 3:
+        raise ValueError("separation_A and force_kcal_per_molA must be 1-D arrays of equal length >= 3")
+    order = np.argsort(d, kind="stable")
+    d = _units.angstrom_to_m(d[order])
+    f = f[order] * KCALMOL_PER_A_TO_N
+    fs = f
+    if smooth:
+        from scipy.signal import savgol_filter
+
+        win = int(smooth) | 1
+        fs = savgol_filter(f, win, min(3, win - 1))
+    i = int(np.argmin(fs))
+    d_max, f_min = refined_min(d, fs, i)
+    out = {"max_tensile_force": float(max(-f_min, 0.0)), "separation_at_max": d_max, "units": "SI",
+           "curve": {"separation": d, "force": f, "force_smoothed": fs}}
+    cross = np.nonzero((fs[:i] >= 0) & (fs[1:i + 1] < 0))[0]
+    if cross.size:
+        j = int(cross[-1])
+        d_zero = float(d[j] + (d[j + 1] - d[j]) * fs[j] / (fs[j] - fs[j + 1]))
+    else:
+        d_zero = float("nan")
+    out["zero_force_separation"] = d_zero
+    out["z0_zero_to_min"] = d_max - d_zero
+    try:
+        fit = fit_traction_law(d, fs, kind=law, offset=fit_offset)
+    except (ValueError, RuntimeError) as exc:
+        fit = {"error": str(exc), "z0": float("nan")}
+    out["traction_fit"] = fit
+    out["z0"] = fit["z0"]
+    out["z0_stderr"] = fit.get("stderr", {}).get("z0", float("nan"))
+    if radius_m is not None:
+        fmag = out["max_tensile_force"]
+        out["eff_work_jkr"] = fmag / (1.5 * math.pi * float(radius_m))
+        out["eff_work_dmt"] = fmag / (2.0 * math.pi * float(radius_m))
+        if law == "sphere_lj93" and "params" in fit:
+            fit["w"] = fit["params"]["Fc"] / (2.0 * math.pi * float(radius_m))
+    else:
+        out["eff_work_jkr"] = out["eff_work_dmt"] = None
+    return out
+
+
+def rate_extrapolation(rates, forces, target_rate: float = 1.0, forces_stderr=None,
+                       temperature_K: float | None = None) -> dict:
+    """Pull-off force vs loading rate: linear fit F = a + b ln(rate) (Bell 1978; Evans-Ritchie 1997).
+
+    In the Bell-Evans regime the most probable rupture force grows with the logarithm of the loading
+    rate, F = (kT / x_b) ln(rate x_b / (k_off kT)); ``F0`` is the fit evaluated at ``target_rate`` (same
+    unit as ``rates``: default 1, e.g. 1 m/s for pulling speeds in m/s).  ``slope`` is dF/d ln(rate);
+    ``stderr`` of F0 from the fit covariance (weighted by ``forces_stderr`` if given, otherwise scaled
+    by the residuals; nan with two points).  With ``temperature_K`` and forces in N, ``x_beta`` =
+    kT / slope (m).  Extrapolating far below the simulated rates is a lower bound on the slow-pulling
+    force only while the Bell-Evans regime holds: near equilibrium the force levels off at a finite
+    value (Friddle, Noy & De Yoreo, PNAS 109 (2012) 13573), so F0 below that is not physical.
+    """
+    r = np.asarray(rates, float).ravel()
+    fo = np.asarray(forces, float).ravel()
+    if r.shape != fo.shape or r.size < 2 or np.any(r <= 0):
+        raise ValueError("need >= 2 positive rates with one force each")
+    x = np.log(r)
+    a = np.column_stack([np.ones_like(x), x])
+    if forces_stderr is not None:
+        w = 1.0 / np.asarray(forces_stderr, float).ravel()
+    else:
+        w = np.ones_like(x)
+    aw, fw = a * w[:, None], fo * w
+    coef, *_ = np.linalg.lstsq(aw, fw, rcond=None)
+    cov = np.linalg.inv(aw.T @ aw)
+    dof = x.size - 2
+    if forces_stderr is None:
+        cov = cov * (np.sum((fw - aw @ coef) ** 2) / dof if dof > 0 else np.nan)
+    xt = math.log(float(target_rate))
+    g = np.array([1.0, xt])
+    f0 = float(coef[0] + coef[1] * xt)
+    out = {"F0": f0, "slope": float(coef[1]), "intercept": float(coef[0]),
+           "stderr": float(math.sqrt(g @ cov @ g)) if np.all(np.isfinite(cov)) else float("nan"),
+           "slope_stderr": float(math.sqrt(cov[1, 1])) if np.isfinite(cov[1, 1]) else float("nan"),
+           "target_rate": float(target_rate)}
+    if temperature_K is not None and coef[1] > 0:
+        out["x_beta"] = _units.BOLTZMANN * float(temperature_K) / float(coef[1])
+    return out
