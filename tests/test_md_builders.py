@@ -304,6 +304,18 @@ def test_a_built_system_is_an_ase_atoms_and_back(tmp_path):
     assert list(again.arrays["ff_types"]) == list(s.types) and np.allclose(again.positions, s.positions, atol=1e-6)
 
 
+@pytest.mark.parametrize("builder", [silica_slab, silica_asperity, ots_sam, water_slab, water_cylinder, water_cap,
+                                     place_on])
+def test_every_builder_makes_a_small_valid_system_with_no_arguments(builder, tmp_path):
+    """md.build's builders all have defaults: called bare, each gives a neutral system whose every bonded term
+    is typed (the data file writes), small enough for a quick look (ase.visualize.view(to_atoms(s)))."""
+    s = builder()
+    assert 0 < s.n_atoms < 5000
+    assert abs(s.total_charge()) < 1e-9
+    ff = combine("silica_interface", "ots_trappe_ua", "water_spce")
+    write_data(s, ff, tmp_path / "s.data")
+
+
 def test_unreachable_silanol_density_fails_with_the_achievable_range():
     with pytest.raises(ValueError, match=r"achievable 4\.50\.\.4\.50"):
         silica_slab(2, 2, face="111", thickness=6.0, silanol_density=7.0)

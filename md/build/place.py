@@ -8,11 +8,13 @@ import numpy as np
 
 from md.system.topology import System, merge, translate
 from md.build.common import _plain
+from md.build.silica import silica_slab
+from md.build.water import water_cap
 
 # ================================================================================================ assembly
 
-def place_on(substrate: System, adsorbate: System, gap: float = 3.0, *, vacuum: float = 15.0,
-             center: bool = True, tolerance: float = 1e-3) -> System:
+def place_on(substrate: System | None = None, adsorbate: System | None = None, gap: float = 3.0, *,
+             vacuum: float = 15.0, center: bool = True, tolerance: float = 1e-3) -> System:
     """Put ``adsorbate`` on top of ``substrate``: its lowest atom ``gap`` (A) above the substrate's highest.
 
     The box is the substrate's in x, y; z extends ``vacuum`` above the highest atom. Axes along which the
@@ -20,7 +22,14 @@ def place_on(substrate: System, adsorbate: System, gap: float = 3.0, *, vacuum: 
     have the substrate's length (to ``tolerance`` A); along the others the adsorbate is centred on the box
     when ``center`` and must fit. Bonded terms are kept (no bonds across the interface). Groups of the same
     name are concatenated; groups 'substrate' and 'adsorbate' tell the two parts apart.
+
+    With no arguments: an R = 11 A water cap on an 8 x 2 cristobalite (111) slab 10 A thick (a small contact-angle
+    system); a missing ``adsorbate`` is that cap, sized to the substrate's y length.
     """
+    if substrate is None:
+        substrate = silica_slab(8, 2, thickness=10.0)
+    if adsorbate is None:
+        adsorbate = water_cap(11.0, float(substrate.cell[1]))
     axes = str(adsorbate.info.get("periodic_axes", "xy"))
     shift = np.zeros(3)
     for k, ax in enumerate("xy"):

@@ -12,6 +12,7 @@ import numpy as np
 
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, merge, minimum_image, remove_atoms, with_bonded_terms
+from md.build.silica import silica_slab
 from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, sam_forcefield
 
 # ================================================================================================ OTS monolayer
@@ -66,9 +67,9 @@ def _chain_template(ff: ForceField, chain_length: int, tilt_deg: float, azimuth_
     return np.array(pos), types, bonds
 
 
-def ots_sam(substrate: System, coverage: float = 4.5, *, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
-            chain_length: int = 18, seed: int = 0, min_spacing: float = 4.4, site_group: str = "silanol_O_top",
-            vacuum: float = 10.0, forcefield: ForceField | None = None) -> System:
+def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg: float = 15.0,
+            tilt_azimuth_deg: float = 0.0, chain_length: int = 18, seed: int = 0, min_spacing: float = 4.4,
+            site_group: str = "silanol_O_top", vacuum: float = 10.0, forcefield: ForceField | None = None) -> System:
     """Graft an OTS monolayer (C``chain_length`` united-atom chains on Si(OH)2 heads) onto a flat silica slab.
 
     Grafting sites are drawn (seeded, random order) from the substrate's top silanol O (group ``site_group``)
@@ -85,7 +86,12 @@ def ots_sam(substrate: System, coverage: float = 4.5, *, tilt_deg: float = 15.0,
 
     Groups added: 'sam' (all chain atoms incl. head OH), 'sam_head_si', 'sam_ch3', 'sam_anchor_O'.
     ``info``: chains, coverage (nm^-2), thickness (mean CH3 height above the mean anchor-O plane, A), sites.
+
+    ``substrate=None`` grafts onto a small cristobalite (111) slab, ``silica_slab(3, 2, thickness=10.0,
+    face="111", silanol_density=4.5, seed=seed)`` (the smoke SAM's).
     """
+    if substrate is None:
+        substrate = silica_slab(3, 2, thickness=10.0, face="111", silanol_density=4.5, seed=seed)
     ff = forcefield or sam_forcefield()
     rng = np.random.default_rng(seed)
     if chain_length < 2:

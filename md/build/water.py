@@ -84,7 +84,7 @@ def _water_system(sites: np.ndarray, cell: np.ndarray, ff: ForceField, rng, info
     return replace(s, info=_plain(info))
 
 
-def water_slab(lx: float, ly: float, thickness: float = 30.0, *, density: float = WATER_DENSITY,
+def water_slab(lx: float = 20.0, ly: float = 20.0, thickness: float = 30.0, *, density: float = WATER_DENSITY,
                vacuum: float = 15.0, seed: int = 0, forcefield: ForceField | None = None) -> System:
     """A water film periodic in x, y (box ``lx`` x ``ly`` A), ``thickness`` A thick, centred in z with
     ``vacuum`` above and below (for gamma_lv and density profiles, or to put on a substrate).
@@ -112,8 +112,9 @@ def water_slab(lx: float, ly: float, thickness: float = 30.0, *, density: float 
     return _water_system(sites, cell, ff, rng, info)
 
 
-def water_cylinder(radius: float, length: float, *, box_x: float | None = None, density: float = WATER_DENSITY,
-                   vacuum: float = 15.0, seed: int = 0, forcefield: ForceField | None = None) -> System:
+def water_cylinder(radius: float = 11.0, length: float = 20.0, *, box_x: float | None = None,
+                   density: float = WATER_DENSITY, vacuum: float = 15.0, seed: int = 0,
+                   forcefield: ForceField | None = None) -> System:
     """A quasi-2-D droplet: a water cylinder of ``radius`` (A) with its axis along y, periodic along y with
     period ``length`` (A, the box y length), circular cross-section in x-z.
 
@@ -165,8 +166,8 @@ def cap_radius(radius_equivalent: float, contact_angle_deg: float) -> float:
     return float(radius_equivalent) * math.sqrt(math.pi / (th - math.sin(th) * math.cos(th)))
 
 
-def water_cap(radius: float, length: float, *, contact_angle_deg: float = 90.0, box_x: float | None = None,
-              density: float = WATER_DENSITY, vacuum: float = 15.0, seed: int = 0,
+def water_cap(radius: float = 11.0, length: float = 20.0, *, contact_angle_deg: float = 90.0,
+              box_x: float | None = None, density: float = WATER_DENSITY, vacuum: float = 15.0, seed: int = 0,
               forcefield: ForceField | None = None) -> System:
     """A quasi-2-D droplet started near its resting shape: a cylindrical cap, periodic along y (period
     ``length`` A), whose flat base lies on the plane z = ``vacuum`` and meets the circular surface at

@@ -83,11 +83,17 @@ def job_for(recipe: Recipe, fidelity: str) -> Job:
                content_sha256=recipe.canonical_sha256(fidelity))
 
 
-def run_hash(recipe: Recipe, fidelity: str, forcefield_files: Sequence[str]) -> tuple[str, dict[str, Any]]:
-    """The run hash of ``recipe`` at ``fidelity`` (hex digest and the hashed document;
-    :func:`md.engine.hashing.run_hash` with the workflow's version)."""
-    return hashing.run_hash(recipe.canonical(fidelity), fidelity, forcefield_files,
-                            get_workflow(recipe.workflow).version)
+def run_hash(recipe: Recipe | str | Path, fidelity: str,
+             forcefield_files: Sequence[str] | None = None) -> tuple[str, dict[str, Any]]:
+    """The run hash of ``recipe`` (a Recipe, a shipped name or a file) at ``fidelity``: hex digest and the hashed
+    document (:func:`md.engine.hashing.run_hash` with the workflow's version). ``forcefield_files`` defaults to
+    the workflow's own for the recipe's settings -- what a run would use."""
+    if not isinstance(recipe, Recipe):
+        recipe = load_recipe(recipe)
+    wf = get_workflow(recipe.workflow)
+    if forcefield_files is None:
+        forcefield_files = wf.forcefield_files(recipe.settings(fidelity))
+    return hashing.run_hash(recipe.canonical(fidelity), fidelity, forcefield_files, wf.version)
 
 
 def run_recipe(recipe: Recipe | str | Path, fidelity: str = "quick", *, out: str | Path | None = None,
