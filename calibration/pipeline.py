@@ -287,8 +287,7 @@ def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, wor
 def current_hash(recipe_name: str, fidelity: str) -> str:
     """The run hash md would give `recipe_name` at `fidelity` now."""
     from md.recipe import load_recipe
-    from md.runner import run_hash
-    from md.workflows import get_workflow
+    from md.workflows import get_workflow, run_hash
 
     recipe = load_recipe(recipe_name)
     wf = get_workflow(recipe.workflow)
@@ -304,7 +303,7 @@ def md_job(task: tuple) -> dict:
     if committed is not None and committed.get("run_hash") == digest:
         return {"recipe": recipe_name, "result": committed, "source": "committed", "wall_s": time.perf_counter() - start}
     from md.recipe import load_recipe
-    from md.runner import run_recipe
+    from md.workflows import run_recipe
 
     # resume: a run this job (or a worker that died, or an earlier calibration) left unfinished goes on from its
     # last restart instead of starting again; with nothing to resume it is a fresh run
