@@ -106,6 +106,9 @@ class DriverSettings:
     rest_fraction: float = 1e-3
     samples_per_flight: int = 64
     samples_per_step: int = 3
+    #: integrate contacts of laws with a compiled form (`ContactLaw.compiled`) with the compiled kernel
+    #: (`continuum.contact_kernel`, the same DOP853 algorithm); False: always the Python stepper
+    compiled: bool = True
 
 
 def flight_time_to(gap0: float, v0: float, gravity: float, target: float) -> float:
@@ -237,12 +240,7 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
         return DOP853(rhs, t_start, np.asarray(y_start, float), t_bound=settings.max_time, rtol=settings.rtol,
                       atol=atol, first_step=min(first, cap), max_step=cap)
 
-    solver = start(t0, [gap0, v0])
-    at(t0)
-    peak_force = law.force(gap0)
-    max_pen = -gap0
     e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
-
     pull = {"force": math.inf, "after_max": False}
     profiles: dict = {}
 
@@ -255,8 +253,6 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
             if snap is not None:
                 pull["force"] = f
                 profiles["pull_off"] = {"t": s, "gap": gap_, "force": f, **snap}
-
-    sample(t0, gap0, v0)
 
     def finish(t_end, gap_end, v_end, end, booked):
         at(t_end)
@@ -273,6 +269,53 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                    energy_lost=e_mech_in - e_mech_out if free else math.nan, energy_booked=booked,
                    profiles=profiles or None)
         return {"bounce": b, "t": t_end, "gap": gap_end, "v": v_end, "end": end, "booked": booked}
+
+    compiled = law.compiled(t0) if settings.compiled else None
+    kernel = None
+    if compiled is not None:
+        from .compiled_contact import run_compiled
+        kernel = run_compiled(compiled, mass, gravity, t0, gap0, v0, rtol=settings.rtol, atol=atol,
+                              first_step=1e-3 * length / speed, max_step=law.max_step(speed),
+                              t_bound=settings.max_time, release=law.release_gap(),
+                              bound_is_final=law.bound_is_final, has_history=law.has_history,
+                              samples_per_step=settings.samples_per_step)
+    if kernel is not None:
+        law.compiled_commit(compiled.S, kernel.last_accept - t0)
+        for t_, gap_, v_, f_, stored_, diss_, kind_ in kernel.samples:
+            if kind_ == 0.0:
+                record(t_, gap_, v_, f_, index, stored_, diss_)
+            else:
+                record(t_, gap_, v_, 0.0, -1, 0.0, extra_booked=diss_)
+        peak_force, max_pen = kernel.peak_force, kernel.max_penetration
+        if kernel.max_approach is not None:
+            # the profiles the Python stepper takes: at the first maximum approach, and at the lowest force after it
+            te, ge = kernel.max_approach
+            at(te)
+            snap = law.snapshot(ge)
+            if snap is not None:
+                profiles["max_approach"] = {"t": te, "gap": ge, "force": law.force(ge), **snap}
+            pull["after_max"] = True
+        if kernel.pull_off is not None:
+            te, ge, fe = kernel.pull_off
+            at(te)
+            snap = law.snapshot(ge)
+            if snap is not None:
+                pull["force"] = fe
+                profiles["pull_off"] = {"t": te, "gap": ge, "force": fe, **snap}
+        if kernel.end != "stop_time":
+            return finish(kernel.t, kernel.gap, kernel.v, kernel.end, kernel.booked)
+        # the law's force jumps here (a time event): the Python law samples and accepts it and goes on
+        te, ye = kernel.t, [kernel.gap, kernel.v]
+        at(te)
+        sample(te, ye[0], ye[1])
+        law.accept(ye[0])
+        solver = start(te, ye)
+    else:
+        solver = start(t0, [gap0, v0])
+        at(t0)
+        peak_force = law.force(gap0)
+        max_pen = -gap0
+        sample(t0, gap0, v0)
 
     while True:
         release = law.release_gap()       # may grow during a contact (bridges hold beyond the dry release)

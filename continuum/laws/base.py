@@ -95,6 +95,16 @@ class ContactLaw(ABC):
     def accept(self, gap: float) -> None:
         """Update history after an accepted integration step (stateless laws ignore it)."""
 
+    def compiled(self, t0: float):
+        """The law's compiled form for the contact that starts at `t0` (s), a
+        `continuum.compiled_contact.CompiledLaw`, or None (the driver's Python stepper integrates it).
+        Called after `prepare` and `reset`."""
+        return None
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        """Take back the history `state` (the CompiledLaw's S) after a compiled contact whose last accepted
+        state was `last_accept` s after touch."""
+
     def snapshot(self, gap: float) -> dict | None:
         """Spatial profiles at `gap` (pressure, deflection...) for laws that have them, else None."""
         return None

@@ -281,6 +281,32 @@ class RigidRoughRoller(ContactLaw):
     def release_gap(self):
         return self.end_gap
 
+    # ------------------------------------------------------------------ compiled form
+    def compiled(self, t0: float):
+        """The tables as the compiled kernel reads them (`continuum.contact_kernel.LAW_RIGID_TABLE`)."""
+        from ..compiled_contact import CompiledLaw
+        from .. import contact_kernel as ck
+
+        key = (id(self._force), id(self._energy), id(self._count))
+        if getattr(self, "_compiled_key", None) != key:
+            (ftx, fty, fc), (etx, ety, ec) = self._force.tck, self._energy.tck
+            if self._force.degrees != (3, 3) or self._energy.degrees != (3, 3):
+                raise ValueError("the compiled footprint law evaluates bicubic tables only")
+            P = np.zeros(7)
+            P[ck.P_END_GAP], P[ck.P_REACH], P[ck.P_ATTACH] = self.end_gap, self.reach, self.attach_stretch
+            P[ck.P_RELEASE], P[ck.P_R_IN], P[ck.P_H_LO] = self.release_stretch, self._r_in, self._h_lo
+            P[ck.P_LOOP] = float(self.surface.loop_energy)
+            tables = tuple(np.ascontiguousarray(a, float) for a in (ftx, fty, fc, etx, ety, ec, self._count.x))
+            self._compiled_tables = (P, tables + (np.ascontiguousarray(self._count.c, float),))
+            self._compiled_key = key
+        P, T = self._compiled_tables
+        S = np.array([self.h_min, self.count_min, self.max_contacts, float(self.beyond_tables), 0.0])
+        return CompiledLaw(ck.LAW_RIGID_TABLE, P, T, S)
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        self.h_min, self.count_min, self.max_contacts = float(state[0]), float(state[1]), float(state[2])
+        self.beyond_tables = int(state[3])
+
     def on_release(self):
         return self.dissipated(self.end_gap)
 

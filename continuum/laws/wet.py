@@ -247,6 +247,22 @@ class WetRoughRoller(ContactLaw):
         self.bridges.accept(gap, self.t)
         self.longest_contact = max(self.longest_contact, self.t)
 
+    def compiled(self, t0: float):
+        """Before t_a no bridge exists and this law is its dry law: the dry law's compiled form, stopping at t_a
+        (where bridges condense on every summit in contact and this law goes on in Python)."""
+        dry = self.dry.compiled(t0)
+        if dry is None:
+            return None
+        dry.t_stop = t0 + self.bridges.t_a
+        return dry
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        # what `accept` does before t_a at every accepted state: the dry history, the contact time seen
+        self.dry.compiled_commit(state, last_accept)
+        self.bridges.t_acc = last_accept
+        self.bridges.g_acc = 0.0
+        self.longest_contact = max(self.longest_contact, last_accept)
+
     def release_gap(self):
         dry = self.dry.release_gap()
         return max(dry, self.bridges.d_k) if self.bridges.ever else dry
