@@ -124,3 +124,14 @@ def run_compiled(law_c: CompiledLaw, mass: float, gravity: float, t0: float, gap
 def power_law(k: float, n: float) -> CompiledLaw:
     """F = k (-h)^n for h < 0 (N; k in N/m^n), no history: Hertz sphere (n = 3/2, k = 4/3 E* sqrt(R)) for tests."""
     return CompiledLaw(ck.LAW_POWER, np.array([k, n]), EMPTY_TABLES, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+
+
+def warm_up() -> None:
+    """Load (or compile, the first time on a machine: ~15 s) the kernel in this process: a process pool forked
+    after it inherits the compiled code instead of loading it again in every worker (~1.5 s each)."""
+    law = power_law(1.0, 1.5)
+    saved = KernelStats(**vars(STATS))
+    run_compiled(law, 1.0, 0.0, 0.0, 0.0, -1.0, rtol=1e-6, atol=np.array([1e-9, 1e-9]), first_step=1e-3,
+                 max_step=math.inf, t_bound=10.0, release=0.0, bound_is_final=True, has_history=False,
+                 samples_per_step=1)
+    STATS.__dict__.update(vars(saved))

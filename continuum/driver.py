@@ -162,6 +162,32 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
             if ek_ref:
                 worst = max(worst, abs(e - e0) / ek_ref)
 
+    def record_block(rows: np.ndarray, phase_: int) -> None:
+        """`record` for many samples at once: rows of the compiled kernel (t, gap, v, force, stored, dissipated,
+        kind), kind 1 the instant after release (phase -1, no force, nothing stored, the loss booked)."""
+        nonlocal worst, worst_abs, turnover
+        if len(rows) == 0:
+            return
+        t_, gap_, v_, f_, stored, extra, kind = rows.T
+        after = kind != 0.0
+        f_ = np.where(after, 0.0, f_)
+        stored = np.where(after, 0.0, stored)
+        phases = np.where(after, -1, phase_)
+        kinetic = 0.5 * mass * v_ * v_
+        e = kinetic + mass * gravity * gap_ + stored + booked + extra
+        trace.t.extend(t_.tolist())
+        trace.gap.extend(gap_.tolist())
+        trace.velocity.extend(v_.tolist())
+        trace.force.extend(f_.tolist())
+        trace.phase.extend(phases.tolist())
+        trace.energy.extend(e.tolist())
+        turnover = max(turnover, float(np.max(kinetic + np.abs(stored) + booked + extra)))
+        dev = float(np.max(np.abs(e - e0)))
+        worst_abs = max(worst_abs, dev)
+        if ek_ref:
+            worst = max(worst, dev / ek_ref)
+
+    record.block = record_block
     e0 = energy(gap, v, 0.0)
     for index in range(settings.max_bounces):
         # ---------------- free flight (closed form) ----------------
@@ -281,11 +307,7 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
                               samples_per_step=settings.samples_per_step)
     if kernel is not None:
         law.compiled_commit(compiled.S, kernel.last_accept - t0)
-        for t_, gap_, v_, f_, stored_, diss_, kind_ in kernel.samples:
-            if kind_ == 0.0:
-                record(t_, gap_, v_, f_, index, stored_, diss_)
-            else:
-                record(t_, gap_, v_, 0.0, -1, 0.0, extra_booked=diss_)
+        record.block(kernel.samples, index)
         peak_force, max_pen = kernel.peak_force, kernel.max_penetration
         if kernel.max_approach is not None:
             # the profiles the Python stepper takes: at the first maximum approach, and at the lowest force after it

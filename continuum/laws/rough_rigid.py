@@ -159,9 +159,18 @@ class RigidRoughRoller(ContactLaw):
                 # values, spline coefficients: ~16 floats per node)
                 "peak_bytes": 8 * (100 * min(_BLOCK_STATES, nodes * 2 * n_gauss) + 16 * nodes)}
 
+    #: Table sets kept per law (by design depth): a sweep or bisection that comes back to an impact speed
+    #: finds its tables instead of building them again (~1 s each); the same depth gives the same tables.
+    MAX_KEPT_TABLES = 24
+
     def _build(self, depth: float) -> None:
         import time
 
+        kept = self.__dict__.setdefault("_kept_tables", {})
+        if depth in kept:
+            (self._force, self._energy, self._count, self._h_lo, self._h_hi, self.table_depth,
+             self.table_points) = kept[depth]
+            return
         start = time.perf_counter()
         refusal = table_cost_refusal(self.sigma, self.table_shape(self.sigma, self.release_stretch, self.end_gap, depth,
                                                                   self.resolution),
@@ -188,6 +197,9 @@ class RigidRoughRoller(ContactLaw):
         self.table_depth = depth
         self.build_seconds += time.perf_counter() - start
         self.table_points = force.size
+        if len(kept) >= self.MAX_KEPT_TABLES:
+            kept.pop(next(iter(kept)))
+        kept[depth] = (self._force, self._energy, self._count, self._h_lo, self._h_hi, depth, self.table_points)
 
     def prepare(self, mass: float, speed: float, gravity: float) -> None:
         """Extend the tables if this impact can reach deeper than they do."""
@@ -201,9 +213,18 @@ class RigidRoughRoller(ContactLaw):
         """Depth below the datum (m) at which the approach branch has absorbed `energy` (J); beyond the
         averaged model's range the scene is refused (`SceneError`)."""
         first = min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
-        return beyond_range(lambda: absorbing_depth(lambda ds: self._integrate("pressure", -ds, np.zeros_like(ds)),
-                                                    energy, first_step=first, weight=weight,
+        return beyond_range(lambda: absorbing_depth(self._approach_forces, energy, first_step=first, weight=weight,
                                                     max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma), self.sigma)
+
+    def _approach_forces(self, depths: np.ndarray) -> np.ndarray:
+        """First-approach forces (N) at `depths` (m below the datum), remembered: the depth search walks the same
+        batches of depths for every impact (its steps depend on the law only), so each contact after the first
+        re-reads them instead of re-integrating (~20 ms per contact)."""
+        memo = self.__dict__.setdefault("_approach_memo", {})
+        key = depths.tobytes()
+        if key not in memo:
+            memo[key] = self._integrate("pressure", -depths, np.zeros_like(depths))
+        return memo[key].copy()
 
     # ------------------------------------------------------------------ state
     def reset(self) -> None:
@@ -287,8 +308,8 @@ class RigidRoughRoller(ContactLaw):
         from ..compiled_contact import CompiledLaw
         from .. import contact_kernel as ck
 
-        key = (id(self._force), id(self._energy), id(self._count))
-        if getattr(self, "_compiled_key", None) != key:
+        # the splines these arrays came from are kept with them (an identity test on live objects)
+        if getattr(self, "_compiled_for", None) != (self._force, self._energy, self._count):
             (ftx, fty, fc), (etx, ety, ec) = self._force.tck, self._energy.tck
             if self._force.degrees != (3, 3) or self._energy.degrees != (3, 3):
                 raise ValueError("the compiled footprint law evaluates bicubic tables only")
@@ -298,7 +319,7 @@ class RigidRoughRoller(ContactLaw):
             P[ck.P_LOOP] = float(self.surface.loop_energy)
             tables = tuple(np.ascontiguousarray(a, float) for a in (ftx, fty, fc, etx, ety, ec, self._count.x))
             self._compiled_tables = (P, tables + (np.ascontiguousarray(self._count.c, float),))
-            self._compiled_key = key
+            self._compiled_for = (self._force, self._energy, self._count)
         P, T = self._compiled_tables
         S = np.array([self.h_min, self.count_min, self.max_contacts, float(self.beyond_tables), 0.0])
         return CompiledLaw(ck.LAW_RIGID_TABLE, P, T, S)
