@@ -114,7 +114,7 @@ def test_ots_asperity_is_grafted_at_sam_density():
     from md.build import silica_asperity
     from md.workflows.pulloff import _graft_dome
     s = _settings("pulloff_ots", "quick")
-    asp = silica_asperity(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
+    asp = silica_asperity.system(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
                           margin=s["asperity_margin_A"], silanol_density=4.5, face="111", seed=int(s["seed"]))
     sam, g = _graft_dome(asp, s, int(s["seed"]) + 30)
     assert g["chains_per_projected_nm2"] >= 4.0 and g["chains"] == g["requested_chains"]
@@ -180,7 +180,7 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     ff = _ff(["silica_interface", "ots_trappe_ua"])
     lower = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, "111")
     upper = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 11, "111")
-    system = place_on(lower, flip_upside_down(upper), gap=3.0, vacuum=40.0)
+    system = place_on.system(lower, flip_upside_down(upper), gap=3.0, vacuum=40.0)
     data = write_data(system, ff, tmp_path / "ots.data")
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")
     n_low = len(system.group("substrate"))

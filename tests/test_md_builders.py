@@ -13,8 +13,8 @@ import re
 import numpy as np
 import pytest
 
-from md.build import (SILICA_FACE, flip_upside_down, ots_sam, place_on, sam_forcefield, silica_asperity,
-                      silica_forcefield, silica_slab, water_cap, water_cylinder, water_forcefield, water_slab)
+from md import build
+from md.build import SILICA_FACE, sam_forcefield, silica_forcefield, water_forcefield
 from md.system.forcefield import (combine, lammps_angle_coeffs, lammps_bond_coeffs, lammps_dihedral_coeffs,
                                   lammps_type_ids)
 from md.system.lammps_data import read_back_check, write_data
@@ -23,6 +23,14 @@ from md.system.topology import (MissingParameterError, System, merge, minimum_im
 from md.units import AVOGADRO, WATER_DENSITY
 
 from conftest import require_backend
+
+#: The specs below check the System each builder makes (``builder.system``: what the builders hand each other and
+#: the workflows write); the public builders return that same build as an ``ase.Atoms``
+#: (test_public_builders_return_the_same_build_as_ase_atoms).
+BUILDERS = ("silica_slab", "silica_asperity", "ots_sam", "water_slab", "water_cylinder", "water_cap", "place_on",
+            "flip_upside_down")
+silica_slab, silica_asperity, ots_sam, water_slab, water_cylinder, water_cap, place_on, flip_upside_down = (
+    getattr(build, name).system for name in BUILDERS)
 
 CHARGE_TOL = 1e-6
 SILICA = ("SC4", "OC23", "OC24", "HOY")
@@ -304,16 +312,36 @@ def test_a_built_system_is_an_ase_atoms_and_back(tmp_path):
     assert list(again.arrays["ff_types"]) == list(s.types) and np.allclose(again.positions, s.positions, atol=1e-6)
 
 
-@pytest.mark.parametrize("builder", [silica_slab, silica_asperity, ots_sam, water_slab, water_cylinder, water_cap,
-                                     place_on])
-def test_every_builder_makes_a_small_valid_system_with_no_arguments(builder, tmp_path):
-    """md.build's builders all have defaults: called bare, each gives a neutral system whose every bonded term
-    is typed (the data file writes), small enough for a quick look (ase.visualize.view(to_atoms(s)))."""
-    s = builder()
-    assert 0 < s.n_atoms < 5000
-    assert abs(s.total_charge()) < 1e-9
+@pytest.mark.parametrize("name", BUILDERS[:-1])
+def test_every_builder_makes_a_small_valid_system_with_no_arguments(name, tmp_path):
+    """md.build's builders all have defaults: called bare, each gives a neutral ase.Atoms whose every bonded
+    term is typed (the data file writes from the Atoms), small enough for a quick look (ase.visualize.view)."""
+    require_backend("ase", "ASE")
+    atoms = getattr(build, name)()
+    assert 0 < len(atoms) < 5000
+    assert abs(atoms.get_initial_charges().sum()) < 1e-9
     ff = combine("silica_interface", "ots_trappe_ua", "water_spce")
-    write_data(s, ff, tmp_path / "s.data")
+    write_data(atoms, ff, tmp_path / "s.data")
+
+
+def test_public_builders_return_the_same_build_as_ase_atoms(tmp_path):
+    """build.X(...) is build.X.system(...) as an ase.Atoms: the System read back from it writes the same data
+    file byte for byte; builders take Atoms as their inputs (ots_sam's substrate, place_on, flip_upside_down)."""
+    require_backend("ase", "ASE")
+    from ase import Atoms
+    from md.system.atoms import from_atoms
+    ff = combine("silica_interface", "ots_trappe_ua")
+    slab = build.silica_slab(3, 2, thickness=10.0, face="111", silanol_density=4.5, seed=4)
+    sam = build.ots_sam(slab, seed=5)
+    pair = build.place_on(sam, build.flip_upside_down(slab), gap=3.0)
+    assert all(isinstance(x, Atoms) for x in (slab, sam, pair))
+    ref_slab = silica_slab(3, 2, thickness=10.0, face="111", silanol_density=4.5, seed=4)
+    ref_pair = place_on(ots_sam(ref_slab, seed=5), flip_upside_down(ref_slab), gap=3.0)
+    write_data(from_atoms(pair), ff, tmp_path / "a.data")
+    write_data(ref_pair, ff, tmp_path / "b.data")
+    assert (tmp_path / "a.data").read_bytes() == (tmp_path / "b.data").read_bytes()
+    assert list(pair.arrays["ff_types"]) == list(ref_pair.types) and np.array_equal(pair.arrays["mol-id"],
+                                                                                       ref_pair.mol_ids)
 
 
 def test_unreachable_silanol_density_fails_with_the_achievable_range():

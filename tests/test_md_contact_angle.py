@@ -221,7 +221,7 @@ def test_work_of_adhesion_sl_and_its_propagated_error():
 def test_water_cap_starts_as_a_cylindrical_cap_of_the_requested_angle_and_volume():
     R0, L = 20.0, 26.3
     for th in (40.0, 90.0, 120.0):
-        w = water_cap(R0, L, contact_angle_deg=th, seed=2)
+        w = water_cap.system(R0, L, contact_angle_deg=th, seed=2)
         o = w.positions[w.group("water_O")]
         i = w.info
         assert i["periodic_axes"] == "y" and w.cell[1] == L

@@ -1,12 +1,31 @@
-"""What the builders share: the force fields they type with, bonded-term geometry from a force field, and the
-sources they cite."""
+"""What the builders share: the Atoms-returning wrapper (:func:`atoms_builder`), the force fields they type with,
+bonded-term geometry from a force field, and the sources they cite."""
 from __future__ import annotations
 
-from typing import Any, Mapping
+import functools
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from md.system.atoms import to_atoms
 from md.system.forcefield import ForceField, combine, load_forcefield
+from md.system.topology import System
+
+def atoms_builder(build_system: Callable[..., System]):
+    """The public form of a builder: the same arguments, an :class:`ase.Atoms` back (:func:`md.system.atoms.to_atoms`:
+    force-field types, molecule ids, charges and masses as arrays; bonds, angles, dihedrals and groups in
+    ``info``). ``builder.system(...)`` is the same build as a :class:`md.system.topology.System` -- what the
+    builders pass each other; :func:`md.system.atoms.from_atoms` turns the Atoms back into exactly that System."""
+    @functools.wraps(build_system)
+    def build(*args, **kwargs):
+        return to_atoms(build_system(*args, **kwargs))
+    build.system = build_system
+    build.__annotations__ = {**build_system.__annotations__, "return": "ase.Atoms"}
+    build.__doc__ = (build_system.__doc__ or "").rstrip() + (
+        "\n\n    Returns an ``ase.Atoms``; ``.system(...)`` takes the same arguments and returns the "
+        ":class:`md.system.topology.System`.\n    ")
+    return build
+
 
 SOURCES = {
     "cristobalite": "idealised beta-cristobalite Fd-3m, a = 7.16 A: R. W. G. Wyckoff, Z. Kristallogr. 62 (1925) 189; "

@@ -1,4 +1,5 @@
 """Assembling built systems: :func:`place_on` stacks one on another; :func:`flip_upside_down` turns one over.
+Both take Atoms or Systems.
 """
 from __future__ import annotations
 
@@ -6,13 +7,16 @@ from dataclasses import replace
 
 import numpy as np
 
+from md.system.atoms import as_system
 from md.system.topology import System, merge, translate
-from md.build.common import _plain
+from md.system.topology import flip_upside_down as _flip_system
+from md.build.common import _plain, atoms_builder
 from md.build.silica import silica_slab
 from md.build.water import water_cap
 
 # ================================================================================================ assembly
 
+@atoms_builder
 def place_on(substrate: System | None = None, adsorbate: System | None = None, gap: float = 3.0, *,
              vacuum: float = 15.0, center: bool = True, tolerance: float = 1e-3) -> System:
     """Put ``adsorbate`` on top of ``substrate``: its lowest atom ``gap`` (A) above the substrate's highest.
@@ -26,10 +30,8 @@ def place_on(substrate: System | None = None, adsorbate: System | None = None, g
     With no arguments: an R = 11 A water cap on an 8 x 2 cristobalite (111) slab 10 A thick (a small contact-angle
     system); a missing ``adsorbate`` is that cap, sized to the substrate's y length.
     """
-    if substrate is None:
-        substrate = silica_slab(8, 2, thickness=10.0)
-    if adsorbate is None:
-        adsorbate = water_cap(11.0, float(substrate.cell[1]))
+    substrate = silica_slab.system(8, 2, thickness=10.0) if substrate is None else as_system(substrate)
+    adsorbate = water_cap.system(11.0, float(substrate.cell[1])) if adsorbate is None else as_system(adsorbate)
     axes = str(adsorbate.info.get("periodic_axes", "xy"))
     shift = np.zeros(3)
     for k, ax in enumerate("xy"):
@@ -58,3 +60,10 @@ def place_on(substrate: System | None = None, adsorbate: System | None = None, g
     groups["adsorbate"] = np.arange(substrate.n_atoms, out.n_atoms)
     out = replace(out, groups=groups, info=_plain(info))
     return out
+
+
+@atoms_builder
+def flip_upside_down(structure) -> System:
+    """``structure`` (Atoms or System) rotated 180 degrees about x (a proper rotation: chirality kept), with its
+    ``top``/``bottom`` group names swapped (:func:`md.system.topology.flip_upside_down`)."""
+    return _flip_system(as_system(structure))

@@ -10,10 +10,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from md.system.atoms import as_system
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, merge, minimum_image, remove_atoms, with_bonded_terms
 from md.build.silica import silica_slab
-from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, sam_forcefield
+from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, sam_forcefield
 
 # ================================================================================================ OTS monolayer
 
@@ -67,6 +68,7 @@ def _chain_template(ff: ForceField, chain_length: int, tilt_deg: float, azimuth_
     return np.array(pos), types, bonds
 
 
+@atoms_builder
 def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg: float = 15.0,
             tilt_azimuth_deg: float = 0.0, chain_length: int = 18, seed: int = 0, min_spacing: float = 4.4,
             site_group: str = "silanol_O_top", vacuum: float = 10.0, forcefield: ForceField | None = None) -> System:
@@ -90,8 +92,8 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
     ``substrate=None`` grafts onto a small cristobalite (111) slab, ``silica_slab(3, 2, thickness=10.0,
     face="111", silanol_density=4.5, seed=seed)`` (the smoke SAM's).
     """
-    if substrate is None:
-        substrate = silica_slab(3, 2, thickness=10.0, face="111", silanol_density=4.5, seed=seed)
+    substrate = (silica_slab.system(3, 2, thickness=10.0, face="111", silanol_density=4.5, seed=seed)
+                 if substrate is None else as_system(substrate))
     ff = forcefield or sam_forcefield()
     rng = np.random.default_rng(seed)
     if chain_length < 2:

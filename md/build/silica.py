@@ -43,7 +43,7 @@ from scipy.spatial import cKDTree
 
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, minimum_image, with_bonded_terms
-from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, silica_forcefield
+from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, silica_forcefield
 
 CRISTOBALITE_A = 7.16                     #: A, idealised cubic beta-cristobalite (Wyckoff 1925)
 QUARTZ = {"a": 4.916, "c": 5.4054, "spacegroup": 154,     # P3_221
@@ -392,6 +392,7 @@ def _finish_silica(system: System, ff: ForceField, vacuum: float, frozen_depth: 
     return with_bonded_terms(out, ff)
 
 
+@atoms_builder
 def silica_slab(nx: int = 4, ny: int = 4, *, thickness: float | None = 25.0, layers: int | None = None,
                 silanol_density: float = 4.7, polymorph: str = "cristobalite", face: str | None = None,
                 seed: int = 0, vacuum: float = 10.0, frozen_depth: float = 5.0, density_tolerance: float = 0.10,
@@ -446,6 +447,7 @@ def silica_slab(nx: int = 4, ny: int = 4, *, thickness: float | None = 25.0, lay
     return replace(system, groups=groups, info=_plain(info))
 
 
+@atoms_builder
 def silica_asperity(radius: float = 15.0, holder_thickness: float = 10.0, *, nx: int | None = None,
                     ny: int | None = None, margin: float = 10.0, silanol_density: float = 4.7,
                     polymorph: str = "cristobalite", face: str | None = None, seed: int = 0, vacuum: float = 10.0,

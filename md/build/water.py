@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, minimum_image, with_bonded_terms
-from md.build.common import _angle_theta0, _bond_r0, _plain, water_forcefield
+from md.build.common import _angle_theta0, _bond_r0, _plain, atoms_builder, water_forcefield
 from md.units import AVOGADRO, WATER_DENSITY
 
 # ================================================================================================ water
@@ -84,6 +84,7 @@ def _water_system(sites: np.ndarray, cell: np.ndarray, ff: ForceField, rng, info
     return replace(s, info=_plain(info))
 
 
+@atoms_builder
 def water_slab(lx: float = 20.0, ly: float = 20.0, thickness: float = 30.0, *, density: float = WATER_DENSITY,
                vacuum: float = 15.0, seed: int = 0, forcefield: ForceField | None = None) -> System:
     """A water film periodic in x, y (box ``lx`` x ``ly`` A), ``thickness`` A thick, centred in z with
@@ -112,6 +113,7 @@ def water_slab(lx: float = 20.0, ly: float = 20.0, thickness: float = 30.0, *, d
     return _water_system(sites, cell, ff, rng, info)
 
 
+@atoms_builder
 def water_cylinder(radius: float = 11.0, length: float = 20.0, *, box_x: float | None = None,
                    density: float = WATER_DENSITY, vacuum: float = 15.0, seed: int = 0,
                    forcefield: ForceField | None = None) -> System:
@@ -166,6 +168,7 @@ def cap_radius(radius_equivalent: float, contact_angle_deg: float) -> float:
     return float(radius_equivalent) * math.sqrt(math.pi / (th - math.sin(th) * math.cos(th)))
 
 
+@atoms_builder
 def water_cap(radius: float = 11.0, length: float = 20.0, *, contact_angle_deg: float = 90.0,
               box_x: float | None = None, density: float = WATER_DENSITY, vacuum: float = 15.0, seed: int = 0,
               forcefield: ForceField | None = None) -> System:

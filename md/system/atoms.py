@@ -19,7 +19,7 @@ import numpy as np
 from md.system.forcefield import available_forcefields, load_forcefield
 from md.system.topology import System
 
-__all__ = ["to_atoms", "from_atoms", "element_of"]
+__all__ = ["to_atoms", "from_atoms", "as_system", "element_of"]
 
 _TERMS = ("bonds", "bond_types", "angles", "angle_types", "dihedrals", "dihedral_types")
 
@@ -77,3 +77,8 @@ def from_atoms(atoms) -> System:
                   cell=np.diag(cell), pbc=tuple(bool(p) for p in atoms.pbc), **terms,
                   groups={k: np.asarray(v, int) for k, v in info.get("groups", {}).items()},
                   info=dict(info.get("system_info", {})))
+
+
+def as_system(structure) -> System:
+    """``structure`` as a System: a System as it is, an ``ase.Atoms`` through :func:`from_atoms`."""
+    return structure if isinstance(structure, System) else from_atoms(structure)

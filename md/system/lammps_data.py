@@ -22,6 +22,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from md.system.forcefield import ForceField, combine, lammps_pair_coeffs, lammps_type_ids, load_forcefield
+from md.system.atoms import as_system
 from md.system.topology import System
 
 __all__ = ["write_data", "read_atoms", "read_back_check", "ReadBack", "lammps_setup_commands", "style_of"]
@@ -52,8 +53,9 @@ def _coeff_section(title: str, terms: Sequence[Any]) -> list[str]:
     return lines + [""]
 
 
-def write_data(system: System, forcefield: ForceField, path: str | Path, *, title: str | None = None) -> Path:
-    """Write ``system`` as a LAMMPS data file (atom_style full, units real); returns the path.
+def write_data(system: System | Any, forcefield: ForceField, path: str | Path, *, title: str | None = None) -> Path:
+    """Write ``system`` (a System, or the ``ase.Atoms`` a builder returns: :func:`md.system.atoms.as_system`) as a
+    LAMMPS data file (atom_style full, units real); returns the path.
 
     Every atom type must be a force-field atom type and every bonded term must carry a force-field type name
     (build systems with :func:`md.system.topology.with_bonded_terms`); otherwise KeyError names the missing one.
@@ -66,6 +68,7 @@ def write_data(system: System, forcefield: ForceField, path: str | Path, *, titl
     the box adds up to a box length, so no image flags make every bond's unwrapped length its minimum-image
     length. (tests/test_md_substrate_start.py checks that every bond is at its length under minimum image.)
     """
+    system = as_system(system)
     path = Path(path)
     ids = lammps_type_ids(forcefield)
     missing = sorted(set(system.types.tolist()) - set(ids))

@@ -22,6 +22,7 @@ import numpy as np
 from md import analysis as A
 from md import units as U
 from md.build import flip_upside_down, place_on
+from md.system.atoms import as_system
 from md.system.forcefield import ForceField
 from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
@@ -104,7 +105,8 @@ class Adhesion(Workflow):
         seed = int(s["seed"])
         lower = _surface_slab(lower_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed, face)
         upper = _surface_slab(upper_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10, face)
-        system = place_on(lower, flip_upside_down(upper), gap=s["contact_gap_A"], vacuum=s["separation_A"] + 15.0)
+        system = as_system(place_on(lower, flip_upside_down(upper), gap=s["contact_gap_A"],
+                                    vacuum=s["separation_A"] + 15.0))
         data = run_dir / "system.data"
         write_data(system, ff, data)
         groups = {"lower": system.group("substrate"), "upper": system.group("adsorbate"),

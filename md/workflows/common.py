@@ -23,6 +23,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from md.build import SILICA_FACE, ots_sam, silica_slab
+from md.system.atoms import as_system
 from md.system.forcefield import ForceField, combine, load_forcefield
 from md.system.lammps_data import lammps_setup_commands
 from md.units import SPCE_WATER_MOLAR_MASS
@@ -221,9 +222,10 @@ def _surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mappi
                   face: str) -> System:
     if kind == "silica":
         dens = settings["silanol_density"] if face == "001" else 4.5
-        return silica_slab(nx, ny, thickness=thickness, silanol_density=dens, face=face, seed=seed)
-    slab = silica_slab(nx, ny, thickness=thickness, face="111", silanol_density=4.5, seed=seed)
-    return ots_sam(slab, coverage=settings["sam_coverage"], chain_length=settings["chain_length"], seed=seed + 1)
+        return as_system(silica_slab(nx, ny, thickness=thickness, silanol_density=dens, face=face, seed=seed))
+    slab = as_system(silica_slab(nx, ny, thickness=thickness, face="111", silanol_density=4.5, seed=seed))
+    return as_system(ots_sam(slab, coverage=settings["sam_coverage"], chain_length=settings["chain_length"],
+                             seed=seed + 1))
 
 
 # ================================================================================================ base class

@@ -18,6 +18,7 @@ import numpy as np
 from md import analysis as A
 from md import units as U
 from md.build import place_on, water_cap
+from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
 from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
@@ -68,9 +69,9 @@ class ContactAngleWorkflow(Workflow):
         sub = _surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, _silica_face(s))
         R0 = float(s["droplet_radius_A"])
         wff = _ff(_water_ff_names(s["water_model"]))
-        drop = water_cap(R0, float(sub.cell[1]), contact_angle_deg=s["droplet_initial_angle_deg"], seed=seed + 1,
-                         forcefield=wff)
-        system = place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0))
+        drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s["droplet_initial_angle_deg"],
+                                   seed=seed + 1, forcefield=wff))
+        system = as_system(place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0)))
         return sub, drop, system
 
     def plan(self, s, run_dir):

@@ -23,6 +23,7 @@ import numpy as np
 from md import analysis as A
 from md import units as U
 from md.build import flip_upside_down, ots_sam, place_on, silica_asperity
+from md.system.atoms import as_system
 from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
 from md.system.topology import System, with_groups
@@ -55,8 +56,8 @@ class PullOff(Workflow):
         R = float(s["asperity_radius_A"])
         face = _silica_face(s)
         dens = s["silanol_density"] if face == "001" else 4.5
-        asp = silica_asperity(radius=R, holder_thickness=s["holder_thickness_A"], margin=s["asperity_margin_A"],
-                              silanol_density=dens, face=face, seed=seed)
+        asp = as_system(silica_asperity(radius=R, holder_thickness=s["holder_thickness_A"],
+                                        margin=s["asperity_margin_A"], silanol_density=dens, face=face, seed=seed))
         nx, ny = asp.info["surface_cells"]
         fnx, fny = (s["flat_nx"] or nx), (s["flat_ny"] or ny)
         if (fnx, fny) != (nx, ny):
@@ -67,8 +68,8 @@ class PullOff(Workflow):
         if s["surface"] == "ots":
             asp, ginfo = _graft_dome(asp, s, seed + 30)
             info["asperity_sam"] = ginfo
-        system = place_on(flat, flip_upside_down(asp), gap=s["initial_gap_A"],
-                          vacuum=s["retract_distance_A"] + 15.0)
+        system = as_system(place_on(flat, flip_upside_down(asp), gap=s["initial_gap_A"],
+                                    vacuum=s["retract_distance_A"] + 15.0))
         info.update(asperity=_summary(asp), flat=_summary(flat), box_A=system.cell.tolist())
         return system, info
 
@@ -487,9 +488,9 @@ def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, d
     for n in range(len(chosen), 0, -1):
         grp = sites[np.array(chosen[:n], int)]
         try:
-            sam = ots_sam(with_groups(asp, graft_sites=grp), coverage=(n + 0.49) / (cell_area / 100.0),
-                          chain_length=s["chain_length"], seed=seed, site_group="graft_sites",
-                          min_spacing=spacing - 1e-6, tilt_deg=DOME_CHAIN_TILT_DEG)
+            sam = as_system(ots_sam(with_groups(asp, graft_sites=grp), coverage=(n + 0.49) / (cell_area / 100.0),
+                                    chain_length=s["chain_length"], seed=seed, site_group="graft_sites",
+                                    min_spacing=spacing - 1e-6, tilt_deg=DOME_CHAIN_TILT_DEG))
             break
         except ValueError as exc:
             last = exc

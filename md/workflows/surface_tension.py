@@ -14,6 +14,7 @@ import numpy as np
 from md import analysis as A
 from md import units as U
 from md.build import water_slab
+from md.system.atoms import as_system
 from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 
@@ -32,7 +33,7 @@ class SurfaceTension(Workflow):
     def plan(self, s, run_dir):
         ff = _ff(self.forcefield_files(s))
         seed = int(s["seed"])
-        film = water_slab(s["lx_A"], s["ly_A"], s["film_thickness_A"], vacuum=s["vacuum_A"], seed=seed)
+        film = as_system(water_slab(s["lx_A"], s["ly_A"], s["film_thickness_A"], vacuum=s["vacuum_A"], seed=seed))
         data = run_dir / "system.data"
         write_data(film, ff, data)
         n = film.n_atoms
