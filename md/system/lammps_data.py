@@ -1,10 +1,11 @@
-"""LAMMPS data files (``atom_style full``, ``units real``) for :class:`md.system.topology.System`, and a read-back check.
+"""LAMMPS data files (``atom_style full``, ``units real``) for :class:`md.system.topology.System` (or the
+``ase.Atoms`` a builder returns), and a read-back check.
 
 ASE's LAMMPS writer drops bonds, angles and dihedrals; this one writes them. Type numbering is the force
 field's own: atom types in the order of ``ForceField.atom_types`` (:func:`md.system.forcefield.lammps_type_ids`),
 bond/angle/dihedral types in the order of ``ForceField.bond_types`` etc., the numbering that
-:func:`md.system.forcefield.lammps_pair_coeffs`, :func:`~md.system.forcefield.lammps_bond_coeffs` and friends use -- so an
-input script built from the same force field matches the data file. Every type of the force field is declared
+:func:`md.system.forcefield.lammps_pair_coeffs`, :func:`~md.system.forcefield.lammps_bond_coeffs` and friends use --
+so an input script built from the same force field matches the data file. Every type of the force field is declared
 (also those the system does not use). Sections written: Masses, Bond/Angle/Dihedral Coeffs (from the force
 field), Atoms (``id mol type q x y z``), Bonds, Angles, Dihedrals. Pair Coeffs are *not* written: the input
 script sets ``pair_coeff`` from :func:`md.system.forcefield.lammps_pair_coeffs`.
@@ -82,7 +83,8 @@ def write_data(system: System | Any, forcefield: ForceField, path: str | Path, *
         table = {t.name: k for k, t in enumerate(fftypes, start=1)}
         term_ids[kind] = table
         if len(terms) and len(names) != len(terms):
-            raise KeyError(f"the system's {kind}s carry no type names; build it with md.system.topology.with_bonded_terms")
+            raise KeyError(f"the system's {kind}s carry no type names; "
+                           "build it with md.system.topology.with_bonded_terms")
         unknown = sorted(set(names.tolist()) - set(table))
         if unknown:
             raise KeyError(f"{kind} types {unknown} are not in force field {forcefield.name!r}")
