@@ -194,6 +194,30 @@ def test_a_finished_run_is_reused_not_repeated(needs_lammps, cache, tmp_path):
     assert json.loads((tmp_path / "c" / "result.json").read_text())["run_hash"] == first.result["run_hash"]
 
 
+def test_each_workflow_declares_the_quantities_it_yields():
+    from md.workflows import WORKFLOWS
+    assert {name: dict(cls.yields) for name, cls in WORKFLOWS.items()} == EXPECTED
+
+
+def test_a_committed_result_reads_as_a_typed_md_result_and_writes_its_files(tmp_path):
+    """MDResult: quantities, stderr and units by name from result.json, provenance, and .write(dir) copying
+    result.json with the curves and figures beside it (what --out gets)."""
+    from md.workflows import MDResult, run_hash
+    from nanoimpact import data
+    folder = data.shipped_root() / "md" / "results" / "surface_tension_spce-smoke"
+    r = MDResult.read(folder)
+    raw = json.loads((folder / "result.json").read_text())
+    assert r.run_hash == raw["run_hash"] == run_hash("surface_tension_spce", "smoke")[0]
+    assert r.quantities["surface_tension"] == raw["quantities"]["surface_tension"]["value"]
+    assert r.stderr["surface_tension"] == raw["quantities"]["surface_tension"]["stderr"]
+    assert r.units["surface_tension"] == "N/m" and r.provenance["package"] == "nanoimpact"
+    with pytest.raises(TypeError):
+        r.quantities["surface_tension"] = 0.0                     # frozen, read-only mappings
+    out = r.write(tmp_path / "copy")
+    assert sorted(p.name for p in out.iterdir()) == sorted(p.name for p in folder.iterdir())
+    assert (out / "result.json").read_bytes() == (folder / "result.json").read_bytes()
+
+
 def test_a_changed_workflow_protocol_changes_the_run_hash(monkeypatch):
     """Raising a workflow's version invalidates its cached and committed runs; version 1 leaves hashes alone."""
     from md import workflows

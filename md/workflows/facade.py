@@ -20,6 +20,7 @@ from md.engine.runner import run_job
 from md.engine.store import export
 from md.recipe import Recipe, load_recipe
 from md.workflows.registry import get_workflow
+from nanoimpact.fileio import atomic_write_bytes
 
 __all__ = ["MDResult", "run_recipe", "run_hash", "job_for"]
 
@@ -68,8 +69,18 @@ class MDResult:
         return cls.from_result(json.loads((run_dir / "result.json").read_text()), run_dir)
 
     def write(self, folder: str | Path) -> Path:
-        """Copy ``result.json``, the CSV curves and the PNG figures into ``folder`` (the files ``--out`` gets)."""
-        return export(self.run_dir, Path(folder))
+        """Copy ``result.json``, the CSV curves and the PNG figures into ``folder`` (the files ``--out`` gets), from
+        a run directory of the cache or from a folder that holds them beside ``result.json`` (``--out``, the
+        committed results); each file atomically, ``result.json`` last."""
+        folder = Path(folder)
+        if (self.run_dir / "export").is_dir():
+            return export(self.run_dir, folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        for f in sorted(self.run_dir.iterdir()):
+            if f.is_file() and f.name != "result.json":
+                atomic_write_bytes(folder / f.name, f.read_bytes())
+        atomic_write_bytes(folder / "result.json", (self.run_dir / "result.json").read_bytes())
+        return folder
 
 
 def job_for(recipe: Recipe, fidelity: str) -> Job:
