@@ -158,23 +158,6 @@ def _stages(*stages: Stage) -> list[Stage]:
     return [s for s in stages if s.steps > 0]
 
 
-def _read_data_positions(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """(ids, positions (N, 3) in A) from the Atoms section of a LAMMPS data file (``atom_style full``)."""
-    lines = Path(path).read_text().splitlines()
-    start = next(i for i, l in enumerate(lines) if l.strip().startswith("Atoms"))
-    rows = []
-    for l in lines[start + 2:]:
-        s = l.split("#")[0].split()
-        if not s:
-            if rows:
-                break
-            continue
-        rows.append((int(s[0]), float(s[4]), float(s[5]), float(s[6])))
-    arr = np.array(rows)
-    order = np.argsort(arr[:, 0])
-    return arr[order, 0].astype(int), arr[order, 1:]
-
-
 def _ff(names: list[str]) -> ForceField:
     return load_forcefield(names[0]) if len(names) == 1 else combine(*names)
 
