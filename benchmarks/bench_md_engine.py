@@ -4,7 +4,7 @@
                                                    [--steps 3000] [--chunk 500] [--repeats 2] [--json PATH]
 
 1. The recipe (default: the `smoke` SPC/E film, 801 atoms) is run through the real runner
-   (``md.runner.run_recipe``, in process, one rank) with `equilibrate_steps`/`sample_steps` raised so the
+   (``md.workflows.run_recipe``, in process, one rank) with `equilibrate_steps`/`sample_steps` raised so the
    leg has ``--steps`` MD steps in chunks of ``--chunk``. Every LAMMPS command the engine issues is recorded
    and the wall time spent inside LAMMPS is summed (``_InProcess._run``), including set-up, minimisation and
    the per-chunk sample files and restarts.
@@ -34,7 +34,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from md import runner as R                      # noqa: E402
+from md import workflows as W                   # noqa: E402
+from md.engine.lammps import InProcess          # noqa: E402
 from md.lammps_loader import lmp_binary, mpi_env   # noqa: E402
 from md.recipe import RECIPE_DIR, parse_recipe   # noqa: E402
 
@@ -69,7 +70,7 @@ def bench_recipe(name: str, fidelity: str, steps: int, chunk: int, **overrides):
 def run_inprocess(recipe, fidelity: str, cache: Path):
     recorded: list[str] = []
     inside = [0.0]
-    orig = R._InProcess._run
+    orig = InProcess._run
 
     def _run(self, cmds):
         recorded.extend(cmds)
@@ -79,13 +80,13 @@ def run_inprocess(recipe, fidelity: str, cache: Path):
         finally:
             inside[0] += time.perf_counter() - t0
 
-    R._InProcess._run = _run
+    InProcess._run = _run
     try:
         t0 = time.perf_counter()
-        out = R.run_recipe(recipe, fidelity, cache=cache, np_=1, progress=False, force=True, echo=None)
+        out = W.run_recipe(recipe, fidelity, cache=cache, np_=1, progress=False, force=True, echo=None)
         total = time.perf_counter() - t0
     finally:
-        R._InProcess._run = orig
+        InProcess._run = orig
     legs = sorted((out.run_dir / "legs").iterdir())
     if len(legs) != 1:
         raise SystemExit("this benchmark expects a one-leg recipe (surface_tension or contact_angle)")

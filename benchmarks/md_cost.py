@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from bench_md_engine import LOOP, bench_recipe    # noqa: E402  (same folder; sys.path[0] when run as a script)
-from md import runner as R                        # noqa: E402
+from md import workflows as R                     # noqa: E402  (run_recipe, run_hash)
 from md.recipe import RECIPE_DIR, load_recipe     # noqa: E402
 from md.workflows import get_workflow             # noqa: E402
 

@@ -1,7 +1,7 @@
 """``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N]``.
 
 Runs one MD recipe (``inputs/md/*.toml``, or a recipe name such as ``adhesion_silica``) through
-:func:`md.workflows.run_recipe` (looked up through :mod:`md.runner`), prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
+:func:`md.workflows.run_recipe`, prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
 into ``--out``. Exit codes (``nanoimpact.errors``): 0 done (or reused from the cache), 1 LAMMPS failed (message
 and the last lines of its log on stderr; no result.json is written), 2 invalid recipe or arguments (one line),
 3 LAMMPS not installed (one line), 75 the same run is in progress in another process and ``--no-wait`` was
@@ -86,8 +86,12 @@ def run(argv: list[str]) -> int:
     verbosity = getattr(args, "verbose", 0) - getattr(args, "quiet", 0)
     if not logging_ready() or hasattr(args, "verbose") or hasattr(args, "quiet"):
         setup_logging(verbosity)
+    import md.workflows                          # run_recipe looked up at call time (tests replace it)
+    from md.engine.lammps import MDRunError
+    from md.engine.runner import Interrupted
     from md.recipe import load_recipe
-    from md.runner import Interrupted, MDRunError, run_recipe
+
+    run_recipe = md.workflows.run_recipe
 
     check_out_dir(args.out)
     check_out_dir(args.cache, "--cache")

@@ -404,7 +404,7 @@ def no_work():
     with pytest.MonkeyPatch.context() as mp:
         for target in ("continuum.impact.run_impact", "continuum.paper.report.make_paper",
                        "calibration.pipeline.executor", "calibration.pipeline.md_job", "calibration.sweep.executor",
-                       "md.runner.run_recipe", "md.doctor.run_doctor"):
+                       "md.workflows.run_recipe", "md.doctor.run_doctor"):
             mp.setattr(target, started)
         yield
 

