@@ -70,31 +70,55 @@ def _clean(obj):
 _INLINE_MIN = 8
 
 
+def _plain(obj):
+    """A JSON leaf value: NumPy scalars as Python numbers, paths as strings, non-finite floats as None."""
+    if isinstance(obj, (np.floating, np.integer)):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
 def _encode(obj, level: int) -> str:
-    """JSON text of `obj` (plain JSON types) indented by 2 like json.dumps(indent=2), except that a list of
-    `_INLINE_MIN` or more numbers is written on one line."""
+    """JSON text of `obj` indented by 2 like json.dumps(indent=2), except that a list of `_INLINE_MIN` or more
+    numbers is written on one line (by the C encoder). Arrays become lists, non-finite floats null."""
     pad, inner = "  " * level, "  " * (level + 1)
+    if isinstance(obj, np.ndarray):
+        if obj.ndim == 1 and obj.size >= _INLINE_MIN and obj.dtype.kind in "fiu":
+            values = obj.tolist()
+            return json.dumps(values if np.all(np.isfinite(obj)) else [v if math.isfinite(v) else None for v in values])
+        obj = obj.tolist()
     if isinstance(obj, dict):
         if not obj:
             return "{}"
-        items = ",\n".join(f"{inner}{json.dumps(k)}: {_encode(v, level + 1)}" for k, v in obj.items())
+        items = ",\n".join(f"{inner}{json.dumps(str(k) if not isinstance(k, str) else k)}: {_encode(v, level + 1)}"
+                            for k, v in obj.items())
         return "{\n" + items + "\n" + pad + "}"
-    if isinstance(obj, list):
+    if isinstance(obj, (list, tuple)):
         if not obj:
             return "[]"
-        if len(obj) >= _INLINE_MIN and all(type(v) in (float, int) or v is None for v in obj):
-            return json.dumps(obj, allow_nan=False)
+        if len(obj) >= _INLINE_MIN and all(type(v) is float or type(v) is int for v in obj):
+            if all(math.isfinite(v) for v in obj):
+                return json.dumps(obj)
+            return json.dumps([v if math.isfinite(v) else None for v in obj])
         return "[\n" + ",\n".join(inner + _encode(v, level + 1) for v in obj) + "\n" + pad + "]"
-    return json.dumps(obj, allow_nan=False)
+    leaf = _plain(obj)
+    if isinstance(leaf, (dict, list, tuple, np.ndarray)):
+        return _encode(leaf, level)
+    try:
+        return json.dumps(leaf, allow_nan=False)
+    except TypeError:
+        return json.dumps(leaf, default=_json_default, allow_nan=False)
 
 
 def dumps(data: dict) -> str:
     """result.json text: indented, with long lists of numbers (profiles: thousands of floats) on one line each.
 
-    The same JSON values as json.dumps(indent=2); its pure-Python indenting encoder took ~4 s for a 100-bounce
-    run's profiles, the C encoder writes each list of numbers in microseconds."""
-    plain = json.loads(json.dumps(_clean(data), default=_json_default, allow_nan=False))
-    return _encode(plain, 0)
+    The same JSON values as json.dumps(_clean(data), indent=2, default=_json_default); its pure-Python indenting
+    encoder took ~4 s for a 100-bounce run's profiles, the C encoder writes each list of numbers at once."""
+    return _encode(data, 0)
 
 
 def write_timeseries(path: Path, trace: dict) -> None:
