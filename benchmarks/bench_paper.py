@@ -1,0 +1,192 @@
+"""What `nanoimpact paper` costs, per set and per impact, against a floor; how the cost grows.
+
+    python benchmarks/bench_paper.py [--sets paper,silicon,calibrated] [--workers 2]
+                                     [--baseline REV] [--skip-paper] [--repeat 5]
+
+Prints, from one run of this script (so the ratios are comparable on a shared machine):
+
+1. the paper's wall and CPU time per parameter set (`continuum.paper.run.run_paper`, one set at a time,
+   each in a fresh interpreter with a process pool of `--workers`), and with `--baseline REV` the same
+   for the code of git revision REV (exported with `git archive` into a temporary folder and run there);
+   the CPU time (the process and its pool) is the steadier measure on a shared machine;
+2. the cost of one rough impact (rough_silica, `paper` set, rigid substrate, 100 nm drop) through the
+   driver with the compiled contact kernel, through the driver with the Python DOP853 stepper, and the
+   floor: the same contact in the compiled kernel alone (tables built, no trace recorded by Python);
+3. how the cost grows with the number of bounces (the whole rough_silica run, 1-100 bounces) and with
+   the table size (footprint tables at the `fast`, `standard` and `reference` resolutions, all at rtol 1e-8).
+
+The load average is printed at the start and the end: absolute times move by +-30 % on the shared
+2-core machine, ratios much less.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+PAPER_SNIPPET = """
+import sys
+from continuum.paper.run import run_paper
+run_paper([sys.argv[2]], sys.argv[1], workers=int(sys.argv[3]), progress=lambda m: None)
+"""
+
+
+def paper_walls(code_root: Path, sets: list[str], workers: int) -> dict[str, tuple[float, float]]:
+    """(wall s, CPU s of the process and its pool) of run_paper for each set, each in a fresh interpreter run
+    from `code_root`."""
+    import resource
+
+    out = {}
+    for name in sets:
+        with tempfile.TemporaryDirectory() as folder:
+            env = {**os.environ, "PYTHONPATH": str(code_root)}
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            start = time.perf_counter()
+            subprocess.run([sys.executable, "-c", PAPER_SNIPPET, folder, name, str(workers)], cwd=code_root, env=env,
+                           check=True, capture_output=True)
+            wall = time.perf_counter() - start
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        out[name] = (wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime))
+    return out
+
+
+def export_revision(rev: str, dest: Path) -> Path:
+    """The tree of git revision `rev` exported into `dest` (no worktree, nothing in .git changes)."""
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
+    return dest
+
+
+def _best(fn, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def per_impact(repeat: int, resolution: str = "standard") -> dict:
+    """Seconds per rough impact: driver + kernel, driver + Python stepper, kernel alone (the floor)."""
+    from continuum.compiled_contact import run_compiled
+    from continuum.driver import DriverSettings, simulate
+    from continuum.impact import first_impact_speed
+    from continuum.models import select_law
+    from continuum.scene import resolve_scene
+
+    resolved = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params="paper",
+                             overrides={"physics.half_space": "off", "numerics.fidelity": resolution,
+                                        "numerics.rtol": 1e-8})
+    scene = resolved.scene
+    v = first_impact_speed(resolved)
+    law, _ = select_law(scene, v)
+    m, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
+
+    def driver(compiled):
+        return simulate(law, m, g, impact_velocity=v, settings=DriverSettings(
+            rtol=rtol, max_bounces=1, max_time=1.0, samples_per_flight=2, compiled=compiled))
+
+    run = driver(True)                                   # compiles (or loads) the kernel, sizes the tables
+    law.prepare(m, v, g)
+    law.reset()
+    length = law.length_scale(m, v)
+    atol = np.array([rtol * length, rtol * v]) * 0.1
+
+    def kernel():
+        c = law.compiled(0.0)
+        return run_compiled(c, m, g, 0.0, 0.0, -v, rtol=rtol, atol=atol, first_step=1e-3 * length / v,
+                            max_step=math.inf, t_bound=1.0, release=law.release_gap(), bound_is_final=True,
+                            has_history=True, samples_per_step=3)
+
+    out = kernel()
+    return {"compiled": _best(lambda: driver(True), repeat), "python": _best(lambda: driver(False), max(1, repeat // 2)),
+            "floor": _best(kernel, repeat), "table_nodes": law.table_points, "samples": len(out.samples),
+            "restitution": run.bounces[0].restitution, "stuck": run.stuck}
+
+
+def per_bounce(repeat: int) -> list[tuple[int, float, int]]:
+    """Wall (s) of the whole rough_silica impact run (select_law, tables, driver; `silicon` set, which rebounds
+    100 times) for 1 to 100 bounces."""
+    from continuum.impact import run_impact
+    from continuum.scene import resolve_scene
+
+    rows = []
+    for n in (1, 10, 30, 100):
+        resolved = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params="silicon",
+                                 overrides={"physics.half_space": "off", "numerics.max_bounces": n})
+        holder = {}
+
+        def once():
+            holder["r"] = run_impact(resolved)[0]
+
+        rows.append((n, _best(once, repeat), holder["r"]["n_bounces"]))
+    return rows
+
+
+def load() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sets", default="paper,silicon,calibrated")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--baseline", default=None, help="git revision to time the paper with as well")
+    parser.add_argument("--skip-paper", action="store_true")
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args(argv)
+    sets = args.sets.split(",")
+    print(f"load average at start: {load()}  ({os.cpu_count()} CPUs, Python {sys.version.split()[0]})")
+    from continuum.compiled_contact import warm_up
+    warm_up()                                   # the kernel's load (or first compile) is not an impact's cost
+
+    print("\n## Cost of one rough impact (rough_silica, paper set, rigid substrate, 100 nm drop; best of "
+          f"{args.repeat})")
+    print(f"{'tables':10s} {'nodes':>7s} {'driver+kernel ms':>17s} {'driver+Python ms':>17s} {'floor ms':>9s} "
+          f"{'kernel/floor':>13s} {'Python/floor':>13s} {'samples':>8s}")
+    for res in ("fast", "standard", "reference"):
+        c = per_impact(args.repeat, res)
+        print(f"{res:10s} {c['table_nodes']:7d} {1e3 * c['compiled']:17.2f} {1e3 * c['python']:17.1f} "
+              f"{1e3 * c['floor']:9.3f} {c['compiled'] / c['floor']:13.1f} {c['python'] / c['floor']:13.0f} "
+              f"{c['samples']:8d}")
+
+    print(f"\n## Whole run against the number of bounces (rough_silica, silicon set; best of {max(1, args.repeat // 2)})")
+    print(f"{'bounces':>8s} {'wall s':>8s} {'per bounce ms':>14s} {'each bounce after the first ms':>31s}")
+    rows = per_bounce(max(1, args.repeat // 2))
+    first = rows[0][1]
+    for n, wall, got in rows:
+        extra = f"{1e3 * (wall - first) / (got - 1):31.2f}" if got > 1 else f"{'':>31s}"
+        print(f"{got:8d} {wall:8.3f} {1e3 * wall / max(got, 1):14.1f} {extra}")
+
+    if not args.skip_paper:
+        print(f"\n## nanoimpact paper, one set at a time ({args.workers} workers)")
+        walls = {"this tree": paper_walls(ROOT, sets, args.workers)}
+        if args.baseline:
+            with tempfile.TemporaryDirectory() as tmp:
+                walls[f"baseline {args.baseline}"] = paper_walls(export_revision(args.baseline, Path(tmp)), sets,
+                                                                 args.workers)
+        print(f"{'code':24s} " + " ".join(f"{s + ' wall/CPU s':>22s}" for s in sets) + f" {'total wall/CPU s':>18s}")
+        for name, w in walls.items():
+            tw, tc = sum(v[0] for v in w.values()), sum(v[1] for v in w.values())
+            print(f"{name:24s} " + " ".join(f"{w[s][0]:11.1f} {w[s][1]:10.1f}" for s in sets) + f" {tw:9.1f} {tc:8.1f}")
+        if args.baseline:
+            base, now = walls[f"baseline {args.baseline}"], walls["this tree"]
+            ratio = [(base[s][0] / now[s][0], base[s][1] / now[s][1]) for s in sets]
+            tot = (sum(v[0] for v in base.values()) / sum(v[0] for v in now.values()),
+                   sum(v[1] for v in base.values()) / sum(v[1] for v in now.values()))
+            print(f"{'speed-up':24s} " + " ".join(f"{a:11.1f} {b:10.1f}" for a, b in ratio) + f" {tot[0]:9.1f} {tot[1]:8.1f}")
+    print(f"\nload average at end: {load()}")
+
+
+if __name__ == "__main__":
+    main()
