@@ -7,22 +7,10 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ..models import select_law
 from ..provenance import provenance
 from ..results import dumps
 from . import checks, figures
-from .cases import Case
-from .run import resolve_case, run_paper
-
-
-def fig4_curves(set_name: str, fidelity: str | None) -> dict:
-    """Pressure-gap characteristics of rough silica and OTS-covered silica for one set."""
-    curves = {}
-    for key, scene in (("silica", "rough_silica.toml"), ("ots", "rough_ots.toml")):
-        resolved = resolve_case(Case(key, scene), set_name, fidelity)
-        law, _ = select_law(resolved.scene, 0.0)
-        curves[key] = figures.characteristic(law.surface)
-    return curves
+from .run import fig4_curves, run_paper
 
 
 def _fmt(x, spec=".4g"):
@@ -140,8 +128,8 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
         impacts = {c: v for (c, s), v in collected["impacts"].items() if s == set_name}
         sweeps = {c: v for (c, s), v in collected["sweeps"].items() if s == set_name}
         wet = {c: v for (c, s), v in collected["wet"].items() if s == set_name}
-        curves = fig4_curves(set_name if set_name in sets else next(s for s in sets if Path(s).stem == set_name),
-                             fidelity)
+        curves = collected["curves"].get(set_name) or fig4_curves(
+            set_name if set_name in sets else next(s for s in sets if Path(s).stem == set_name), fidelity)
         figures.save(figures.fig4(curves, set_name, out), out / f"fig4_{set_name}.png")
         figures.save(figures.fig5a(impacts, set_name, out), out / f"fig5a_{set_name}.png")
         figures.save(figures.fig5b(impacts, set_name, out), out / f"fig5b_{set_name}.png")

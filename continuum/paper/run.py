@@ -136,10 +136,27 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
             "gravity": g, "v_drop": v0, "sigma": scene.surfaces.roughness.sigma}
 
 
+def fig4_curves(set_name: str, fidelity: str | None) -> dict:
+    """Pressure-gap characteristics of rough silica and OTS-covered silica for one set (Fig 4)."""
+    from .figures import characteristic
+
+    curves = {}
+    for key, scene in (("silica", "rough_silica.toml"), ("ots", "rough_ots.toml")):
+        resolved = resolve_case(Case(key, scene), set_name, fidelity)
+        law, _ = select_law(resolved.scene, 0.0)
+        curves[key] = characteristic(law.surface)
+    return curves
+
+
+def _curves_task(params: str, fidelity: str | None) -> dict:
+    """Fig 4's curves as a pool task (GW tables for two scenes, ~1-2 s), beside the runs instead of after them."""
+    return {"kind": "curves", "case": "fig4", "set": Path(params).stem, "curves": fig4_curves(params, fidelity)}
+
+
 def _run(task):
     kind, args = task
     start, cpu = time.perf_counter(), time.process_time()
-    out = {"impact": _impact_task, "sweep": _sweep_task, "wet": _wet_task}[kind](*args)
+    out = {"impact": _impact_task, "sweep": _sweep_task, "wet": _wet_task, "curves": _curves_task}[kind](*args)
     out["wall_s"] = time.perf_counter() - start
     out["cpu_s"] = time.process_time() - cpu       # on a shared machine the CPU time is the steadier measure
     return out
@@ -170,7 +187,8 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
     tasks += [("sweep", (case, s, fidelity)) for s in sets for case in fig8_cases()]
     # absolute: the runs write there from the workers, whose working directory may differ (a Dask cluster)
     tasks += [("impact", (case, s, fidelity, str(out.resolve()))) for s in sets for case in dry_cases() + wet_cases()]
-    collected = {"impacts": {}, "sweeps": {}, "wet": {}, "wall_s": {}, "cpu_s": {}}
+    tasks += [("curves", (s, fidelity)) for s in sets]
+    collected = {"impacts": {}, "sweeps": {}, "wet": {}, "curves": {}, "wall_s": {}, "cpu_s": {}}
     start = time.perf_counter()
     own = executor is None
     warm_up()                       # forked workers inherit the compiled contact kernel
@@ -182,7 +200,10 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
         progress(f"paper: {len(tasks)} runs for set(s) {', '.join(sets)} on {executor.describe()}")
         for done, (_, item) in enumerate(executor.map(_run, tasks), 1):
             key = (item["case"], item["set"])
-            collected[{"impact": "impacts", "sweep": "sweeps", "wet": "wet"}[item["kind"]]][key] = item
+            if item["kind"] == "curves":
+                collected["curves"][item["set"]] = item["curves"]
+            else:
+                collected[{"impact": "impacts", "sweep": "sweeps", "wet": "wet"}[item["kind"]]][key] = item
             collected["wall_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["wall_s"]
             collected["cpu_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["cpu_s"]
             progress(f"  [{done}/{len(tasks)}] {item['kind']} {item['case']} ({item['set']}): {item['wall_s']:.1f} s "
