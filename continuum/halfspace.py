@@ -452,7 +452,7 @@ def solve_coupled(halfspace: LineHalfSpace, gap_rigid, pressure_law: PressureLaw
 
     Measured (tests' set-up: N = 256, R = 5 um, E* = 100 GPa, x_ref = 3.3 mm, h_ref = the hard
     contact's approach at W' = 1 N/m, cold start p = 0; coupling mu = max|dp/dh| sum_j |D_ij|;
-    table in docs/_fragments/halfspace.md). Exponential wall p0 exp(-h/lam), lam = 1e-9 ... 1e-15 m
+    table in docs/halfspace.md). Exponential wall p0 exp(-h/lam), lam = 1e-9 ... 1e-15 m
     (mu = 0.2 ... 2e5): Newton 3, 4, 5, 6, 6, 8, 10, 14 iterations; PTC 6, 5, 6, 6, 6, 8, 14, 22;
     fixed point 10, 24, 334, 2686 (lam = 1e-9 ... 3e-12), then no convergence in 5000. With a
     tensile well (depth 0.1-1 p0, range 1e-12 - 1e-11 m): Newton 2-18 iterations wherever the

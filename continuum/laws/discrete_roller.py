@@ -40,7 +40,7 @@ Cost: each force evaluation touches only the prefix of the summits sorted by eff
 that are attached or within reach, so it is O(contacts). The force is discontinuous (a summit
 jumps onto the JKR curve at -8/9 P_c and leaves it at -5/9 P_c), so the driver's adaptive
 integrator shrinks its steps at each event: cost per impact grows with the number of summits
-that touch (docs/_fragments/discrete.md gives measured numbers).
+that touch (docs/discrete.md gives measured numbers).
 """
 from __future__ import annotations
 

@@ -25,59 +25,35 @@ but unattached summits. Per unit nominal area::
 
 with Phi_t(z) = int_{-inf}^{min(z, z_max)} phi. U_JKR(-Delta) is the Fuller-Tabor loop area.
 
-Fast evaluation (dimensionless: h = d/sigma, t = z/sigma, x = delta/delta_c, lambda = delta_c/sigma)
------------------------------------------------------------------------------------------------
-q(x) is the per-summit law in JKR units (P/P_c, U/(P_c delta_c), a^2/(beta delta_c)), q_H its Hertz
-part, x0 = 1.2114 the approach where P_JKR changes sign, x_r = Delta/delta_c,
-xi = (zeta_eff - d)/delta_c in [-x_r, 0]. With A(h, xi) = int_xi^0 q(x) phi(h + lambda x) lambda dx,
-exactly (per unit area, for d <= z_max)::
-
-    X = n [Hertz(h) + S G(h)] + n S * { 0                      approach   (zeta_eff = d)
-                                        Wr(h)                  release    (zeta_eff = d - Delta)
-                                        A(h, xi)               threshold inside the window }
-
-* Hertz(h) = (4/3) E* beta^{1/2} sigma^{3/2} F_{3/2}(h) (energy F_{5/2}, area F_1),
-  F_nu(h) = Gamma(nu+1)/sqrt(2 pi) e^{-h^2/4} D_{-nu-1}(h) (parabolic-cylinder function,
-  DLMF 12.5.1; ``gw_integral``). scipy's pbdv costs ~6 us per point, so log F_nu is tabulated from
-  it at build time (cubic Hermite with the exact derivative F_nu' = -nu F_{nu-1}). With truncation
-  the table holds log[int_h^{z_max} (t-h)^nu phi dt / u^{nu+1}] in r = sqrt(u), u = t_max - h: full
-  relative accuracy up to z_max, where "untruncated minus the part above z_max" cancels.
-* G(h) = int_0^{x_top} (q - q_H) phi(h + lambda x) lambda dx (x_top = (z_max - d)/delta_c),
-  Wr(h) = int_{-x_r}^0 q phi lambda dx, A0(h) = int_0^{x0} q phi lambda dx (the compressed summits
-  with P < 0, for the tensile part): one 1-D table (in h, or in r).
-* A(h, xi): 2-D table in (h, w) over the window only, w = sqrt((xi + x_r)/x_r), which removes the
-  square-root singularity of P_JKR at the fold. A(h, 0) = 0 is a node column, so the window meets the
-  approach branch exactly; at xi = -x_r the table is corrected by s (Wr - A(h, -x_r)), s = -xi/x_r
-  (linear, of the size of the table error) so that it meets the release branch exactly too: the law
-  is continuous wherever a threshold changes branch (a jump there stalls the coupled
-  pressure-deflection solve; docs/halfspace.md).
-* Above z_max only stretched summits remain: X = n S int_{xi}^{xi_top} q phi lam dx, from a 1-D
-  band table (release thresholds) or A(h, xi) - A(h, xi_top) (threshold inside the window, corrected
-  linearly in xi to meet the band table at xi = -x_r).
-  (For the compressive/tensile split, within x0 delta_c of z_max every summit is tensile.)
-All tables are piecewise-cubic Hermite with exact node derivatives, built by Gauss-Legendre
-quadrature in the JKR variable s = sqrt(a/a0) (x = (s^4 - s)/d_c is explicit: no root finding, no
-singularity at the fold; y = sqrt(s - 1) for q - q_H, whose x^{3/2} term is analytic in y). Their
-error is measured by ``table_error`` against scipy.integrate.quad of the defining integrals
-(``quadrature_pressure`` etc.). States deeper than the tables (d < -20 sigma) are integrated on
-the fly with fixed Gauss-Legendre nodes.
+Fast evaluation
+---------------
+Exactly decomposed (Hertz part + JKR correction + the branch of the threshold: approach, release or
+inside the stretched window) into 1-D tables in h = d/sigma and a 2-D window table in (h, w),
+w = sqrt((xi + x_r)/x_r), all piecewise-cubic Hermite with exact node derivatives, built by
+Gauss-Legendre quadrature in the JKR variable s = sqrt(a/a0) (layout: `gw_layout`; closed forms:
+`summits`). The law is continuous where a threshold changes branch. Derivation, table errors
+(`table_error` against the adaptive quadrature of `gw_reference`) and costs: docs/rough-gw.md.
+States deeper than the tables (d < -20 sigma) are integrated on the fly with fixed Gauss-Legendre nodes.
 
 Sources: J. A. Greenwood & J. B. P. Williamson, Proc. R. Soc. Lond. A 295 (1966) 300-319;
 K. N. G. Fuller & D. Tabor, Proc. R. Soc. Lond. A 345 (1975) 327-342; K. L. Johnson, K. Kendall &
 A. D. Roberts, Proc. R. Soc. Lond. A 324 (1971) 301-313; Abramowitz & Stegun ch. 19 / DLMF §12.5
 (parabolic-cylinder functions); E. J. Gumbel, *Statistics of Extremes* (1958) §3.1 (characteristic
-largest value). Details and measured errors: docs/_fragments/rough_gw.md.
+largest value).
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate, special
 
 from ..reference import jkr as _jkr
+from .gw_layout import (_BUILD_BLOCK, _DH, _DT_PANEL, _GL_W, _GL_X, _H_DEEP, _H_ZERO, _HERTZ_NU, _T_CUT, RESOLUTIONS,
+                        _Cubic1D, _gl_nodes, _Hermite2D, _panels, _window_shape, table_size)
+from .gw_reference import quadrature_contact_fraction, quadrature_energy, quadrature_pressure, table_error
+from .summits import (_DC, _S_FOLD, _S_LOAD, _S_ZERO, TENSILE_ONSET, SummitStatistics, _dx_ds, _g_of_s,
+                      _gauss_mass, _out, _phi, _q_of_s, _s_of_x, _x_of_s, expected_max_height, gw_integral)
 
 __all__ = [
     "SummitStatistics",
@@ -91,292 +67,6 @@ __all__ = [
     "TENSILE_ONSET",
     "table_size",
 ]
-
-_SQRT2PI = math.sqrt(2.0 * math.pi)
-# JKR in the reduced variable s = sqrt(a/a0): delta/delta0 = s^4 - s, delta_c/delta0 = _DC.
-_DC = 0.75 * 4.0 ** (-1.0 / 3.0)
-_S_FOLD = 4.0 ** (-1.0 / 3.0)          # delta = -delta_c (displacement-controlled release)
-_S_LOAD = 0.75 ** (1.0 / 3.0)          # P = -P_c (load-controlled release)
-_S_ZERO = 1.5 ** (1.0 / 3.0)           # P = 0 on the stable branch
-#: delta/delta_c at which the stable JKR branch changes sign (P < 0 below): 1.2114...
-TENSILE_ONSET = (_S_ZERO**4 - _S_ZERO) / _DC
-
-#: spacing multipliers of the fidelity presets (tables are 4th-order: error ~ multiplier^4)
-RESOLUTIONS = {"fast": 2.0, "standard": 1.0, "reference": 0.5}
-_DH = 0.05          # node spacing in h (units of sigma) at resolution 1
-_DT_W = 0.15        # largest t-step (sigma) between w-nodes of the 2-D table at resolution 1
-_NW_MIN = 24        # fewest w-cells at resolution 1
-_T_CUT = 8.5        # untruncated: adhesive tables neglect summits above 8.5 sigma (mass 9.5e-18)
-_H_ZERO = 30.0      # F_nu(h) < 1e-195 beyond h = 30: taken as 0
-_H_DEEP = -20.0     # tables cover h >= -20; deeper states use on-the-fly quadrature
-_DT_PANEL = 0.25    # largest t-span (sigma) of one Gauss-Legendre panel in the build quadratures
-_BUILD_BLOCK = 2_000_000   # most floats in one block of the window table's build quadrature
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
-_GH_X, _GH_W = np.polynomial.hermite_e.hermegauss(60)   # weight exp(-t^2/2)
-_HERTZ_NU = (1.5, 2.5, 1.0)            # pressure, energy, contact area
-
-
-# ==============================================================================================
-# Parameters and small closed forms
-# ==============================================================================================
-@dataclass(frozen=True)
-class SummitStatistics:
-    """Greenwood-Williamson summit statistics of a rough surface (composite of both surfaces)."""
-
-    sigma: float
-    """Standard deviation of summit heights about the summit mean plane (m); paper eq 9's sigma.
-    Summit sigma is smaller than the RMS of surface heights."""
-    density: float
-    """Summits per unit nominal area n (1/m^2)."""
-    radius: float
-    """Tip radius beta of every summit (m); the paper's R in eqs 4-8."""
-
-    def __post_init__(self):
-        for name in ("sigma", "density", "radius"):
-            v = getattr(self, name)
-            try:
-                ok = math.isfinite(float(v)) and float(v) > 0.0
-            except (TypeError, ValueError):
-                ok = False
-            if not ok:
-                raise ValueError(f"SummitStatistics.{name} = {v!r}: must be a positive finite number")
-
-
-def expected_max_height(n_summits) -> float:
-    """Characteristic largest of N Gaussian summit heights, in units of sigma: Phi^{-1}(1 - 1/N).
-
-    Extreme-value statistics (Gumbel, *Statistics of Extremes*, 1958, §3.1): the characteristic
-    largest value u_N of N independent draws is defined by N [1 - Phi(u_N)] = 1, i.e. one summit is
-    expected above it. It is the mode of the Gumbel limit of the maximum (the mean is larger by
-    about 0.577/u_N). We truncate the summit distribution there: the model then holds exactly
-    N - 1 expected summits, one less than the footprint, and first touch / last release are at a
-    finite, well-defined height. Computed as -ndtri(1/N) (no cancellation for large N).
-    """
-    n = np.asarray(n_summits, float)
-    if np.any(~(n > 1.0)):
-        raise ValueError(f"expected_max_height: need more than one summit (got {n_summits!r})")
-    return _out(-special.ndtri(1.0 / n))
-
-
-def _out(x):
-    x = np.asarray(x)
-    return x[()] if x.ndim == 0 else x
-
-
-def _phi(t):
-    return np.exp(-0.5 * t * t) / _SQRT2PI
-
-
-def gw_integral(nu, h):
-    """F_nu(h) = (1/sqrt(2 pi)) int_h^inf (s - h)^nu exp(-s^2/2) ds, exactly (nu > -1).
-
-    = Gamma(nu+1)/sqrt(2 pi) exp(-h^2/4) D_{-nu-1}(h) (DLMF 12.5.1 with U(a, z) = D_{-a-1/2}(z);
-    Abramowitz & Stegun 19.5.3), scipy.special.pbdv. For h < -12 (pbdv loses ~1e-13 relative and
-    would overflow further out) the integral is E[(Z - h)^nu], evaluated by 60-point Gauss-Hermite
-    quadrature (the integrand is smooth there; P(Z < -12) ~ 2e-33). Vectorised; slow (~6 us/point):
-    the surface tabulates it.
-    """
-    h = np.asarray(h, float)
-    out = np.zeros_like(h)
-    mid = (h >= -12.0) & (h <= 38.0)
-    if np.any(mid):
-        d, _ = special.pbdv(-nu - 1.0, h[mid])
-        out[mid] = special.gamma(nu + 1.0) / _SQRT2PI * np.exp(-0.25 * h[mid] ** 2) * d
-    low = h < -12.0
-    if np.any(low):
-        z = _GH_X[None, :] - h[low, None]
-        out[low] = (np.maximum(z, 0.0) ** nu) @ _GH_W / _SQRT2PI
-    return _out(out)
-
-
-# ---------------------------------------------------------------------------- JKR in s = sqrt(a/a0)
-def _x_of_s(s):
-    """delta/delta_c."""
-    return (s**4 - s) / _DC
-
-
-def _dx_ds(s):
-    return (4.0 * s**3 - 1.0) / _DC
-
-
-def _q_of_s(s):
-    """(P/P_c, U/(P_c delta_c), a^2/(beta delta_c)) on the JKR curve (closed forms, see reference.jkr)."""
-    s3 = s**3
-    s4 = s3 * s
-    f = s3 * (16.0 / 9.0 * s3 - 8.0 / 3.0)
-    u = (2.0 / 3.0) / _DC * (((16.0 / 15.0 * s3 - 8.0 / 3.0) * s3 + 1.0) * s4 + 0.6)
-    return np.stack([f, u, s4 / _DC])
-
-
-def _g_of_s(s):
-    """JKR minus Hertz (same units as _q_of_s) for compressed summits, s >= 1; cancellation-free force."""
-    s3 = s**3
-    s15 = s * np.sqrt(s)
-    c = np.maximum(s3 - 1.0, 0.0)
-    x = _x_of_s(s)
-    fh = 16.0 / 9.0 * (x * _DC) ** 1.5
-    gf = 16.0 / 9.0 * s15 * (3.0 * s3 * s3 - 3.0 * s3 + 1.0) / (s15**3 + c * np.sqrt(c)) - 8.0 / 3.0 * s3
-    q = _q_of_s(s)
-    return np.stack([gf, q[1] - 0.4 * x * fh, s / _DC])
-
-
-def _s_of_x(x):
-    """Stable-branch s for delta/delta_c = x >= -1 (closed-form quartic inverse of reference.jkr)."""
-    # with beta = 1, dgamma = 1/(2 pi), E* = 1: a0 = delta0 = 1, so a = s^2 and delta = x d_c.
-    a = _jkr.radius_from_approach(np.asarray(x, float) * _DC, 1.0, 0.5 / math.pi, 1.0)
-    return np.sqrt(a)
-
-
-def _panels(bounds, t_of, dt_max):
-    """Split the intervals between sorted `bounds` so that each spans at most dt_max in t_of(.)."""
-    b = np.asarray(bounds, float)
-    span = np.abs(np.diff(t_of(b)))
-    k = np.maximum(1, np.ceil(span / dt_max).astype(int))
-    lo = np.repeat(b[:-1], k)
-    width = np.repeat(np.diff(b) / k, k)
-    frac = np.concatenate([np.arange(m) for m in k])
-    left = lo + frac * width
-    return np.append(left, b[-1])
-
-
-def _gl_nodes(bounds):
-    """Gauss-Legendre (8-point) nodes, weights and panel index for panels between `bounds`."""
-    a, b = bounds[:-1, None], bounds[1:, None]
-    half = 0.5 * (b - a)
-    x = (a + b) * 0.5 + half * _GL_X[None, :]
-    w = half * _GL_W[None, :]
-    pid = np.broadcast_to(np.arange(len(bounds) - 1)[:, None], x.shape)
-    return x.ravel(), w.ravel(), pid.ravel()
-
-
-def _window_shape(lam, xr, ttop, scale):
-    """(h-cells, w-cells, sub-panels per w-cell, band cells) of the window tables (`_build_window`)."""
-    dh = _DH * scale
-    h0, h1 = -_T_CUT, ttop + lam * xr
-    nh = max(4, int(math.ceil((h1 - h0) / dh)))
-    # w-cells: the resolution of a table in sqrt((xi + x_r)/(x_r + x0)) with max(24, 2 (x_r + x0) lam / 0.15)
-    # cells over [-x_r, x0] (the earlier layout, measured in docs/rough-gw.md), of which the window
-    # [-x_r, 0] is the fraction sqrt(x_r/(x_r + x0)) of the cells
-    span = xr + TENSILE_ONSET
-    nw = int(math.ceil(max(_NW_MIN, 2.0 * span * lam / _DT_W) * math.sqrt(xr / span) / scale))
-    # largest xi-step between w-nodes: the last cell (xi = -x_r (1 - w^2) is steepest at w = 1)
-    dxi = xr * (1.0 - (1.0 - 1.0 / nw) ** 2)
-    nsub = max(1, int(math.ceil(dxi * lam / _DT_PANEL)))
-    # along the band h moves by up to 2 lam x_r per unit w: keep its h-steps <= dh
-    nband = max(nw, int(math.ceil(2.0 * xr * lam / dh)))
-    return nh, nw, nsub, nband
-
-
-#: Peak bytes per node of the 2-D window table while it is built: node values and derivatives of three
-#: quantities (4 x 3 x 8 B), the Gaussian at the w-nodes (2 x 8 B), one quantity's Hermite blocks and
-#: monomial coefficients (2 x 16 x 8 B) and the coefficients already kept (2 x 16 x 8 B): 624 B, rounded up
-#: after measuring with tracemalloc (tests/test_extremes.py checks the estimate bounds the measured peak).
-_BYTES_PER_NODE = 800
-#: Fixed part of the build's peak: quadrature blocks of `_BUILD_BLOCK` floats (about six arrays of them).
-_BUILD_FIXED_BYTES = 6 * 8 * 2_000_000
-
-
-def table_size(stats, work_of_adhesion: float, e_star: float, z_max=None, detachment: str = "displacement",
-               resolution="standard") -> dict:
-    """What `GWJKRSurface(...)` with these arguments would allocate and compute, without building it.
-
-    Returns ``nodes`` (2-D window table), ``shape`` (h-cells, w-cells), ``band_cells``,
-    ``quadrature_points`` (integrand evaluations of the build), ``peak_bytes`` (an upper estimate of
-    the build's peak allocation) and ``lambda`` = delta_c/sigma. The window table spans the release
-    stretch Delta = x_r delta_c in steps of ~0.15 sigma and h from -8.5 sigma to z_max + Delta in steps
-    of 0.05 sigma (x the resolution multiplier), so its size grows like (delta_c/sigma)^2: with sigma
-    well below delta_c (soft, strongly adhesive summits on a very smooth surface) it outgrows any
-    memory. Hertz summits (work of adhesion 0) have no adhesive tables.
-    """
-    scale = RESOLUTIONS.get(resolution, resolution) if isinstance(resolution, str) else float(resolution)
-    scale = float(scale)
-    sigma = stats.sigma
-    out = {"nodes": 0, "shape": (0, 0), "band_cells": 0, "quadrature_points": 0,
-           "peak_bytes": 1_000_000, "lambda": 0.0}
-    if not work_of_adhesion > 0.0:
-        return out
-    delta_c = float(_jkr.critical_approach(stats.radius, work_of_adhesion, e_star))
-    lam = delta_c / sigma
-    xr = 1.0 if detachment == "displacement" else -_jkr.LOAD_DETACH_APPROACH_RATIO
-    tmax = math.inf if z_max is None or not math.isfinite(z_max) else float(z_max)
-    ttop = min(tmax, _T_CUT)
-    nh, nw, nsub, nband = _window_shape(lam, xr, ttop, scale)
-    nodes = (nh + 1) * (nw + 1)
-    band = nband if math.isfinite(tmax) else 0
-    # band: node i integrates up to its own s_i over panels of <= 0.25 sigma in t (about 4 lam x_r of them)
-    band_points = band * 8 * max(50, int(4.0 * lam * xr / _DT_PANEL)) // 2
-    out.update(nodes=nodes, shape=(nh, nw), band_cells=band, lambda_=lam,
-               quadrature_points=int((nh + 1) * nw * nsub * 8 + band_points),
-               peak_bytes=int(nodes * _BYTES_PER_NODE + _BUILD_FIXED_BYTES))
-    out["lambda"] = out.pop("lambda_")
-    return out
-
-
-# ==============================================================================================
-# Piecewise-cubic Hermite tables on uniform grids
-# ==============================================================================================
-_M = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-3.0, -2.0, 3.0, -1.0], [2.0, 1.0, -2.0, 1.0]])
-
-
-class _Cubic1D:
-    """Columns of C1 piecewise cubics on x0 + i dx, from node values and exact node derivatives."""
-
-    def __init__(self, x0, dx, values, derivs):
-        v = np.asarray(values, float)          # (K, n)
-        m = np.asarray(derivs, float) * dx
-        v0, v1, m0, m1 = v[:, :-1], v[:, 1:], m[:, :-1], m[:, 1:]
-        coef = np.stack([v0, m0, 3.0 * (v1 - v0) - 2.0 * m0 - m1, 2.0 * (v0 - v1) + m0 + m1], axis=-1)
-        self.coef = np.ascontiguousarray(coef.transpose(1, 0, 2))   # (ncell, K, 4)
-        self.x0, self.dx, self.ncell = float(x0), float(dx), v.shape[1] - 1
-        self.x1 = self.x0 + self.ncell * self.dx
-
-
-class _Hermite2D:
-    """Bicubic Hermite interpolant on a uniform (a, b) grid; one coefficient block per cell."""
-
-    def __init__(self, a0, da, b0, db, F, Fa, Fb, Fab):
-        na, nb = F.shape
-        Fa, Fb, Fab = Fa * da, Fb * db, Fab * da * db
-        # D[cell, (a-basis), (b-basis)], basis order (value@0, deriv@0, value@1, deriv@1)
-        D = np.empty((na - 1, nb - 1, 4, 4))
-        for ia, (sa, ka) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
-            for ib, (sb, kb) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
-                src = (F, Fb, Fa, Fab)[2 * ka + kb]
-                D[:, :, ia, ib] = src[sa:na - 1 + sa, sb:nb - 1 + sb]
-        # monomial coefficients of b^l a^m: C[., ., l, m] = sum_tu M[m, t] D[., ., t, u] M[l, u], as batched
-        # 4x4 products (a 4-index einsum here cost ~7 us per cell)
-        C = np.swapaxes(_M @ D @ _M.T, -1, -2)
-        del D
-        self.coef = np.ascontiguousarray(C).reshape((na - 1) * (nb - 1), 16)
-        self.a0, self.inv_da, self.b0, self.inv_db = float(a0), 1.0 / da, float(b0), 1.0 / db
-        self.na, self.nb = na - 1, nb - 1
-
-    def __call__(self, a, b, deriv=True):
-        """(F, dF/da, dF/db) at points (a, b); b must lie in the grid, a outside it takes edge values."""
-        ta = (a - self.a0) * self.inv_da
-        np.minimum(ta, self.na * (1.0 - 1e-15), out=ta)
-        np.maximum(ta, 0.0, out=ta)
-        tb = (b - self.b0) * self.inv_db
-        ia = ta.astype(np.intp)
-        ib = tb.astype(np.intp)
-        np.minimum(ib, self.nb - 1, out=ib)
-        ta -= ia
-        tb -= ib
-        ia *= self.nb
-        ia += ib
-        c = np.take(self.coef, ia, axis=0).T.reshape(4, 4, -1)        # [l, m, n], contiguous rows
-        c0, c1, c2, c3 = c
-        T = ((c3 * tb + c2) * tb + c1) * tb + c0                          # T[m] = sum_l c[l, m] b^l
-        T0, T1, T2, T3 = T
-        F = ((T3 * ta + T2) * ta + T1) * ta + T0
-        if not deriv:
-            return F, None, None
-        Fa = ((3.0 * T3 * ta + 2.0 * T2) * ta + T1) * self.inv_da
-        S0, S1, S2, S3 = (3.0 * c3 * tb + 2.0 * c2) * tb + c1
-        Fb = (((S3 * ta + S2) * ta + S1) * ta + S0) * self.inv_db
-        return F, Fa, Fb
-
-
 # ==============================================================================================
 # The surface
 # ==============================================================================================
@@ -976,43 +666,9 @@ class GWJKRSurface:
 
     def table_error(self, n_points: int = 48, seed: int = 0, h_range=None,
                     quantities=("pressure", "energy", "contact_fraction")):
-        """Measured table error against scipy.integrate.quad of the defining integrals.
-
-        Random states: h = d/sigma uniform in h_range (default [-4, min(z_max, 6) + Delta/sigma],
-        the range an impact uses; with truncation a quarter of them in the band
-        z_max - 1.2114 delta_c < d < z_max + Delta), zeta* drawn in equal shares as +inf
-        (approach), inside [d - Delta, d] (fixed threshold) and below d - Delta (releasing). Error norm:
-        |X - X_quad| / max(|X_quad|, S) with S = n P_c (pressure), n P_c delta_c (energy),
-        n pi beta delta_c (area); for work_of_adhesion = 0, S = 0 (pure relative error; states with
-        X_quad = 0 are skipped). Returns {quantity: max error, "points": n, "norm": text}.
-        """
-        rng = np.random.default_rng(seed)
-        if h_range is None:
-            h_range = (-4.0, min(self._tmax, 6.0) + self._dn)
-        h = rng.uniform(*h_range, n_points)
-        if self.truncated and self.adhesive:     # a quarter in the band within x0 delta_c of z_max
-            band = np.arange(n_points) % 4 == 3
-            h[band] = rng.uniform(self._hband, self._tmax + self._dn, np.count_nonzero(band))
-        kind = np.arange(n_points) % 3
-        zs = np.where(kind == 0, np.inf,
-                      np.where(kind == 1, h - self._dn * rng.uniform(0, 1, n_points),
-                               h - self._dn - rng.uniform(0, 1, n_points)))
-        d, zeta = h * self.sigma, zs * self.sigma
-        fns = {"pressure": (self.pressure, quadrature_pressure, 0),
-               "energy": (self.energy, quadrature_energy, 1),
-               "contact_fraction": (self.contact_fraction, quadrature_contact_fraction, 2)}
-        out = {"points": n_points, "h_range": tuple(h_range),
-               "norm": "|X - X_quad| / max(|X_quad|, S), S = n P_c, n P_c delta_c, n pi beta delta_c"}
-        for q in quantities:
-            fast, slow, j = fns[q]
-            x = fast(d, zeta)
-            ref = slow(d, zeta, self.stats, self.work_of_adhesion, self.e_star,
-                       z_max=self._tmax if self.truncated else None, detachment=self.detachment)
-            s = self._as[j] if self.adhesive else 0.0
-            den = np.maximum(np.abs(ref), s)
-            ok = den > 0
-            out[q] = float(np.max(np.abs(x - ref)[ok] / den[ok])) if np.any(ok) else 0.0
-        return out
+        """Measured table error against scipy.integrate.quad of the defining integrals
+        (`continuum.rough.gw_reference.table_error`, which says how the states are drawn and the norm)."""
+        return table_error(self, n_points, seed, h_range, quantities)
 
     def describe(self) -> dict:
         return {"sigma": self.sigma, "density": self.density, "radius": self.radius,
@@ -1021,101 +677,3 @@ class GWJKRSurface:
                 "delta_c": self.delta_c, "release_stretch": self.release_stretch,
                 "sigma_over_delta_c": self.sigma / self.delta_c if self.adhesive else math.inf,
                 "build_seconds": self.build_seconds}
-
-
-def _gauss_mass(a, b):
-    """int_a^{b} phi (standard normal), a, b may be +-inf; 0 if b <= a. Cancellation-free tails."""
-    a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
-    m = np.where(a > 0, special.ndtr(-a) - special.ndtr(-b), special.ndtr(b) - special.ndtr(a))
-    return np.where(b > a, np.maximum(m, 0.0), 0.0)
-
-
-# ==============================================================================================
-# Reference implementation by adaptive quadrature (slow, for tests and table_error)
-# ==============================================================================================
-def _summit_law(kind, stats, g, e_star):
-    beta = stats.radius
-    if g > 0:
-        if kind == 0:
-            return lambda dl: float(_jkr.force_from_approach(dl, beta, g, e_star))
-        if kind == 1:
-            return lambda dl: float(_jkr.energy_from_approach(dl, beta, g, e_star))
-        return lambda dl: math.pi * float(_jkr.radius_from_approach(dl, beta, g, e_star)) ** 2
-    rb = math.sqrt(beta)
-    if kind == 0:
-        return lambda dl: 4.0 / 3.0 * e_star * rb * dl**1.5
-    if kind == 1:
-        return lambda dl: 8.0 / 15.0 * e_star * rb * dl**2.5
-    return lambda dl: math.pi * beta * dl
-
-
-def _quadrature(kind, d, zeta, stats, g, e_star, z_max, detachment, part):
-    sigma, n = stats.sigma, stats.density
-    if g > 0:
-        dc = float(_jkr.critical_approach(stats.radius, g, e_star))
-        rel = dc if detachment == "displacement" else \
-            -float(_jkr.load_controlled_detach_approach(stats.radius, g, e_star))
-        pc = float(_jkr.pull_off_force(stats.radius, g))
-        scale = [pc, pc * dc, math.pi * stats.radius * dc][kind]
-        x0 = TENSILE_ONSET * dc
-    else:
-        dc = rel = 0.0
-        scale = [4.0 / 3.0 * e_star * math.sqrt(stats.radius) * sigma**1.5,
-                 8.0 / 15.0 * e_star * math.sqrt(stats.radius) * sigma**2.5,
-                 math.pi * stats.radius * sigma][kind]
-        x0 = 0.0
-    law = _summit_law(kind, stats, g, e_star)
-    tmax = math.inf if z_max is None or not math.isfinite(z_max) else float(z_max)
-    d, zeta = np.broadcast_arrays(np.asarray(d, float), np.asarray(zeta, float))
-    out = np.zeros(d.shape)
-    for idx in np.ndindex(d.shape):
-        dd, zz = float(d[idx]), float(zeta[idx])
-        h = dd / sigma
-        te = max(min(zz, dd), dd - rel) / sigma
-        top = min(tmax, max(h, 0.0) + 13.0)
-        lo, hi = te, top
-        if part == "tensile":
-            hi = min(hi, h + x0 / sigma)
-        elif part == "compressive":
-            lo = max(lo, h + x0 / sigma)
-        if hi <= lo:
-            continue
-
-        def f(t):
-            return law(sigma * (t - h)) * math.exp(-0.5 * t * t) / (_SQRT2PI * scale)
-
-        cand = sorted(b for b in (h, h + dc / sigma, h + 5 * dc / sigma, h + 30 * dc / sigma,
-                                  h + x0 / sigma, -4.0, -2.0, 0.0, 2.0, 4.0, 6.0) if lo < b < hi)
-        brk = [lo]
-        for b in cand + [hi]:                   # drop slivers (quad cannot converge on them)
-            if b - brk[-1] > 1e-9:
-                brk.append(b)
-        brk[-1] = hi
-        total = 0.0
-        for a, b in zip(brk[:-1], brk[1:]):
-            v, _ = integrate.quad(f, a, b, epsabs=1e-14, epsrel=1e-11, limit=400)
-            total += v
-        out[idx] = n * scale * total
-    return _out(out)
-
-
-def quadrature_pressure(d, zeta, stats, work_of_adhesion, e_star, z_max=None, detachment="displacement",
-                        part="total"):
-    """Reference p(d, zeta) (Pa) by scipy.integrate.quad of n int_{zeta_eff}^{z_max} P(z - d) phi dz.
-
-    Same arguments as GWJKRSurface (z_max in units of sigma). part: "total", "compressive"
-    (summits with P > 0) or "tensile". Per-summit laws from continuum.reference.jkr (Hertz if
-    work_of_adhesion = 0). Slow: a Python loop of adaptive quadratures, for tests only.
-    """
-    return _quadrature(0, d, zeta, stats, work_of_adhesion, e_star, z_max, detachment, part)
-
-
-def quadrature_energy(d, zeta, stats, work_of_adhesion, e_star, z_max=None, detachment="displacement"):
-    """Reference stored energy (J/m^2) n int U_JKR(z - d) phi dz by adaptive quadrature (slow)."""
-    return _quadrature(1, d, zeta, stats, work_of_adhesion, e_star, z_max, detachment, "total")
-
-
-def quadrature_contact_fraction(d, zeta, stats, work_of_adhesion, e_star, z_max=None,
-                                detachment="displacement"):
-    """Reference real-contact fraction n int pi a(z - d)^2 phi dz by adaptive quadrature (slow)."""
-    return _quadrature(2, d, zeta, stats, work_of_adhesion, e_star, z_max, detachment, "total")

@@ -31,7 +31,7 @@ import warnings
 
 import numpy as np
 
-from .gw import SummitStatistics, _gauss_mass
+from .summits import SummitStatistics, _gauss_mass
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
