@@ -194,4 +194,5 @@ def test_the_paper_runner_runs_on_the_executor_it_is_given_and_leaves_it_open(tm
         assert dict(ex.map(square_or_fail, [2])) == {0: 4}          # still open: its owner closes it
     assert set(got["impacts"]) == {("hertz", "paper")} and set(got["sweeps"]) == {("hertz", "paper")}
     assert (tmp_path / "paper" / "cases" / "hertz" / "paper" / "result.json").is_file()
-    assert lines[0].startswith("paper: 2 runs for set(s) paper on " + ex.describe())
+    assert set(got["curves"]) == {"paper"}                           # Fig 4's curves: a pool task per set
+    assert lines[0].startswith("paper: 3 runs for set(s) paper on " + ex.describe())   # impact, sweep, curves
