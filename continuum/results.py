@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from nanoimpact.fileio import json_leaf
+
 #: Bump the major number on incompatible changes to result.json.
 SCHEMA_VERSION = "1.0"
 
@@ -70,17 +72,6 @@ def _clean(obj):
 _INLINE_MIN = 8
 
 
-def _plain(obj):
-    """A JSON leaf value: NumPy scalars as Python numbers, paths as strings, non-finite floats as None."""
-    if isinstance(obj, (np.floating, np.integer)):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
-
-
 def _encode(obj, level: int) -> str:
     """JSON text of `obj` indented by 2 like json.dumps(indent=2), except that a list of `_INLINE_MIN` or more
     numbers is written on one line (by the C encoder). Arrays become lists, non-finite floats null."""
@@ -104,7 +95,7 @@ def _encode(obj, level: int) -> str:
                 return json.dumps(obj)
             return json.dumps([v if math.isfinite(v) else None for v in obj])
         return "[\n" + ",\n".join(inner + _encode(v, level + 1) for v in obj) + "\n" + pad + "]"
-    leaf = _plain(obj)
+    leaf = json_leaf(obj)
     if isinstance(leaf, (dict, list, tuple, np.ndarray)):
         return _encode(leaf, level)
     try:

@@ -6,10 +6,14 @@ share a temporary name), is flushed and fsync'ed, then moved into place with `os
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 
 def _umask() -> int:
@@ -43,6 +47,29 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
 def atomic_write_text(path: str | Path, text: str) -> Path:
     """Write UTF-8 `text` to `path` atomically; returns the path."""
     return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def json_leaf(obj: Any) -> Any:
+    """A value JSON can hold: NumPy scalars as Python numbers, paths as strings, non-finite floats as None
+    (strict JSON has no NaN or Infinity); anything else unchanged."""
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def clean_json(obj: Any) -> Any:
+    """`obj` with every mapping, sequence and array turned into JSON containers and every leaf `json_leaf`'d."""
+    if isinstance(obj, Mapping):
+        return {str(k): clean_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [clean_json(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return clean_json(obj.tolist())
+    return json_leaf(obj)
 
 
 def atomic_write_json(path: str | Path, obj: Any, *, indent: int | None = 2, default=None) -> Path:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +19,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from md.engine.plan import Leg, Plan
-from nanoimpact.fileio import atomic_write_bytes, atomic_write_text
+from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, clean_json  # noqa: F401 (clean_json: re-exported)
 
 __all__ = ["DEFAULT_CACHE", "cache_root", "read_samples", "read_frames", "parse_ave_time", "parse_dump",
            "leg_state", "truncate_samples", "export", "write_csv", "clean_json", "RunContext", "RunOutcome"]
@@ -156,22 +155,6 @@ def write_csv(path: Path, columns: Sequence[str], rows: np.ndarray) -> None:
     for r in np.atleast_2d(rows):
         w.writerow([repr(float(x)) for x in r])
     path.write_text(buf.getvalue())
-
-
-def clean_json(obj):
-    if isinstance(obj, Mapping):
-        return {str(k): clean_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [clean_json(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return clean_json(obj.tolist())
-    if isinstance(obj, np.generic):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
 
 
 @dataclass
