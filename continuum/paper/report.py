@@ -110,6 +110,12 @@ def wet_lines(set_name: str, wet: dict, impacts: dict) -> list[str]:
     return out
 
 
+def _of_set(collected: dict, set_name: str) -> tuple[dict, dict, dict]:
+    """A set's impacts, sweeps and wet sweeps from the collected runs, keyed by case."""
+    return tuple({c: v for (c, s), v in collected[kind].items() if s == set_name}
+                 for kind in ("impacts", "sweeps", "wet"))
+
+
 def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
                executor_name: str = "processes", scheduler: str | None = None, executor=None,
                progress: Callable[[str], None] = print) -> dict:
@@ -119,17 +125,13 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
     `executor_name` executor with `workers` and `scheduler` (default: a local pool of CPU-count processes)."""
     out = Path(out)
     start = time.perf_counter()
-    collected = run_paper(sets, out, fidelity=fidelity, workers=workers, executor_name=executor_name,
-                          scheduler=scheduler, executor=executor, progress=progress)
-    all_checks, summary = [], ["# nanoimpact paper: dry, wet and SAM cases", "",
-                               f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
-                               "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]
-    for set_name in (Path(s).stem for s in sets):
-        impacts = {c: v for (c, s), v in collected["impacts"].items() if s == set_name}
-        sweeps = {c: v for (c, s), v in collected["sweeps"].items() if s == set_name}
-        wet = {c: v for (c, s), v in collected["wet"].items() if s == set_name}
+
+    def draw(set_name: str, collected: dict) -> None:
+        """A set's figures, drawn here while the pool runs the next set (~5 s of matplotlib per set)."""
+        impacts, sweeps, wet = _of_set(collected, set_name)
         curves = collected["curves"].get(set_name) or fig4_curves(
             set_name if set_name in sets else next(s for s in sets if Path(s).stem == set_name), fidelity)
+        collected["curves"][set_name] = curves
         figures.save(figures.fig4(curves, set_name, out), out / f"fig4_{set_name}.png")
         figures.save(figures.fig5a(impacts, set_name, out), out / f"fig5a_{set_name}.png")
         figures.save(figures.fig5b(impacts, set_name, out), out / f"fig5b_{set_name}.png")
@@ -137,6 +139,15 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
         figures.save(figures.fig7(impacts, set_name, out), out / f"fig7_{set_name}.png")
         figures.save(figures.fig8a(sweeps, set_name, out, wet), out / f"fig8a_{set_name}.png")
         figures.save(figures.fig8b(wet, set_name, out), out / f"fig8b_{set_name}.png")
+
+    collected = run_paper(sets, out, fidelity=fidelity, workers=workers, executor_name=executor_name,
+                          scheduler=scheduler, executor=executor, progress=progress, on_set_done=draw)
+    all_checks, summary = [], ["# nanoimpact paper: dry, wet and SAM cases", "",
+                               f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
+                               "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]
+    for set_name in (Path(s).stem for s in sets):
+        impacts, sweeps, wet = _of_set(collected, set_name)
+        curves = collected["curves"][set_name]
         set_checks = checks.evaluate(set_name, {c: v["result"] for c, v in impacts.items()}, sweeps,
                                      {k: {"loop_area": v["loop_area"]} for k, v in curves.items()})
         set_checks += checks.evaluate_wet(set_name, wet, {c: v["result"] for c, v in impacts.items()})

@@ -171,23 +171,42 @@ def fig8_cases() -> list[Case]:
     return [Case("hertz", "hertz_roller.toml", {"numerics.max_bounces": 1}, ("8a",))] + rough
 
 
+def paper_tasks(sets: list[str], out: Path, fidelity: str | None) -> list[tuple[str, tuple]]:
+    """The runs of every set, set after set; within a set the longest first (the wet near-escape sweeps, then
+    the Fig 8a sweeps, the impacts, Fig 4's curves), so no long run starts last and the first sets finish
+    early: `run_paper` hands each finished set to its caller (its figures) while the pool runs the next."""
+    tasks = []
+    for s in sets:
+        tasks += [("wet", (case, s, fidelity)) for case in wet_cases()]
+        tasks += [("sweep", (case, s, fidelity)) for case in fig8_cases()]
+        # absolute: the runs write there from the workers, whose working directory may differ (a Dask cluster)
+        tasks += [("impact", (case, s, fidelity, str(out.resolve()))) for case in dry_cases() + wet_cases()]
+        tasks.append(("curves", (s, fidelity)))
+    return tasks
+
+
+def _set_of(task) -> str:
+    kind, args = task
+    return Path(args[0] if kind == "curves" else args[1]).stem
+
+
 def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
               executor_name: str = "processes", scheduler: str | None = None, executor=None,
-              progress: Callable[[str], None] = print) -> dict:
+              progress: Callable[[str], None] = print,
+              on_set_done: Callable[[str, dict], None] | None = None) -> dict:
     """Run every dry case and sweep for every parameter set; returns the collected outputs.
 
     Runs go to `executor` (an object from nanoimpact.executors, left open: its owner closes it) or, without one,
     to a new `executor_name` executor (default: a local process pool of `workers`, default the CPU count).
-    The first run that fails stops the rest and its error propagates.
+    The first run that fails stops the rest and its error propagates. `on_set_done(set_name, collected)` is
+    called in this process as soon as every run of a set has arrived (the pool goes on with the other sets).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    # longest first (the wet near-escape sweeps, then the Fig 8a sweeps), so no long run starts last
-    tasks = [("wet", (case, s, fidelity)) for s in sets for case in wet_cases()]
-    tasks += [("sweep", (case, s, fidelity)) for s in sets for case in fig8_cases()]
-    # absolute: the runs write there from the workers, whose working directory may differ (a Dask cluster)
-    tasks += [("impact", (case, s, fidelity, str(out.resolve()))) for s in sets for case in dry_cases() + wet_cases()]
-    tasks += [("curves", (s, fidelity)) for s in sets]
+    tasks = paper_tasks(sets, out, fidelity)
+    left = {}
+    for task in tasks:
+        left[_set_of(task)] = left.get(_set_of(task), 0) + 1
     collected = {"impacts": {}, "sweeps": {}, "wet": {}, "curves": {}, "wall_s": {}, "cpu_s": {}}
     start = time.perf_counter()
     own = executor is None
@@ -208,6 +227,9 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
             collected["cpu_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["cpu_s"]
             progress(f"  [{done}/{len(tasks)}] {item['kind']} {item['case']} ({item['set']}): {item['wall_s']:.1f} s "
                      f"({item['cpu_s']:.1f} s CPU)")
+            left[item["set"]] -= 1
+            if left[item["set"]] == 0 and on_set_done is not None:
+                on_set_done(item["set"], collected)
     except BaseException:
         if own:
             executor.close(cancel=True)
