@@ -89,11 +89,12 @@ def run_point(task: tuple) -> dict:
     """Run one point (module-level: picklable for process pools and Dask) and write its result.json."""
     scene, params, overrides, folder = task
     from continuum.impact import run_impact
-    from continuum.results import dumps
+    from continuum.results import write_result_files
 
     resolved = resolve_scene(scene, params=params, overrides=overrides, override_label="sweep")
     result, _ = run_impact(resolved)
-    atomic_write_text(Path(folder) / "result.json", dumps(result) + "\n")
+    Path(folder).mkdir(parents=True, exist_ok=True)
+    write_result_files(folder, result)
     return _row(result)
 
 

@@ -41,7 +41,7 @@ def test_paper_output_has_figures_data_summary_and_case_results(paper_run):
     assert {"name", "set", "values", "threshold", "pass"} <= set(checks["checks"][0])
     assert "Parameter set `paper`" in (out / "summary.md").read_text()
     result = json.loads((out / "cases" / "rough_silica" / "paper" / "result.json").read_text())
-    assert result["schema_version"] == "1.0" and result["n_bounces"] >= 2
+    assert result["schema_version"] == "2.0" and result["n_bounces"] >= 2
 
 
 def _wet_sweep(wet_durations, wet_stuck):
