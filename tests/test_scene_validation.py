@@ -76,7 +76,7 @@ BAD = [
 ]
 
 
-@pytest.mark.parametrize("key,path,value,words", BAD, ids=[f"{p}={v!r}" for _, p, v, _ in BAD])
+@pytest.mark.parametrize("key,path,value,words", BAD, ids=[f"{p}=<deleted>" if v is _DELETE else f"{p}={v!r}" for _, p, v, _ in BAD])
 def test_bad_scene_is_refused_naming_key_value_and_range(key, path, value, words):
     with pytest.raises(SceneError) as err:
         resolve_scene(table=_with(path, value))
