@@ -42,7 +42,7 @@ def _profiled_record():
     x = np.linspace(-1e-7, 1e-7, 257)
     bounces = [{"index": k, "duration": 1e-5 * (k + 1),
                 "profiles": {"max_approach": {"t": 1e-4 * k, "gap": -1e-9, "force": 1e-6, "x": x,
-                                              "pressure": np.cos(x * 1e7 + k) * 1e6},
+                                              "pressure": np.cos(x * 1e7 + k) * 1e6, "short": [0.5, 1.0]},
                              "pull_off": {"t": 2e-4, "gap": 1e-10, "force": -1e-9, "x": x.tolist(),
                                           "pressure": (np.sin(x * 1e7) * 1e5).tolist()}}} for k in range(3)]
     bounces.append({"index": 3, "duration": None, "profiles": None})
@@ -56,14 +56,14 @@ def test_profiles_go_to_the_npz_and_come_back_exactly(tmp_path):
     stored = json.loads(text)
     assert len(text) < 5000                                    # 12 arrays of 257 floats would be ~60 kB
     prof = stored["bounces"][1]["profiles"]["max_approach"]
-    assert prof["arrays_file"] == PROFILES_FILE and set(prof["array_keys"]) == {"x", "pressure"}
+    assert prof["arrays_file"] == PROFILES_FILE and prof["array_fields"] == ["x", "pressure", "short"]
     assert prof["t"] == 1e-4 and "pressure" not in prof
     back = load_result(tmp_path)
     for k in range(3):
         for instant in ("max_approach", "pull_off"):
             want, got = record["bounces"][k]["profiles"][instant], back["bounces"][k]["profiles"][instant]
             assert set(got) == set(want)
-            for field in ("x", "pressure"):
+            for field in set(want) - {"t", "gap", "force"}:
                 assert np.array_equal(np.asarray(got[field]), np.asarray(want[field]))   # float64 both ways
             assert got["t"] == want["t"] and got["force"] == want["force"]
     assert back["bounces"][3]["profiles"] is None
