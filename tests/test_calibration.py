@@ -203,17 +203,54 @@ def test_sweep_validates_first_then_resumes_without_rerunning(tmp_path):
     assert (tmp_path / "sw" / "sweep.png").stat().st_size > 0
 
 
+#: the recipe whose smoke MD runs on a Dask worker in the pipeline test (the others come from the session's shared
+#: smoke runs or, surface_tension_spce, from its committed result)
+RUN_ON_WORKER = "contact_angle_silica"
+
+
 @pytest.mark.md
-def test_smoke_pipeline_on_two_dask_workers(tmp_path):
+@pytest.mark.filterwarnings("ignore:No artists with labels found:UserWarning")     # Fig 8b without its wet cases
+def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
+    """The whole pipeline on executor 'dask' with two workers: the MD jobs, the paper's cases and the
+    uncertainty samples are Dask tasks. Each MD source is exercised once: one recipe's LAMMPS runs on a worker
+    ('ran'), surface_tension_spce is the committed result ('committed'), and the other five are the smoke runs
+    other md tests made this session (md_smoke), copied into this test's md cache and found there by their hash
+    ('md cache'): smoke MD proves plumbing, so running it again here would prove nothing more. The paper's case
+    lists are cut to the three impacts its figures read, one bounce each, and one sweep (as test_executors cuts
+    them; the cases themselves are test_paper's), and the smoke recipe's uncertainty to two samples."""
+    import shutil
+    from dataclasses import replace
+
     from calibration import CalibrationReport, calibrate
+    from calibration.mdset import recipes_needed
+    from continuum.paper import run
+
+    cache = tmp_path / "md"
+    cache.mkdir()
+    shared = [r for r in recipes_needed() if r not in (RUN_ON_WORKER, "surface_tension_spce")]
+    for name in shared:
+        run_dir = md_smoke(name).outcome.run_dir
+        shutil.copytree(run_dir, cache / run_dir.name)
+    # the cases the figures read (hertz, rough silica, rough OTS), one bounce each; one sweep; no wet case
+    cheap = [replace(c, overrides={**c.overrides, "numerics.max_bounces": 1}) for c in run.dry_cases()
+             if c.name in ("hertz", "rough_silica", "rough_ots")]
+    monkeypatch.setattr(run, "dry_cases", lambda: cheap)
+    monkeypatch.setattr(run, "wet_cases", lambda: [])
+    monkeypatch.setattr(run, "fig8_cases", lambda: cheap[:1])
+    recipe = tmp_path / "smoke.toml"
+    text = (ROOT / "inputs" / "calibration" / "smoke.toml").read_text()
+    assert "\nsamples = 4\n" in text
+    recipe.write_text(text.replace("\nsamples = 4\n", "\nsamples = 2\n"))
 
     out = tmp_path / "cal"
-    report = calibrate(ROOT / "inputs" / "calibration" / "smoke.toml", out, md_fidelity="smoke", executor_name="dask",
-                       workers=2, params_out=tmp_path / "calibrated_smoke.toml", md_cache=str(tmp_path / "md"),
-                       progress=lambda m: None)
+    report = calibrate(recipe, out, md_fidelity="smoke", executor_name="dask", workers=2,
+                       params_out=tmp_path / "calibrated_smoke.toml", md_cache=str(cache), progress=lambda m: None)
     assert isinstance(report, CalibrationReport) and report.name == "calibrated_smoke"
+    sources = {r: v["source"] for r, v in report.md_sources.items()}
+    assert sources == {**{r: "md cache" for r in shared}, RUN_ON_WORKER: "ran", "surface_tension_spce": "committed"}
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
+    assert sorted(p.name for p in (out / "paper" / "cases").iterdir()) == ["hertz", "rough_ots", "rough_silica"]
     assert len(report.md_sources) == 7 and len(report.rows) == 8
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
@@ -221,5 +258,5 @@ def test_smoke_pipeline_on_two_dask_workers(tmp_path):
     scene = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params=str(tmp_path / "calibrated_smoke.toml"))
     assert scene.scene.surfaces.roughness.summit_modulus == 10e9
     saved = json.loads((out / "calibration.json").read_text())
-    assert saved["bands"]["samples"] == 4 and saved == json.loads(json.dumps(report.to_dict(), default=str))
+    assert saved["bands"]["samples"] == 2 and saved == json.loads(json.dumps(report.to_dict(), default=str))
     assert saved["versions"]["nanoimpact"] and saved["rows"][0]["key"] == report.rows[0].key

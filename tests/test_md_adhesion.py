@@ -211,14 +211,14 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
 
 
 @pytest.mark.md
-def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(needs_lammps, cache):
+def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(md_smoke):
     """adhesion_ots at smoke: the chain is continuous (each held back starts where its neighbour's was, moved by
     the nominal step), the inward chain is pressed into the contact, the dispersion tail is attractive (W grows)
     and of the size the review estimated (OTS-OTS 9-11 mJ/m^2), z0 and sigma0 carry stderrs, and the flag for a
     curve without a repulsive end is reported."""
     from md.engine.store import read_samples
     from md.workflows.adhesion import Adhesion
-    outcome = _run(load_recipe("adhesion_ots"), cache)
+    outcome = md_smoke("adhesion_ots").outcome              # the session's smoke run, shared with test_md_workflows
     r = outcome.result
     s = r["settings"]
     legs = outcome.run_dir / "legs"
@@ -251,11 +251,13 @@ def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(needs
 
 
 @pytest.mark.md
-def test_pulloff_drag_and_repeats(needs_lammps, cache):
+def test_pulloff_drag_and_repeats(md_smoke, cache):
     """The old lab-frame thermostat drags the moving asperity by about gamma M v (measured here from the holder's
     reaction and the asperity's momentum); the comoving thermostat leaves no drag beyond noise. Two repeated pulls
-    give the pull-off force its spread."""
-    new = _run(_recipe("pulloff_silica", retract_repeats=2, new_name="pulloff_silica_repeats"), cache).result
+    give the pull-off force its spread. The comoving run is the session's pulloff_silica smoke run (its smoke
+    preset pulls twice); only the lab-frame one runs here."""
+    new = md_smoke("pulloff_silica").outcome.result
+    assert new["settings"]["tip_thermostat"] == "comoving"
     old = _run(_recipe("pulloff_silica", tip_thermostat="lab", retract_repeats=1, new_name="pulloff_silica_lab"),
                cache).result
     lab = old["quantities"]["residual_drag_force"]

@@ -366,16 +366,10 @@ def test_contact_angle_protocol_change_raised_the_workflow_version():
 # ------------------------------------------------------------------------------------ LAMMPS (smoke)
 
 @pytest.mark.md
-def test_silica_smoke_run_reports_the_angle_at_the_waters_plane_with_w_sl_and_drift(needs_lammps, tmp_path):
-    import io
-    from contextlib import redirect_stdout
-
+def test_silica_smoke_run_reports_the_angle_at_the_waters_plane_with_w_sl_and_drift(md_smoke):
     from md.engine.store import read_samples
-    from md.workflows import run_recipe
     from md.system.lammps_data import read_atoms
-    buf = io.StringIO()
-    with redirect_stdout(buf):
-        out = run_recipe(load_recipe("contact_angle_silica"), "smoke", cache=tmp_path / "c", progress=False)
+    out = md_smoke("contact_angle_silica").outcome          # the session's smoke run, shared with test_md_workflows
     r = out.result
     q, d = r["quantities"], r["details"]
     assert set(r["legs"]) == {"substrate", "droplet"}

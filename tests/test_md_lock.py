@@ -168,21 +168,19 @@ def _md(cache: Path, out: Path, *extra: str) -> subprocess.Popen:
 
 
 @pytest.mark.md
-def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(needs_lammps, tmp_path):
+def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(md_smoke, tmp_path):
     """The issue's reproduction: two runs started together on one fresh cache. One runs, the other waits for it
     (and says so) and then reuses its finished result: both exit 0 with byte-identical result.json files.
 
-    The reference is a run alone in its own cache, started at the same moment (it shares no file with the other
-    two, so this costs one run's wall time instead of two). Same recipe, seeds and binary on one rank: LAMMPS is
-    deterministic across processes here, so the numbers are compared for equality, not within a tolerance --
-    the samples and frames of the two run directories are bit-identical too (measured: gamma_lv equal to the
-    last digit in all three; 0.0709267 N/m with the analysis of the issue's time). Without the lock (the runner
-    before this test) both runs exited 0 and reported 0.0625448 N/m, neither the single run's value."""
+    The reference is a run alone in its own cache: the session's smoke run of the recipe (md_smoke, in process,
+    shared with test_md_workflows; it shares no file with the other two). Same recipe, seeds and binary on one
+    rank: LAMMPS is deterministic across processes here, so the numbers are compared for equality, not within a
+    tolerance -- the samples and frames of the two run directories are bit-identical too (measured: gamma_lv
+    equal to the last digit in all three; 0.0709267 N/m with the analysis of the issue's time). Without the lock
+    (the runner before this test) both runs exited 0 and reported 0.0625448 N/m, neither the single run's value."""
+    alone_run = md_smoke(RECIPE)
     t0 = time.monotonic()
-    (tmp_path / "alone").mkdir()
-    procs = {"alone": _md(tmp_path / "alone" / "cache", tmp_path / "alone" / "out")}
-    for k in ("a", "b"):
-        procs[k] = _md(tmp_path / "shared", tmp_path / f"out_{k}")
+    procs = {k: _md(tmp_path / "shared", tmp_path / f"out_{k}") for k in ("a", "b")}
     res = {k: (p, *p.communicate(timeout=900)) for k, p in procs.items()}
     wall = time.monotonic() - t0
     for k, (p, out, err) in res.items():
@@ -199,11 +197,12 @@ def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(needs
     ra, rb = ((tmp_path / f"out_{k}" / "result.json").read_bytes() for k in ("a", "b"))
     assert ra == rb
     shared = json.loads(ra)
-    alone = json.loads((tmp_path / "alone" / "out" / "result.json").read_text())
+    alone = json.loads((alone_run.out / "result.json").read_text())
     assert shared["run_hash"] == alone["run_hash"]
     assert shared["quantities"] == alone["quantities"]                      # bit-identical, see the docstring
     gamma = shared["quantities"]["surface_tension"]["value"]
-    alone_dir = next((tmp_path / "alone" / "cache").iterdir())
+    alone_dir = alone_run.outcome.run_dir
+    assert not alone_run.outcome.reused and alone_dir != run_dir
     for f in ("legs/film/samples.csv", *(str(p.relative_to(run_dir)) for p in (run_dir / "legs/film/frames").iterdir())):
         assert (run_dir / f).read_bytes() == (alone_dir / f).read_bytes(), f
     print(f"\ngamma_lv: alone {alone['quantities']['surface_tension']['value']!r}, simultaneous {gamma!r} (both); "

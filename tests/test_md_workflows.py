@@ -97,11 +97,6 @@ def test_unit_conversions_use_codata_and_agree_with_the_analysis_module():
 
 # ------------------------------------------------------------------------------------ LAMMPS runs
 
-@pytest.fixture(scope="module")
-def cache(tmp_path_factory):
-    return tmp_path_factory.mktemp("md-cache")
-
-
 class _Lines(logging.Handler):
     def __init__(self):
         super().__init__(logging.INFO)
@@ -112,14 +107,16 @@ class _Lines(logging.Handler):
 
 
 def _run(name, cache, out, **kw):
-    """Run a recipe at smoke; returns the result and what the engine logged (INFO on md.engine.runner)."""
+    """Run a recipe (a shipped name or a Recipe) at smoke; returns the result and what the engine logged (INFO on
+    md.engine.runner)."""
     from md.workflows import run_recipe
     engine_log, handler = logging.getLogger("md.engine.runner"), _Lines()
     level = engine_log.level
     engine_log.addHandler(handler)
     engine_log.setLevel(logging.INFO)
     try:
-        outcome = run_recipe(load_recipe(name), "smoke", cache=cache, out=out, progress=False, **kw)
+        recipe = load_recipe(name) if isinstance(name, str) else name
+        outcome = run_recipe(recipe, "smoke", cache=cache, out=out, progress=False, **kw)
     finally:
         engine_log.removeHandler(handler)
         engine_log.setLevel(level)
@@ -139,14 +136,15 @@ def _total_charge(data_file: Path) -> float:
 
 @pytest.mark.md
 @pytest.mark.parametrize("name", RECIPES)
-def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(needs_lammps, name, cache, tmp_path):
-    outcome, text = _run(name, cache, tmp_path / "out")
-    assert not outcome.reused
+def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(name, md_smoke):
+    run = md_smoke(name)                        # the session's one smoke run of it (other tests read it too)
+    outcome, out = run.outcome, run.out
+    assert not outcome.reused and "wrote " in run.log
     r = outcome.result
     wf = r["workflow"]
     # result.json in the run directory (named by the hash) and in --out, identical
     assert (outcome.run_dir / "result.json").is_file()
-    assert json.loads((tmp_path / "out" / "result.json").read_text()) == r
+    assert json.loads((out / "result.json").read_text()) == r
     assert outcome.run_dir.name.endswith(r["run_hash"][:16]) and len(r["run_hash"]) == 64
     for key in ("schema_version", "run_hash", "quantities", "fidelity", "n_atoms", "steps", "timestep_fs",
                 "ns_per_day", "seeds", "provenance", "notes"):
@@ -174,21 +172,21 @@ def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(needs_lammps, n
     assert math.isfinite(r["quantities"][main]["value"])
     if wf == "adhesion":
         assert any("not a free energy" in n or "not the free energy" in n for n in r["notes"])
-    assert (tmp_path / "out" / FIGURES[wf]).stat().st_size > 1000
-    assert list((tmp_path / "out").glob("*.csv"))
+    assert (out / FIGURES[wf]).stat().st_size > 1000
+    assert list(out.glob("*.csv"))
 
 
 @pytest.mark.md
-def test_a_finished_run_is_reused_not_repeated(needs_lammps, cache, tmp_path):
+def test_a_finished_run_is_reused_not_repeated(md_smoke, md_smoke_cache, tmp_path):
     from md.cli import main
-    first, _ = _run("adhesion_silica", cache, tmp_path / "a")        # cached by the parametrised test
-    again, text = _run("adhesion_silica", cache, tmp_path / "b")
+    first = md_smoke("adhesion_silica").outcome
+    again, text = _run("adhesion_silica", md_smoke_cache, tmp_path / "b")
     assert again.reused and "reusing cached result" in text
     assert again.result == first.result and again.run_dir == first.run_dir
     buf = io.StringIO()
     with redirect_stdout(buf):
-        code = main(["adhesion_silica", "--fidelity", "smoke", "--cache", str(cache), "--out", str(tmp_path / "c"),
-                     "--quiet"])
+        code = main(["adhesion_silica", "--fidelity", "smoke", "--cache", str(md_smoke_cache),
+                     "--out", str(tmp_path / "c"), "--quiet"])
     # the reuse is logged (INFO, hidden by --quiet); the printed summary says "(cached)"
     assert code == 0 and "(cached)" in buf.getvalue() and "work_of_adhesion" in buf.getvalue()
     assert json.loads((tmp_path / "c" / "result.json").read_text())["run_hash"] == first.result["run_hash"]
@@ -283,9 +281,15 @@ def test_a_lammps_error_leaves_no_result_and_shows_the_log_tail(needs_lammps, tm
 
 @pytest.mark.md
 def test_mpirun_two_ranks_runs_a_recipe(needs_lammps, tmp_path):
-    outcome, _ = _run("adhesion_silica_ots", tmp_path / "cache", tmp_path / "out", np_=2)
+    """The smallest recipe (one leg, 801 atoms), cut to four chunks: mpirun's plumbing (a fresh start, a chunk
+    continued from a restart on two ranks) is the same for every recipe and every length."""
+    t = json.loads(json.dumps(dict(load_recipe("surface_tension_spce").raw), default=dict))
+    t["fidelity"]["smoke"].update(sample_steps=200)
+    outcome, _ = _run(parse_recipe(t, name="surface_tension_spce_short"), tmp_path / "cache", tmp_path / "out",
+                      np_=2)
     r = outcome.result
     assert r["np"] == 2 and r["provenance"]["engine"] == "mpirun -np 2 lmp"
-    assert "Loop time of" in (outcome.run_dir / "legs" / "contact" / "log.lammps").read_text()
-    assert "on 2 procs" in (outcome.run_dir / "legs" / "contact" / "log.lammps").read_text()
-    assert math.isfinite(r["quantities"]["work_of_adhesion"]["value"])
+    log = (outcome.run_dir / "legs" / "film" / "log.lammps").read_text()
+    assert log.count("Loop time of") >= 3 and "on 2 procs" in log         # the minimisation and the chunks
+    assert r["legs"]["film"]["total_steps"] == 400
+    assert math.isfinite(r["quantities"]["surface_tension"]["value"])
