@@ -49,15 +49,13 @@ import math
 import numpy as np
 
 from ..halfspace import LineHalfSpace
+from ..physics import jkr_kernel as jk
 from ..reference import jkr as ref
 from ..rough.datum import tallest_summit
 from ..rough.gw import SummitStatistics
 from .base import ContactLaw
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
-_DC = 0.75 * 4.0 ** (-1.0 / 3.0)            # delta_c / delta0
-#: h(s) = U / (pi dgamma beta delta0 (s - 1)), Horner coefficients (continuum.reference.jkr)
-_H_COEF = (16.0 / 15.0, 16.0 / 15.0, 16.0 / 15.0, -1.6, -1.6, -1.6, -0.6, -0.6, -0.6, -0.6)
 #: Up to this many attached summits the per-summit laws run in scalar arithmetic
 _SCALAR_MAX = 24
 #: Summits generated per batch (bounds memory for dense surfaces; part of the realisation's definition).
@@ -217,8 +215,8 @@ class DiscreteRoughRoller(ContactLaw):
     def _laws(self, delta: np.ndarray) -> dict:
         """Per-summit JKR (or Hertz) quantities at approaches `delta` (m) on the stable branch.
 
-        JKR in s = sqrt(a/a0) (continuum.reference.jkr's nondimensionalisation): delta/delta0 =
-        s^4 - s, solved in closed form by the same Ferrari/Cardano route as the reference, without
+        JKR in s = sqrt(a/a0) (`continuum.physics.jkr_kernel`): delta/delta0 = s^4 - s, solved in
+        closed form by the kernel's unchecked root (the reference's Ferrari/Cardano route, without
         its argument checks (the history rule never asks for delta < -Delta); then P, U, dP/d delta
         and a are explicit in s. Returns arrays "force" (N) and, lazily via `_energy` etc., the rest.
         """
@@ -228,76 +226,27 @@ class DiscreteRoughRoller(ContactLaw):
         if delta.size <= _SCALAR_MAX:
             return self._laws_scalar(delta)
         d = delta * self._inv_delta0
-        np.maximum(d, -_DC, out=d)
-        t = d * d
-        t *= d
-        t *= 1.0 / 27.0
-        t += 1.0 / 256.0
-        np.maximum(t, 0.0, out=t)
-        np.sqrt(t, out=t)
-        t += 1.0 / 16.0
-        cc = np.cbrt(t)                                   # Cardano: C
-        dd = d / cc
-        dd *= -1.0 / 3.0                                  # D = -d/(3C)
-        den = cc * cc
-        den += d * (1.0 / 3.0)
-        dd *= dd
-        den += dd
-        w2 = 0.25 / den                                   # w^2 = 2m, m = (1/8)/(C^2 + d/3 + D^2)
-        w = np.sqrt(w2)
-        t = 2.0 / w
-        t -= w2
-        np.maximum(t, 0.0, out=t)
-        np.sqrt(t, out=t)
-        s = w
-        s += t
-        s *= 0.5                                          # stable (larger) root
-        s3 = s * s * s
-        fp = 4.0 * s3 - 1.0
-        f = s3 * s
-        f -= s
-        f -= d
-        step = np.zeros_like(s)
-        np.divide(f, fp, out=step, where=fp > 1e-3)       # one Newton polish away from the fold
-        s -= step
-        s3 = s * s * s
-        force = 8.0 / 3.0 * s3
-        force -= 4.0
-        force *= s3
-        force *= self._pscale
-        return {"delta": delta, "d": d, "s": s, "force": force}
+        s = jk.stable_root(d)                             # clamps d to the fold in place
+        return {"delta": delta, "d": d, "s": s, "force": jk.stable_force_in_place(s, self._pscale)}
 
     def _laws_scalar(self, delta: np.ndarray) -> dict:
         """_laws for a few summits: the same formulas in scalar arithmetic (numpy calls cost more here)."""
         inv, ps = self._inv_delta0, self._pscale
         ds, ss, fs = [], [], []
         for dl in delta.tolist():
-            d = max(dl * inv, -_DC)
-            cc = math.cbrt(1.0 / 16.0 + math.sqrt(max(1.0 / 256.0 + d * d * d / 27.0, 0.0)))
-            dd = -d / (3.0 * cc)
-            w = math.sqrt(0.25 / (cc * cc + d / 3.0 + dd * dd))
-            s = 0.5 * (w + math.sqrt(max(2.0 / w - w * w, 0.0)))
+            d, s = jk.stable_root_scalar(dl * inv)
             s3 = s * s * s
-            fp = 4.0 * s3 - 1.0
-            if fp > 1e-3:
-                s -= (s3 * s - s - d) / fp
-                s3 = s * s * s
             ds.append(d)
             ss.append(s)
             fs.append(ps * s3 * (8.0 / 3.0 * s3 - 4.0))
         return {"delta": delta, "d": np.array(ds), "s": np.array(ss), "force": np.array(fs)}
 
     def _energy(self, q: dict) -> np.ndarray:
-        """Stored energy U(delta) (J) along the stable branch, U(0) = 0 (reference.jkr closed form)."""
+        """Stored energy U(delta) (J) along the stable branch, U(0) = 0 (the kernel's closed form)."""
         if not self.adhesive:
             dp = np.maximum(q["delta"], 0.0)
             return 0.4 * self._hertz_k * dp * dp * np.sqrt(dp)
-        s = q["s"]
-        sm1 = q["d"] / (s * (s * s + s + 1.0))
-        acc = np.full_like(s, _H_COEF[0])
-        for c in _H_COEF[1:]:
-            acc = acc * s + c
-        return self._pscale * self._delta0 * sm1 * acc
+        return jk.energy_of_s(q["d"], q["s"], self._pscale * self._delta0)
 
     def _stiffness(self, q: dict) -> np.ndarray:
         """dP/d delta (N/m); -inf exactly at the fold."""
@@ -307,7 +256,7 @@ class DiscreteRoughRoller(ContactLaw):
         s3 = s * s * s
         den = 4.0 * s3 - 1.0
         with np.errstate(divide="ignore", invalid="ignore"):
-            k = self._pscale * self._inv_delta0 * 4.0 * s * s * (4.0 * s3 - 3.0) / den
+            k = jk.stiffness_of_s(s, s3, self._pscale * self._inv_delta0)
         return np.where(den > 0.0, k, -np.inf)
 
     def _area(self, q: dict) -> np.ndarray:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+from ..physics import jkr_kernel as jk
 from ..reference import jkr as ref
 from .base import ContactLaw
 
@@ -64,14 +65,9 @@ class JKRSphere(ContactLaw):
         if delta + self.delta_c < 1e-6 * self.delta_c:
             u = math.sqrt(float(ref.radius_from_approach(delta, *self._p())))
         else:
-            beta, cb = self.radius, self._c * self.radius
-            u = max(self._cache[1], self._u_fold * (1.0 + 1e-3), (2.0 * beta * max(delta, 0.0)) ** 0.25)
-            for _ in range(100):
-                f = ((u * u) * (u * u) - cb * u - beta * delta)
-                step = f / (4.0 * u * u * u - cb)
-                u -= step
-                if abs(step) <= 2e-16 * u:
-                    break
+            beta = self.radius
+            u = jk.sqrt_radius_newton(delta, beta, self._c * beta, max(self._cache[1], self._u_fold * (1.0 + 1e-3),
+                                                                      (2.0 * beta * max(delta, 0.0)) ** 0.25))
         self._cache = (delta, u)
         return u
 
@@ -94,15 +90,8 @@ class JKRSphere(ContactLaw):
         return self._energy_of_radius(a) - self._energy_at_touch
 
     def _energy_of_radius(self, a: float) -> float:
-        """Antiderivative of P(a) d(delta)/da: 2Ka^5/(5 beta^2) - (2/7) c2 a^(7/2) + pi dgamma a^2 (J).
-
-        With K = 4E*/3 (Johnson's K), c = sqrt(2 pi dgamma/E*), c2 = K c/(2 beta) + 2 sqrt(8 pi
-        dgamma E*)/beta; the a^1 term of P d(delta)/da is sqrt(8 pi dg E*) c a / 2 = 2 pi dg a.
-        """
-        beta = self.radius
-        c2 = self._k * self._c / (2.0 * beta) + 2.0 * self._adh / beta
-        return (2.0 * self._k * a**5 / (5.0 * beta * beta) - 2.0 / 7.0 * c2 * a**3.5
-                + math.pi * self.work_of_adhesion * a * a)
+        """Antiderivative of P(a) d(delta)/da (J), `continuum.physics.jkr_kernel.energy_of_radius`."""
+        return jk.energy_of_radius(a, self.radius, self._k, self._c, self._adh, self.work_of_adhesion)
 
     def release_gap(self):
         return -self.detach_approach

@@ -58,6 +58,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..physics import jkr_kernel as _k
+
 __all__ = [
     "LOOP_AREA_DISPLACEMENT",
     "LOOP_AREA_LOAD",
@@ -86,16 +88,11 @@ __all__ = [
     "normalised_force_from_approach",
 ]
 
-# d_c = delta_c / delta0 = (3/4) 4^{-1/3}
-_DC = 0.75 * 4.0 ** (-1.0 / 3.0)
-# Relative slack for delta slightly below -delta_c (rounding in the caller's delta_c).
-_FOLD_RTOL = 1e-12
-# Band above -d_c that is the fold itself for the stiffness: delta = -critical_approach(...) lands
-# within about 2 eps of -d_c on either side (critical_approach and delta0 are rounded separately;
-# measured +-1.6 eps over 2e5 random parameter sets), so "at -delta_c" must not depend on which side
-# rounding puts it. 16 eps keeps a margin; the double root is unresolvable there anyway (s is only
-# good to sqrt(eps)).
-_FOLD_SNAP = 16.0 * np.finfo(float).eps
+# The reduced-variable JKR kernel (continuum.physics.jkr_kernel): d_c = delta_c / delta0, the checked
+# root of s^4 - s = d, h(s) and the energy/slope in s. This module adds the SI wrappers and named points.
+_DC = _k.D_C
+_solve_s = _k.solve_s
+_h = _k.h_of_s
 
 
 def _out(x):
@@ -175,15 +172,6 @@ def approach_from_radius(a, radius, work_of_adhesion, e_star):
     return _out(a * a / b - np.sqrt(2.0 * np.pi * g / e) * np.sqrt(a))
 
 
-def _h(s):
-    """h(s) = g(s)/(s - 1) with g = 16/15 s^10 - 8/3 s^7 + s^4 + 3/5 (Horner)."""
-    c = (16.0 / 15.0, 16.0 / 15.0, 16.0 / 15.0, -1.6, -1.6, -1.6, -0.6, -0.6, -0.6, -0.6)
-    acc = np.zeros_like(s) + c[0]
-    for ck in c[1:]:
-        acc = acc * s + ck
-    return acc
-
-
 def energy_from_radius(a, radius, work_of_adhesion, e_star):
     """Energy U = int_0^delta(a) P d delta' (J) along the JKR curve, zero at the touch point a = a0.
 
@@ -201,56 +189,8 @@ def energy_from_radius(a, radius, work_of_adhesion, e_star):
 
 
 # ----------------------------------------------------------------------------------------------
-# Exact inverse: s^4 - s - d = 0 by Ferrari / Cardano
+# Exact inverse: s^4 - s - d = 0 by Ferrari / Cardano (continuum.physics.jkr_kernel.solve_s)
 # ----------------------------------------------------------------------------------------------
-def _solve_s(d, branch):
-    """Roots s >= 0 of s^4 - s = d. Returns (s, at_fold) arrays.
-
-    branch 'stable': larger root, d >= -d_c; 'unstable': smaller root, -d_c <= d <= 0.
-    """
-    d = np.asarray(d, float)
-    if branch not in ("stable", "unstable"):
-        raise ValueError(f"branch = {branch!r}: must be 'stable' or 'unstable'")
-    if np.any(~np.isfinite(d)):
-        raise ValueError("approach must be finite")
-    below = d < -_DC * (1.0 + _FOLD_RTOL)
-    if np.any(below):
-        raise ValueError(
-            "approach below -delta_c (the JKR separation distance, critical_approach): no JKR "
-            f"contact exists there (min delta/delta_c = {float(np.min(d)) / _DC:.12g} < -1)"
-        )
-    if branch == "unstable" and np.any(d > 0.0):
-        raise ValueError("the unstable JKR branch exists only for -delta_c <= delta <= 0")
-    d = np.maximum(d, -_DC)
-    # At the fold the resolvent's discriminant 1/256 + d^3/27 vanishes, but not in floating point
-    # (_DC**3/27 is not exactly 1/256): decide "at the fold" on d itself, within _FOLD_SNAP.
-    at_fold = d <= -_DC * (1.0 - _FOLD_SNAP)
-    # resolvent cubic m^3 + d m - 1/8 = 0: C^3 = 1/16 + sqrt(1/256 + d^3/27), D = -d/(3C),
-    # m = C + D = (C^3 + D^3)/(C^2 - C D + D^2) = (1/8)/(C^2 + d/3 + D^2).
-    rad = np.maximum(1.0 / 256.0 + d**3 / 27.0, 0.0)
-    cc = np.cbrt(1.0 / 16.0 + np.sqrt(rad))
-    dd = -d / (3.0 * cc)
-    m = 0.125 / (cc * cc + d / 3.0 + dd * dd)
-    w = np.sqrt(2.0 * m)
-    disc = np.sqrt(np.maximum(2.0 / w - w * w, 0.0))
-    sign = 1.0 if branch == "stable" else -1.0
-    s = 0.5 * (w + sign * disc)
-    if branch == "unstable":
-        # small root: s (1 - s^3) = -d, so s = -d / (1 - s^3) avoids the cancellation in w - disc.
-        s = np.where(d < 0.0, -d / (1.0 - np.minimum(s, 4.0 ** (-1.0 / 3.0)) ** 3), 0.0)
-    # Newton polish on f(s) = s^4 - s - d, keeping a step only if it lowers |f| and stays on branch.
-    sf = 4.0 ** (-1.0 / 3.0)
-    for _ in range(2):
-        f = s**4 - s - d
-        fp = 4.0 * s**3 - 1.0
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            s_new = s - f / fp
-            ok = np.isfinite(s_new) & (np.abs(s_new**4 - s_new - d) <= np.abs(f))
-        ok &= (s_new >= sf) if branch == "stable" else ((s_new <= sf) & (s_new >= 0.0))
-        s = np.where(ok, s_new, s)
-    return s, at_fold
-
-
 def radius_from_approach(delta, radius, work_of_adhesion, e_star, branch="stable"):
     """Contact radius a (m) at approach delta (m), the exact inverse of approach_from_radius.
 
@@ -297,7 +237,7 @@ def stiffness_from_approach(delta, radius, work_of_adhesion, e_star, branch="sta
     den = 4.0 * s3 - 1.0
     at_fold = at_fold | ((den <= 0.0) if branch == "stable" else (den >= 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.pi * g * b / d0 * 4.0 * s * s * (4.0 * s3 - 3.0) / den
+        k = _k.stiffness_of_s(s, s3, np.pi * g * b / d0)
     # Both branches meet at the fold with a vertical tangent: dP/d delta -> -inf along the stable
     # branch (P rises from -P_c to -5/9 P_c as delta falls to -delta_c), +inf along the unstable one.
     sign = -1.0 if branch == "stable" else 1.0
@@ -317,8 +257,7 @@ def energy_from_approach(delta, radius, work_of_adhesion, e_star):
     d0 = _delta0(b, g, e)
     dn = np.asarray(delta, float) / d0
     s, _ = _solve_s(dn, "stable")
-    sm1 = np.maximum(dn, -_DC) / (s * (s * s + s + 1.0))
-    return _out(np.pi * g * b * d0 * sm1 * _h(s))
+    return _out(_k.energy_of_s(np.maximum(dn, -_DC), s, np.pi * g * b * d0))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -366,9 +305,8 @@ LOAD_DETACH_APPROACH_RATIO = float(
 def _loop_coefficient(s):
     """U(s)/(P_c delta_c) for a stable-branch point s (dimensionless)."""
     d = s**4 - s
-    sm1 = d / (s * (s * s + s + 1.0))
     # pi dgamma beta delta0 / (P_c delta_c) = (2/3) / d_c
-    return float((2.0 / 3.0) / _DC * sm1 * _h(np.float64(s)))
+    return float((2.0 / 3.0) / _DC * _k.s_minus_one(d, s) * _h(np.float64(s)))
 
 
 #: Fuller-Tabor loop area / (P_c delta_c), detachment at -delta_c (displacement control): 0.93550...

@@ -48,12 +48,15 @@ import time
 
 import numpy as np
 
+from ..physics import jkr_kernel as jk
 from ..reference import jkr as _jkr
 from .gw_layout import (_BUILD_BLOCK, _DH, _DT_PANEL, _GL_W, _GL_X, _H_DEEP, _H_ZERO, _HERTZ_NU, _T_CUT, RESOLUTIONS,
                         _Cubic1D, _gl_nodes, _Hermite2D, _panels, _window_shape, table_size)
 from .gw_reference import quadrature_contact_fraction, quadrature_energy, quadrature_pressure, table_error
-from .summits import (_DC, _S_FOLD, _S_LOAD, _S_ZERO, TENSILE_ONSET, SummitStatistics, _dx_ds, _g_of_s,
-                      _gauss_mass, _out, _phi, _q_of_s, _s_of_x, _x_of_s, expected_max_height, gw_integral)
+from ..physics.jkr_kernel import S_FOLD as _S_FOLD, S_LOAD as _S_LOAD, S_ZERO as _S_ZERO, dx_ds as _dx_ds
+from ..physics.jkr_kernel import reduced_curve as _q_of_s, reduced_curve_minus_hertz as _g_of_s, x_of_s as _x_of_s
+from .summits import (TENSILE_ONSET, SummitStatistics, _gauss_mass, _out, _phi, _s_of_x, expected_max_height,
+                      gw_integral)
 
 __all__ = [
     "SummitStatistics",
@@ -434,11 +437,7 @@ class GWJKRSurface:
             V[k, 1] = _g_of_s(sv)[j] @ wphi
             V[k, 2:] = 0.0
             if dV is not None:
-                s3 = sv**3
-                gp = [8.0 * sv * sv * (4.0 / 3.0 * s3 - 1.0) * _DC / (4.0 * s3 - 1.0)
-                      - 8.0 / 3.0 * _DC**1.5 * np.sqrt(x),                   # d(f - f_H)/dx
-                      None, 1.0 / (4.0 * s3 - 1.0)]
-                gp[1] = _g_of_s(sv)[0]                                       # d(u - u_H)/dx = f - f_H
+                gp = jk.reduced_curve_minus_hertz_slopes(sv, x)
                 dV[k, 1] = -(gp[j] @ wphi) / self._lam
                 dV[k, 2:] = 0.0
         return H, dH

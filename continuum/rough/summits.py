@@ -2,8 +2,9 @@
 
 `SummitStatistics` (sigma, density, tip radius), the characteristic largest summit height, the exact
 GW integral F_nu(h) (parabolic-cylinder functions), the standard-normal mass between two heights, and
-the JKR law in the reduced variable s = sqrt(a/a0) (delta/delta0 = s^4 - s). Used by the tabulated
-surface (`continuum.rough.gw`), its slow reference (`gw_reference`) and the branch laws.
+the stable JKR root in the reduced variable s = sqrt(a/a0) (delta/delta0 = s^4 - s; the other JKR
+closed forms are in `continuum.physics.jkr_kernel`). Used by the tabulated surface
+(`continuum.rough.gw`), its slow reference (`gw_reference`) and the branch laws.
 
 Sources: J. A. Greenwood & J. B. P. Williamson, Proc. R. Soc. Lond. A 295 (1966) 300-319; Abramowitz &
 Stegun ch. 19 / DLMF §12.5; E. J. Gumbel, *Statistics of Extremes* (1958) §3.1; K. L. Johnson, K. Kendall &
@@ -17,16 +18,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
+from ..physics import jkr_kernel as jk
 from ..reference import jkr as _jkr
 
 __all__ = ["SummitStatistics", "expected_max_height", "gw_integral", "TENSILE_ONSET"]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
-# JKR in the reduced variable s = sqrt(a/a0): delta/delta0 = s^4 - s, delta_c/delta0 = _DC.
-_DC = 0.75 * 4.0 ** (-1.0 / 3.0)
-_S_FOLD = 4.0 ** (-1.0 / 3.0)          # delta = -delta_c (displacement-controlled release)
-_S_LOAD = 0.75 ** (1.0 / 3.0)          # P = -P_c (load-controlled release)
-_S_ZERO = 1.5 ** (1.0 / 3.0)           # P = 0 on the stable branch
+# JKR in the reduced variable s = sqrt(a/a0): delta/delta0 = s^4 - s, delta_c/delta0 = _DC (continuum.physics.jkr_kernel).
+_DC = jk.D_C
+_S_ZERO = jk.S_ZERO                    # P = 0 on the stable branch
 #: delta/delta_c at which the stable JKR branch changes sign (P < 0 below): 1.2114...
 TENSILE_ONSET = (_S_ZERO**4 - _S_ZERO) / _DC
 _GH_X, _GH_W = np.polynomial.hermite_e.hermegauss(60)   # weight exp(-t^2/2)
@@ -110,36 +110,6 @@ def _gauss_mass(a, b):
 
 
 # ---------------------------------------------------------------------------- JKR in s = sqrt(a/a0)
-def _x_of_s(s):
-    """delta/delta_c."""
-    return (s**4 - s) / _DC
-
-
-def _dx_ds(s):
-    return (4.0 * s**3 - 1.0) / _DC
-
-
-def _q_of_s(s):
-    """(P/P_c, U/(P_c delta_c), a^2/(beta delta_c)) on the JKR curve (closed forms, see reference.jkr)."""
-    s3 = s**3
-    s4 = s3 * s
-    f = s3 * (16.0 / 9.0 * s3 - 8.0 / 3.0)
-    u = (2.0 / 3.0) / _DC * (((16.0 / 15.0 * s3 - 8.0 / 3.0) * s3 + 1.0) * s4 + 0.6)
-    return np.stack([f, u, s4 / _DC])
-
-
-def _g_of_s(s):
-    """JKR minus Hertz (same units as _q_of_s) for compressed summits, s >= 1; cancellation-free force."""
-    s3 = s**3
-    s15 = s * np.sqrt(s)
-    c = np.maximum(s3 - 1.0, 0.0)
-    x = _x_of_s(s)
-    fh = 16.0 / 9.0 * (x * _DC) ** 1.5
-    gf = 16.0 / 9.0 * s15 * (3.0 * s3 * s3 - 3.0 * s3 + 1.0) / (s15**3 + c * np.sqrt(c)) - 8.0 / 3.0 * s3
-    q = _q_of_s(s)
-    return np.stack([gf, q[1] - 0.4 * x * fh, s / _DC])
-
-
 def _s_of_x(x):
     """Stable-branch s for delta/delta_c = x >= -1 (closed-form quartic inverse of reference.jkr)."""
     # with beta = 1, dgamma = 1/(2 pi), E* = 1: a0 = delta0 = 1, so a = s^2 and delta = x d_c.

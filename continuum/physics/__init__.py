@@ -1,0 +1,1 @@
+"""Pure physics shared by the continuum laws, references and surfaces (closed forms, no state)."""
