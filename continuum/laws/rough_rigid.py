@@ -36,7 +36,7 @@ import math
 import numpy as np
 from scipy.interpolate import CubicSpline, RectBivariateSpline
 
-from ..rough.gw import GWJKRSurface
+from ..rough.surface import SummitSurface
 from .base import ContactLaw
 from .rough_roller import SECONDS_PER_STATE as _SECONDS_PER_STATE, beyond_range
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
@@ -79,7 +79,7 @@ class RigidRoughRoller(ContactLaw):
     bound_is_final = True
     has_history = True
 
-    def __init__(self, surface: GWJKRSurface, radius: float, length: float, *, resolution: str = "standard",
+    def __init__(self, surface: SummitSurface, radius: float, length: float, *, resolution: str = "standard",
                  depth_safety: float = 1.5):
         self.surface = surface
         self.radius, self.length = radius, length
@@ -87,8 +87,8 @@ class RigidRoughRoller(ContactLaw):
         self.resolution = resolution
         self.depth_safety = depth_safety
         self.release_stretch = float(surface.release_stretch)
-        self.attach_stretch = float(getattr(surface, "attach_stretch", 0.0))   # r_in = -delta_in (m)
-        self.reach = float(getattr(surface, "reach", 0.0))                     # attraction range (m)
+        self.attach_stretch = float(surface.attach_stretch)   # r_in = -delta_in (m)
+        self.reach = float(surface.reach)                     # attraction range (m)
         self.touch_gap = self.reach
         self.end_gap = max(self.release_stretch, self.reach)
         self._r_in = min(self.attach_stretch, self.release_stretch)
@@ -103,7 +103,11 @@ class RigidRoughRoller(ContactLaw):
         #: accepted states deeper than the tables (evaluated by the integral itself)
         self.beyond_tables = 0
         #: "tabulated" (GW tables of JKR or Hertz summits) or "generic" (quadrature of any summit law)
-        self.surface_kind = "tabulated" if isinstance(surface, GWJKRSurface) else "generic"
+        self.surface_kind = surface.kind
+        self.table_points = 0
+        self._kept_tables: dict = {}
+        self._approach_memo: dict = {}
+        self._compiled_for = None
         self.reset()
 
     # ------------------------------------------------------------------ tables
@@ -131,7 +135,7 @@ class RigidRoughRoller(ContactLaw):
         out = np.empty(hf.size)
         per = 2 * self.res[3]
         step = max(1, _BLOCK_STATES // per)
-        fun = getattr(self.surface, what)
+        fun = {"pressure": self.surface.pressure, "energy": self.surface.energy, "contacts": self.surface.contacts}[what]
         for i in range(0, hf.size, step):
             hb, rb = hf[i:i + step], rf[i:i + step]
             s, w = self._gauss(hb, rb)
@@ -166,7 +170,7 @@ class RigidRoughRoller(ContactLaw):
     def _build(self, depth: float) -> None:
         import time
 
-        kept = self.__dict__.setdefault("_kept_tables", {})
+        kept = self._kept_tables
         if depth in kept:
             (self._force, self._energy, self._count, self._h_lo, self._h_hi, self.table_depth,
              self.table_points) = kept[depth]
@@ -220,7 +224,7 @@ class RigidRoughRoller(ContactLaw):
         """First-approach forces (N) at `depths` (m below the datum), remembered: the depth search walks the same
         batches of depths for every impact (its steps depend on the law only), so each contact after the first
         re-reads them instead of re-integrating (~20 ms per contact)."""
-        memo = self.__dict__.setdefault("_approach_memo", {})
+        memo = self._approach_memo
         key = depths.tobytes()
         if key not in memo:
             memo[key] = self._integrate("pressure", -depths, np.zeros_like(depths))
@@ -309,7 +313,7 @@ class RigidRoughRoller(ContactLaw):
         from .. import contact_kernel as ck
 
         # the splines these arrays came from are kept with them (an identity test on live objects)
-        if getattr(self, "_compiled_for", None) != (self._force, self._energy, self._count):
+        if self._compiled_for != (self._force, self._energy, self._count):
             (ftx, fty, fc), (etx, ety, ec) = self._force.tck, self._energy.tck
             if self._force.degrees != (3, 3) or self._energy.degrees != (3, 3):
                 raise ValueError("the compiled footprint law evaluates bicubic tables only")
@@ -350,12 +354,12 @@ class RigidRoughRoller(ContactLaw):
     def diagnostics(self):
         return {"max_contacts": self.max_contacts, "edge_touched": self.edge_touched,
                 "max_nominal_pressure": self.max_pressure, "table_depth": self.table_depth,
-                "table_points": getattr(self, "table_points", 0), "table_build_seconds": self.build_seconds,
+                "table_points": self.table_points, "table_build_seconds": self.build_seconds,
                 "contacts_seen": len(self.depth_history), "accepted_states_beyond_tables": self.beyond_tables}
 
     def describe(self):
         s = self.surface
-        return {"name": self.name, "source": f"GW (1966) summits ({getattr(s, 'law_name', 'jkr')}); paper eqs 9-15; "
+        return {"name": self.name, "source": f"GW (1966) summits ({s.law_name}); paper eqs 9-15; "
                 "rigid substrate, exact footprint integral tabulated in (gap, window)",
                 "radius": self.radius, "length": self.length, "half_space": False, "resolution": self.resolution,
                 "sigma": s.stats.sigma, "summit_density": s.stats.density, "summit_radius": s.stats.radius,

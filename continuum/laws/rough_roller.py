@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from ..halfspace import LineHalfSpace, solve_coupled
-from ..rough.gw import GWJKRSurface
+from ..rough.surface import SummitSurface
 from .base import ContactLaw
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
@@ -70,7 +70,7 @@ class RoughRoller(ContactLaw):
 
     Parameters
     ----------
-    surface : GWJKRSurface
+    surface : SummitSurface
         Summit statistics and laws (pressure per nominal area as a function of separation).
     radius, length : float
         Roller radius R and length l (m).
@@ -89,7 +89,7 @@ class RoughRoller(ContactLaw):
     bound_is_final = True
     has_history = True
 
-    def __init__(self, surface: GWJKRSurface, radius: float, length: float, e_star: float, *,
+    def __init__(self, surface: SummitSurface, radius: float, length: float, e_star: float, *,
                  half_space: bool = True, grid_points: int = 256, depth_safety: float = 1.5,
                  coupling_tol: float = 1e-11):
         self.surface = surface
@@ -100,7 +100,7 @@ class RoughRoller(ContactLaw):
         self.coupling_tol = coupling_tol
         self.z_top = float(surface.z_max)        # tallest summit above the mean plane (m)
         self.release_stretch = float(surface.release_stretch)
-        self.reach = float(getattr(surface, "reach", 0.0))        # non-contact attraction range (m)
+        self.reach = float(surface.reach)        # non-contact attraction range (m)
         self.touch_gap = self.reach
         self.end_gap = max(self.release_stretch, self.reach)
         self.edge_touched = False
@@ -114,7 +114,7 @@ class RoughRoller(ContactLaw):
                              "fallback_iterations": 0, "max_residual": 0.0, "tolerance": coupling_tol,
                              "scale": "max(max|p|, n P_c)"}
         #: "tabulated" (GW tables of JKR or Hertz summits) or "generic" (quadrature of any summit law)
-        self.surface_kind = "tabulated" if isinstance(surface, GWJKRSurface) else "generic"
+        self.surface_kind = surface.kind
         #: surface states evaluated so far (a stiffness or a compressive/tensile split counts twice)
         self.work_states = 0
         self._set_grid(max(4.0 * surface.stats.sigma, 4.0 * self.release_stretch))

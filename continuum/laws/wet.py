@@ -127,6 +127,10 @@ class MeniscusBridges:
                 total += scale * (c0 * m0 + c1 * m1 + c2 * m2)
         return float(2.0 * self.length * self.density * np.dot(total, w))
 
+    def full_force(self, gap: float) -> float:
+        """Attraction (N, >= 0) at `gap` with every summit within D_K bridged (a bound on the bridges' pull)."""
+        return self._integral("force", gap, gap - self.d_k)
+
     def force(self, gap: float, t: float) -> float:
         """Total attraction of the bridges (N, >= 0) at a trial state."""
         s = self.offset(gap, t)
@@ -212,7 +216,7 @@ class WetRoughRoller(ContactLaw):
         """
         depth = self.dry.quasi_static_depth(0.5 * mass * speed * speed, mass * gravity)
         deep = -2.0 * depth
-        pull = self.bridges._integral("force", deep, deep - self.bridges.d_k)
+        pull = self.bridges.full_force(deep)
         self.design_pull = pull
         self.dry.prepare(mass, speed, gravity + pull / mass)
 

@@ -101,6 +101,13 @@ class GWJKRSurface:
     quadrature of the defining integrals on the fly (exact, ~50 us per state; not expected).
     """
 
+    #: the `continuum.rough.surface.SummitSurface` interface: JKR (or Hertz) summits touch before they
+    #: attract, and tables evaluate them
+    kind = "tabulated"
+    law_name = "jkr"
+    attach_stretch = 0.0
+    reach = 0.0
+
     def __init__(self, stats: SummitStatistics, work_of_adhesion: float, e_star: float, z_max=None,
                  detachment: str = "displacement", resolution="standard"):
         t_start = time.perf_counter()

@@ -39,7 +39,11 @@ _CHUNK = 512
 
 
 class GWBranchSurface:
-    """GW average of a SummitLaw over Gaussian summit heights, truncated at z_max (units of sigma)."""
+    """GW average of a SummitLaw over Gaussian summit heights, truncated at z_max (units of sigma).
+
+    A `continuum.rough.surface.SummitSurface`, evaluated by quadrature."""
+
+    kind = "generic"
 
     def __init__(self, stats: SummitStatistics, law, z_max=None, resolution="standard"):
         start = time.perf_counter()
