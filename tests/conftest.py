@@ -41,7 +41,16 @@ class SmokeRun:
 
 @pytest.fixture(scope="session")
 def md_smoke_cache(tmp_path_factory) -> Path:
-    """The md cache every shared smoke run (md_smoke) goes into; a test may read it (reuse) but not run into it."""
+    """The md cache every shared smoke run (md_smoke) goes into; a test may read it (reuse) but not run into it.
+
+    Under pytest-xdist (the README's `-n 2`) every worker has its own session, so the cache sits in the folder
+    the workers' temporary folders share: a recipe one worker ran, the other finds by its hash (the md run lock
+    makes a worker that asks while the other runs it wait, then reuse it). It is new each pytest run, so
+    whatever it holds was run by this run."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        cache = tmp_path_factory.getbasetemp().parent / "md-smoke-cache"
+        cache.mkdir(exist_ok=True)
+        return cache
     return tmp_path_factory.mktemp("md-smoke-cache")
 
 
