@@ -13,8 +13,8 @@ gaps relative to the rigid geometry. Cost: ~10-50 ms.
 Bounded cost (`check_table_cost`): before any table is built, the memory the averaged model's
 GW tables would take is estimated from the scene (the window table grows like (delta_c/sigma)^2,
 `continuum.rough.gw.table_size`) and so is the time of the rigid-substrate footprint tables (nodes
-over the range of gaps, `RigidRoughRoller.table_shape`, times a measured cost per surface state).
-A scene beyond `MEMORY_BOUND_BYTES` or `continuum.laws.rough_rigid.MAX_BUILD_SECONDS` is refused
+over the range of gaps, `continuum.laws.costs.table_shape`, times a measured cost per surface state).
+A scene beyond `MEMORY_BOUND_BYTES` or `continuum.laws.costs.MAX_BUILD_SECONDS` is refused
 with a one-line `SceneError` naming the key, the value, the estimate and the way out (discrete
 summits, a larger sigma, tabulated JKR summits, the half-space grid law). docs/model.md, "Bounded
 cost".
@@ -68,12 +68,12 @@ def rough_impact_estimate(stats, summit_e_star: float, e_star: float, radius: fl
     the summits' and the bodies' contact moduli; radius, length (m) of the roller; z_max_sigma: the
     truncation (tallest summit, units of sigma); mass (kg), speed (m/s) at touch, gravity (m/s^2).
     """
-    from .laws.rough_rigid import RigidRoughRoller
-    from .rough.gw import GWJKRSurface
+    from .model.factory import averaged_surface, rigid_roller
 
     start = time.perf_counter()
-    surface = GWJKRSurface(stats, 0.0, summit_e_star, z_max=z_max_sigma, resolution="fast")
-    law = RigidRoughRoller(surface, radius, length, resolution="fast")
+    surface = averaged_surface(stats, work_of_adhesion=0.0, summit_e_star=summit_e_star, z_max=z_max_sigma,
+                               resolution="fast")
+    law = rigid_roller(surface, radius, length, resolution="fast")
     energy = 0.5 * mass * speed * speed
     depth = law.quasi_static_depth(energy, mass * gravity)
     half = math.sqrt(2.0 * radius * depth)
@@ -103,7 +103,7 @@ def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_
     which coarsens those tables' spacing). Returns the estimates (recorded in the result).
     Raises `continuum.scene.SceneError` (key surfaces.roughness.sigma) with a one-line reason.
     """
-    from .laws.rough_rigid import MAX_BUILD_SECONDS, SECONDS_PER_STATE, RigidRoughRoller, table_cost_refusal
+    from .laws.costs import MAX_BUILD_SECONDS, SECONDS_PER_STATE, table_cost_refusal, table_shape
     from .rough.gw import table_size
     from .scene import SceneError
 
@@ -133,7 +133,7 @@ def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_
         # the first design depth is at least 1.5 x the Hertz estimate (adhesion only pulls deeper); the
         # tables are checked again against the same bound with the real design depth before each build
         depth = 1.5 * depth_estimate
-        shape = RigidRoughRoller.table_shape(sigma, release_stretch, end_gap, depth, rigid_resolution)
+        shape = table_shape(sigma, release_stretch, end_gap, depth, rigid_resolution)
         kind = "tabulated" if gw_tables else "generic"
         rec["rigid_table"] = {"nodes": shape["nodes"], "states": shape["states"], "design_depth_at_least": depth,
                               "resolution": rigid_resolution, "surface": kind,

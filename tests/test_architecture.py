@@ -3,6 +3,9 @@
 - `nanoimpact` (the shared leaf) imports none of `continuum`, `md`, `calibration`, not even lazily;
 - `continuum` and `md` never import each other, and neither imports `calibration`;
 - inside md, the engine (`md.engine`) never imports a workflow (`md.workflows`) or the recipe (`md.recipe`);
+- inside continuum, only the model's factory (`continuum.model.factory`) imports a concrete contact law
+  (a module of `continuum.laws` that defines a `ContactLaw` subclass); the laws and the model read summit
+  surfaces through their declared protocol (`continuum.rough.surface.SummitSurface`), never by `getattr`;
 - no module of the project imports another in a circle (function-level imports included);
 - no library module switches matplotlib's backend (`matplotlib.use`) or draws through pyplot.
 """
@@ -164,3 +167,71 @@ def test_the_md_engine_never_imports_a_workflow_or_the_recipe():
            for m, line in _imported_modules(p, known)
            if m in ("md.recipe", "md.workflows") or m.startswith(("md.workflows.", "md.recipe."))]
     assert not bad, "\n".join(bad)
+
+
+# ------------------------------------------------------------------------------------------ continuum laws
+
+FACTORY = "continuum.model.factory"
+
+
+def _concrete_law_modules() -> set[str]:
+    """Modules of `continuum.laws` that define a ContactLaw subclass (directly or through another law)."""
+    classes: dict[str, tuple[str, set[str]]] = {}
+    for path in _modules("continuum"):
+        name = _module_name(path)
+        if name.startswith("continuum.laws."):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.ClassDef):
+                    bases = {b.id if isinstance(b, ast.Name) else b.attr for b in node.bases
+                             if isinstance(b, (ast.Name, ast.Attribute))}
+                    classes[node.name] = (name, bases)
+    laws, grown = {"ContactLaw"}, True
+    while grown:
+        new = {c for c, (_, bases) in classes.items() if bases & laws} - laws
+        laws |= new
+        grown = bool(new)
+    return {classes[c][0] for c in laws if c in classes and c != "ContactLaw"}
+
+
+def test_inside_continuum_only_the_model_factory_imports_concrete_laws():
+    modules = _all_modules()
+    known = set(modules)
+    concrete = _concrete_law_modules()
+    assert {"continuum.laws.hertz", "continuum.laws.jkr", "continuum.laws.rough_roller", "continuum.laws.rough_rigid",
+            "continuum.laws.discrete_roller", "continuum.laws.wet"} <= concrete
+    assert "continuum.laws.base" not in concrete
+    bad = [f"{p.relative_to(ROOT)}:{line} imports {m}"
+           for name, p in modules.items()
+           if name.startswith("continuum.") and name != FACTORY and not name.startswith("continuum.laws.")
+           for m, line in _imported_modules(p, known) if m in concrete]
+    assert not bad, "\n".join(bad)
+
+
+def test_the_law_scan_sees_the_factorys_function_level_imports():
+    """The factory imports every concrete law inside its functions: the scan must see them all."""
+    modules = _all_modules()
+    seen = {m for m, _ in _imported_modules(modules[FACTORY], set(modules))}
+    assert _concrete_law_modules() <= seen
+
+
+@pytest.mark.parametrize("package", ["continuum/laws", "continuum/model"])
+def test_laws_and_model_never_probe_an_object_with_getattr(package):
+    bad = [f"{path.relative_to(ROOT)}:{node.lineno} {node.func.id}(...)"
+           for path in sorted((ROOT / package).rglob("*.py"))
+           for node in ast.walk(ast.parse(path.read_text()))
+           if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in ("getattr", "hasattr")]
+    assert not bad, "\n".join(bad)
+
+
+def test_both_summit_surfaces_satisfy_the_declared_protocol():
+    from continuum.rough.branch_laws import make_summit_law
+    from continuum.rough.gw import GWJKRSurface, SummitStatistics
+    from continuum.rough.gw_branches import GWBranchSurface
+    from continuum.rough.surface import SummitSurface
+
+    stats = SummitStatistics(3e-9, 1e13, 0.2e-6)
+    tabulated = GWJKRSurface(stats, 0.0, 10e9, z_max=4.0, resolution="fast")
+    generic = GWBranchSurface(stats, make_summit_law("dmt", 0.2e-6, 0.12, 10e9, z0=0.3e-9, delta_max=1e-7), z_max=4.0)
+    for surface in (tabulated, generic):
+        assert isinstance(surface, SummitSurface)
+    assert (tabulated.kind, generic.kind) == ("tabulated", "generic")

@@ -38,37 +38,12 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 from ..rough.surface import SummitSurface
 from .base import ContactLaw
-from .rough_roller import SECONDS_PER_STATE as _SECONDS_PER_STATE, beyond_range
+from .costs import (_BLOCK_STATES, MAX_BUILD_SECONDS, RESOLUTION, SECONDS_PER_STATE, beyond_range, table_cost_refusal,
+                    table_shape)
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
-#: Table resolution per fidelity: (points per release stretch in h, points per sigma in h, w-nodes, Gauss nodes).
-RESOLUTION = {"fast": (8, 40, 9, 16), "standard": (16, 80, 17, 24), "reference": (32, 160, 33, 40)}
-#: Most surface states evaluated at once while the tables are built (bounds the build's temporaries).
-_BLOCK_STATES = 200_000
-#: Cost of one surface state (pressure or energy) in the table build (`rough_roller.SECONDS_PER_STATE`:
-#: 2.0 us tabulated JKR summits, 19 us generic laws, measured on a busy 2-core machine). Used to bound
-#: the build's time before it starts.
-SECONDS_PER_STATE = _SECONDS_PER_STATE
-#: Most estimated seconds one build of the tables may take; beyond it the scene is refused (issue 12).
-MAX_BUILD_SECONDS = 30.0
-
-
-def table_cost_refusal(sigma: float, shape: dict, surface_kind: str, release_stretch: float, depth: float):
-    """A SceneError if tables of `shape` (`RigidRoughRoller.table_shape`) would take longer than
-    MAX_BUILD_SECONDS to build on `surface_kind` summits, else None."""
-    from ..scene import SceneError
-
-    seconds = shape["states"] * SECONDS_PER_STATE[surface_kind]
-    if seconds <= MAX_BUILD_SECONDS:
-        return None
-    way = ("physics.adhesion_law = 'jkr' (tabulated summits, ~10x cheaper per state), " if surface_kind == "generic"
-           else "")
-    return SceneError(
-        "surfaces.roughness.sigma", sigma,
-        f"the rigid-substrate footprint tables would evaluate {shape['states']:.3g} {surface_kind} surface states "
-        f"(~{seconds:.3g} s: {shape['nodes']:.3g} nodes spaced {shape['step']:.3g} m over an impact depth of "
-        f"~{depth:.3g} m and a release stretch of {release_stretch:.3g} m), above the {MAX_BUILD_SECONDS:g} s bound; "
-        f"use {way}physics.half_space = 'on' (grid law, no footprint table) or surfaces.roughness.mode = 'discrete'")
+# the costs and bounds live in `continuum.laws.costs`; their old names here still work
+__all__ = ["RigidRoughRoller", "RESOLUTION", "MAX_BUILD_SECONDS", "SECONDS_PER_STATE", "table_cost_refusal"]
 
 
 class RigidRoughRoller(ContactLaw):
@@ -145,23 +120,8 @@ class RigidRoughRoller(ContactLaw):
             out[i:i + step] = np.sum(q * w, axis=-1)
         return 2.0 * self.length * math.sqrt(2.0 * self.radius) * out.reshape(shape)
 
-    @staticmethod
-    def table_shape(sigma: float, release_stretch: float, end_gap: float, depth: float,
-                    resolution: str = "standard") -> dict:
-        """Nodes of the (gap, window) tables `_build` makes for a design `depth` (m), and the surface
-        states their quadrature evaluates (2 x Gauss nodes per node, for the force and the energy)."""
-        per_delta, per_sigma, n_w, n_gauss = RESOLUTION[resolution]
-        step = min(sigma / per_sigma, depth / (4 * per_sigma))
-        if release_stretch > 0.0:
-            step = min(step, release_stretch / per_delta)
-        n_h = int(math.floor((end_gap + 2 * step + depth) / step)) + 1
-        nodes = n_h * n_w
-        return {"gap_nodes": n_h, "window_nodes": n_w, "nodes": nodes,
-                "states": 2 * nodes * 2 * n_gauss + n_h * 2 * n_gauss, "step": step,
-                # the build holds one block of states (nodes, weights, separations, thresholds and the surface's
-                # own temporaries: 75 floats each measured with tracemalloc, 100 taken) and the tables (grids,
-                # values, spline coefficients: ~16 floats per node)
-                "peak_bytes": 8 * (100 * min(_BLOCK_STATES, nodes * 2 * n_gauss) + 16 * nodes)}
+    #: Nodes and surface states of the footprint tables for a design depth (`continuum.laws.costs.table_shape`).
+    table_shape = staticmethod(table_shape)
 
     #: Table sets kept per law (by design depth): a sweep or bisection that comes back to an impact speed
     #: finds its tables instead of building them again (~1 s each); the same depth gives the same tables.

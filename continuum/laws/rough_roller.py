@@ -34,35 +34,11 @@ import numpy as np
 from ..halfspace import LineHalfSpace, solve_coupled
 from ..rough.surface import SummitSurface
 from .base import ContactLaw
+from .costs import MAX_RUN_SECONDS, SECONDS_PER_STATE, beyond_range
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
 
-
-#: Cost of one surface-state evaluation (s), measured on a busy 2-core machine (load 6-9): tabulated JKR or
-#: Hertz summits (GWJKRSurface) 2.0 us, generic summit laws (GWBranchSurface: DMT, Maugis-Dugdale, layered)
-#: 19 us with its states sorted by depth (shared with the rigid law's table bound).
-SECONDS_PER_STATE = {"tabulated": 2.5e-6, "generic": 2.5e-5}
-#: Most estimated seconds of surface evaluations one run of the grid law may spend (issue 12); beyond it
-#: the run stops with a one-line SceneError naming the way out. rough_silica as shipped (`standard`, up to
-#: 57 bounces over sigma = 3-30 nm) uses 2-93 s of it; Maugis-Dugdale summits on the grid (quadrature,
-#: ~10x the cost per state) reach it after ~60 contacts at `standard`.
-MAX_RUN_SECONDS = 600.0
-
-
-def beyond_range(depth_search, sigma: float) -> float:
-    """Run `depth_search()` (an `absorbing_depth` call); its range refusal becomes a `SceneError`.
-
-    An adhesive approach pulls the roller deeper than the Hertz estimate that `continuum.models`
-    checks before the tables are built, so the averaged model's range (10 sigma below the summits'
-    mean plane, `continuum.laws.depth`) can first be crossed at a contact's start: the run then
-    stops with the same one-line refusal, naming surfaces.roughness.sigma."""
-    from ..scene import SceneError
-
-    try:
-        return depth_search()
-    except SceneError:
-        raise
-    except ValueError as exc:
-        raise SceneError("surfaces.roughness.sigma", float(sigma), str(exc)) from None
+# the costs and bounds live in `continuum.laws.costs`; their old names here still work
+__all__ = ["RoughRoller", "MAX_RUN_SECONDS", "SECONDS_PER_STATE", "beyond_range"]
 
 
 class RoughRoller(ContactLaw):

@@ -1,0 +1,285 @@
+"""Typed decisions: which adhesion law, whether the half-space, whether menisci; each carries the numbers
+that decided it and writes its own record (result.json -> models.adhesion / half_space / menisci).
+
+Summit law (rough contact). Tabor's parameter of the summits, mu = (beta dgamma^2/(E*^2 z0^3))^{1/3},
+places them on Johnson & Greenwood's adhesion map (J. Colloid Interface Sci. 192 (1997) 326):
+mu > 5 JKR, mu < 0.1 DMT, Maugis-Dugdale between. Adhesion is then left out only if it cannot
+change a rebound: the estimated loss per impact (summits in contact at the quasi-static depth x
+one summit's hysteresis loop) is below 1e-3 of the impact energy AND the summits' pull-off forces
+add up to less than 1e-2 of the estimated peak force. The Fuller-Tabor parameter theta is
+recorded but does not decide alone: the `paper` set has theta = 87 ("negligible" by Fuller &
+Tabor's nominally flat criterion) yet loses 28 % per impact, because only ~3 summits touch and
+each loop is a sizeable part of a 6e-16 J impact.
+
+Half-space. Left out when the estimated deflection span across the footprint is below 1e-3 sigma
+(`continuum.estimates`): the summits' gaps then move by less than a thousandth of their spread.
+
+Menisci. Left out when the air is dry (RH = 0), when the faces are hydrophobic (cos t1 + cos t2
+<= 0: no bridge pulls), for smooth contact and discrete summits (not modelled), and otherwise
+decided after a dry run (`continuum.impact.run_impact`): bridges cannot form before t_a, so if no
+contact of the dry run lasts t_a, the wet run is identical and the dry one is kept.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from .. import menisci as men
+from ..reference import jkr as jkr_ref
+from ..scene import Scene
+from .regime import Regime, regime_of, sam_layer, summit_e_star
+
+#: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
+TABOR_JKR, TABOR_DMT = 5.0, 0.1
+#: Adhesion is negligible below these estimated fractions: loss per impact / impact energy, and
+#: summed pull-off / peak force.
+NEGLIGIBLE_LOSS, NEGLIGIBLE_PULL = 1e-3, 1e-2
+#: The half-space is negligible when its deflection span across the footprint is below this * sigma.
+NEGLIGIBLE_DEFLECTION = 1e-3
+LAW_NAMES = {"jkr": "JKR with Fuller-Tabor hysteresis", "dmt": "DMT (no hysteresis)",
+             "maugis_dugdale": "Maugis-Dugdale (jump-in and jump-out from its own solution)",
+             "none": "Hertz (no adhesion)"}
+
+
+# ----------------------------------------------------------------------------- summit laws
+def summit_law(name: str, scene: Scene):
+    """The per-summit law (continuum.rough.branch_laws) for a law name and the scene's surfaces.
+
+    Tabulated to a compression of 30 sigma (the rough model refuses impacts deeper than 10 sigma
+    below the mean plane; the tallest summit is < 6 sigma above it)."""
+    from ..rough.branch_laws import make_summit_law
+
+    surf = scene.surfaces
+    beta, w, e_s = surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star(scene)
+    return make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range, layer=sam_layer(scene),
+                           detachment=scene.physics.detachment, delta_max=30.0 * surf.roughness.sigma)
+
+
+def loop_per_summit(name: str, scene: Scene) -> float:
+    """Energy (J) one summit loses per approach-retreat cycle under `name`."""
+    if name == "none":
+        return 0.0
+    if name == "jkr" and sam_layer(scene) is None:
+        surf = scene.surfaces
+        return float(jkr_ref.loop_area(surf.roughness.summit_radius, surf.interface_work_of_adhesion,
+                                       summit_e_star(scene), detachment=scene.physics.detachment))
+    return float(summit_law(name, scene).loop_energy)
+
+
+def pull_off_per_summit(name: str, scene: Scene) -> float:
+    """Pull-off force (N) of one summit under `name`."""
+    surf = scene.surfaces
+    beta, w = surf.roughness.summit_radius, surf.interface_work_of_adhesion
+    if name == "jkr" and sam_layer(scene) is None:
+        return float(jkr_ref.pull_off_force(beta, w))
+    if name == "dmt" and sam_layer(scene) is None:
+        return 2.0 * math.pi * beta * w
+    return float(summit_law(name, scene).pull_off_force)
+
+
+# ----------------------------------------------------------------------------- adhesion
+@dataclass(frozen=True)
+class AdhesionDecision:
+    """The adhesion law of the summits (or sphere) and the numbers that decided it (SI)."""
+
+    law: str
+    """'jkr', 'dmt', 'maugis_dugdale' or 'none': the law that runs."""
+    decided_by: str
+    why: str
+    work_of_adhesion: float
+    source: str
+    """Where the work of adhesion comes from: 'SAM-SAM' or 'surfaces.work_of_adhesion'."""
+    interaction_range_z0: float
+    tabor_parameter: float | None = None
+    fuller_tabor_theta: float | None = None
+    on_the_map: bool = False
+    """Decided on Johnson & Greenwood's map (the Tabor bounds are recorded)."""
+    estimated_loss_fraction: float | None = None
+    estimated_pull_fraction: float | None = None
+    loop_energy_per_summit: float | None = None
+    map_suggests: str | None = None
+    """The map's law where the geometry could not run it (discrete summits: JKR instead)."""
+
+    @property
+    def used(self) -> bool:
+        return self.law != "none"
+
+    def record(self) -> dict:
+        rec = {"work_of_adhesion": self.work_of_adhesion, "source": self.source,
+               "interaction_range_z0": self.interaction_range_z0}
+        if self.tabor_parameter is not None:
+            rec["tabor_parameter"] = self.tabor_parameter
+        if self.fuller_tabor_theta is not None:
+            rec["fuller_tabor_theta"] = self.fuller_tabor_theta
+        if self.on_the_map:
+            rec["tabor_bounds"] = {"jkr_above": TABOR_JKR, "dmt_below": TABOR_DMT, "source": "Johnson & Greenwood 1997"}
+        if self.estimated_loss_fraction is not None:
+            rec.update({"estimated_loss_fraction": self.estimated_loss_fraction,
+                        "estimated_pull_fraction": self.estimated_pull_fraction,
+                        "loop_energy_per_summit": self.loop_energy_per_summit,
+                        "negligible_below": {"loss": NEGLIGIBLE_LOSS, "pull": NEGLIGIBLE_PULL}})
+        # where the geometry overrode the map, "law" still names the map's choice (as recorded since the override
+        # was introduced) and "map_suggests" repeats it; the law that runs is in models.contact_law
+        rec.update({"law": self.map_suggests or self.law, "decided_by": self.decided_by, "why": self.why})
+        if self.map_suggests is not None:
+            rec["map_suggests"] = self.map_suggests
+        return rec
+
+
+def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
+    """Summit (or sphere) adhesion law for `scene` in `regime` (its estimate, if any, weighs the loss)."""
+    surf, phys = scene.surfaces, scene.physics
+    w = regime.work_of_adhesion
+    base = dict(work_of_adhesion=w, source="SAM-SAM" if surf.sam is not None else "surfaces.work_of_adhesion",
+                interaction_range_z0=regime.interaction_range, tabor_parameter=regime.tabor_parameter,
+                fuller_tabor_theta=regime.fuller_tabor_theta)
+    mu = regime.tabor_parameter
+    if phys.adhesion_law != "auto":
+        return AdhesionDecision(phys.adhesion_law, "scene", f"physics.adhesion_law = '{phys.adhesion_law}' set in the scene",
+                                **base)
+    if w <= 0.0:
+        return AdhesionDecision("none", "work_of_adhesion", "auto: no work of adhesion, Hertz contact", **base)
+    if scene.contact == "smooth":
+        if scene.body.shape == "cylinder":
+            return AdhesionDecision("none", "geometry", "auto: a smooth roller has no adhesive line-contact law here "
+                                    "(2-D JKR is not implemented); adhesion is left out and the result says so", **base)
+        return AdhesionDecision("jkr", "geometry",
+                                f"auto: smooth sphere, JKR (the only adhesive sphere law; Tabor mu = {mu:.3g})", **base)
+    law = "jkr" if mu > TABOR_JKR else "dmt" if mu < TABOR_DMT else "maugis_dugdale"
+    base["on_the_map"] = True
+    loop = loop_per_summit(law, scene)
+    n_pull = pull_off_per_summit(law, scene)
+    estimate = regime.estimate
+    if estimate is not None:
+        loss = estimate.contacts * loop / estimate.impact_energy
+        pull = estimate.contacts * n_pull / estimate.peak_force if estimate.peak_force > 0 else math.inf
+        base.update(estimated_loss_fraction=loss, estimated_pull_fraction=pull, loop_energy_per_summit=loop)
+        if loss < NEGLIGIBLE_LOSS and pull < NEGLIGIBLE_PULL:
+            return AdhesionDecision("none", "estimated_loss_fraction",
+                                    f"auto: {LAW_NAMES[law]} summits (Tabor mu = {mu:.3g}) would lose {loss:.2g} of "
+                                    f"the impact energy per impact and pull {pull:.2g} of the peak force: negligible, "
+                                    "adhesion left out", **base)
+    return AdhesionDecision(law, "tabor_parameter", f"auto: Tabor mu = {mu:.3g} of the summits -> {LAW_NAMES[law]}",
+                            **base)
+
+
+def for_discrete_summits(decision: AdhesionDecision) -> AdhesionDecision:
+    """Discrete summits run JKR or Hertz only: a DMT or Maugis-Dugdale choice becomes JKR, and says so."""
+    if decision.law not in ("dmt", "maugis_dugdale"):
+        return decision
+    return replace(decision, law="jkr", map_suggests=decision.law,
+                   why=decision.why + "; discrete summits are JKR or Hertz only: JKR used (force 'averaged' mode for "
+                                      "this law)")
+
+
+def decide_adhesion(scene: Scene, estimate=None) -> tuple[str, dict]:
+    """Summit (or sphere) adhesion law for `scene` and the record of why (`adhesion_decision`, as a pair)."""
+    d = adhesion_decision(scene, regime_of(scene, estimate=estimate))
+    return d.law, d.record()
+
+
+# ----------------------------------------------------------------------------- half-space
+@dataclass(frozen=True)
+class HalfSpaceDecision:
+    """Whether the summits are coupled to the elastic half-space, and the deflection that decided it."""
+
+    used: bool
+    decided_by: str
+    why: str
+    estimated_deflection_span: float | None = None
+    """Span of the estimated deflection across the footprint (m), rough contact."""
+    deflection_over_sigma: float | None = None
+    rough: bool = True
+    """False for smooth contact, whose record carries no numbers (the closed form contains the half-space)."""
+
+    def record(self) -> dict:
+        if not self.rough:
+            return {"used": self.used, "decided_by": self.decided_by, "why": self.why}
+        return {"estimated_deflection_span": self.estimated_deflection_span,
+                "deflection_over_sigma": self.deflection_over_sigma, "negligible_below": NEGLIGIBLE_DEFLECTION,
+                "used": self.used, "decided_by": self.decided_by, "why": self.why}
+
+
+#: Smooth contact: the closed-form laws contain the elastic half-space.
+SMOOTH_HALF_SPACE = HalfSpaceDecision(False, "geometry", "smooth contact: the closed-form law already contains the "
+                                                         "elastic half-space", rough=False)
+
+
+def half_space_decision(scene: Scene, regime: Regime) -> HalfSpaceDecision:
+    """Whether the rough contact couples its summits to the elastic half-space, and why."""
+    choice = scene.physics.half_space
+    sigma = scene.surfaces.roughness.sigma
+    est = regime.estimate
+    numbers = dict(estimated_deflection_span=est.deflection_span if est else None,
+                   deflection_over_sigma=est.deflection_span / sigma if est else None)
+    if choice != "auto":
+        return HalfSpaceDecision(choice == "on", "scene", f"physics.half_space = '{choice}' set in the scene", **numbers)
+    ratio = est.deflection_span / sigma
+    used = ratio >= NEGLIGIBLE_DEFLECTION
+    why = (f"auto: estimated deflection across the footprint {est.deflection_span:.3g} m = {ratio:.3g} sigma "
+           + (">= " if used else "< ") + f"{NEGLIGIBLE_DEFLECTION:g} sigma: "
+           + ("coupled (FFT influence coefficients)" if used else "left out, rigid substrate"))
+    return HalfSpaceDecision(used, "deflection_over_sigma", why, **numbers)
+
+
+def decide_half_space(scene: Scene, estimate) -> tuple[bool, dict]:
+    """Whether the rough contact couples its summits to the elastic half-space, and why (as a pair)."""
+    d = half_space_decision(scene, regime_of(scene, estimate=estimate))
+    return d.used, d.record()
+
+
+# ----------------------------------------------------------------------------- menisci
+@dataclass(frozen=True)
+class MenisciDecision:
+    """'off', 'on' or 'after_dry_run' (settled by `run_impact` after a dry run), and the numbers that decided it."""
+
+    choice: str
+    decided_by: str
+    why: str
+    relative_humidity: float
+    wetting_sum: float | None = None
+    """cos t1 + cos t2 of the faces (where the geometry and humidity let it matter)."""
+    contact_angles_deg: tuple[float, float] | None = None
+
+    @property
+    def used(self) -> bool | None:
+        """True or False, None while pending a dry run."""
+        return None if self.choice == "after_dry_run" else self.choice == "on"
+
+    def record(self) -> dict:
+        rec: dict = {"relative_humidity": self.relative_humidity}
+        if self.wetting_sum is not None:
+            rec["cos_theta1_plus_cos_theta2"] = self.wetting_sum
+            rec["contact_angles_deg"] = list(self.contact_angles_deg)
+        if self.used is not None:
+            rec["used"] = self.used
+        rec.update({"decided_by": self.decided_by, "why": self.why})
+        return rec
+
+
+def menisci_decision(scene: Scene) -> MenisciDecision:
+    """'off', 'on' or 'after_dry_run', with the numbers that decided it."""
+    choice, surf, env = scene.physics.menisci, scene.surfaces, scene.environment
+    rh = env.relative_humidity
+    if choice == "off":
+        return MenisciDecision("off", "scene", "physics.menisci = 'off' set in the scene", rh)
+    if scene.contact != "rough" or surf.roughness.mode != "averaged":
+        return MenisciDecision("off", "geometry", "menisci are modelled for averaged rough contact only", rh)
+    if rh <= 0.0:
+        return MenisciDecision("off", "relative_humidity", "dry: environment.relative_humidity = 0", rh)
+    t1, t2 = surf.contact_angles
+    wet = men.wetting_sum(t1, t2)
+    numbers = dict(wetting_sum=wet, contact_angles_deg=(math.degrees(t1), math.degrees(t2)))
+    if wet <= 0.0:
+        return MenisciDecision("off", "contact_angles", f"hydrophobic: cos t1 + cos t2 = {wet:.3g} <= 0, no bridge pulls",
+                               rh, **numbers)
+    if choice == "on":
+        return MenisciDecision("on", "scene", "physics.menisci = 'on' set in the scene", rh, **numbers)
+    return MenisciDecision("after_dry_run", "longest_contact_time",
+                           "auto: decided after a dry run (bridges cannot form before t_a)", rh, **numbers)
+
+
+def decide_menisci(scene: Scene) -> tuple[str, dict]:
+    """'off', 'on' or 'after_dry_run', with the record of why (`menisci_decision`, as a pair)."""
+    d = menisci_decision(scene)
+    return d.choice, d.record()

@@ -1,0 +1,77 @@
+"""The factory: builds the contact law the decisions call for. The only module of `continuum` (outside
+`continuum.laws` itself) that imports a concrete law class; everything else sees a `ContactLaw`
+(`tests/test_architecture.py` holds it to that).
+
+Each function takes what has been decided (law names, booleans, table resolutions) and the scene's
+numbers, and returns the built object; nothing here decides or records.
+"""
+from __future__ import annotations
+
+from ..laws.base import ContactLaw
+from ..scene import Scene
+
+
+def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float) -> tuple[ContactLaw, str]:
+    """The closed-form law of a smooth body under `adhesion` ('none' or 'jkr'), and what it is."""
+    from ..laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
+    from ..laws.jkr import JKRSphere
+
+    body, surf, phys = scene.body, scene.surfaces, scene.physics
+    e_star = surf.e_star
+    if adhesion == "none":
+        if body.shape == "sphere":
+            return HertzSphere(body.radius, e_star), "smooth sphere, no adhesion: Hertz point contact"
+        if phys.line_stiffness == "implicit":
+            return (HertzLine(body.radius, body.length, e_star),
+                    "smooth cylinder, no adhesion: Hertz line contact with b(W) solved exactly")
+        k, load = roller_constant_stiffness(body.mass, first_impact_speed, body.radius, body.length, e_star)
+        return (LinearSpring(k, {"reference_load": load, "reference_speed": first_impact_speed}),
+                "smooth cylinder, line_stiffness = 'constant': K of eq 1 frozen at the first impact's peak load "
+                "(paper eq 2)")
+    # jkr; scene validation admits only a sphere for smooth contact
+    return (JKRSphere(body.radius, surf.interface_work_of_adhesion, e_star, phys.detachment),
+            f"smooth sphere, JKR with Fuller-Tabor hysteresis, {phys.detachment}-controlled release")
+
+
+def averaged_surface(stats, *, summit_law=None, work_of_adhesion: float = 0.0, summit_e_star: float = 0.0,
+                     z_max: float, detachment: str = "displacement", resolution="standard"):
+    """The GW surface of the summits: generic (`summit_law` given, quadrature) or tabulated JKR/Hertz."""
+    if summit_law is not None:
+        from ..rough.gw_branches import GWBranchSurface
+        return GWBranchSurface(stats, summit_law, z_max=z_max, resolution=resolution)
+    from ..rough.gw import GWJKRSurface
+    return GWJKRSurface(stats, work_of_adhesion, summit_e_star, z_max=z_max, detachment=detachment,
+                        resolution=resolution)
+
+
+def rigid_roller(surface, radius: float, length: float, resolution: str = "standard") -> ContactLaw:
+    """Averaged rough roller on a rigid substrate (footprint tables at `resolution`)."""
+    from ..laws.rough_rigid import RigidRoughRoller
+    return RigidRoughRoller(surface, radius, length, resolution=resolution)
+
+
+def grid_roller(surface, scene: Scene) -> ContactLaw:
+    """Averaged rough roller on the elastic half-space (grid of scene.numerics.grid_points cells)."""
+    from ..laws.rough_roller import RoughRoller
+    body = scene.body
+    return RoughRoller(surface, body.radius, body.length, scene.surfaces.e_star, half_space=True,
+                       grid_points=scene.numerics.grid_points)
+
+
+def discrete_roller(scene: Scene, stats, work_of_adhesion: float, summit_e_star: float, half_space: bool,
+                    footprint_half_width: float) -> ContactLaw:
+    """A seeded realisation of individual summits (surfaces.roughness.seed) under the roller."""
+    from ..laws.discrete_roller import DiscreteRoughRoller
+    body, surf = scene.body, scene.surfaces
+    return DiscreteRoughRoller(stats, work_of_adhesion, summit_e_star, body.radius, body.length, surf.e_star,
+                               seed=surf.roughness.seed, detachment=scene.physics.detachment, half_space=half_space,
+                               grid_points=scene.numerics.grid_points, footprint_half_width=footprint_half_width)
+
+
+def with_menisci(dry: ContactLaw, scene: Scene, stats, parameters: dict) -> ContactLaw:
+    """`dry` (an averaged rough roller) plus capillary bridges with the scene's meniscus `parameters`."""
+    from ..laws.wet import MeniscusBridges, WetRoughRoller
+    body, p = scene.body, parameters
+    bridges = MeniscusBridges(stats, dry.z_top, body.radius, body.length, p["bridge_pull_off"], p["kelvin_gap"],
+                              p["condensation_time"], p["growth_length"])
+    return WetRoughRoller(dry, bridges, p)

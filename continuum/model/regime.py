@@ -1,0 +1,124 @@
+"""The numbers that place a scene, computed once: summit modulus and layers, Tabor and Fuller-Tabor
+parameters, plasticity index, the first impact's estimate, and the menisci's parameters.
+
+Every decision (`continuum.model.decisions`) and record (`continuum.model.record`) reads them from one
+`Regime`, so no number is computed twice with different guards.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .. import menisci as men
+from .. import regimes
+from ..estimates import RoughImpactEstimate, rough_impact_estimate
+from ..scene import Scene
+
+
+def summit_e_star(scene: Scene) -> float:
+    """Contact modulus of the summits (Pa): surfaces.roughness.summit_modulus, else the bodies' E*."""
+    rough = scene.surfaces.roughness
+    return rough.summit_modulus if rough.summit_modulus is not None else scene.surfaces.e_star
+
+
+def sam_layer(scene: Scene) -> tuple[float, float, float] | None:
+    """(total thickness m, Young's modulus Pa, Poisson's ratio) of the SAM layers in series, or None.
+
+    Both surfaces carry a layer of surfaces.sam.thickness, so a summit contact compresses two.
+    """
+    sam = scene.surfaces.sam
+    if sam is None or sam.layer_modulus is None:
+        return None
+    return 2.0 * sam.thickness, sam.layer_modulus, sam.layer_poisson_ratio
+
+
+def first_impact_speed(scene: Scene) -> float:
+    """Speed (m/s) at the first touch: sqrt(2 g h0) for a release height, else the given velocity."""
+    if scene.release_height is not None:
+        return math.sqrt(2.0 * scene.environment.gravity * scene.release_height)
+    return scene.impact_velocity
+
+
+def impact_estimate(scene: Scene, speed: float) -> RoughImpactEstimate:
+    """Quasi-static first approach of Hertz summits on a rigid substrate absorbing an impact at `speed` (m/s)
+    (`continuum.estimates`): depth, contacts, peak force and the half-space's deflection span."""
+    from ..rough.datum import tallest_summit
+    from ..rough.gw import SummitStatistics
+
+    body, rough = scene.body, scene.surfaces.roughness
+    datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
+    # beyond the averaged model's range the depth search refuses the scene (SceneError, continuum.laws.costs)
+    return rough_impact_estimate(SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius),
+                                 summit_e_star(scene), scene.surfaces.e_star, body.radius, body.length,
+                                 datum["z_max"], body.mass, speed, scene.environment.gravity)
+
+
+@dataclass(frozen=True)
+class Regime:
+    """Where a scene sits, from its surfaces (and, for rough contact, its first impact); SI."""
+
+    rough: bool
+    """contact = 'rough' (summits) or 'smooth' (the body itself)."""
+    radius: float
+    """Radius of the contacting asperity (m): the summits' tip radius, or the body's radius."""
+    e_star: float
+    """Contact modulus of that asperity (Pa): the summits' E*, or the bodies'."""
+    work_of_adhesion: float
+    """Interface work of adhesion (J/m^2): SAM-SAM where both faces are covered."""
+    interaction_range: float
+    """Range z0 (m) of the surface interaction, for the Tabor parameter."""
+    tabor_parameter: float | None
+    """Tabor's mu of the asperity; None without adhesion."""
+    fuller_tabor_theta: float | None
+    """Fuller-Tabor theta of the summits; None for smooth contact or without adhesion."""
+    plasticity_index: float | None
+    """GW plasticity index of the summits; None for smooth contact or without surfaces.hardness."""
+    estimate: RoughImpactEstimate | None
+    """The first impact's Hertz estimate (rough contact), or None where none was asked for."""
+
+
+def regime_of(scene: Scene, speed: float | None = None, estimate: RoughImpactEstimate | None = None) -> Regime:
+    """The scene's regime; for rough contact the impact estimate at `speed` (m/s) unless `estimate` is given
+    (neither: no estimate)."""
+    surf = scene.surfaces
+    rough = scene.contact == "rough"
+    w, z0 = surf.interface_work_of_adhesion, surf.interface_interaction_range
+    if rough:
+        beta, e_s = surf.roughness.summit_radius, summit_e_star(scene)
+        if estimate is None and speed is not None:
+            estimate = impact_estimate(scene, speed)
+    else:
+        beta, e_s = scene.body.radius, surf.e_star
+        estimate = None
+    adhesive = w > 0
+    return Regime(
+        rough=rough, radius=beta, e_star=e_s, work_of_adhesion=w, interaction_range=z0,
+        tabor_parameter=regimes.tabor_parameter(beta, w, e_s, z0) if adhesive else None,
+        fuller_tabor_theta=regimes.fuller_tabor_theta(surf.roughness.sigma, beta, w, e_s) if rough and adhesive
+        else None,
+        plasticity_index=regimes.plasticity_index(e_s, surf.hardness, surf.roughness.sigma, beta)
+        if rough and surf.hardness is not None else None,
+        estimate=estimate)
+
+
+def meniscus_parameters(scene: Scene) -> dict:
+    """Kelvin radius and gap, bridge pull, t_a and growth length for the scene (SI), with their sources."""
+    surf, env, m = scene.surfaces, scene.environment, scene.menisci
+    t1, t2 = surf.contact_angles
+    rh, temp = env.relative_humidity, env.temperature
+    r_k = men.kelvin_radius(rh, temp, m.surface_tension, m.molar_volume)
+    d_k = men.kelvin_gap(r_k, t1, t2)
+    beta = surf.roughness.summit_radius
+    if m.condensation_model == "nucleation":
+        t_a, t_src = men.nucleation_condensation_time(rh, temp), "nucleation (Szoszkiewicz & Riedo 2005)"
+    else:
+        t_a, t_src = m.condensation_time, "menisci.condensation_time"
+    h1 = m.growth_length if m.growth_length is not None else men.default_growth_length(rh)
+    return {"kelvin_radius": r_k, "kelvin_gap": d_k, "kelvin_gap_over_summit_radius": d_k / beta,
+            "bridge_pull_off": men.bridge_pull_off(beta, m.surface_tension, t1, t2),
+            "condensation_time": t_a, "condensation_time_source": t_src, "growth_length": h1,
+            "growth_length_source": "menisci.growth_length" if m.growth_length is not None
+            else "1/(n_w^(1/3) ln(1/RH)) (one molecule's cross-section)",
+            "surface_tension": m.surface_tension, "force_law": "constant Kelvin radius, F0 (1 - g/D_K), "
+            "rupture at D_K (docs/model.md, Menisci)", "bridges_see": "rigid geometry (half-space deflection left "
+            "out of the bridges' gaps)"}

@@ -1,0 +1,164 @@
+"""Choose the models a scene needs, have the factory build its contact law, and say why.
+
+regime (`continuum.model.regime`, computed once) -> decisions (`decisions`) -> plan of the rough law (table
+resolution, cost checks) -> law (`factory`) -> record (`record`, result.json -> models).
+"""
+from __future__ import annotations
+
+from ..estimates import check_table_cost
+from ..laws.base import ContactLaw
+from ..reference import jkr as jkr_ref
+from ..scene import Scene, SceneError
+from . import factory
+from . import record as rec
+from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, for_discrete_summits, half_space_decision,
+                        menisci_decision, summit_law)
+from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of, sam_layer
+
+#: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
+FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
+#: GW tables estimated to take longer than this (s) are built only after the adhesive approach has been
+#: checked against the averaged model's range (`adhesive_range_check`, < 1 s).
+LARGE_TABLE_SECONDS = 2.0
+
+
+def adhesive_range_check(scene: Scene, stats, z_max_sigma: float, speed: float) -> None:
+    """Refuse (SceneError, continuum.laws.costs.beyond_range) if the first impact's adhesive JKR
+    approach, integrated by quadrature over the footprint on a rigid substrate, would press the roller
+    beyond the averaged model's range; return otherwise."""
+    surface = factory.averaged_surface(stats, summit_law=summit_law("jkr", scene), z_max=z_max_sigma)
+    law = factory.rigid_roller(surface, scene.body.radius, scene.body.length, resolution="fast")
+    law.quasi_static_depth(0.5 * scene.body.mass * speed * speed, scene.body.mass * scene.environment.gravity)
+
+
+def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None = None,
+              with_menisci: bool = False, speed: float | None = None, estimate=None,
+              regime: Regime | None = None) -> tuple[ContactLaw, dict]:
+    """GW rough roller for `scene` and the record of its datum and regime numbers.
+
+    `adhesion` (a law name) and `half_space` default to the scene's choices; where the scene says
+    'auto' they are decided as `select_law` does (with the estimate at `speed`, m/s, if given, else
+    at the scene's first impact). Before any table is built the tables' size is estimated and a
+    scene beyond the bounds is refused with a `SceneError` (`continuum.estimates.check_table_cost`).
+    """
+    from ..rough.datum import tallest_summit
+    from ..rough.gw import SummitStatistics
+
+    body, surf, phys = scene.body, scene.surfaces, scene.physics
+    rough = surf.roughness
+    if speed is None:
+        speed = first_impact_speed(scene)
+    est = estimate
+    if adhesion is None or half_space is None:
+        if est is None and "auto" in (phys.adhesion_law, phys.half_space):
+            est = impact_estimate(scene, speed)
+        decided = regime_of(scene, estimate=est)
+        if adhesion is None:
+            adhesion = adhesion_decision(scene, decided).law
+        if half_space is None:
+            half_space = half_space_decision(scene, decided).used
+    if regime is None:
+        regime = regime_of(scene, estimate=est)
+    w = surf.interface_work_of_adhesion if adhesion != "none" else 0.0
+    datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
+    stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
+    e_s = regime.e_star
+    table = scene.numerics.table
+    generic = adhesion in ("dmt", "maugis_dugdale") or sam_layer(scene) is not None
+    cost = None
+    slaw = None
+    if rough.mode != "discrete":
+        if not generic and table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
+                jkr_ref.critical_approach(rough.summit_radius, w, e_s)):
+            table = "standard"      # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
+        if not half_space and est is None:
+            est = impact_estimate(scene, speed)
+        if generic:
+            slaw = summit_law(adhesion, scene)
+            release_stretch, end_gap = max(-slaw.delta_out, 0.0), max(-slaw.delta_out, slaw.reach, 0.0)
+        else:
+            release_stretch = end_gap = (float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) *
+                                         (1.0 if phys.detachment == "displacement"
+                                          else -jkr_ref.LOAD_DETACH_APPROACH_RATIO) if w > 0 else 0.0)
+        try:
+            cost = check_table_cost(stats=stats, work_of_adhesion=w, summit_e_star=e_s, z_max_sigma=datum["z_max"],
+                                    detachment=phys.detachment, resolution=table, gw_tables=not generic,
+                                    rigid=not half_space, rigid_resolution=table,
+                                    release_stretch=release_stretch, end_gap=end_gap,
+                                    depth_estimate=est.depth if est else None, sigma_key_value=rough.sigma)
+        except SceneError:
+            # Refused for size. The Hertz estimate leaves adhesion out, and an adhesive approach can pull the
+            # roller beyond the averaged model's range, where every way out of the size refusal would be refused
+            # too: say so instead (the approach branch by quadrature, no tables; < 1 s).
+            if w > 0 and not generic:
+                adhesive_range_check(scene, stats, datum["z_max"], speed)
+            raise
+        if w > 0 and not generic and cost.get("gw_table", {}).get("estimated_seconds", 0.0) > LARGE_TABLE_SECONDS:
+            # a large table (seconds, hundreds of MB) is worth building only if the impact stays in range
+            adhesive_range_check(scene, stats, datum["z_max"], speed)
+    surface = None
+    if rough.mode == "discrete":
+        # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
+        law = factory.discrete_roller(scene, stats, w, e_s, half_space, datum["footprint_half_width"])
+        delta_c = law.delta_c
+    else:
+        surface = factory.averaged_surface(stats, summit_law=slaw, work_of_adhesion=w, summit_e_star=e_s,
+                                           z_max=datum["z_max"], detachment=phys.detachment, resolution=table)
+        delta_c = surface.delta_c
+        # on a rigid substrate the footprint tables follow the GW tables' resolution: where adhesion dominates
+        # (sigma/delta_c < 3) `fast` ones miss too (energy audit 1.1e-3 of the turnover at sigma/delta_c = 2.3),
+        # so both are `standard`
+        law = (factory.grid_roller(surface, scene) if half_space
+               else factory.rigid_roller(surface, body.radius, body.length, resolution=table))
+    record = rec.rough_law_record(
+        scene, datum=datum, regime=rec.rough_regime_record(scene, regime, w, delta_c), surface=surface, cost=cost,
+        table=table, fast_min_sigma_over_delta_c=FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, law=law,
+        summit_law_record=(slaw.describe() if slaw is not None else adhesion) if generic else None)
+    if with_menisci:
+        law = factory.with_menisci(law, scene, stats, meniscus_parameters(scene))
+    return law, record
+
+
+def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None) -> tuple[ContactLaw, dict]:
+    """The contact law for `scene` and a record of what runs, what is left out, and why.
+
+    `menisci` overrides the meniscus decision (True/False); None decides it here, where 'auto'
+    with a wet, hydrophilic scene is recorded as pending (`run_impact` settles it after a dry run).
+    """
+    models: dict = {}
+    m = menisci_decision(scene)
+    m_rec = m.record()
+    if scene.contact == "rough":
+        regime = regime_of(scene, first_impact_speed)
+        estimate = regime.estimate
+        adhesion = adhesion_decision(scene, regime)
+        if scene.surfaces.roughness.mode == "discrete":
+            adhesion = for_discrete_summits(adhesion)
+        hs = half_space_decision(scene, regime)
+        wet = menisci if menisci is not None else (m.choice == "on")
+        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, estimate=estimate, regime=regime)
+        models["estimate"] = rec.estimate_record(estimate)
+        models["contact_law"] = {**law.describe(), **record,
+                                 "why": "contact = 'rough': GW summits on a grid under the roller"}
+        models["adhesion"] = {"used": adhesion.used, **adhesion.record()}
+        models["half_space"] = hs.record()
+        if menisci is not None:
+            m_rec = {**m_rec, "used": menisci}
+        if wet:
+            m_rec.update(meniscus_parameters(scene))
+        models["menisci"] = m_rec
+        models["sam"] = rec.sam_record(scene)
+        models["free_flight"] = rec.free_flight_record()
+        return law, models
+    adhesion = adhesion_decision(scene, regime_of(scene))
+    law, why = factory.smooth_law(scene, adhesion.law, first_impact_speed)
+    a_rec = adhesion.record()
+    if not adhesion.used and scene.surfaces.interface_work_of_adhesion > 0 and scene.physics.adhesion_law == "none":
+        a_rec = {**a_rec, "why": "adhesion_law = 'none' (work_of_adhesion ignored)"}
+    models["adhesion"] = {"used": adhesion.used, **a_rec}
+    models["contact_law"] = {**law.describe(), "why": why}
+    models["menisci"] = m_rec
+    models["half_space"] = SMOOTH_HALF_SPACE.record()
+    models["sam"] = rec.sam_record(scene)
+    models["free_flight"] = rec.free_flight_record()
+    return law, models
