@@ -11,12 +11,10 @@ import io
 import json
 import math
 from contextlib import redirect_stdout
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from md import units as U
 from md.recipe import load_recipe, parse_recipe
 
 
@@ -96,8 +94,8 @@ def test_dispersion_tail_applies_to_trappe_pairs_only():
     """'trappe': every pair with a CH2/CH3 united atom (OTS-OTS, silica-OTS, water-OTS), never an IFF-IFF pair;
     the OTS head Si (IFF LJ) pairs with silica keep the cutoff."""
     from md.workflows.adhesion import TRAPPE_UA, _tail_pair_table
-    from md.workflows.common import _ff
-    ff = _ff(["silica_interface", "ots_trappe_ua", "water_spce"])
+    from md.workflows.common import forcefield_of
+    ff = forcefield_of(["silica_interface", "ots_trappe_ua", "water_spce"])
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")
     i = {n: k for k, n in enumerate(names)}
     assert inc[i["CH2"], i["CH3"]] and inc[i["CH2"], i["OC24"]] and inc[i["OW"], i["CH3"]]
@@ -175,11 +173,11 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     from md.engine.plan import id_ranges
     from md.system.lammps_data import read_atoms
     from md.workflows.adhesion import _tail_pair_table
-    from md.workflows.common import _ff, _surface_slab
+    from md.workflows.common import forcefield_of, surface_slab
     s = _settings("adhesion_ots")
-    ff = _ff(["silica_interface", "ots_trappe_ua"])
-    lower = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, "111")
-    upper = _surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 11, "111")
+    ff = forcefield_of(["silica_interface", "ots_trappe_ua"])
+    lower = surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, "111")
+    upper = surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 11, "111")
     system = place_on.system(lower, flip_upside_down(upper), gap=3.0, vacuum=40.0)
     data = write_data(system, ff, tmp_path / "ots.data")
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")

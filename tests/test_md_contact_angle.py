@@ -297,8 +297,8 @@ def test_only_deep_si_and_bridging_o_are_held_and_silanols_are_constrained_not_f
     n_sub = len(types)
     assert 0 < len(_ids(frozen)) < 0.6 * n_sub
     # the silanol O-H bond is constrained (SHAKE), not held
-    from md.workflows.common import _ff
-    ff = _ff(wf.forcefield_files(s))
+    from md.workflows.common import forcefield_of
+    ff = forcefield_of(wf.forcefield_files(s))
     oh = next(k for k, t in enumerate(ff.bond_types, 1) if sorted(t.types) == ["HOY", "OC24"])
     shake = next(c for c in leg.define(0) if " shake " in c)
     assert f" {oh} " in shake.split(" a ")[0] + " "
@@ -326,7 +326,7 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
     Q3 silanols: no two top silanol O closer than 4 A (minimum image; the (001) face has pairs at 2.53 A)."""
     from md.system.topology import minimum_image
     from md.workflows import get_workflow
-    from md.workflows.common import _silica_face, _surface_slab
+    from md.workflows.common import silica_face_of, surface_slab
     from md.workflows.pulloff import PullOff
 
     def min_oo(system, group):
@@ -338,8 +338,8 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
 
     for name in ("contact_angle_silica", "adhesion_silica"):
         s = load_recipe(name).settings("smoke")
-        assert _silica_face(s) == "111"
-        slab = _surface_slab("silica", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, _silica_face(s))
+        assert silica_face_of(s) == "111"
+        slab = surface_slab("silica", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, silica_face_of(s))
         assert slab.info["face"] == "111" and slab.info["q_distribution"]["Q2"] == 0
         assert min_oo(slab, slab.group("silanol_O_top")) > 4.0
     _, plan, _ = _plan("contact_angle_silica", tmp_path)

@@ -83,10 +83,10 @@ def test_the_substrate_is_minimised_by_fire_at_1_fs_and_run_at_the_recipes_times
 def test_no_recipe_minimises_with_fire_above_1_fs(fidelity):
     """Every recipe at every fidelity, through the helper every workflow minimises with (FIRE for the solids,
     cg for rigid water): FIRE never above 1 fs, the recipe's timestep restored after it."""
-    from md.workflows.common import _minimize
+    from md.workflows.common import minimize_lines
     for name in RECIPES:
         s = load_recipe(name).settings(fidelity)
-        at_fire, dt = _fire_timesteps(_minimize(s), dt=s["timestep_fs"])
+        at_fire, dt = _fire_timesteps(minimize_lines(s), dt=s["timestep_fs"])
         assert all(x <= FIRE_DT_MAX_FS for x in at_fire), (name, at_fire)
         assert dt == s["timestep_fs"], name
 
@@ -99,7 +99,7 @@ def test_quick_silica_substrate_survives_fire(needs_lammps, tmp_path):
     O-H at its length and the energy lower."""
     from md.lammps_loader import new_lammps
     from md.workflows import get_workflow
-    from md.workflows.common import _ff
+    from md.workflows.common import forcefield_of
     s = dict(load_recipe("contact_angle_silica").settings("quick"))
     s["minimize_steps"] = 60
     wf = get_workflow("contact_angle")
@@ -107,7 +107,7 @@ def test_quick_silica_substrate_survives_fire(needs_lammps, tmp_path):
     leg = plan.legs[0]
     d = tmp_path / "legs" / leg.name
     d.mkdir(parents=True)
-    oh = next(k for k, t in enumerate(_ff(wf.forcefield_files(s)).bond_types, 1) if sorted(t.types) == ["HOY", "OC24"])
+    oh = next(k for k, t in enumerate(forcefield_of(wf.forcefield_files(s)).bond_types, 1) if sorted(t.types) == ["HOY", "OC24"])
     lmp = new_lammps()
     try:
         for c in leg.fresh(d):
@@ -133,7 +133,7 @@ def test_quick_silica_substrate_survives_fire(needs_lammps, tmp_path):
 
 def _substrates(name: str, fidelity: str):
     """The periodic silica (with its SAM) the recipe's workflow builds, and the cell counts it asked for."""
-    from md.workflows.common import _silica_face, _surface_slab
+    from md.workflows.common import silica_face_of, surface_slab
     from md.workflows.pulloff import PullOff
     s = load_recipe(name).settings(fidelity)
     seed = int(s["seed"])
@@ -141,16 +141,16 @@ def _substrates(name: str, fidelity: str):
         system, _ = PullOff().build(s)
         return [system], None
     kinds = s["surfaces"] if name.startswith("adhesion") else [s["surface"]]
-    slabs = [_surface_slab(k, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10 * i, _silica_face(s))
+    slabs = [surface_slab(k, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10 * i, silica_face_of(s))
              for i, k in enumerate(kinds)]
     return slabs, (s["nx"], s["ny"])
 
 
 def _forcefield_r0(system) -> np.ndarray:
-    from md.workflows.common import _ff
+    from md.workflows.common import forcefield_of
     names = ["silica_interface"] + (["ots_trappe_ua"] if "CH3" in set(system.types.tolist()) else []) \
         + (["water_spce"] if "OW" in set(system.types.tolist()) else [])
-    r0 = {t.name: float(t.coeffs[1]) for t in _ff(names).bond_types}
+    r0 = {t.name: float(t.coeffs[1]) for t in forcefield_of(names).bond_types}
     return np.array([r0[n] for n in system.bond_types])
 
 

@@ -28,9 +28,9 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.topology import System
 
-from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, Workflow, _common_define, _equil, _ff, _figure,
-                                 _fresh_from_data, _intersect, _minimize, _q, _restart_head, _round_up, _seed,
-                                 _silica_face, _stages, _steps, _summary, _surface_slab, _thermostat)
+from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+                                 fresh_from_data, intersect_ids, minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed,
+                                 silica_face_of, stage_list, steps_of, system_summary, surface_slab, thermostat_lines)
 
 # ================================================================================================ adhesion
 
@@ -99,19 +99,19 @@ class Adhesion(Workflow):
         return rows
 
     def plan(self, s, run_dir):
-        ff = _ff(self.forcefield_files(s))
+        ff = forcefield_of(self.forcefield_files(s))
         lower_kind, upper_kind = s["surfaces"]
-        face = _silica_face(s)
+        face = silica_face_of(s)
         seed = int(s["seed"])
-        lower = _surface_slab(lower_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed, face)
-        upper = _surface_slab(upper_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10, face)
+        lower = surface_slab(lower_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed, face)
+        upper = surface_slab(upper_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10, face)
         system = as_system(place_on(lower, flip_upside_down(upper), gap=s["contact_gap_A"],
                                     vacuum=s["separation_A"] + 15.0))
         data = run_dir / "system.data"
         write_data(system, ff, data)
         groups = {"lower": system.group("substrate"), "upper": system.group("adsorbate"),
-                  "lower_fixed": _intersect(system, "frozen", "substrate"),
-                  "upper_back": _intersect(system, "frozen", "adsorbate")}
+                  "lower_fixed": intersect_ids(system, "frozen", "substrate"),
+                  "upper_back": intersect_ids(system, "frozen", "adsorbate")}
         tail = _tail_applies(s, system)
         study = s["dispersion_tail"] == "trappe"   # contact frames for the cutoff study, even without TraPPE atoms
         if study:
@@ -126,7 +126,7 @@ class Adhesion(Workflow):
 
         def define(upper_free: bool, salt: int):
             def d(step: int) -> list[str]:
-                cmds = _common_define(s, "mobile") + [
+                cmds = common_define(s, "mobile") + [
                     "neigh_modify exclude group lower_fixed lower_fixed",
                     "neigh_modify exclude group upper_back upper_back",
                     "fix hold_lower lower_fixed setforce 0.0 0.0 0.0",
@@ -136,43 +136,43 @@ class Adhesion(Workflow):
                     cmds += [_BACK_RIGID]
                 else:
                     cmds += ["fix hold_upper upper_back setforce 0.0 0.0 0.0"]
-                return cmds + _thermostat("mobile", s, step, salt)
+                return cmds + thermostat_lines("mobile", s, step, salt)
             return d
 
         def fresh_contact(leg_dir: Path) -> list[str]:
-            return _fresh_from_data(ff, data, s, groups) + setup_groups()
+            return fresh_from_data(ff, data, s, groups) + setup_groups()
 
         def fresh_from_minimized(shift: float):
             def f(leg_dir: Path) -> list[str]:
-                return _fresh_from_data(ff, minimized, s, groups) + setup_groups() + \
+                return fresh_from_data(ff, minimized, s, groups) + setup_groups() + \
                     ([f"displace_atoms upper move 0.0 0.0 {shift:.6f} units box"] if shift else [])
             return f
 
         def frames(sample_key: str, per_leg: int, on: bool = True) -> Frames | None:
-            return Frames("tailset", _round_up(_steps(s, sample_key) / per_leg, si)) if on else None
+            return Frames("tailset", round_up(steps_of(s, sample_key) / per_leg, si)) if on else None
 
-        base = dict(define=None, restart_head=_restart_head(s), columns=columns,
+        base = dict(define=None, restart_head=restart_header_lines(s), columns=columns,
                     sample_interval=si, chunk_steps=s["chunk_steps"], n_atoms=n)
-        sample = Stage("sample", _steps(s, "sample_steps"))
+        sample = Stage("sample", steps_of(s, "sample_steps"))
         contact = Leg(name="contact", fresh=fresh_contact,
                       prepare=lambda d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"]
-                      + _minimize(s, d / "minimized.data") + ["unfix back_min", _BACK_RIGID],
-                      stages=_stages(_equil(s, "mobile", 1), sample),
+                      + minimize_lines(s, d / "minimized.data") + ["unfix back_min", _BACK_RIGID],
+                      stages=stage_list(equilibrate_stage(s, "mobile", 1), sample),
                       frames=frames("sample_steps", TAIL_FRAMES_CONTACT, study),
                       **{**base, "define": define(True, 1)})
         legs = [
             contact,
             Leg(name="separated", fresh=fresh_from_minimized(s["separation_A"]), prepare=lambda d: ["reset_timestep 0"],
-                stages=_stages(_equil(s, "mobile", 2), sample), **{**base, "define": define(False, 2)}),
+                stages=stage_list(equilibrate_stage(s, "mobile", 2), sample), **{**base, "define": define(False, 2)}),
         ]
         registries = []
         if s["free_energy"] == "pmf":
             # a chain: each window continues (positions and velocities) from its neighbour's last restart, moved
             # rigidly by the difference of the nominal separations; the first from the contact leg's last state,
             # moved laterally to the registry's offset
-            pmf_equil = Stage("equilibrate", _steps(s, "pmf_equilibrate_steps"), (), sampled=False)
-            pmf_sample = Stage("sample", _steps(s, "pmf_sample_steps"))
-            stages = _stages(pmf_equil, pmf_sample)
+            pmf_equil = Stage("equilibrate", steps_of(s, "pmf_equilibrate_steps"), (), sampled=False)
+            pmf_sample = Stage("sample", steps_of(s, "pmf_sample_steps"))
+            stages = stage_list(pmf_equil, pmf_sample)
             total = sum(st.steps for st in stages)
             cell = (float(system.cell[0]) / s["nx"], float(system.cell[1]) / s["ny"])
             registries = _registry_offsets(int(s["lateral_registries"]), cell)
@@ -180,7 +180,7 @@ class Adhesion(Workflow):
 
             def from_leg(prev_dir: Path, prev_total: int, move: tuple[float, float, float]):
                 def f(leg_dir: Path) -> list[str]:
-                    cmds = _restart_head(s)(prev_dir / f"restart.{prev_total}") + [f"timestep {s['timestep_fs']:g}"]
+                    cmds = restart_header_lines(s)(prev_dir / f"restart.{prev_total}") + [f"timestep {s['timestep_fs']:g}"]
                     if any(abs(x) > 0 for x in move):
                         cmds.append(f"displace_atoms upper move {move[0]:.6f} {move[1]:.6f} {move[2]:.6f} units box")
                     return cmds
@@ -203,11 +203,11 @@ class Adhesion(Workflow):
                     salt += 1
         info = {"area_A2": area, "box_A": system.cell.tolist(), "surfaces": list(s["surfaces"]), "face": face,
                 "n_lower": int(len(groups["lower"])), "n_upper": int(len(groups["upper"])),
-                "lower": _summary(lower), "upper": _summary(upper), "dispersion_tail": s["dispersion_tail"],
+                "lower": system_summary(lower), "upper": system_summary(upper), "dispersion_tail": s["dispersion_tail"],
                 "tail_applies": bool(tail), "tail_study": bool(study),
                 "registry_offsets_A": [list(o) for o in registries]}
         return Plan(legs=legs, timestep_fs=s["timestep_fs"], n_atoms=n,
-                    seeds={"structure_lower": seed, "structure_upper": seed + 10, "velocities": _seed(seed, 3, 1),
+                    seeds={"structure_lower": seed, "structure_upper": seed + 10, "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed},
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
@@ -219,7 +219,7 @@ class Adhesion(Workflow):
         cache = self.__dict__.setdefault("_tail_cache", {})
         if (ctx.run_dir, mode) not in cache:
             ids_all, types_all, _ = read_atoms(ctx.run_dir / "system.data")
-            cache[(ctx.run_dir, mode)] = (_tail_pair_table(_ff(ctx.plan.forcefield_files), mode),
+            cache[(ctx.run_dir, mode)] = (_tail_pair_table(forcefield_of(ctx.plan.forcefield_files), mode),
                                           dict(zip(ids_all.tolist(), (types_all - 1).tolist())))
         (names, eps, sig, inc), type_of = cache[(ctx.run_dir, mode)]
         steps, ids, pos, box = ctx.frames(leg) if frames is None else frames
@@ -274,11 +274,11 @@ class Adhesion(Workflow):
                     e = self._tail(ctx, mode, "contact", rm, frames=last)["energy"]
                     study[f"{mode}_{rm:g}A_J_m2"] = -float(e[0]) * conv
             tail_det["cutoff_study_last_contact_frame"] = study
-        q = {"work_of_adhesion": _q(w["value"] + w_tail_static, w["stderr"], "J/m^2",
+        q = {"work_of_adhesion": quantity_record(w["value"] + w_tail_static, w["stderr"], "J/m^2",
                                     kind="energy per area (not a free energy)" + (
                                         "; dispersion beyond the cutoff for TraPPE pairs included (static)"
                                         if tail_on else "")),
-             "interface_area": _q(U.angstrom_to_m(U.angstrom_to_m(area)), 0.0, "m^2")}
+             "interface_area": quantity_record(U.angstrom_to_m(U.angstrom_to_m(area)), 0.0, "m^2")}
         details["energy"]["cutoff_only_J_m2"] = w["value"]
         curves: dict[str, tuple[list[str], np.ndarray]] = {}
         figures = {}
@@ -296,7 +296,7 @@ class Adhesion(Workflow):
             ax.set_ylabel("potential energy (kcal/mol)")
             ax.set_title(f"W = {w['value']:.3f} ± {w['stderr']:.3f} J/m² (energy)")
             ax.legend()
-        figures["energy_timeseries"] = _figure(draw_energy)
+        figures["energy_timeseries"] = figure_writer(draw_energy)
         if s["free_energy"] != "pmf":
             notes.append("free energy not estimated at this fidelity (free_energy = 'none'); the quick and "
                          "production recipes integrate the mean force over separation to measure T dS.")
@@ -345,16 +345,16 @@ class Adhesion(Workflow):
         w_e = w["value"] + w_tail_static
         tds = w_e - wf
         repulsive = bool(ti["repulsive_end"])
-        q["work_of_adhesion_free_energy"] = _q(
+        q["work_of_adhesion_free_energy"] = quantity_record(
             wf, wf_err, "J/m^2", kind="free energy per area (force integration from the zero-force point of the "
             "registry-averaged mean-force curve, trapezoid rule" + ("; dispersion beyond the cutoff for TraPPE pairs "
                                                                    "included" if tail_on else "") + ")",
             discretisation_error=wf_disc, value_pchip=wf_pchip, repulsive_end=repulsive,
             registry_spread=float(np.std(w_reg, ddof=1)) if n_reg >= 2 else 0.0, registries=n_reg)
-        q["entropic_term_TdS"] = _q(tds, math.hypot(w["stderr"], wf_err), "J/m^2",
+        q["entropic_term_TdS"] = quantity_record(tds, math.hypot(w["stderr"], wf_err), "J/m^2",
                                     kind="T dS / A = (dE - dF) / A", discretisation_error=wf_disc)
         if tail_on:
-            q["dispersion_tail_work"] = _q(wf - ti_cut["value"], None, "J/m^2",
+            q["dispersion_tail_work"] = quantity_record(wf - ti_cut["value"], None, "J/m^2",
                                            kind="static dispersion beyond the cutoff for TraPPE pairs, in W_F: "
                                                 "tail force integrated over the windows + tail energy left at "
                                                 "the last window")
@@ -364,13 +364,13 @@ class Adhesion(Workflow):
             pk = A.traction_peak(dsep, f_tot, ebar, area)
             pk_disc = pk["discretisation_error"] if np.isfinite(pk["discretisation_error"]) else 0.0
             rng = A.flat_slab_range(wf, math.hypot(wf_err, wf_disc), pk["sigma0"], math.hypot(pk["stderr"], pk_disc))
-            q["peak_traction_sigma0"] = _q(pk["sigma0"], pk["stderr"], "Pa",
+            q["peak_traction_sigma0"] = quantity_record(pk["sigma0"], pk["stderr"], "Pa",
                                            kind=f"maximum tensile traction of the flat-slab mean-force curve "
                                                 f"({pk['method']}: the vertex of the quadratic through the three "
                                                 f"windows around the most attractive one)",
                                            discretisation_error=pk["discretisation_error"],
                                            separation_m=U.angstrom_to_m(pk["separation_A"]))
-            q["interaction_range_z0"] = _q(rng["z0"], rng["stderr"], "m",
+            q["interaction_range_z0"] = quantity_record(rng["z0"], rng["stderr"], "m",
                                            kind="z0 = 1.026 W_F / sigma0 (Maugis 1992, LJ 9-3 law), from the "
                                                 "flat-slab mean-force curve", dugdale_range_h0_m=rng["h0"])
             zsig.update(peak=pk, z0=rng)
@@ -432,7 +432,7 @@ class Adhesion(Workflow):
             ax.set_ylabel("mean force on upper slab (kcal/mol/Å)")
             ax.set_title(f"dF/A = {wf:.3f} ± {wf_err:.3f} (stat.) ± {wf_disc:.3f} (grid) J/m²")
             ax.legend(fontsize=7)
-        figures["pmf"] = _figure(draw_pmf)
+        figures["pmf"] = figure_writer(draw_pmf)
         return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
 
 

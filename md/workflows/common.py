@@ -41,7 +41,7 @@ WATER_MASS = SPCE_WATER_MOLAR_MASS       # g/mol, SPC/E (force-field masses), fr
 
 # ================================================================================================ LAMMPS helpers
 
-def _seed(base: int, *salt: int) -> int:
+def derived_seed(base: int, *salt: int) -> int:
     """A LAMMPS-valid seed (1 .. 900 000 000) derived from ``base`` and ``salt``."""
     x = int(base)
     for s in salt:
@@ -49,21 +49,21 @@ def _seed(base: int, *salt: int) -> int:
     return x + 1
 
 
-def _restart_head(settings: Mapping[str, Any]) -> Callable[[Path], list[str]]:
+def restart_header_lines(settings: Mapping[str, Any]) -> Callable[[Path], list[str]]:
     def head(path: Path) -> list[str]:
         return [f"read_restart {Path(path).as_posix()}",
-                f"kspace_style pppm {settings['kspace_accuracy']:g}", "kspace_modify slab 3.0"] + _neighbor()
+                f"kspace_style pppm {settings['kspace_accuracy']:g}", "kspace_modify slab 3.0"] + neighbor_lines()
     return head
 
 
-def _neighbor() -> list[str]:
+def neighbor_lines() -> list[str]:
     return ["neighbor 2.0 bin", "neigh_modify delay 0 every 1 check yes"]
 
 
-def _fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], groups: Mapping[str, Any]) -> list[str]:
+def fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], groups: Mapping[str, Any]) -> list[str]:
     cmds = lammps_setup_commands(ff, data, boundary="p p f", pair="long", cutoff=settings["cutoff_A"],
                                  kspace_accuracy=settings["kspace_accuracy"])
-    cmds += _neighbor()
+    cmds += neighbor_lines()
     cmds += [f"timestep {settings['timestep_fs']:g}"]
     for name, idx in groups.items():
         if len(idx):
@@ -73,16 +73,16 @@ def _fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], gr
     return cmds
 
 
-def _thermostat(group: str, settings: Mapping[str, Any], step: int, salt: int = 0) -> list[str]:
+def thermostat_lines(group: str, settings: Mapping[str, Any], step: int, salt: int = 0) -> list[str]:
     t = settings["temperature_K"]
     damp = settings["thermostat_damping_fs"]
     if settings["thermostat"] == "nose-hoover":
         return [f"fix thermostat {group} nvt temp {t:g} {t:g} {damp:g}"]
-    return [f"fix thermostat {group} langevin {t:g} {t:g} {damp:g} {_seed(settings['seed'], 17, salt, step)} "
+    return [f"fix thermostat {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings['seed'], 17, salt, step)} "
             f"zero yes", f"fix integrate {group} nve"]
 
 
-def _common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
+def common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
     return ["fix zwalls all wall/reflect zlo EDGE zhi EDGE",
             f"compute tmob {mobile} temp",
             "variable pe equal pe", "variable temp equal c_tmob",
@@ -93,14 +93,14 @@ def _common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
 
 #: timestep (fs) FIRE runs at, whatever the MD timestep: FIRE grows its step to tmax (LAMMPS default 10) times the
 #: timestep, and nothing is constrained while it runs (SHAKE comes afterwards; FIRE breaks SHAKE's restraints, see
-#: :func:`_minimize_water`), so the silanol O-H bond (IFF 495 kcal/mol/A^2, H: period 9.5 fs) vibrates freely.
+#: :func:`minimize_water_lines`), so the silanol O-H bond (IFF 495 kcal/mol/A^2, H: period 9.5 fs) vibrates freely.
 #: At 1 fs (steps up to 10 fs, the timestep of every flexible-O-H recipe) the minimisations are stable; at the 2 fs
 #: of a SHAKE recipe (steps up to 20 fs, two O-H periods) the O-H integration diverges wherever FIRE's global power
 #: test does not see it -- the quick contact_angle_silica substrate (4320 atoms) lost a silanol H at FIRE step 46.
 FIRE_TIMESTEP_FS = 1.0
 
 
-def _minimize(settings: Mapping[str, Any], write: Path | None = None, style: str = "fire") -> list[str]:
+def minimize_lines(settings: Mapping[str, Any], write: Path | None = None, style: str = "fire") -> list[str]:
     """FIRE (or ``style``) minimisation of ``minimize_steps`` iterations; FIRE at :data:`FIRE_TIMESTEP_FS` when the
     MD timestep is longer, the MD timestep restored afterwards."""
     n = int(settings["minimize_steps"])
@@ -115,17 +115,17 @@ def _minimize(settings: Mapping[str, Any], write: Path | None = None, style: str
     return cmds + ["reset_timestep 0"]
 
 
-def _minimize_water(settings: Mapping[str, Any], write: Path | None = None) -> list[str]:
+def minimize_water_lines(settings: Mapping[str, Any], write: Path | None = None) -> list[str]:
     """Minimisation of a system with rigid water: conjugate gradients (FIRE moves SHAKE clusters apart: LAMMPS
     turns SHAKE into restraints while minimising, and FIRE's steps break them; cg does not)."""
-    return _minimize(settings, write, style="cg")
+    return minimize_lines(settings, write, style="cg")
 
 
 #: silanol O-H bond (IFF OC24-HOY, 0.945 A): constrained where silanols are mobile at a 2 fs timestep
 SILANOL_OH = (("OC24", "HOY"),)
 
 
-def _shake(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[str]:
+def shake_lines(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[str]:
     """``fix shake`` on every bond/angle type the force field marks rigid (SPC/E), and on the bond types
     between the atom-type pairs in ``also`` (e.g. :data:`SILANOL_OH`); [] if none."""
     pairs = {tuple(sorted(p)) for p in also}
@@ -138,42 +138,42 @@ def _shake(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[str]:
     return [f"fix rigidwater all shake 1.0e-5 50 0{args} kbond 2.0e5"]
 
 
-def _round_up(n: float, k: int) -> int:
+def round_up(n: float, k: int) -> int:
     return int(max(k, k * math.ceil(float(n) / k - 1e-9)))
 
 
-def _steps(settings: Mapping[str, Any], key: str) -> int:
+def steps_of(settings: Mapping[str, Any], key: str) -> int:
     n = int(settings[key])
-    return 0 if n == 0 else _round_up(n, settings["sample_interval"])
+    return 0 if n == 0 else round_up(n, settings["sample_interval"])
 
 
-def _equil(settings: Mapping[str, Any], group: str, salt: int = 0, extra: tuple[str, ...] = ()) -> Stage:
+def equilibrate_stage(settings: Mapping[str, Any], group: str, salt: int = 0, extra: tuple[str, ...] = ()) -> Stage:
     t = settings["temperature_K"]
-    return Stage("equilibrate", _steps(settings, "equilibrate_steps"),
-                 (f"velocity {group} create {t:g} {_seed(settings['seed'], 3, salt)} mom yes rot no dist gaussian",)
+    return Stage("equilibrate", steps_of(settings, "equilibrate_steps"),
+                 (f"velocity {group} create {t:g} {derived_seed(settings['seed'], 3, salt)} mom yes rot no dist gaussian",)
                  + extra, sampled=False)
 
 
-def _stages(*stages: Stage) -> list[Stage]:
+def stage_list(*stages: Stage) -> list[Stage]:
     return [s for s in stages if s.steps > 0]
 
 
-def _ff(names: list[str]) -> ForceField:
+def forcefield_of(names: list[str]) -> ForceField:
     return load_forcefield(names[0]) if len(names) == 1 else combine(*names)
 
 
-def _intersect(system: System, a: str, b: str) -> np.ndarray:
+def intersect_ids(system: System, a: str, b: str) -> np.ndarray:
     return np.intersect1d(system.group(a), system.group(b))
 
 
-def _q(value: float, stderr: float | None, units: str, **extra) -> dict[str, Any]:
+def quantity_record(value: float, stderr: float | None, units: str, **extra) -> dict[str, Any]:
     d = {"value": float(value), "stderr": None if stderr is None or not np.isfinite(stderr) else float(stderr),
          "units": units}
     d.update(extra)
     return d
 
 
-def _figure(draw: Callable) -> Callable[[Path], None]:
+def figure_writer(draw: Callable) -> Callable[[Path], None]:
     def save(path: Path) -> None:
         from matplotlib.figure import Figure    # object API: no pyplot state, no backend switch
         fig = Figure(figsize=(6.0, 4.2), dpi=110)
@@ -184,7 +184,7 @@ def _figure(draw: Callable) -> Callable[[Path], None]:
     return save
 
 
-def _silica_face(settings: Mapping[str, Any]) -> str:
+def silica_face_of(settings: Mapping[str, Any]) -> str:
     """The cristobalite face of a recipe's silica: the recipe's ``silica_face`` (default
     :data:`md.build.SILICA_FACE` = '111', isolated Q3 silanols) for bare silica; always (111) when an OTS SAM
     is involved (it is grafted on (111), and the two slabs of a pair must share the lateral cell)."""
@@ -194,14 +194,14 @@ def _silica_face(settings: Mapping[str, Any]) -> str:
     return settings.get("silica_face", SILICA_FACE)
 
 
-def _held_deep(system: System, group: str = "frozen") -> np.ndarray:
+def held_deep(system: System, group: str = "frozen") -> np.ndarray:
     """Atoms of ``group`` (the builder's deep layer) that are Si or bridging O: only these are held; silanol O
     and H stay mobile everywhere."""
     idx = np.asarray(system.group(group), int)
     return idx[np.isin(system.types[idx], ["SC4", "OC23"])]
 
 
-def _surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mapping[str, Any], seed: int,
+def surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mapping[str, Any], seed: int,
                   face: str) -> System:
     if kind == "silica":
         dens = settings["silanol_density"] if face == "001" else 4.5
@@ -231,7 +231,7 @@ class Workflow:
 
 
 
-def _summary(system: System) -> dict[str, Any]:
+def system_summary(system: System) -> dict[str, Any]:
     keep = ("builder", "polymorph", "face", "n_atoms", "silanol_density_top", "silanol_density_bottom", "chains",
             "coverage_nm2", "thickness_A", "radius_requested_A", "silanol_density_dome", "total_charge")
     return {k: system.info[k] for k in keep if k in system.info}
@@ -250,5 +250,5 @@ WATER_MODELS: dict[str, dict[str, Any]] = {
 }
 
 
-def _water_ff_names(model: str) -> list[str]:
+def water_forcefield_names(model: str) -> list[str]:
     return list(WATER_MODELS[model]["forcefields"])

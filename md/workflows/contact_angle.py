@@ -24,10 +24,10 @@ from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.topology import System, remove_atoms
 
-from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, _common_define, _equil, _ff, _figure,
-                                 _fresh_from_data, _held_deep, _intersect, _minimize, _minimize_water, _q,
-                                 _restart_head, _seed, _shake, _silica_face, _stages, _steps, _summary, _surface_slab,
-                                 _thermostat, _water_ff_names)
+from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+                                 fresh_from_data, held_deep, intersect_ids, minimize_lines, minimize_water_lines, quantity_record,
+                                 restart_header_lines, derived_seed, shake_lines, silica_face_of, stage_list, steps_of, system_summary, surface_slab,
+                                 thermostat_lines, water_forcefield_names)
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
 DROPLET_GAP_A = 3.0
@@ -60,61 +60,61 @@ class ContactAngleWorkflow(Workflow):
 
     def forcefield_files(self, s):
         return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else []) + \
-            _water_ff_names(s["water_model"])
+            water_forcefield_names(s["water_model"])
 
     def build(self, s) -> tuple[System, System, System]:
         """(substrate, droplet, both placed in one box) -- the substrate's coordinates are those of the combined
         system, so atom ids 1..n_substrate are the same in both legs."""
         seed = int(s["seed"])
-        sub = _surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, _silica_face(s))
+        sub = surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, silica_face_of(s))
         R0 = float(s["droplet_radius_A"])
-        wff = _ff(_water_ff_names(s["water_model"]))
+        wff = forcefield_of(water_forcefield_names(s["water_model"]))
         drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s["droplet_initial_angle_deg"],
                                    seed=seed + 1, forcefield=wff))
         system = as_system(place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0)))
         return sub, drop, system
 
     def plan(self, s, run_dir):
-        ff = _ff(self.forcefield_files(s))
+        ff = forcefield_of(self.forcefield_files(s))
         seed = int(s["seed"])
         sub, drop, system = self.build(s)
         substrate = system.group("substrate")
         water = system.group("adsorbate")
-        held = np.intersect1d(_held_deep(system), substrate)
+        held = np.intersect1d(held_deep(system), substrate)
         sub_data, water_data = run_dir / "substrate.data", run_dir / "water.data"
         write_data(system, ff, run_dir / "system.data", title="contact_angle system (reference; the legs read the "
                    "two parts)")
         write_data(remove_atoms(system, water), ff, sub_data, title="contact_angle substrate")
         write_data(remove_atoms(system, substrate), ff, water_data, title="contact_angle droplet")
         if s["surface"] == "silica":
-            ref = _intersect(system, "silanol_O_top", "substrate")
+            ref = intersect_ids(system, "silanol_O_top", "substrate")
         else:
             ref = system.group("sam_ch3")
         water_o = np.intersect1d(system.group("water_O"), water)
         n_sub, n = len(substrate), system.n_atoms
         dt = s["timestep_fs"]
-        shake = _shake(ff, also=SILANOL_OH)
+        shake = shake_lines(ff, also=SILANOL_OH)
         sub_groups = {"substrate": substrate, "frozen": held}
 
         def fresh_substrate(leg_dir: Path) -> list[str]:
             # minimised with nothing held (no setforce, no exclusions): the deep layer is held only afterwards,
             # at its relaxed positions
-            return _fresh_from_data(ff, sub_data, s, sub_groups) + ["group mobile subtract all frozen"] + \
-                _minimize(s, leg_dir / "minimized.data")
+            return fresh_from_data(ff, sub_data, s, sub_groups) + ["group mobile subtract all frozen"] + \
+                minimize_lines(s, leg_dir / "minimized.data")
 
         def define(salt: int, with_water: bool):
             def d(step: int) -> list[str]:
-                return _common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake + \
+                return common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake + \
                     ["fix hold frozen setforce 0.0 0.0 0.0"] + \
                     (["variable nw equal count(water)/3"] if with_water else []) + \
-                    _thermostat("mobile", s, step, salt)
+                    thermostat_lines("mobile", s, step, salt)
             return d
 
         t = s["temperature_K"]
         sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=define(0, False), prepare=lambda d: [],
-                      restart_head=_restart_head(s),
-                      stages=[Stage("equilibrate", _steps(s, "substrate_equilibrate_steps"),
-                                    (f"velocity mobile create {t:g} {_seed(seed, 3, 0)} mom yes rot no "
+                      restart_head=restart_header_lines(s),
+                      stages=[Stage("equilibrate", steps_of(s, "substrate_equilibrate_steps"),
+                                    (f"velocity mobile create {t:g} {derived_seed(seed, 3, 0)} mom yes rot no "
                                      f"dist gaussian",), sampled=False)],
                       columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s["sample_interval"],
                       chunk_steps=s["chunk_steps"], n_atoms=n_sub)
@@ -122,7 +122,7 @@ class ContactAngleWorkflow(Workflow):
 
         def fresh_droplet(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
             # the equilibrated substrate, then the water: ids n_sub+1.. as in the combined build
-            return _restart_head(s)(sub_dir / f"restart.{_total}") + [
+            return restart_header_lines(s)(sub_dir / f"restart.{_total}") + [
                 f"timestep {dt:g}",
                 f"read_data {water_data.as_posix()} add append group water",
                 f"group framed id {id_ranges(np.union1d(water_o, ref))}",
@@ -130,22 +130,22 @@ class ContactAngleWorkflow(Workflow):
                 f"delete_atoms overlap {DROPLET_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
 
         drop_leg = Leg(name="droplet", fresh=fresh_droplet, define=define(1, True),
-                       prepare=lambda d: _minimize_water(s), restart_head=_restart_head(s),
-                       stages=_stages(_equil(s, "mobile", 1), Stage("sample", _steps(s, "sample_steps"))),
+                       prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
+                       stages=stage_list(equilibrate_stage(s, "mobile", 1), Stage("sample", steps_of(s, "sample_steps"))),
                        columns={"pe": "v_pe", "temp": "v_temp", "n_water": "v_nw"},
                        sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"], n_atoms=n,
                        frames=Frames("framed", s["frame_interval"] or s["sample_interval"]))
         ids = lammps_type_ids(ff)
-        info = {"substrate": _summary(sub), "droplet": dict(drop.info), "box_A": system.cell.tolist(),
+        info = {"substrate": system_summary(sub), "droplet": dict(drop.info), "box_A": system.cell.tolist(),
                 "n_substrate": int(n_sub), "n_water_molecules_built": int(len(water_o)),
                 "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
-                "silica_face": _silica_face(s),
+                "silica_face": silica_face_of(s),
                 "water_O_ids": (water_o + 1).tolist(), "surface_ref_ids": (ref + 1).tolist(),
                 "surface_ref": "top silanol O" if s["surface"] == "silica" else "OTS CH3 groups",
                 "water_model": s["water_model"], "type_ids": ids}
         return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
                     seeds={"structure_substrate": seed, "structure_water": seed + 1,
-                           "velocities_substrate": _seed(seed, 3, 0), "velocities": _seed(seed, 3, 1),
+                           "velocities_substrate": derived_seed(seed, 3, 0), "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed}, forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
@@ -190,40 +190,40 @@ class ContactAngleWorkflow(Workflow):
                          f"lies above the plane: the droplet is not (yet) in contact; reported as 180 deg.")
         else:
             status, angle, angle_err = "wets", 0.0, None
-        q = {"contact_angle": _q(angle, angle_err, "deg",
+        q = {"contact_angle": quantity_record(angle, angle_err, "deg",
                                  kind={"measured": "circle fit, read at the water's dividing plane",
                                        "no_contact": "180 = no contact (mark, not a measurement)",
                                        "wets": "0 = wets (mark, not a measurement): see contact_angle_upper_bound"}
                                  [status], status=status),
-             "droplet_bulk_density": _q(U.g_per_cm3_to_kg_per_m3(r.bulk_density), None, "kg/m^3"),
-             "base_half_width": _q(U.angstrom_to_m(r.base_half_width_A), None, "m")}
-        q["surface_tension_lv"] = _q(gamma, None, "N/m", kind=f"the water model's published gamma_lv "
+             "droplet_bulk_density": quantity_record(U.g_per_cm3_to_kg_per_m3(r.bulk_density), None, "kg/m^3"),
+             "base_half_width": quantity_record(U.angstrom_to_m(r.base_half_width_A), None, "m")}
+        q["surface_tension_lv"] = quantity_record(gamma, None, "N/m", kind=f"the water model's published gamma_lv "
                                      f"({model['gamma_source']})")
         if status == "wets":
             bound, why = (wet["theta_max_deg"], "the water spans the periodic box (a film); a cap of this volume "
                           f"touches its image at {wet['theta_max_deg']:.1f} deg") if wet["spans_box"] else \
                 (wet["theta_resolvable_deg"], f"no circle can be fitted above the excluded layer "
                  f"({r.fit_error}); a cap of this volume is that flat below {wet['theta_resolvable_deg']:.1f} deg")
-            q["contact_angle_upper_bound"] = _q(bound, None, "deg", kind="wets: theta below this bound")
+            q["contact_angle_upper_bound"] = quantity_record(bound, None, "deg", kind="wets: theta below this bound")
             wl = A.work_of_adhesion_sl(gamma, bound)
-            q["work_of_adhesion_sl"] = _q(wl["value"], None, "J/m^2", kind="lower bound (wets): "
+            q["work_of_adhesion_sl"] = quantity_record(wl["value"], None, "J/m^2", kind="lower bound (wets): "
                                           "gamma_lv (1 + cos theta_upper_bound)")
-            q["gamma_lv_cos_theta"] = _q(wl["gamma_cos_theta"], None, "N/m", kind="lower bound (wets)")
+            q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], None, "N/m", kind="lower bound (wets)")
             notes.append(f"wets: theta < {bound:.1f} deg ({why}); W_SL >= {wl['value'] * 1e3:.1f} mJ/m^2. "
                          f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
                          f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
         elif status == "measured":
             wl = A.work_of_adhesion_sl(gamma, angle, None, angle_err)
-            q["work_of_adhesion_sl"] = _q(wl["value"], wl["stderr"], "J/m^2",
+            q["work_of_adhesion_sl"] = quantity_record(wl["value"], wl["stderr"], "J/m^2",
                                           kind="Young-Dupre W_SL = gamma_lv (1 + cos theta), this water model's gamma")
-            q["gamma_lv_cos_theta"] = _q(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
+            q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
                                          kind="gamma_lv cos theta (meniscus force), this water model's gamma")
         # drift of the block angles against time
         dt_ns = ctx.plan.timestep_fs * 1e-6
         t_blocks = np.interp(r.block_frames, np.arange(len(steps)), steps.astype(float)) * dt_ns
         drift = A.block_drift(r.block_angles_deg, t_blocks)
         if status == "measured":
-            q["contact_angle_drift"] = _q(drift["slope"], drift["stderr"], "deg/ns",
+            q["contact_angle_drift"] = quantity_record(drift["slope"], drift["stderr"], "deg/ns",
                                           kind="slope of the block angles against time (OLS)",
                                           drifting=bool(drift["drifting"]))
             if drift["drifting"]:
@@ -283,5 +283,5 @@ class ContactAngleWorkflow(Workflow):
                    "drift": drift, "wetting": wet, "fit_error": r.fit_error, "cap_height_A": r.cap_height_A,
                    "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames), "n_water_molecules": n_water,
                    "water_model": s["water_model"], "gamma_lv_N_m": gamma}
-        return Analysis(quantities=q, curves=curves, figures={"density_map": _figure(draw)}, notes=notes,
+        return Analysis(quantities=q, curves=curves, figures={"density_map": figure_writer(draw)}, notes=notes,
                         details=details)

@@ -28,9 +28,9 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
 from md.system.topology import System, with_groups
 
-from md.workflows.common import (Workflow, _common_define, _equil, _ff, _figure, _fresh_from_data, _intersect,
-                                 _minimize, _q, _restart_head, _round_up, _seed, _silica_face, _stages, _steps,
-                                 _summary, _surface_slab, _thermostat)
+from md.workflows.common import (Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data, intersect_ids,
+                                 minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed, silica_face_of, stage_list, steps_of,
+                                 system_summary, surface_slab, thermostat_lines)
 
 # ================================================================================================ pull-off
 
@@ -54,7 +54,7 @@ class PullOff(Workflow):
     def build(self, s) -> tuple[System, dict[str, Any]]:
         seed = int(s["seed"])
         R = float(s["asperity_radius_A"])
-        face = _silica_face(s)
+        face = silica_face_of(s)
         dens = s["silanol_density"] if face == "001" else 4.5
         asp = as_system(silica_asperity(radius=R, holder_thickness=s["holder_thickness_A"],
                                         margin=s["asperity_margin_A"], silanol_density=dens, face=face, seed=seed))
@@ -63,37 +63,37 @@ class PullOff(Workflow):
         if (fnx, fny) != (nx, ny):
             raise ValueError(f"flat_nx/flat_ny ({fnx}, {fny}) must match the asperity's holder cells ({nx}, {ny}) "
                              f"(both are periodic in x and y); set them to 0")
-        flat = _surface_slab(s["surface"], nx, ny, s["flat_thickness_A"], s, seed + 20, face)
+        flat = surface_slab(s["surface"], nx, ny, s["flat_thickness_A"], s, seed + 20, face)
         info: dict[str, Any] = {"radius_A": R, "face": face}
         if s["surface"] == "ots":
             asp, ginfo = _graft_dome(asp, s, seed + 30)
             info["asperity_sam"] = ginfo
         system = as_system(place_on(flat, flip_upside_down(asp), gap=s["initial_gap_A"],
                                     vacuum=s["retract_distance_A"] + 15.0))
-        info.update(asperity=_summary(asp), flat=_summary(flat), box_A=system.cell.tolist())
+        info.update(asperity=system_summary(asp), flat=system_summary(flat), box_A=system.cell.tolist())
         return system, info
 
     def plan(self, s, run_dir):
-        ff = _ff(self.forcefield_files(s))
+        ff = forcefield_of(self.forcefield_files(s))
         system, info = self.build(s)
         data = run_dir / "system.data"
         write_data(system, ff, data)
         groups = {"flat": system.group("substrate"), "tip": system.group("adsorbate"),
-                  "flat_fixed": _intersect(system, "frozen", "substrate"),
-                  "holder_rigid": _intersect(system, "frozen", "adsorbate")}
+                  "flat_fixed": intersect_ids(system, "frozen", "substrate"),
+                  "holder_rigid": intersect_ids(system, "frozen", "adsorbate")}
         tip_mobile = np.setdiff1d(groups["tip"], groups["holder_rigid"])
         n = system.n_atoms
         dt = s["timestep_fs"]
         si = s["sample_interval"]
         seed = int(s["seed"])
         v_app = U.m_per_s_to_angstrom_per_fs(s["approach_speed_m_s"])
-        n_app = _round_up(s["approach_distance_A"] / (v_app * dt), si)
+        n_app = round_up(s["approach_distance_A"] / (v_app * dt), si)
         columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_holder": "v_zh", "tip_zmin": "v_tipmin",
                    "flat_zmax": "v_flatmax", "f_holder": "f_hold_holder[3]", "p_tip": "v_ptip"}
 
         def define(salt: int):
             def d(step: int) -> list[str]:
-                return _common_define(s, "mobile") + [
+                return common_define(s, "mobile") + [
                     "neigh_modify exclude group flat_fixed flat_fixed",
                     "neigh_modify exclude group holder_rigid holder_rigid",
                     "fix hold_flat flat_fixed setforce 0.0 0.0 0.0",
@@ -107,16 +107,16 @@ class PullOff(Workflow):
             return d
 
         def fresh(leg_dir: Path) -> list[str]:
-            return _fresh_from_data(ff, data, s, groups) + [
+            return fresh_from_data(ff, data, s, groups) + [
                 "group held union flat_fixed holder_rigid", "group mobile subtract all held",
                 "group flat_mobile subtract flat flat_fixed", "group tip_mobile subtract tip holder_rigid"]
 
         vz = lambda v: f"velocity holder_rigid set 0.0 0.0 {v:.10g} units box"
         approach = Leg(
-            name="approach", fresh=fresh, define=define(0), prepare=lambda d: _minimize(s, d / "minimized.data"),
-            restart_head=_restart_head(s),
-            stages=_stages(_equil(s, "mobile", 1, (vz(0.0),)), Stage("approach", n_app, (vz(-v_app),)),
-                           Stage("hold", _steps(s, "hold_steps"), (vz(0.0),))),
+            name="approach", fresh=fresh, define=define(0), prepare=lambda d: minimize_lines(s, d / "minimized.data"),
+            restart_head=restart_header_lines(s),
+            stages=stage_list(equilibrate_stage(s, "mobile", 1, (vz(0.0),)), Stage("approach", n_app, (vz(-v_app),)),
+                           Stage("hold", steps_of(s, "hold_steps"), (vz(0.0),))),
             columns=columns, sample_interval=si, chunk_steps=s["chunk_steps"], n_atoms=n,
             info={"v_approach_A_fs": v_app})
         legs = [approach]
@@ -125,24 +125,24 @@ class PullOff(Workflow):
         t = s["temperature_K"]
         for k, v in enumerate(s["retract_speeds_m_s"]):
             v_ret = U.m_per_s_to_angstrom_per_fs(v)
-            n_ret = _round_up(s["retract_distance_A"] / (v_ret * dt), si)
+            n_ret = round_up(s["retract_distance_A"] / (v_ret * dt), si)
             for j in range(repeats):
                 def fresh_retract(leg_dir: Path, _total=approach.total_steps) -> list[str]:
-                    return _restart_head(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
+                    return restart_header_lines(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
                 stages = [Stage("retract", n_ret, (vz(v_ret),))]
                 if repeats > 1:     # independent pulls: fresh velocities, then hold_steps more in contact
-                    stages = _stages(Stage("rehold", _steps(s, "hold_steps"), (
-                        f"velocity mobile create {t:g} {_seed(seed, 7, k, j)} mom yes rot no dist gaussian",
+                    stages = stage_list(Stage("rehold", steps_of(s, "hold_steps"), (
+                        f"velocity mobile create {t:g} {derived_seed(seed, 7, k, j)} mom yes rot no dist gaussian",
                         vz(0.0)), sampled=False)) + stages
                 legs.append(Leg(name=f"retract_{k}" + (f"_{j}" if j else ""), fresh=fresh_retract,
                                 define=define(100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
-                                restart_head=_restart_head(s), stages=stages, columns=columns, sample_interval=si,
+                                restart_head=restart_header_lines(s), stages=stages, columns=columns, sample_interval=si,
                                 chunk_steps=s["chunk_steps"], n_atoms=n,
                                 info={"speed_m_s": v, "v_A_fs": v_ret, "repeat": j}))
         info.update(n_flat=int(len(groups["flat"])), n_tip=int(len(groups["tip"])),
                     tip_mobile_mass_g_mol=float(system.masses[tip_mobile].sum()), tip_thermostat=s["tip_thermostat"])
         return Plan(legs=legs, timestep_fs=dt, n_atoms=n,
-                    seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": _seed(seed, 3, 1),
+                    seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed, **({"sam_asperity": seed + 30} if s["surface"] == "ots" else {})},
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
@@ -201,17 +201,17 @@ class PullOff(Workflow):
         gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(info["tip_mobile_mass_g_mol"] * v_slow /
                                                            s["thermostat_damping_fs"])
         err = lambda x: x / (2 * math.pi * R_m) if x else None
-        q = {"pull_off_force": _q(F, f_err, "N", speed_m_s=slow["speed_m_s"], repeats=len(slow["results"]),
+        q = {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"], repeats=len(slow["results"]),
                                   kind=f"maximum tensile force on retraction (mean of {len(slow['results'])}; "
                                        f"stderr: {slow['how']})"),
-             "separation_at_max_tension": _q(best["separation_at_max"], None, "m"),
+             "separation_at_max_tension": quantity_record(best["separation_at_max"], None, "m"),
              "interaction_range_z0": z0q,
-             "work_of_adhesion_eff_jkr": _q(F / (1.5 * math.pi * R_m), f_err / (1.5 * math.pi * R_m) if f_err else None,
+             "work_of_adhesion_eff_jkr": quantity_record(F / (1.5 * math.pi * R_m), f_err / (1.5 * math.pi * R_m) if f_err else None,
                                             "J/m^2", kind="F / (1.5 pi R)"),
-             "work_of_adhesion_eff_dmt": _q(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
+             "work_of_adhesion_eff_dmt": quantity_record(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
                                             kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit; at MD "
                                                  "scale the contact is DMT-like, Tabor mu ~ 0.06)"),
-             "residual_drag_force": _q(float(U.kcal_per_mol_A_to_N(drag.mean())),
+             "residual_drag_force": quantity_record(float(U.kcal_per_mol_A_to_N(drag.mean())),
                                        float(U.kcal_per_mol_A_to_N(math.sqrt(np.sum(drag_err ** 2)) / len(drag))),
                                        "N", kind="mean thermostat force on the moving asperity along the pulling "
                                                  "axis on retraction (holder reaction - interaction + momentum change)",
@@ -262,7 +262,7 @@ class PullOff(Workflow):
         if len(speeds) >= 2:
             ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in per_speed]),
                                        target_rate=float(min(speeds)) / 10.0, temperature_K=s["temperature_K"])
-            q["pull_off_force_extrapolated"] = _q(ext["F0"], ext["stderr"], "N",
+            q["pull_off_force_extrapolated"] = quantity_record(ext["F0"], ext["stderr"], "N",
                                                   kind=f"F = a + b ln(v) fitted to {len(speeds)} speeds, "
                                                        f"evaluated at {ext['target_rate']:g} m/s")
             details["rate_extrapolation"] = ext
@@ -281,7 +281,7 @@ class PullOff(Workflow):
             ax.set_ylabel("force on asperity (nN)")
             ax.set_title(f"pull-off {F * 1e9:.3f} nN, R = {s['asperity_radius_A']:g} Å")
             ax.legend(fontsize=7)
-        figures["pulloff_curve"] = _figure(draw)
+        figures["pulloff_curve"] = figure_writer(draw)
         return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
 
 
@@ -291,7 +291,7 @@ def _thermostat_fix(name: str, group: str, settings: Mapping[str, Any], step: in
     damp = settings["thermostat_damping_fs"]
     if settings["thermostat"] == "nose-hoover":
         return [f"fix {name} {group} nvt temp {t:g} {t:g} {damp:g}"]
-    return [f"fix {name} {group} langevin {t:g} {t:g} {damp:g} {_seed(settings['seed'], 17, salt, step)} zero yes",
+    return [f"fix {name} {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings['seed'], 17, salt, step)} zero yes",
             f"fix {name}_nve {group} nve"]
 
 
@@ -302,7 +302,7 @@ def _pulloff_thermostat(s: Mapping[str, Any], step: int, salt: int) -> list[str]
     flat in the lab frame ('lab')."""
     mode = s["tip_thermostat"]
     if mode == "lab":
-        return _thermostat("mobile", s, step, salt)
+        return thermostat_lines("mobile", s, step, salt)
     cmds = _thermostat_fix("thermo_flat", "flat_mobile", s, step, 2 * salt)
     if mode == "comoving":
         cmds += ["compute tip_com tip_mobile temp/com"] + \
@@ -361,11 +361,11 @@ def _z0_quantity(r: Mapping[str, Any]) -> dict[str, Any]:
     asperity's compliance; the calibration takes z0 from the flat-slab force curve of the adhesion workflow."""
     if r["z0"] is not None and np.isfinite(r["z0"]):
         e = r.get("z0_stderr")
-        return _q(r["z0"], e if e is not None and np.isfinite(e) else None, "m",
+        return quantity_record(r["z0"], e if e is not None and np.isfinite(e) else None, "m",
                   kind="z0 of the LJ 9-3 traction law fitted to the retraction curve (stderr from the fit's "
                        "covariance; includes the asperity's compliance)")
     zm = r["z0_zero_to_min"]
-    return _q(zm / (3 ** (1 / 6) - 1) if np.isfinite(zm) else float("nan"), None, "m",
+    return quantity_record(zm / (3 ** (1 / 6) - 1) if np.isfinite(zm) else float("nan"), None, "m",
               kind="z0 = (zero-to-minimum distance) / (3^(1/6) - 1) (the 9-3 law fit failed: "
                    f"{r['traction_fit'].get('error', '?')})")
 
@@ -378,7 +378,7 @@ def _z0_mean(rs: list[Mapping[str, Any]]) -> dict[str, Any]:
     e = np.array([r.get("z0_stderr") or 0.0 for r in rs if r["z0"] is not None and np.isfinite(r["z0"])])
     e = np.where(np.isfinite(e), e, 0.0)
     avg = A.registry_average(z, e) if z.size >= 2 else {"mean": float(z[0]), "stderr": float(e[0]) or None}
-    return _q(avg["mean"], avg["stderr"], "m", kind=f"mean z0 of the LJ 9-3 law fitted to {z.size} retraction "
+    return quantity_record(avg["mean"], avg["stderr"], "m", kind=f"mean z0 of the LJ 9-3 law fitted to {z.size} retraction "
                                                     f"curves (includes the asperity's compliance)")
 
 

@@ -18,9 +18,9 @@ from md.system.atoms import as_system
 from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 
-from md.workflows.common import (WATER_MASS, Workflow, _common_define, _equil, _ff, _figure, _fresh_from_data,
-                                 _minimize_water, _q, _restart_head, _seed, _shake, _stages, _steps, _thermostat,
-                                 _water_ff_names)
+from md.workflows.common import (WATER_MASS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data,
+                                 minimize_water_lines, quantity_record, restart_header_lines, derived_seed, shake_lines, stage_list, steps_of, thermostat_lines,
+                                 water_forcefield_names)
 
 class SurfaceTension(Workflow):
     """SPC/E film: gamma_lv from the pressure tensor, bulk density from the profile."""
@@ -28,10 +28,10 @@ class SurfaceTension(Workflow):
     yields = {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"}
 
     def forcefield_files(self, s):
-        return _water_ff_names(s["water_model"])
+        return water_forcefield_names(s["water_model"])
 
     def plan(self, s, run_dir):
-        ff = _ff(self.forcefield_files(s))
+        ff = forcefield_of(self.forcefield_files(s))
         seed = int(s["seed"])
         film = as_system(water_slab(s["lx_A"], s["ly_A"], s["film_thickness_A"], vacuum=s["vacuum_A"], seed=seed))
         data = run_dir / "system.data"
@@ -41,13 +41,13 @@ class SurfaceTension(Workflow):
         groups = {"water_O": film.group("water_O")}
 
         def define(step: int) -> list[str]:
-            return _common_define(s, "all") + _shake(ff) + _thermostat("all", s, step) + [
+            return common_define(s, "all") + shake_lines(ff) + thermostat_lines("all", s, step) + [
                 "variable pxx equal pxx", "variable pyy equal pyy", "variable pzz equal pzz",
                 "variable lz equal lz"]
 
-        leg = Leg(name="film", fresh=lambda d: _fresh_from_data(ff, data, s, groups), define=define,
-                  prepare=lambda d: _minimize_water(s), restart_head=_restart_head(s),
-                  stages=_stages(_equil(s, "all", 1), Stage("sample", _steps(s, "sample_steps"))),
+        leg = Leg(name="film", fresh=lambda d: fresh_from_data(ff, data, s, groups), define=define,
+                  prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
+                  stages=stage_list(equilibrate_stage(s, "all", 1), Stage("sample", steps_of(s, "sample_steps"))),
                   columns={"pe": "v_pe", "temp": "v_temp", "pxx": "v_pxx", "pyy": "v_pyy", "pzz": "v_pzz",
                            "lz": "v_lz"},
                   sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"], n_atoms=n,
@@ -56,7 +56,7 @@ class SurfaceTension(Workflow):
         info = {"film": dict(film.info), "box_A": film.cell.tolist(), "n_molecules": int(film.info["n_molecules"]),
                 "lj_epsilon_kcal": ow.epsilon, "lj_sigma_A": ow.sigma}
         return Plan(legs=[leg], timestep_fs=s["timestep_fs"], n_atoms=n,
-                    seeds={"structure": seed, "velocities": _seed(seed, 3, 1), "thermostat_base": seed},
+                    seeds={"structure": seed, "velocities": derived_seed(seed, 3, 1), "thermostat_base": seed},
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
@@ -72,11 +72,11 @@ class SurfaceTension(Workflow):
                                     width_A=dens["width_A"])
         st = A.surface_tension(d["pxx"], d["pyy"], d["pzz"], d["lz"], tail_correction_N_per_m=tail,
                                n_blocks=s["n_blocks"])
-        q = {"surface_tension": _q(st["value"], st["stderr"], "N/m",
+        q = {"surface_tension": quantity_record(st["value"], st["stderr"], "N/m",
                                    kind="Kirkwood-Buff from the pressure tensor, LJ tail correction included"),
-             "surface_tension_uncorrected": _q(st["value_uncorrected"], st["stderr"], "N/m",
+             "surface_tension_uncorrected": quantity_record(st["value_uncorrected"], st["stderr"], "N/m",
                                                kind="LJ truncated at the cutoff, no tail correction"),
-             "density": _q(dens["value"], dens["stderr"], "kg/m^3", kind="liquid density (tanh fit)")}
+             "density": quantity_record(dens["value"], dens["stderr"], "kg/m^3", kind="liquid density (tanh fit)")}
         prof = dens["profile"]
         curves = {"density_profile": (["z_m", "density_kg_m3"], np.column_stack([prof["z"], prof["density"]])),
                   "pressure_tensor": (["step", "pxx_Pa", "pyy_Pa", "pzz_Pa", "lz_m"],
@@ -95,7 +95,7 @@ class SurfaceTension(Workflow):
             ax.set_ylabel("density (kg/m³)")
             ax.set_title(f"ρ = {dens['value']:.0f} kg/m³, γ = {st['value'] * 1e3:.1f} ± "
                          f"{st['stderr'] * 1e3:.1f} mN/m")
-        return Analysis(quantities=q, curves=curves, figures={"density_profile": _figure(draw)}, notes=notes,
+        return Analysis(quantities=q, curves=curves, figures={"density_profile": figure_writer(draw)}, notes=notes,
                         details={"tail_correction_N_per_m": tail, "interface_width_A": dens["width_A"],
                                  "half_thickness_A": dens["half_thickness_A"],
                                  "rho_vapour_kg_m3": dens["rho_vapour"]})
