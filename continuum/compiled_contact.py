@@ -135,3 +135,6 @@ def warm_up() -> None:
                  max_step=math.inf, t_bound=10.0, release=0.0, bound_is_final=True, has_history=False,
                  samples_per_step=1)
     STATS.__dict__.update(vars(saved))
+    from .laws import bridge_kernel as bk                  # the wet law's compiled bridge sum, loaded the same way
+    bk.bridge_integral(bk.KIND_FORCE, -1.0, -2.0, math.inf, False, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0,
+                       np.ones(3), np.ones(3), bk._GL_X, bk._GL_W)

@@ -36,10 +36,13 @@ import numpy as np
 from scipy import special
 
 from .. import menisci as men
+from . import bridge_kernel as bk
 from .base import ContactLaw
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
+#: The bridge law's coefficients per kind, as the compiled kernel takes them.
+_COEFFS = {kind: tuple(np.array(c, dtype=float) for c in men.bridge_polynomials(kind)) for kind in ("force", "energy")}
 
 
 def _moments(a, b):
@@ -87,7 +90,18 @@ class MeniscusBridges:
     def _integral(self, kind: str, gap: float, s_lo: float, s_hi: float = math.inf, formed_at=None) -> float:
         """sum over bridged summits with s_lo <= u <= s_hi of F (kind 'force', N) or U ('energy', J),
         or their count ('count'). `formed_at` = (g_hi, g_lo): evaluate U not at the summits' present
-        gaps but at their formation gaps, linear in u from g_hi at u = s_hi to g_lo at u = s_lo."""
+        gaps but at their formation gaps, linear in u from g_hi at u = s_hi to g_lo at u = s_lo.
+
+        Compiled (`continuum.laws.bridge_kernel`, ~30x faster); `_integral_numpy` is the same sum in NumPy,
+        the reference the kernel is tested against."""
+        g_hi, g_lo = formed_at if formed_at is not None else (0.0, 0.0)
+        comp, stretch = _COEFFS["energy" if kind == "count" else kind]
+        return bk.bridge_integral(bk.KINDS[kind], float(gap), float(s_lo), float(s_hi), formed_at is not None,
+                                  float(g_hi), float(g_lo), self.z_top, self.radius, self.length, self.density,
+                                  self.sigma, self.f0, self.d_k, comp, stretch, _GL_X, _GL_W)
+
+    def _integral_numpy(self, kind: str, gap: float, s_lo: float, s_hi: float = math.inf, formed_at=None) -> float:
+        """`_integral` in NumPy: the reference for the compiled kernel."""
         q_top = min(-s_lo, self.d_k - gap)             # x^2/2R beyond which no summit is in range
         if not q_top > 0.0 or s_hi <= s_lo:
             return 0.0
