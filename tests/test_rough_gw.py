@@ -359,3 +359,20 @@ def test_invalid_inputs_are_refused():
         GWJKRSurface(st, DGAMMA, ESTAR, resolution="ultra")
     with pytest.raises(ValueError):
         SummitStatistics(-1e-9, DENSITY, BETA)
+
+
+@pytest.mark.parametrize("z_max", [None, ZMAX])
+def test_compiled_window_table_evaluation_is_the_numpy_one(z_max):
+    """The window tables' bicubic evaluation runs compiled (gw_layout._hermite2d_eval); it does the NumPy form's
+    operations in the same order, so the two agree to round-off (bit for bit here; 1e-14 of the table's largest
+    value allowed, a compiler may fuse a multiply-add on another CPU), clamping included (points beyond the grid
+    in a take the edge values)."""
+    surf = surface(0.3, z_max)
+    rng = np.random.default_rng(3)
+    for table in surf._t2:
+        a = rng.uniform(table.a0 - 2.0 / table.inv_da, table.a0 + (table.na + 2) / table.inv_da, 20000)
+        b = rng.uniform(table.b0, table.b0 + 0.999999 * table.nb / table.inv_db, 20000)
+        got, want = table(a, b, deriv=True), table.evaluate_numpy(a, b, deriv=True)
+        for g, w in zip(got, want):
+            assert np.max(np.abs(g - w)) <= 1e-14 * np.max(np.abs(w))
+        assert np.array_equal(table(a, b, deriv=False)[0], got[0])

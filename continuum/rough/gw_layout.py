@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from ..reference import jkr as _jkr
 from .summits import TENSILE_ONSET
@@ -154,7 +155,18 @@ class _Hermite2D:
         self.na, self.nb = na - 1, nb - 1
 
     def __call__(self, a, b, deriv=True):
-        """(F, dF/da, dF/db) at points (a, b); b must lie in the grid, a outside it takes edge values."""
+        """(F, dF/da, dF/db) at points (a, b); b must lie in the grid, a outside it takes edge values.
+
+        Compiled (`_hermite2d_eval`): the same operations in the same order as `evaluate_numpy`, one point at a
+        time without the NumPy temporaries (a footprint-table build spends ~40 % of its time here)."""
+        a = np.ascontiguousarray(a, dtype=float).reshape(-1)
+        b = np.ascontiguousarray(b, dtype=float).reshape(-1)
+        F, Fa, Fb = _hermite2d_eval(self.coef, self.a0, self.inv_da, self.na, self.b0, self.inv_db, self.nb, a, b,
+                                    deriv)
+        return (F, Fa, Fb) if deriv else (F, None, None)
+
+    def evaluate_numpy(self, a, b, deriv=True):
+        """`__call__` in NumPy: the reference the compiled evaluation is tested against."""
         ta = (a - self.a0) * self.inv_da
         np.minimum(ta, self.na * (1.0 - 1e-15), out=ta)
         np.maximum(ta, 0.0, out=ta)
@@ -177,3 +189,42 @@ class _Hermite2D:
         S0, S1, S2, S3 = (3.0 * c3 * tb + 2.0 * c2) * tb + c1
         Fb = (((S3 * ta + S2) * ta + S1) * ta + S0) * self.inv_db
         return F, Fa, Fb
+
+
+@njit(cache=True)
+def _hermite2d_eval(coef, a0, inv_da, na, b0, inv_db, nb, a, b, deriv):
+    """`_Hermite2D.__call__` point by point: clamp a to the grid, locate the cell, Horner in b then in a."""
+    n = a.size
+    F = np.empty(n)
+    Fa = np.empty(n if deriv else 0)
+    Fb = np.empty(n if deriv else 0)
+    top = na * (1.0 - 1e-15)
+    for k in range(n):
+        ta = (a[k] - a0) * inv_da
+        if not (ta == ta and b[k] == b[k]):
+            F[k] = np.nan
+            if deriv:
+                Fa[k] = np.nan
+                Fb[k] = np.nan
+            continue
+        ta = min(ta, top)
+        ta = max(ta, 0.0)
+        tb = (b[k] - b0) * inv_db
+        ia = int(ta)
+        ib = min(int(tb), nb - 1)
+        ta -= ia
+        tb -= ib
+        c = coef[ia * nb + ib]                     # c[4 l + m]: coefficient of b^l a^m
+        T0 = ((c[12] * tb + c[8]) * tb + c[4]) * tb + c[0]
+        T1 = ((c[13] * tb + c[9]) * tb + c[5]) * tb + c[1]
+        T2 = ((c[14] * tb + c[10]) * tb + c[6]) * tb + c[2]
+        T3 = ((c[15] * tb + c[11]) * tb + c[7]) * tb + c[3]
+        F[k] = ((T3 * ta + T2) * ta + T1) * ta + T0
+        if deriv:
+            Fa[k] = ((3.0 * T3 * ta + 2.0 * T2) * ta + T1) * inv_da
+            S0 = (3.0 * c[12] * tb + 2.0 * c[8]) * tb + c[4]
+            S1 = (3.0 * c[13] * tb + 2.0 * c[9]) * tb + c[5]
+            S2 = (3.0 * c[14] * tb + 2.0 * c[10]) * tb + c[6]
+            S3 = (3.0 * c[15] * tb + 2.0 * c[11]) * tb + c[7]
+            Fb[k] = (((S3 * ta + S2) * ta + S1) * ta + S0) * inv_db
+    return F, Fa, Fb
