@@ -135,6 +135,8 @@ def warm_up() -> None:
                  max_step=math.inf, t_bound=10.0, release=0.0, bound_is_final=True, has_history=False,
                  samples_per_step=1)
     STATS.__dict__.update(vars(saved))
+    from .rough.gw_layout import _hermite2d_eval            # and the GW window tables' evaluation
+    _hermite2d_eval(np.zeros((1, 16)), 0.0, 1.0, 1, 0.0, 1.0, 1, np.zeros(1), np.zeros(1), True)
     from .laws import bridge_kernel as bk                  # the wet law's compiled bridge sum, loaded the same way
     bk.bridge_integral(bk.KIND_FORCE, -1.0, -2.0, math.inf, False, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0,
                        np.ones(3), np.ones(3), bk._GL_X, bk._GL_W)
