@@ -48,13 +48,11 @@ import math
 
 import numpy as np
 
-from ..halfspace import LineHalfSpace
 from ..physics import jkr_kernel as jk
 from ..reference import jkr as ref
 from ..rough.datum import tallest_summit
 from ..rough.gw import SummitStatistics
-from .base import ContactLaw
-from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
+from .roller_base import RoughRollerBase
 
 #: Up to this many attached summits the per-summit laws run in scalar arithmetic
 _SCALAR_MAX = 24
@@ -62,7 +60,7 @@ _SCALAR_MAX = 24
 _CHUNK = 1 << 20
 
 
-class DiscreteRoughRoller(ContactLaw):
+class DiscreteRoughRoller(RoughRollerBase):
     """Roller (radius R, length l, m) on a seeded realisation of GW summits with JKR hysteresis.
 
     Parameters
@@ -93,9 +91,9 @@ class DiscreteRoughRoller(ContactLaw):
     """
 
     name = "rough_roller_discrete_jkr"
-    touch_gap = 0.0
-    bound_is_final = True
-    has_history = True
+    depth_search_name = "discrete rough contact"
+    #: a too-deep approach raises the depth search's ValueError (no SceneError naming sigma)
+    refuse_as_scene_error = False
 
     def __init__(self, stats: SummitStatistics, work_of_adhesion: float, summit_e_star: float, radius: float,
                  length: float, e_star: float, *, seed: int, detachment: str = "displacement",
@@ -129,6 +127,7 @@ class DiscreteRoughRoller(ContactLaw):
         else:
             self.delta_c = self.pull_off_force = self.release_stretch = self.loop_energy = 0.0
             self.force_scale = 4.0 / 3.0 * e * math.sqrt(b) * self.sigma**1.5
+        self.end_gap = self.release_stretch                # every summit has let go there
         self._hertz_k = 4.0 / 3.0 * e * math.sqrt(b)
         if self.adhesive:
             self._a0 = float(ref.contact_radius_at_touch(b, g, e))
@@ -273,10 +272,8 @@ class DiscreteRoughRoller(ContactLaw):
         half = max(float(np.max(np.abs(self.sx[:max(reach, 1)]))),
                    math.sqrt(2.0 * self.radius * (depth + 2.0 * self.release_stretch)))
         half = min(1.05 * half, self.footprint_half_width)
-        self.dx = 2.0 * half / self.n
-        self.x = (np.arange(self.n) - (self.n - 1) / 2.0) * self.dx
+        self._line_grid(half)
         self._bin(half)
-        self.hs = LineHalfSpace(self.dx, self.n, self.e_star, x_ref=self.length) if self.use_half_space else None
         self.reset()
 
     def _bin(self, half: float) -> None:
@@ -297,16 +294,19 @@ class DiscreteRoughRoller(ContactLaw):
         """Number of kept summits with effective height >= level."""
         return int(np.searchsorted(self._neg_eff, -level, side="right"))
 
-    def prepare(self, mass: float, speed: float, gravity: float) -> None:
-        """Size the grid (and, if needed, the kept set) for an impact of `mass` (kg) at `speed` (m/s)."""
-        depth = self.depth_safety * self.quasi_static_depth(0.5 * mass * speed**2, mass * gravity)
+    def size_for(self, depth: float, speed: float) -> None:
+        """Size the grid (and, if needed, the kept set) for a design depth (m), at least twice the release
+        stretch."""
         depth = max(depth, 2.0 * self.release_stretch)
         if depth + 2.0 * self.release_stretch > self.depth_keep:
             self._realise(2.0 * (depth + 2.0 * self.release_stretch))
         self.design_depth = depth
         self._set_grid(depth)
-        self.grid_history.append({"half_width": float(self.x[-1] + self.dx / 2), "dx": self.dx,
-                                  "design_depth": depth, "speed": speed})
+        self._record_grid(depth, speed)
+
+    @property
+    def sized_depth(self) -> float:
+        return self.design_depth
 
     def approach_force(self, gap: float) -> float:
         """Force (N) of a monotonic first approach to `gap` on a rigid substrate (grid sizing)."""
@@ -315,12 +315,9 @@ class DiscreteRoughRoller(ContactLaw):
             return 0.0
         return float(np.sum(self._laws(self.eff[:k] - self.z_top - gap)["force"]))
 
-    def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
-        """Approach (m, below the datum) at which the rigid approach branch has absorbed `energy` (J)."""
-        first = min(self.sigma, max(self.release_stretch, 1e-3 * self.sigma)) / 32.0
-        return absorbing_depth(lambda ds: np.array([self.approach_force(-d) for d in ds]), energy,
-                               first_step=first, weight=weight,
-                               max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma, what="discrete rough contact")
+    def approach_forces(self, depths: np.ndarray) -> np.ndarray:
+        """First-approach forces (N) at `depths` (m below the datum), one summit sum each."""
+        return np.array([self.approach_force(-d) for d in depths])
 
     def _summits_at(self, gap: float, de_lo: float, de_of=None):
         """Trial state over the prefix of summits that are attached or within reach.
@@ -345,18 +342,14 @@ class DiscreteRoughRoller(ContactLaw):
         force[att] = q["force"]
         return k, delta, att, q, force, de
 
-    def _state(self, gap: float) -> dict:
-        """Trial state at `gap` with the stored history (cached on the gap)."""
-        if self._cache_gap == gap:
-            return self._cache
+    def _evaluate(self, gap: float) -> dict:
+        """Trial state at `gap` with the stored history (`_state` caches it on the gap)."""
         self.evaluations += 1
         if self.hs is None:
             k, delta, att, q, force, de = self._summits_at(gap, 0.0)
         else:
             k, delta, att, q, force, de = self._coupled(gap)
-        state = {"k": k, "delta": delta, "att": att, "q": q, "force": force, "de": de}
-        self._cache_gap, self._cache = gap, state
-        return state
+        return {"k": k, "delta": delta, "att": att, "q": q, "force": force, "de": de}
 
     def _deflection_at(self, k: int, force_prev: np.ndarray) -> np.ndarray:
         """Half-space deflection (m) at the cells of the first k summits under summit loads `force_prev`
@@ -450,9 +443,6 @@ class DiscreteRoughRoller(ContactLaw):
             self.max_deflection = max(self.max_deflection, float(np.max(np.abs(de))))
             self.max_pressure = max(self.max_pressure, float(np.max(p)))
 
-    def release_gap(self):
-        return self.release_stretch
-
     def on_release(self):
         """Every summit still attached lets go at the release gap: book their loops with the others'."""
         self.detached += int(np.count_nonzero(self.attached))
@@ -460,9 +450,6 @@ class DiscreteRoughRoller(ContactLaw):
         self.k_att = 0
         self._cache_gap = None
         return self.detached * self.loop_energy
-
-    def length_scale(self, mass, speed):
-        return max(self.design_depth / self.depth_safety, self.release_stretch)
 
     def snapshot(self, gap: float) -> dict:
         """Binned pressure, deflection and gap across the grid at `gap`, plus the summits in reach; SI."""
@@ -491,7 +478,7 @@ class DiscreteRoughRoller(ContactLaw):
                 "max_depth": self.max_depth, "strip_depth": self.strip_depth, "beyond_strip": self.beyond_strip,
                 "edge_touched": self.edge_touched, "max_deflection": self.max_deflection,
                 "max_nominal_pressure": self.max_pressure, "force_evaluations": self.evaluations,
-                "grids": self.grid_history[-3:], "contacts_seen": len(self.grid_history)}
+                **self._grid_record()}
 
     def describe(self):
         return {"name": self.name, "mode": "discrete",

@@ -37,38 +37,27 @@ import numpy as np
 from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 from ..rough.surface import SummitSurface
-from .base import ContactLaw
-from .costs import (_BLOCK_STATES, MAX_BUILD_SECONDS, RESOLUTION, SECONDS_PER_STATE, beyond_range, table_cost_refusal,
-                    table_shape)
-from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
+from .costs import _BLOCK_STATES, MAX_BUILD_SECONDS, RESOLUTION, SECONDS_PER_STATE, table_cost_refusal, table_shape
+from .roller_base import RoughRollerBase
 
 # the costs and bounds live in `continuum.laws.costs`; their old names here still work
 __all__ = ["RigidRoughRoller", "RESOLUTION", "MAX_BUILD_SECONDS", "SECONDS_PER_STATE", "table_cost_refusal"]
 
 
-class RigidRoughRoller(ContactLaw):
+class RigidRoughRoller(RoughRollerBase):
     """Roller of radius R and length l (m) on averaged GW/JKR summits over a rigid substrate."""
 
     name = "rough_roller_gw_jkr_rigid"
-    touch_gap = 0.0
-    bound_is_final = True
-    has_history = True
 
     def __init__(self, surface: SummitSurface, radius: float, length: float, *, resolution: str = "standard",
                  depth_safety: float = 1.5):
-        self.surface = surface
+        self._take_surface(surface)
         self.radius, self.length = radius, length
         self.res = RESOLUTION[resolution]
         self.resolution = resolution
         self.depth_safety = depth_safety
-        self.release_stretch = float(surface.release_stretch)
         self.attach_stretch = float(surface.attach_stretch)   # r_in = -delta_in (m)
-        self.reach = float(surface.reach)                     # attraction range (m)
-        self.touch_gap = self.reach
-        self.end_gap = max(self.release_stretch, self.reach)
         self._r_in = min(self.attach_stretch, self.release_stretch)
-        self.sigma = surface.stats.sigma
-        self.z_top = float(surface.z_max)
         self.table_depth = 0.0
         self.build_seconds = 0.0
         self.max_contacts = 0.0
@@ -77,8 +66,6 @@ class RigidRoughRoller(ContactLaw):
         self.depth_history: list[dict] = []
         #: accepted states deeper than the tables (evaluated by the integral itself)
         self.beyond_tables = 0
-        #: "tabulated" (GW tables of JKR or Hertz summits) or "generic" (quadrature of any summit law)
-        self.surface_kind = surface.kind
         self.table_points = 0
         self._kept_tables: dict = {}
         self._approach_memo: dict = {}
@@ -165,22 +152,22 @@ class RigidRoughRoller(ContactLaw):
             kept.pop(next(iter(kept)))
         kept[depth] = (self._force, self._energy, self._count, self._h_lo, self._h_hi, depth, self.table_points)
 
-    def prepare(self, mass: float, speed: float, gravity: float) -> None:
+    def size_for(self, depth: float, speed: float) -> None:
         """Extend the tables if this impact can reach deeper than they do."""
-        depth = self.depth_safety * self.quasi_static_depth(0.5 * mass * speed**2, mass * gravity)
         self.depth_history.append({"design_depth": depth, "speed": speed})
         if depth > self.table_depth or depth < 0.05 * self.table_depth:
             # deeper than the tables, or so much shallower that their spacing is too coarse
             self._build(depth)
 
-    def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
-        """Depth below the datum (m) at which the approach branch has absorbed `energy` (J); beyond the
-        averaged model's range the scene is refused (`SceneError`)."""
-        first = min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
-        return beyond_range(lambda: absorbing_depth(self._approach_forces, energy, first_step=first, weight=weight,
-                                                    max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma), self.sigma)
+    @property
+    def sized_depth(self) -> float:
+        return self.table_depth
 
-    def _approach_forces(self, depths: np.ndarray) -> np.ndarray:
+    def first_depth_step(self) -> float:
+        """1/32 of sigma or of the release stretch (sigma where there is none)."""
+        return min(self.sigma, self.release_stretch if self.release_stretch > 0 else self.sigma) / 32.0
+
+    def approach_forces(self, depths: np.ndarray) -> np.ndarray:
         """First-approach forces (N) at `depths` (m below the datum), remembered: the depth search walks the same
         batches of depths for every impact (its steps depend on the law only), so each contact after the first
         re-reads them instead of re-integrating (~20 ms per contact)."""
@@ -263,9 +250,6 @@ class RigidRoughRoller(ContactLaw):
             self.count_min = self._first_approach_count(gap) if gap < self.attach_stretch else 0.0
         self.max_contacts = max(self.max_contacts, self._attached(gap))
 
-    def release_gap(self):
-        return self.end_gap
-
     # ------------------------------------------------------------------ compiled form
     def compiled(self, t0: float):
         """The tables as the compiled kernel reads them (`continuum.contact_kernel.LAW_RIGID_TABLE`)."""
@@ -292,12 +276,6 @@ class RigidRoughRoller(ContactLaw):
         self.h_min, self.count_min, self.max_contacts = float(state[0]), float(state[1]), float(state[2])
         self.beyond_tables = int(state[3])
 
-    def on_release(self):
-        return self.dissipated(self.end_gap)
-
-    def length_scale(self, mass, speed):
-        return max(self.table_depth / self.depth_safety, self.release_stretch)
-
     def snapshot(self, gap: float) -> dict:
         """Pressure across the footprint at `gap` (rigid substrate: no deflection)."""
         r = self._window(gap)
@@ -318,10 +296,7 @@ class RigidRoughRoller(ContactLaw):
                 "contacts_seen": len(self.depth_history), "accepted_states_beyond_tables": self.beyond_tables}
 
     def describe(self):
-        s = self.surface
-        return {"name": self.name, "source": f"GW (1966) summits ({s.law_name}); paper eqs 9-15; "
+        return {"name": self.name, "source": f"GW (1966) summits ({self.surface.law_name}); paper eqs 9-15; "
                 "rigid substrate, exact footprint integral tabulated in (gap, window)",
                 "radius": self.radius, "length": self.length, "half_space": False, "resolution": self.resolution,
-                "sigma": s.stats.sigma, "summit_density": s.stats.density, "summit_radius": s.stats.radius,
-                "z_max": self.z_top, "delta_c": s.delta_c, "release_stretch": self.release_stretch,
-                "pull_off_force_per_summit": s.pull_off_force, "loop_energy_per_summit": s.loop_energy}
+                **self._averaged_summits_record()}

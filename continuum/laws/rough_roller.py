@@ -31,17 +31,16 @@ import math
 
 import numpy as np
 
-from ..halfspace import LineHalfSpace, solve_coupled
+from ..halfspace import solve_coupled
 from ..rough.surface import SummitSurface
-from .base import ContactLaw
 from .costs import MAX_RUN_SECONDS, SECONDS_PER_STATE, beyond_range
-from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth
+from .roller_base import RoughRollerBase
 
 # the costs and bounds live in `continuum.laws.costs`; their old names here still work
 __all__ = ["RoughRoller", "MAX_RUN_SECONDS", "SECONDS_PER_STATE", "beyond_range"]
 
 
-class RoughRoller(ContactLaw):
+class RoughRoller(RoughRollerBase):
     """Roller (radius R, length l, m) on a GW/JKR rough surface, optionally on an elastic half-space.
 
     Parameters
@@ -61,24 +60,16 @@ class RoughRoller(ContactLaw):
     """
 
     name = "rough_roller_gw_jkr"
-    touch_gap = 0.0
-    bound_is_final = True
-    has_history = True
 
     def __init__(self, surface: SummitSurface, radius: float, length: float, e_star: float, *,
                  half_space: bool = True, grid_points: int = 256, depth_safety: float = 1.5,
                  coupling_tol: float = 1e-11):
-        self.surface = surface
+        self._take_surface(surface)
         self.radius, self.length, self.e_star = radius, length, e_star
         self.use_half_space = half_space
         self.n = grid_points
         self.depth_safety = depth_safety
         self.coupling_tol = coupling_tol
-        self.z_top = float(surface.z_max)        # tallest summit above the mean plane (m)
-        self.release_stretch = float(surface.release_stretch)
-        self.reach = float(surface.reach)        # non-contact attraction range (m)
-        self.touch_gap = self.reach
-        self.end_gap = max(self.release_stretch, self.reach)
         self.edge_touched = False
         self.max_deflection = 0.0                # largest |delta_e| seen (m)
         self.max_contacts = 0.0                  # most summits attached at once
@@ -89,8 +80,6 @@ class RoughRoller(ContactLaw):
         self.solve_record = {"solves": 0, "by_method": {}, "fixed_point_iterations": 0,
                              "fallback_iterations": 0, "max_residual": 0.0, "tolerance": coupling_tol,
                              "scale": "max(max|p|, n P_c)"}
-        #: "tabulated" (GW tables of JKR or Hertz summits) or "generic" (quadrature of any summit law)
-        self.surface_kind = surface.kind
         #: surface states evaluated so far (a stiffness or a compressive/tensile split counts twice)
         self.work_states = 0
         self._set_grid(max(4.0 * surface.stats.sigma, 4.0 * self.release_stretch))
@@ -118,11 +107,8 @@ class RoughRoller(ContactLaw):
     # ------------------------------------------------------------------ grid and state
     def _set_grid(self, depth: float) -> None:
         """Grid spanning |x| <= sqrt(2R (depth + 2 * release stretch))."""
-        half = math.sqrt(2.0 * self.radius * (depth + 2.0 * self.end_gap))
-        self.dx = 2.0 * half / self.n
-        self.x = (np.arange(self.n) - (self.n - 1) / 2.0) * self.dx
+        self._line_grid(math.sqrt(2.0 * self.radius * (depth + 2.0 * self.end_gap)))
         self.parabola = self.x**2 / (2.0 * self.radius)
-        self.hs = LineHalfSpace(self.dx, self.n, self.e_star, x_ref=self.length) if self.use_half_space else None
         self.depth = depth
         self.reset()
 
@@ -132,21 +118,14 @@ class RoughRoller(ContactLaw):
         self.p_last = np.zeros(self.n)
         self._cache_gap = None
 
-    def prepare(self, mass: float, speed: float, gravity: float) -> None:
-        """Size the grid for an impact of `mass` (kg) at `speed` (m/s) before the contact starts."""
-        depth = self.depth_safety * self.quasi_static_depth(0.5 * mass * speed**2, mass * gravity)
+    def size_for(self, depth: float, speed: float) -> None:
+        """A grid for a design depth `depth` (m), at least twice the release stretch."""
         self._set_grid(max(depth, 2.0 * self.release_stretch))
-        self.grid_history.append({"half_width": float(self.x[-1] + self.dx / 2), "dx": self.dx,
-                                  "design_depth": depth, "speed": speed})
+        self._record_grid(depth, speed)
 
-    def quasi_static_depth(self, energy: float, weight: float = 0.0) -> float:
-        """Approach (m, below the datum) at which the rigid approach branch has absorbed `energy` (J).
-
-        Beyond the averaged model's range the scene is refused (`SceneError`, `beyond_range`)."""
-        sigma = self.surface.stats.sigma
-        first = min(sigma, max(self.release_stretch, 1e-3 * sigma)) / 32.0
-        return beyond_range(lambda: absorbing_depth(self.approach_forces, energy, first_step=first, weight=weight,
-                                                    max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * sigma), sigma)
+    @property
+    def sized_depth(self) -> float:
+        return self.depth
 
     def approach_forces(self, depths) -> np.ndarray:
         """Forces (N) of a monotonic first approach to each depth (m below the datum) on a rigid substrate.
@@ -167,20 +146,15 @@ class RoughRoller(ContactLaw):
         """Force (N) of a monotonic first approach to `gap` on a rigid substrate (for grid sizing)."""
         return float(self.approach_forces(np.array([-gap]))[0])
 
-    def _state(self, gap: float):
-        """(d, zeta_eff, p, delta_e) at a trial gap with the stored history (cached)."""
-        if self._cache_gap == gap:
-            return self._cache
+    def _evaluate(self, gap: float):
+        """(d, zeta_eff, p, delta_e) at a trial gap with the stored history (`_state` caches it)."""
         d_rigid = self.z_top + gap + self.parabola
         if self.hs is None:
             zeta = self.surface.effective_threshold(d_rigid, self.zeta)
             p = self.surface.pressure(d_rigid, self.zeta)
             self._count_work(self.n)
-            state = (d_rigid, zeta, p, np.zeros(self.n))
-        else:
-            state = self._coupled(d_rigid)
-        self._cache_gap, self._cache = gap, state
-        return state
+            return d_rigid, zeta, p, np.zeros(self.n)
+        return self._coupled(d_rigid)
 
     def _coupled(self, d_rigid):
         """Self-consistent p and delta_e: warm-started fixed point, then `solve_coupled` if that stalls.
@@ -279,15 +253,6 @@ class RoughRoller(ContactLaw):
         self.max_contacts = max(self.max_contacts,
                                 float(self.length * self.dx * np.sum(self.surface.contacts(d, zeta_eff))))
 
-    def release_gap(self):
-        return self.end_gap
-
-    def on_release(self):
-        return self.dissipated(self.end_gap)
-
-    def length_scale(self, mass, speed):
-        return max(self.depth / self.depth_safety, self.release_stretch)
-
     def snapshot(self, gap: float) -> dict:
         """Pressure, deflection and gap across the grid at `gap` (for Fig 6); SI arrays."""
         d, zeta_eff, p, delta = self._state(gap)
@@ -299,17 +264,13 @@ class RoughRoller(ContactLaw):
     def diagnostics(self):
         return {"max_contacts": self.max_contacts, "edge_touched": self.edge_touched,
                 "max_deflection": self.max_deflection, "max_nominal_pressure": self.max_pressure,
-                "grids": self.grid_history[-3:], "contacts_seen": len(self.grid_history),
+                **self._grid_record(),
                 "surface_work": {"states": self.work_states, "estimated_seconds": self.work_seconds(),
                                  "budget_seconds": MAX_RUN_SECONDS, "surface": self.surface_kind},
                 **({"coupled_solve": {**self.solve_record, "by_method": dict(self.solve_record["by_method"])}}
                    if self.hs is not None else {})}
 
     def describe(self):
-        s = self.surface
         return {"name": self.name, "source": "GW (1966) summits with JKR + Fuller-Tabor hysteresis; paper eqs 9-17",
                 "radius": self.radius, "length": self.length, "e_star": self.e_star,
-                "half_space": self.use_half_space, "grid_points": self.n,
-                "sigma": s.stats.sigma, "summit_density": s.stats.density, "summit_radius": s.stats.radius,
-                "z_max": self.z_top, "delta_c": s.delta_c, "release_stretch": self.release_stretch,
-                "pull_off_force_per_summit": s.pull_off_force, "loop_energy_per_summit": s.loop_energy}
+                "half_space": self.use_half_space, "grid_points": self.n, **self._averaged_summits_record()}
