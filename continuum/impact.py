@@ -71,31 +71,23 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
 
 
 def regime_numbers(scene, models: dict, run) -> dict:
-    """The numbers that place a scene (recorded whatever was decided): Tabor parameter of the summits
-    (or sphere), Fuller-Tabor theta, half-space deflection span / sigma, expected contacts, and the
-    longest contact of the run against the condensation time t_a (SI)."""
-    from . import menisci as men
-    from . import regimes
-    from .models import summit_e_star
+    """The numbers that place a scene (recorded whatever was decided), read from its one `Regime`
+    (`continuum.model.regime`): Tabor parameter of the summits (or sphere), Fuller-Tabor theta, half-space
+    deflection span / sigma, expected contacts, and the longest contact of the run against the condensation
+    time t_a (SI)."""
+    from .model.regime import condensation_time, regime_of
 
-    surf = scene.surfaces
-    w = surf.interface_work_of_adhesion
-    rough = scene.contact == "rough"
-    beta = surf.roughness.summit_radius if rough else scene.body.radius
-    e_s = summit_e_star(scene) if rough else surf.e_star
+    regime = regime_of(scene)
+    rough = regime.rough
     est = models.get("estimate", {})
     longest = max((b.duration for b in run.bounces if b.duration is not None), default=0.0)
-    m = scene.menisci
-    rh = scene.environment.relative_humidity
-    if m.condensation_model == "nucleation":
-        t_a = men.nucleation_condensation_time(rh, scene.environment.temperature) if 0 < rh < 1 else float("inf")
-    else:
-        t_a = m.condensation_time
+    t_a = condensation_time(scene)[0]
     return {
-        "tabor_parameter": regimes.tabor_parameter(beta, w, e_s, surf.interface_interaction_range) if w > 0 else 0.0,
-        "interaction_range_z0": surf.interface_interaction_range,
-        "fuller_tabor_theta": regimes.fuller_tabor_theta(surf.roughness.sigma, beta, w, e_s) if rough else None,
-        "deflection_over_sigma": (est["deflection_span"] / surf.roughness.sigma) if rough and est else None,
+        "tabor_parameter": regime.tabor_parameter if regime.tabor_parameter is not None else 0.0,
+        "interaction_range_z0": regime.interaction_range,
+        # no adhesion: None (JSON null, as the infinite theta it stood for)
+        "fuller_tabor_theta": regime.fuller_tabor_theta,
+        "deflection_over_sigma": (est["deflection_span"] / scene.surfaces.roughness.sigma) if rough and est else None,
         "expected_contacts": est.get("contacts") if rough else None,
         "longest_contact_s": longest, "condensation_time_s": t_a,
         "longest_contact_over_t_a": longest / t_a,

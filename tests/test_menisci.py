@@ -200,3 +200,29 @@ def test_wet_scene_without_contact_angles_is_refused_naming_the_key():
     with pytest.raises(SceneError, match="surfaces.body.contact_angle = None: is required when environment"):
         resolve_scene(table=table, overrides={"environment.relative_humidity": 0.4})
     resolve_scene(table=table, overrides={"environment.relative_humidity": 0.4, "physics.menisci": "off"})
+
+
+@pytest.mark.parametrize("rh", [0.0, 0.4, 1.0])
+def test_condensation_time_is_computed_once_for_every_record(rh):
+    """t_a comes from one function (continuum.model.regime.condensation_time) for the menisci's parameters and the
+    regime record; with nucleation it is infinite without vapour and the attempt time at saturation (the barrier
+    goes as ln(1/RH)); the regime record once guarded RH = 1 to infinity while the menisci did not."""
+    from types import SimpleNamespace
+
+    from continuum.impact import regime_numbers
+    from continuum.model.regime import condensation_time
+
+    scene = _scene(**{"menisci.condensation_model": "nucleation", "environment.relative_humidity": rh,
+                      "impact_velocity": 1e-3,          # saturation is refused with menisci on (Kelvin radius)
+                      **({"physics.menisci": "off"} if rh == 1.0 else {})}).scene
+    t_a, source = condensation_time(scene)
+    assert source.startswith("nucleation")
+    if rh == 0.0:
+        assert t_a == math.inf
+    else:
+        assert t_a == men.nucleation_condensation_time(rh, scene.environment.temperature) and math.isfinite(t_a)
+    run = SimpleNamespace(bounces=[])
+    assert regime_numbers(scene, {}, run)["condensation_time_s"] == t_a
+    if rh > 0.0 and rh < 1.0:
+        from continuum.model.regime import meniscus_parameters
+        assert meniscus_parameters(scene)["condensation_time"] == t_a

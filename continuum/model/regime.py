@@ -101,6 +101,19 @@ def regime_of(scene: Scene, speed: float | None = None, estimate: RoughImpactEst
         estimate=estimate)
 
 
+def condensation_time(scene: Scene) -> tuple[float, str]:
+    """(t_a s, its source): the time a bridge needs to condense, the one computation every record reads.
+
+    Nucleation (Szoszkiewicz & Riedo 2005): infinite without vapour (RH = 0: ln(1/RH) diverges); at saturation
+    the barrier, proportional to ln(1/RH), vanishes and t_a is the attempt time. Else menisci.condensation_time."""
+    m, env = scene.menisci, scene.environment
+    if m.condensation_model != "nucleation":
+        return m.condensation_time, "menisci.condensation_time"
+    rh = env.relative_humidity
+    t_a = men.nucleation_condensation_time(rh, env.temperature) if rh > 0.0 else math.inf
+    return t_a, "nucleation (Szoszkiewicz & Riedo 2005)"
+
+
 def meniscus_parameters(scene: Scene) -> dict:
     """Kelvin radius and gap, bridge pull, t_a and growth length for the scene (SI), with their sources."""
     surf, env, m = scene.surfaces, scene.environment, scene.menisci
@@ -109,10 +122,7 @@ def meniscus_parameters(scene: Scene) -> dict:
     r_k = men.kelvin_radius(rh, temp, m.surface_tension, m.molar_volume)
     d_k = men.kelvin_gap(r_k, t1, t2)
     beta = surf.roughness.summit_radius
-    if m.condensation_model == "nucleation":
-        t_a, t_src = men.nucleation_condensation_time(rh, temp), "nucleation (Szoszkiewicz & Riedo 2005)"
-    else:
-        t_a, t_src = m.condensation_time, "menisci.condensation_time"
+    t_a, t_src = condensation_time(scene)
     h1 = m.growth_length if m.growth_length is not None else men.default_growth_length(rh)
     return {"kelvin_radius": r_k, "kelvin_gap": d_k, "kelvin_gap_over_summit_radius": d_k / beta,
             "bridge_pull_off": men.bridge_pull_off(beta, m.surface_tension, t1, t2),
