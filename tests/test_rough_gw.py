@@ -364,9 +364,10 @@ def test_invalid_inputs_are_refused():
 @pytest.mark.parametrize("z_max", [None, ZMAX])
 def test_compiled_window_table_evaluation_is_the_numpy_one(z_max):
     """The window tables' bicubic evaluation runs compiled (gw_layout._hermite2d_eval); it does the NumPy form's
-    operations in the same order, so the two agree to round-off (bit for bit here; 1e-14 of the table's largest
-    value allowed, a compiler may fuse a multiply-add on another CPU), clamping included (points beyond the grid
-    in a take the edge values)."""
+    operations in the same order, so the two agree to round-off (bit for bit on the machine it was written on;
+    1e-12 of the table's largest value allowed: a compiler may fuse a multiply-add on another CPU, and Horner's
+    partial sums can exceed the value by a few orders), clamping included (points beyond the grid in a take the
+    edge values)."""
     surf = surface(0.3, z_max)
     rng = np.random.default_rng(3)
     for table in surf._t2:
@@ -374,5 +375,5 @@ def test_compiled_window_table_evaluation_is_the_numpy_one(z_max):
         b = rng.uniform(table.b0, table.b0 + 0.999999 * table.nb / table.inv_db, 20000)
         got, want = table(a, b, deriv=True), table.evaluate_numpy(a, b, deriv=True)
         for g, w in zip(got, want):
-            assert np.max(np.abs(g - w)) <= 1e-14 * np.max(np.abs(w))
+            assert np.max(np.abs(g - w)) <= 1e-12 * np.max(np.abs(w))
         assert np.array_equal(table(a, b, deriv=False)[0], got[0])
