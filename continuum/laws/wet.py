@@ -18,7 +18,7 @@ threshold (paper notes on eq 11):
 (Lower summits form bridges last and break first, so a single offset is exact for any path.)
 Force, energy and formation work are double integrals over x and z done with Gauss-Legendre nodes
 in x (panels split where the integrand has kinks) and closed-form Gaussian moments in z (the bridge
-law is piecewise quadratic in g): about 50 us per evaluation, and nothing at all before t_a.
+law is piecewise quadratic in g): about 8 us per evaluation compiled (`bridge_kernel`), nothing before t_a.
 
 The bridges see the rigid geometry d(x): with the elastic half-space on, the half-space deflection
 (femtometres under the paper's roller) is left out of the bridges' gaps; the record says so.
