@@ -38,6 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 #: numba's one-time compile of the contact kernel (cached beside the module) is not a run's cost; an exported
 #: baseline tree starts with an empty cache, so every tree is warmed first, untimed.
+# compile (or load) a tree's numba kernels untimed (whole_command skips it for a revision from before the kernels)
 WARM_SNIPPET = "from continuum.compiled_contact import warm_up; warm_up()"
 
 PAPER_SNIPPET = """
@@ -79,7 +80,8 @@ def whole_command(code_root: Path, sets: list[str], workers: int) -> tuple[float
     import resource
 
     env = {**os.environ, "PYTHONPATH": str(code_root)}
-    subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=code_root, env=env, check=True, capture_output=True)
+    if (code_root / "continuum" / "compiled_contact.py").exists():
+        subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=code_root, env=env, check=True, capture_output=True)
     with tempfile.TemporaryDirectory() as folder:
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
