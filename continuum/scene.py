@@ -12,11 +12,13 @@ import hashlib
 import json
 import math
 import tomllib
+import dataclasses
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from nanoimpact import data
 from nanoimpact.errors import InputError
+from nanoimpact.fields import Resolved, frozen_dataclass, resolved
 
 from .reference.hertz import effective_modulus
 from .schema import FIDELITY, FIELD_BY_PATH, FIELDS, REQUIRED, Field, is_section, to_internal
@@ -31,156 +33,126 @@ class SceneError(InputError):
 
 
 # ----------------------------------------------------------------------------- dataclasses
-@dataclass(frozen=True)
-class Body:
-    """The impacting body. Lengths in m, mass in kg."""
-
-    shape: str
-    radius: float
-    length: float | None
-    mass: float
-
-
-@dataclass(frozen=True)
-class Material:
-    """Elastic constants (Pa, 1) and water contact angle (rad, or None if not given) of one surface."""
-
-    youngs_modulus: float
-    poisson_ratio: float
-    contact_angle: float | None
+# Generated from the key declarations (continuum.schema.FIELDS; nanoimpact.fields.frozen_dataclass): a section's
+# dataclass has one attribute per key of its table, typed, defaulted and documented from the declaration (angles
+# in radians). `Resolved` attributes are the ones `_build` computes from several keys or a preset. Keys that no
+# attribute holds are listed in FOLDED_KEYS with where they go.
+def _members(section: str, skip: tuple[str, ...] = ()) -> list[tuple[str, Field]]:
+    """(attribute, declaration) for the keys directly in `section` ('' for the top level), in declaration order."""
+    out = []
+    for f in FIELDS:
+        parent, _, leaf = f.path.rpartition(".")
+        if parent == section and leaf not in skip:
+            out.append((leaf, f))
+    return out
 
 
-@dataclass(frozen=True)
-class Roughness:
-    """Summit statistics of the (composite) rough surface: sigma (m), density (1/m^2), tip radius (m)."""
-
-    sigma: float
-    summit_density: float
-    summit_radius: float
-    datum: str
-    mode: str
-    seed: int
-    summit_modulus: float | None = None
+def _replace_member(members: list, attr: str, member: Field | Resolved) -> list:
+    return [(a, member if a == attr else m) for a, m in members]
 
 
-@dataclass(frozen=True)
-class SAM:
-    """A self-assembled monolayer on both surfaces: thickness (m), SAM-SAM work of adhesion (J/m^2),
-    water contact angle (rad or None), and optionally its Young's modulus (Pa) and Poisson's ratio as a
-    compliant layer in series with every summit (None: rigid layer)."""
-
-    thickness: float | None
-    work_of_adhesion: float
-    contact_angle: float | None
-    layer_modulus: float | None = None
-    layer_poisson_ratio: float = 0.3
-    interaction_range: float | None = None
+def _dataclass(name: str, members, doc: str, namespace: dict | None = None) -> type:
+    return frozen_dataclass(name, members, doc=doc, module=__name__, namespace=namespace,
+                            unit=lambda f: "rad" if f.degrees else f.unit, default=lambda f: to_internal(f, f.default))
 
 
-@dataclass(frozen=True)
-class Surfaces:
-    """The pair of surfaces: work of adhesion (J/m^2), each side's material, roughness (or None).
+#: Declared keys that no dataclass attribute holds, and where their value goes.
+FOLDED_KEYS = {
+    "params": "ResolvedScene.params_file (the parameter set read)",
+    "body.density": "Body.mass (mass from the density and the shape's volume)",
+    "surfaces.sam.coverage": "Surfaces.sam (None when 'none')",
+}
 
-    `yield_strength` and `hardness` (Pa, optional) are the substrate's, for the plasticity warnings.
-    """
+Body = _dataclass("Body", _replace_member(_members("body", skip=("density",)), "mass",
+    Resolved(float, "kg", "Body mass: body.mass, or body.density times the shape's volume.", key="body.mass")),
+    "The impacting body (SI).")
 
-    work_of_adhesion: float
-    body: Material
-    substrate: Material
-    roughness: Roughness | None = None
-    yield_strength: float | None = None
-    hardness: float | None = None
-    sam: SAM | None = None
-    interaction_range: float = 0.3e-9
-    """z0 (m): range of the bare surfaces' attraction (Tabor parameter, Maugis-Dugdale stress)."""
+# one surface's material: the keys of [surfaces.body] (the substrate has the same three, and two of its own that
+# Surfaces holds)
+Material = _dataclass("Material", [(a, dataclasses.replace(f, doc=f.doc.replace(" of the body", "")))
+                                   for a, f in _members("surfaces.body")],
+                      "Elastic constants and water contact angle of one surface ([surfaces.body] or "
+                      "[surfaces.substrate]).")
 
-    @property
-    def interface_interaction_range(self) -> float:
-        """z0 (m) of the contacting pair: the SAM's when both sides carry one and it is given."""
-        if self.sam is not None and self.sam.interaction_range is not None:
-            return self.sam.interaction_range
-        return self.interaction_range
+Roughness = _dataclass("Roughness", _members("surfaces.roughness"),
+                       "Summit statistics of the (composite) rough surface ([surfaces.roughness]).")
 
-    @property
-    def contact_angles(self) -> tuple[float | None, float | None]:
-        """Water contact angles (rad) of the two contacting faces: the SAM's on both when covered."""
-        if self.sam is not None:
-            return self.sam.contact_angle, self.sam.contact_angle
-        return self.body.contact_angle, self.substrate.contact_angle
-
-    @property
-    def interface_work_of_adhesion(self) -> float:
-        """Work of adhesion (J/m^2) of the contacting pair: the SAM's when both sides carry one."""
-        return self.sam.work_of_adhesion if self.sam is not None else self.work_of_adhesion
-
-    @property
-    def e_star(self) -> float:
-        """Effective (contact) modulus E* in Pa, 1/E* = sum (1 - nu^2)/E (Johnson's convention)."""
-        return float(effective_modulus(self.body.youngs_modulus, self.body.poisson_ratio,
-                                       self.substrate.youngs_modulus, self.substrate.poisson_ratio))
+SAM = _dataclass("SAM", _replace_member(_members("surfaces.sam", skip=("coverage",)), "work_of_adhesion",
+                                        resolved(FIELD_BY_PATH["surfaces.sam.work_of_adhesion"])),
+                 "A self-assembled monolayer on both surfaces ([surfaces.sam] with coverage = 'both'); without "
+                 "layer_modulus the layer is rigid.")
 
 
-@dataclass(frozen=True)
-class Environment:
-    """Gravity (m/s^2), relative humidity (fraction) and temperature (K)."""
-
-    gravity: float
-    relative_humidity: float
-    temperature: float
+def _interface_interaction_range(self) -> float:
+    """z0 (m) of the contacting pair: the SAM's when both sides carry one and it is given."""
+    if self.sam is not None and self.sam.interaction_range is not None:
+        return self.sam.interaction_range
+    return self.interaction_range
 
 
-@dataclass(frozen=True)
-class Physics:
-    """Model choices ('auto' entries are decided per scene in continuum.models)."""
-
-    adhesion_law: str
-    detachment: str
-    line_stiffness: str
-    half_space: str = "auto"
-    menisci: str = "auto"
+def _contact_angles(self) -> tuple[float | None, float | None]:
+    """Water contact angles (rad) of the two contacting faces: the SAM's on both when covered."""
+    if self.sam is not None:
+        return self.sam.contact_angle, self.sam.contact_angle
+    return self.body.contact_angle, self.substrate.contact_angle
 
 
-@dataclass(frozen=True)
-class Menisci:
-    """Capillary condensation settings: t_a (s) and its model, growth length h1 (m, None = from humidity),
-    liquid surface tension (N/m) and molar volume (m^3/mol)."""
-
-    condensation_time: float = 25e-6
-    condensation_model: str = "fixed"
-    growth_length: float | None = None
-    surface_tension: float = 0.072
-    molar_volume: float = 1.807e-5
+def _interface_work_of_adhesion(self) -> float:
+    """Work of adhesion (J/m^2) of the contacting pair: the SAM's when both sides carry one."""
+    return self.sam.work_of_adhesion if self.sam is not None else self.work_of_adhesion
 
 
-@dataclass(frozen=True)
-class Numerics:
-    """Numerical settings; `rtol` is resolved from the fidelity preset unless given."""
-
-    fidelity: str
-    rtol: float
-    max_bounces: int
-    max_time: float
-    rest_fraction: float
-    samples_per_flight: int
-    grid_points: int = 256
-    table: str = "standard"
+def _e_star(self) -> float:
+    """Effective (contact) modulus E* in Pa, 1/E* = sum (1 - nu^2)/E (Johnson's convention)."""
+    return float(effective_modulus(self.body.youngs_modulus, self.body.poisson_ratio,
+                                   self.substrate.youngs_modulus, self.substrate.poisson_ratio))
 
 
-@dataclass(frozen=True)
-class Scene:
-    """A validated scene in SI units (angles in radians)."""
+_surface_keys = dict(_members("surfaces"))
+Surfaces = _dataclass(
+    "Surfaces",
+    [("work_of_adhesion", _surface_keys["work_of_adhesion"]),
+     ("body", Resolved(Material, "", "The body's material ([surfaces.body]).")),
+     ("substrate", Resolved(Material, "", "The substrate's material ([surfaces.substrate]).")),
+     ("roughness", Resolved(Roughness | None, "", "Summit statistics; None for smooth contact.", default=None)),
+     ("yield_strength", FIELD_BY_PATH["surfaces.substrate.yield_strength"]),
+     ("hardness", FIELD_BY_PATH["surfaces.substrate.hardness"]),
+     ("sam", Resolved(SAM | None, "", "The monolayer on both surfaces; None without one.", default=None)),
+     ("interaction_range", _surface_keys["interaction_range"])],
+    "The pair of surfaces: work of adhesion, each side's material, roughness, SAM, and the substrate's yield "
+    "strength and hardness for the plasticity warnings.",
+    namespace={"interface_interaction_range": property(_interface_interaction_range),
+               "contact_angles": property(_contact_angles),
+               "interface_work_of_adhesion": property(_interface_work_of_adhesion),
+               "e_star": property(_e_star)})
 
-    name: str
-    description: str
-    contact: str
-    release_height: float | None
-    impact_velocity: float | None
-    body: Body
-    surfaces: Surfaces
-    environment: Environment
-    physics: Physics
-    numerics: Numerics
-    menisci: Menisci = Menisci()
+Environment = _dataclass("Environment", _members("environment"), "The surroundings ([environment]).")
+Physics = _dataclass("Physics", _members("physics"),
+                     "Model choices ([physics]); 'auto' entries are decided per scene (continuum.model).")
+Menisci = _dataclass("Menisci", _members("menisci"), "Capillary condensation settings ([menisci]).")
+Numerics = _dataclass(
+    "Numerics",
+    _replace_member(_replace_member(_members("numerics"), "rtol", resolved(
+        FIELD_BY_PATH["numerics.rtol"], "Relative tolerance of the contact integrator: numerics.rtol, or the "
+        "fidelity preset's (smooth or rough contact).")), "grid_points", resolved(
+        FIELD_BY_PATH["numerics.grid_points"], "Rough contact: grid points across the footprint: numerics.grid_points, "
+        "or the fidelity preset's.")) + [
+        ("table", Resolved(str, "", "GW table resolution of the fidelity preset.", default="standard"))],
+    "Numerical settings ([numerics]); rtol and grid_points resolved from the fidelity preset unless given.")
+
+_top = dict(_members(""))
+Scene = _dataclass(
+    "Scene",
+    [("name", resolved(_top["name"], "Scene name (the file name without extension unless given).")),
+     ("description", _top["description"]), ("contact", _top["contact"]),
+     ("release_height", _top["release_height"]), ("impact_velocity", _top["impact_velocity"]),
+     ("body", Resolved(Body, "", "The impacting body.")),
+     ("surfaces", Resolved(Surfaces, "", "The pair of surfaces.")),
+     ("environment", Resolved(Environment, "", "The surroundings.")),
+     ("physics", Resolved(Physics, "", "Model choices.")),
+     ("numerics", Resolved(Numerics, "", "Numerical settings.")),
+     ("menisci", Resolved(Menisci, "", "Capillary condensation settings.", default=Menisci()))],
+    "A validated scene in SI units (angles in radians).")
 
 
 @dataclass(frozen=True)
@@ -390,17 +362,12 @@ def _build(v: dict, origin: str) -> Scene:
                              "plane-strain line contact) only", origin)
         for key in ("sigma", "summit_density", "summit_radius"):
             _require(si, f"surfaces.roughness.{key}", origin, "for contact = 'rough'")
-        roughness = Roughness(si["surfaces.roughness.sigma"], si["surfaces.roughness.summit_density"],
-                              si["surfaces.roughness.summit_radius"], si["surfaces.roughness.datum"],
-                              si["surfaces.roughness.mode"], si["surfaces.roughness.seed"],
-                              si["surfaces.roughness.summit_modulus"])
+        roughness = Roughness(**_section(Roughness, si, "surfaces.roughness"))
 
     sam = None
     if si["surfaces.sam.coverage"] == "both":
-        sam = SAM(si["surfaces.sam.thickness"],
-                  _require(si, "surfaces.sam.work_of_adhesion", origin, "when surfaces.sam.coverage = 'both'"),
-                  si["surfaces.sam.contact_angle"], si["surfaces.sam.layer_modulus"],
-                  si["surfaces.sam.layer_poisson_ratio"], si["surfaces.sam.interaction_range"])
+        _require(si, "surfaces.sam.work_of_adhesion", origin, "when surfaces.sam.coverage = 'both'")
+        sam = SAM(**_section(SAM, si, "surfaces.sam"))
         if sam.layer_modulus is not None:
             _require(si, "surfaces.sam.thickness", origin, "when surfaces.sam.layer_modulus is set (the layer's "
                      "compliance is thickness / modulus)")
@@ -449,31 +416,33 @@ def _build(v: dict, origin: str) -> Scene:
     rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else default_rtol
     grid_points = si["numerics.grid_points"] if si["numerics.grid_points"] is not None else preset["grid_points"]
     return Scene(
-        name=si["name"],
-        description=si["description"],
-        contact=si["contact"],
-        release_height=si["release_height"],
-        impact_velocity=si["impact_velocity"],
-        body=Body(shape, si["body.radius"], length, mass),
+        **_section(Scene, si, "", name=si["name"]),
+        body=Body(**_section(Body, si, "body", mass=mass, length=length)),
         surfaces=Surfaces(
-            si["surfaces.work_of_adhesion"],
-            Material(si["surfaces.body.youngs_modulus"], si["surfaces.body.poisson_ratio"],
-                     si["surfaces.body.contact_angle"]),
-            Material(si["surfaces.substrate.youngs_modulus"], si["surfaces.substrate.poisson_ratio"],
-                     si["surfaces.substrate.contact_angle"]),
-            roughness, si["surfaces.substrate.yield_strength"], si["surfaces.substrate.hardness"], sam,
-            si["surfaces.interaction_range"],
-        ),
-        environment=Environment(si["environment.gravity"], si["environment.relative_humidity"],
-                                si["environment.temperature"]),
-        physics=Physics(si["physics.adhesion_law"], si["physics.detachment"], si["physics.line_stiffness"],
-                        si["physics.half_space"], si["physics.menisci"]),
-        numerics=Numerics(si["numerics.fidelity"], rtol, si["numerics.max_bounces"], si["numerics.max_time"],
-                          si["numerics.rest_fraction"], si["numerics.samples_per_flight"], grid_points,
-                          preset["table"]),
-        menisci=Menisci(si["menisci.condensation_time"], si["menisci.condensation_model"],
-                        si["menisci.growth_length"], si["menisci.surface_tension"], si["menisci.molar_volume"]),
+            **_section(Surfaces, si, "surfaces", yield_strength=si["surfaces.substrate.yield_strength"],
+                       hardness=si["surfaces.substrate.hardness"], roughness=roughness, sam=sam),
+            body=Material(**_section(Material, si, "surfaces.body")),
+            substrate=Material(**_section(Material, si, "surfaces.substrate"))),
+        environment=Environment(**_section(Environment, si, "environment")),
+        physics=Physics(**_section(Physics, si, "physics")),
+        numerics=Numerics(**_section(Numerics, si, "numerics", rtol=rtol, grid_points=grid_points,
+                                     table=preset["table"])),
+        menisci=Menisci(**_section(Menisci, si, "menisci")),
     )
+
+
+def _section(cls: type, si: dict, section: str, **given) -> dict:
+    """Keyword arguments of `cls` (a generated section dataclass): `given` values, and every other attribute that
+    is a key of `section` read from the SI values `si`. An attribute that is neither (a nested section, a value
+    _build resolves) must be given by the caller."""
+    prefix = f"{section}." if section else ""
+    out = {}
+    for f in dataclasses.fields(cls):
+        if f.name in given:
+            out[f.name] = given[f.name]
+        elif f"{prefix}{f.name}" in si:
+            out[f.name] = si[f"{prefix}{f.name}"]
+    return out
 
 
 def _nest(flat: dict) -> dict:

@@ -1,5 +1,6 @@
 """One input engine: a `Field` declares a key once (type, unit, range, default, doc), and that declaration
-drives the value check, the one-line error, the docs tables and the JSON Schema for editors.
+drives the value check, the one-line error, the docs tables, the JSON Schema for editors and the frozen
+dataclasses the loaders return (`frozen_dataclass`).
 
 Scene keys (`continuum.schema`), MD recipe keys (`md.recipe`) and calibration recipe keys
 (`calibration.pipeline`) are all `Field`s or subclasses that add what their files need (angles in degrees
@@ -12,13 +13,14 @@ caller's `InputError` subclass naming the key, the value and what is allowed, e.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, Sequence
 
 from .errors import InputError
 
-__all__ = ["REQUIRED", "Field", "markdown_table", "json_schema"]
+__all__ = ["REQUIRED", "Field", "Resolved", "resolved", "frozen_dataclass", "markdown_table", "json_schema"]
 
 JSON_SCHEMA_DIALECT = "https://json-schema.org/draft/2020-12/schema"
 
@@ -191,3 +193,66 @@ def json_schema(fields: Iterable[tuple[str, Field]], *, title: str, description:
             if leaf not in node["required"]:
                 node["required"].append(leaf)
     return root
+
+
+# ---------------------------------------------------------------------- typed values
+@dataclass(frozen=True)
+class Resolved:
+    """An attribute of a generated dataclass that no single key's declaration types: a value the loader resolves
+    (a mass from a density and a shape, a tolerance from a preset) or a nested section. `key` names the
+    declaration it stands for, if one does (the contract tests check that every key lands somewhere)."""
+
+    annotation: Any
+    unit: str
+    doc: str
+    default: Any = REQUIRED
+    key: str | None = None
+
+
+def resolved(f: Field, doc: str | None = None, unit: str | None = None) -> Resolved:
+    """`f` as an attribute that the loader always fills (optional in the file, resolved before the dataclass is
+    built: e.g. a tolerance that defaults to the fidelity preset's)."""
+    kind = list[f.item or float] if f.kind is list else f.kind
+    return Resolved(kind, f.unit if unit is None else unit, f.doc if doc is None else doc, key=f.key)
+
+
+def _attribute(member: Field | Resolved, unit: Callable[[Field], str],
+               default: Callable[[Field], Any]) -> tuple[Any, Any, str, str, str | None]:
+    """(annotation, default or REQUIRED, unit, doc, key) of one attribute."""
+    if isinstance(member, Resolved):
+        return member.annotation, member.default, member.unit, member.doc, member.key
+    kind: Any = list[member.item or float] if member.kind is list else member.kind
+    value = member.default if member.default is REQUIRED else default(member)
+    if member.default is None:
+        kind = kind | None
+    return kind, value, unit(member), member.doc, member.key
+
+
+def frozen_dataclass(name: str, members: Sequence[tuple[str, Field | Resolved]], *, doc: str, module: str,
+                     namespace: dict | None = None, unit: Callable[[Field], str] = lambda f: f.unit,
+                     default: Callable[[Field], Any] = lambda f: f.default) -> type:
+    """A frozen, keyword-only dataclass with one attribute per (name, declaration) in `members`, in that order:
+    typed from the declaration (``float``, ``float | None`` for an optional key, ...), defaulted from it (a
+    required key has no default) and documented from it (the class docstring lists each attribute with its unit
+    and the key it comes from). So a key is declared once and its dataclass follows. `Resolved` members are
+    attributes the loader computes; `namespace` adds properties and methods; `unit`/`default` map a key's file
+    unit and default to the attribute's (angles: degrees in the file, radians in the dataclass). Each
+    dataclass field carries its key, unit and doc in ``metadata``."""
+    spec, lines = [], []
+    for attr, member in members:
+        annotation, value, attr_unit, attr_doc, key = _attribute(member, unit, default)
+        meta = {"key": key, "unit": attr_unit, "doc": attr_doc}
+        if value is REQUIRED:
+            field = dataclasses.field(metadata=meta)
+        elif isinstance(value, list):
+            field = dataclasses.field(default_factory=lambda v=tuple(value): list(v), metadata=meta)
+        else:
+            field = dataclasses.field(default=value, metadata=meta)
+        spec.append((attr, annotation, field))
+        shown = f" [{attr_unit}]" if attr_unit and attr_unit != "1" else ""
+        where = f", from ``{key}``" if key else ""
+        lines.append(f"    {attr}{shown}{where}: {attr_doc}")
+    cls = dataclasses.make_dataclass(name, spec, namespace=dict(namespace or {}), frozen=True, kw_only=True)
+    cls.__module__ = module             # so pickle (process pools, Dask) finds the class where it is defined
+    cls.__doc__ = doc.rstrip() + "\n\n    Attributes (generated from the key declarations):\n" + "\n".join(lines) + "\n"
+    return cls

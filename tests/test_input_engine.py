@@ -155,3 +155,74 @@ def test_a_field_check_names_key_value_and_range_in_one_line():
     assert pair.allowed() == "a list of 2 items, each one of 'silica', 'ots'"
     with pytest.raises(InputError):
         pair.check(["silica"])
+
+
+# ---------------------------------------------------------------------- dataclasses from the declarations
+def test_a_generated_dataclass_follows_its_declarations():
+    """Type, default, requiredness, unit and doc of each attribute come from the key's declaration."""
+    import dataclasses
+
+    from nanoimpact.fields import Resolved, frozen_dataclass
+
+    decl = [("radius", Field("body.radius", float, "m", "Radius.", REQUIRED, low=0.0)),
+            ("length", Field("body.length", float, "m", "Length.", None)),
+            ("count", Field("body.count", int, "1", "How many.", 3)),
+            ("mass", Resolved(float, "kg", "Resolved mass.", key="body.mass"))]
+    cls = frozen_dataclass("Thing", decl, doc="A thing.", module=__name__)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    assert list(fields) == ["radius", "length", "count", "mass"]
+    assert fields["radius"].type is float and fields["length"].type == (float | None)
+    assert fields["count"].default == 3 and fields["length"].default is None
+    assert fields["radius"].default is dataclasses.MISSING and fields["mass"].default is dataclasses.MISSING
+    assert fields["radius"].metadata["key"] == "body.radius" and fields["mass"].metadata["unit"] == "kg"
+    assert "radius [m], from ``body.radius``: Radius." in cls.__doc__
+    thing = cls(radius=1.0, mass=2.0)
+    assert (thing.length, thing.count) == (None, 3)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        thing.radius = 2.0
+    with pytest.raises(TypeError):
+        cls(1.0, 2.0)                      # keyword-only: no silent mix-up of two floats
+    with pytest.raises(TypeError):
+        cls(radius=1.0)                    # a required key (and a resolved value) must be given
+
+
+def test_every_scene_key_lands_in_a_scene_dataclass():
+    """One declaration per key: each scene key is an attribute of exactly one generated dataclass (read by
+    `_build` from the key), or folded into another value as FOLDED_KEYS says; no attribute names a key that
+    is not declared."""
+    import dataclasses
+
+    from continuum import scene
+
+    classes = (scene.Scene, scene.Body, scene.Surfaces, scene.Material, scene.Roughness, scene.SAM,
+               scene.Environment, scene.Physics, scene.Menisci, scene.Numerics)
+    homes: dict[str, list[str]] = {}
+    for cls in classes:
+        for f in dataclasses.fields(cls):
+            if f.metadata.get("key"):
+                homes.setdefault(f.metadata["key"], []).append(f"{cls.__name__}.{f.name}")
+    declared = {f.path for f in SCENE_FIELDS}
+    # Material holds the body's keys; the substrate's same-named keys land in the same attributes
+    for key in ("youngs_modulus", "poisson_ratio", "contact_angle"):
+        homes[f"surfaces.substrate.{key}"] = [f"Material.{key}"]
+    assert set(homes) <= declared, set(homes) - declared
+    missing = declared - set(homes) - set(scene.FOLDED_KEYS)
+    assert not missing, f"scene keys with no dataclass attribute: {sorted(missing)}"
+    assert all(len(h) == 1 for h in homes.values()), {k: h for k, h in homes.items() if len(h) > 1}
+
+
+def test_scene_dataclass_attributes_are_in_si_units():
+    """Angles are declared in degrees and held in radians; every other unit is the declaration's."""
+    import dataclasses
+    import math
+
+    from continuum import scene
+    from continuum.schema import FIELD_BY_PATH
+
+    for f in dataclasses.fields(scene.Material) + dataclasses.fields(scene.SAM):
+        decl = FIELD_BY_PATH.get(f.metadata["key"])
+        if decl is not None and decl.degrees:
+            assert f.metadata["unit"] == "rad"
+    resolved = scene.resolve_scene("rough_silica", params="paper",
+                                   overrides={"surfaces.body.contact_angle": 30.0})
+    assert resolved.scene.surfaces.body.contact_angle == pytest.approx(math.radians(30.0), rel=1e-15)
