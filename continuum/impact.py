@@ -8,7 +8,7 @@ from typing import Callable
 
 from . import plots
 from .driver import Bounce, DriverSettings, simulate
-from .models import meniscus_parameters, select_law
+from .model import dry_run_verdict, select_law
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
 from .scene import ResolvedScene, SceneError
@@ -30,24 +30,12 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     law, models = select_law(scene, first_impact_speed(resolved))
     run, release = _simulate(resolved, law, models, progress)
     if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
-        # auto menisci: bridges cannot form before t_a, so a dry run whose contacts all end sooner is exact
-        t_a = meniscus_parameters(scene)["condensation_time"]
-        released = [b.duration for b in run.bounces if b.duration is not None]
-        longest = max(released, default=0.0)
-        decision = {"longest_contact_s": longest, "condensation_time_s": t_a,
-                    "final_contact": None if run.status not in ("stuck", "rest") else
-                    f"the run ended '{run.status}': the last contact never ends, bridges would form in it after "
-                    "t_a but cannot change any rebound (the body is already held)"}
-        if longest < t_a:
-            models["menisci"].update(decision, used=False, why=(
-                f"auto: the longest contact of the dry run lasted {longest:.3g} s < t_a = {t_a:.3g} s, so no "
-                "bridge can form: the dry run is the wet run"))
-        else:
-            dry_bounces = len(run.bounces)
+        # auto menisci, pending: the dry run settles it (continuum.model.decisions.dry_run_verdict)
+        verdict = dry_run_verdict(scene, [b.duration for b in run.bounces], run.status)
+        if verdict.rerun:
             law, models = select_law(scene, first_impact_speed(resolved), menisci=True)
-            models["menisci"].update(decision, dry_run_bounces=dry_bounces, why=(
-                f"auto: a contact of the dry run lasted {longest:.3g} s >= t_a = {t_a:.3g} s: rerun with menisci"))
             run, release = _simulate(resolved, law, models, progress)
+        models["menisci"].update(verdict.record())
     models["regimes"] = regime_numbers(scene, models, run)
     wall = time.perf_counter() - start
     diagnostics = law.diagnostics()

@@ -85,3 +85,20 @@ def test_adhesion_left_out_for_stiff_weakly_adhesive_summits_is_safe():
     forced, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml", overrides={**stiff, "physics.adhesion_law": "dmt"}))
     assert forced["models"]["adhesion"]["used"] is True
     _assert_same_rebounds(auto, forced, 100e-9)
+
+
+def test_the_dry_run_settles_a_pending_meniscus_decision_at_t_a():
+    """Bridges cannot form before t_a: a dry run whose contacts all end sooner is the wet run; a contact of
+    exactly t_a or longer calls for the wet run; a contact that never ends (stuck) does not count."""
+    from continuum.model import dry_run_verdict
+    from continuum.scene import resolve_scene
+
+    scene = resolve_scene("wet_silica", params="paper", overrides={"menisci.condensation_time": 2e-5}).scene
+    short = dry_run_verdict(scene, [1e-5, 1.99e-5, None], "stuck")
+    assert not short.rerun and short.longest_contact_s == 1.99e-5 and short.dry_run_bounces == 3
+    assert short.record()["used"] is False and "'stuck'" in short.record()["final_contact"]
+    assert "< t_a" in short.record()["why"]
+    at = dry_run_verdict(scene, [2e-5], "escaped")
+    assert at.rerun and at.final_contact is None
+    assert at.record()["dry_run_bounces"] == 1 and "used" not in at.record()    # the wet run's record says used
+    assert dry_run_verdict(scene, [], "escaped").longest_contact_s == 0.0

@@ -7,8 +7,9 @@ can force any choice. The package works in four steps, one module each:
 ``regime``     the numbers that place the scene, computed once (`Regime`, `regime_of`): summit modulus,
                Tabor and Fuller-Tabor parameters, plasticity index, the first impact's estimate, and the
                menisci's parameters;
-``decisions``  typed decisions (`AdhesionDecision`, `HalfSpaceDecision`, `MenisciDecision`), frozen, each
-               with the numbers that decided it and its own record; the criteria are in its docstring;
+``decisions``  typed decisions (`AdhesionDecision`, `HalfSpaceDecision`, `MenisciDecision`, and the
+               `DryRunVerdict` that settles a pending meniscus decision), frozen, each with the numbers that
+               decided it and its own record; the criteria are in its docstring;
 ``factory``    builds the law the decisions call for: the only module outside `continuum.laws` that
                imports a concrete law (`tests/test_architecture.py`);
 ``record``     what result.json's `models` says about the law, the estimate and the SAM;
@@ -18,15 +19,15 @@ and ``select`` runs them: `select_law` (the whole scene) and `rough_law` (the ro
 from __future__ import annotations
 
 from .decisions import (LAW_NAMES, NEGLIGIBLE_DEFLECTION, NEGLIGIBLE_LOSS, NEGLIGIBLE_PULL, TABOR_DMT, TABOR_JKR,
-                        AdhesionDecision, HalfSpaceDecision, MenisciDecision, adhesion_decision, decide_adhesion,
-                        decide_half_space, decide_menisci, half_space_decision, loop_per_summit, menisci_decision,
-                        summit_law)
+                        AdhesionDecision, DryRunVerdict, HalfSpaceDecision, MenisciDecision, adhesion_decision,
+                        decide_adhesion, decide_half_space, decide_menisci, dry_run_verdict, half_space_decision,
+                        loop_per_summit, menisci_decision, summit_law)
 from .regime import Regime, meniscus_parameters, regime_of, sam_layer, summit_e_star
 from .select import FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, LARGE_TABLE_SECONDS, rough_law, select_law
 
 __all__ = [
-    "AdhesionDecision", "HalfSpaceDecision", "MenisciDecision", "Regime",
-    "adhesion_decision", "half_space_decision", "menisci_decision", "regime_of",
+    "AdhesionDecision", "DryRunVerdict", "HalfSpaceDecision", "MenisciDecision", "Regime",
+    "adhesion_decision", "dry_run_verdict", "half_space_decision", "menisci_decision", "regime_of",
     "decide_adhesion", "decide_half_space", "decide_menisci",
     "meniscus_parameters", "sam_layer", "summit_e_star", "summit_law", "loop_per_summit",
     "rough_law", "select_law",

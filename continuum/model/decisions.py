@@ -16,8 +16,8 @@ Half-space. Left out when the estimated deflection span across the footprint is 
 
 Menisci. Left out when the air is dry (RH = 0), when the faces are hydrophobic (cos t1 + cos t2
 <= 0: no bridge pulls), for smooth contact and discrete summits (not modelled), and otherwise
-decided after a dry run (`continuum.impact.run_impact`): bridges cannot form before t_a, so if no
-contact of the dry run lasts t_a, the wet run is identical and the dry one is kept.
+decided after a dry run (`dry_run_verdict`; `continuum.impact.run_impact` runs the two): bridges cannot
+form before t_a, so if no contact of the dry run lasts t_a, the wet run is identical and the dry one is kept.
 """
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 from .. import menisci as men
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
-from .regime import Regime, regime_of, sam_layer, summit_e_star
+from .regime import Regime, meniscus_parameters, regime_of, sam_layer, summit_e_star
 
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
 TABOR_JKR, TABOR_DMT = 5.0, 0.1
@@ -283,3 +283,45 @@ def decide_menisci(scene: Scene) -> tuple[str, dict]:
     """'off', 'on' or 'after_dry_run', with the record of why (`menisci_decision`, as a pair)."""
     d = menisci_decision(scene)
     return d.choice, d.record()
+
+
+@dataclass(frozen=True)
+class DryRunVerdict:
+    """How a pending meniscus decision ('after_dry_run') is settled: the longest contact of the dry run against
+    the condensation time t_a (s). Bridges cannot form before t_a, so a dry run whose contacts all end sooner is
+    the wet run; otherwise the scene is run again with menisci."""
+
+    longest_contact_s: float
+    condensation_time_s: float
+    dry_run_bounces: int
+    final_contact: str | None = None
+    """Why the last contact does not count, when the run ended held ('stuck' or 'rest'); None otherwise."""
+
+    @property
+    def rerun(self) -> bool:
+        """True when a contact of the dry run lasted t_a: run again with menisci."""
+        return self.longest_contact_s >= self.condensation_time_s
+
+    def record(self) -> dict:
+        """What settles models.menisci (merged into the pending record, or the wet run's)."""
+        longest, t_a = self.longest_contact_s, self.condensation_time_s
+        rec: dict = {"longest_contact_s": longest, "condensation_time_s": t_a, "final_contact": self.final_contact}
+        if self.rerun:
+            rec["dry_run_bounces"] = self.dry_run_bounces
+            rec["why"] = f"auto: a contact of the dry run lasted {longest:.3g} s >= t_a = {t_a:.3g} s: rerun with menisci"
+        else:
+            rec["used"] = False
+            rec["why"] = (f"auto: the longest contact of the dry run lasted {longest:.3g} s < t_a = {t_a:.3g} s, so no "
+                          "bridge can form: the dry run is the wet run")
+        return rec
+
+
+def dry_run_verdict(scene: Scene, durations, status: str) -> DryRunVerdict:
+    """Settle 'after_dry_run' from the dry run's contact `durations` (s; None for a contact that never ended)
+    and its final `status`."""
+    released = [d for d in durations if d is not None]
+    final = (None if status not in ("stuck", "rest") else
+             f"the run ended '{status}': the last contact never ends, bridges would form in it after t_a but cannot "
+             "change any rebound (the body is already held)")
+    return DryRunVerdict(max(released, default=0.0), meniscus_parameters(scene)["condensation_time"], len(durations),
+                         final)
