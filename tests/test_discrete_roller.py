@@ -244,3 +244,16 @@ def test_few_contacts_discrete_rebound_departs_from_the_average():
     ratios = [h / avg for h, _ in discrete]
     assert max(abs(r - 1) for r in ratios) > 0.2, ratios
     assert max(ratios) - min(ratios) > 0.3, ratios
+
+
+def test_a_too_deep_discrete_approach_refuses_the_scene_naming_sigma():
+    """Every rough roller refuses an approach beyond the rough model's range as a scene error naming
+    surfaces.roughness.sigma (the CLI's input-error exit code), the discrete one included."""
+    from continuum.models import select_law
+    from continuum.scene import SceneError, resolve_scene
+
+    scene = resolve_scene("rough_silica", params="paper", overrides={"surfaces.roughness.mode": "discrete"}).scene
+    law, _ = select_law(scene, 0.001)
+    assert law.quasi_static_depth(1e-16) > 0.0                  # a gentle impact stays in range
+    with pytest.raises(SceneError, match=r"surfaces\.roughness\.sigma = .*discrete rough contact refused"):
+        law.quasi_static_depth(1.0)                             # 1 J: far beyond 10 sigma

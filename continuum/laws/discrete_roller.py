@@ -92,8 +92,6 @@ class DiscreteRoughRoller(RoughRollerBase):
 
     name = "rough_roller_discrete_jkr"
     depth_search_name = "discrete rough contact"
-    #: a too-deep approach raises the depth search's ValueError (no SceneError naming sigma)
-    refuse_as_scene_error = False
 
     def __init__(self, stats: SummitStatistics, work_of_adhesion: float, summit_e_star: float, radius: float,
                  length: float, e_star: float, *, seed: int, detachment: str = "displacement",

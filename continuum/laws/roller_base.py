@@ -19,9 +19,8 @@ The hooks, where the rollers differ:
 
 - `approach_forces(depths)`: first-approach forces (N) at depths (m below the datum), an array;
 - `first_depth_step()`: the depth search's first step (m);
-- `depth_search_name` and `refuse_as_scene_error`: how a too-deep approach is refused (the
-  averaged laws refuse the scene, a `SceneError` naming surfaces.roughness.sigma; the discrete
-  law raises the depth search's ValueError);
+- `depth_search_name`: what a refused depth search calls the contact (a too-deep approach refuses the
+  scene, a `SceneError` naming surfaces.roughness.sigma, for every roller);
 - `size_for(depth, speed)`: size the grid or the tables for a design depth (m);
 - `sized_depth`: the design depth the grid or tables were sized for (m);
 - `_evaluate(gap)`: the trial state at a gap (grid laws; `_state` caches it).
@@ -50,8 +49,6 @@ class RoughRollerBase(ContactLaw):
 
     #: the name a refused depth search gives the contact
     depth_search_name = "rough contact"
-    #: a too-deep approach refuses the scene (SceneError naming surfaces.roughness.sigma), else ValueError
-    refuse_as_scene_error = True
 
     # ------------------------------------------------------------------ hooks
     @abstractmethod
@@ -101,7 +98,7 @@ class RoughRollerBase(ContactLaw):
             return absorbing_depth(self.approach_forces, energy, first_step=first, weight=weight,
                                    max_depth=self.z_top + DEPTH_LIMIT_SIGMAS * self.sigma, what=self.depth_search_name)
 
-        return beyond_range(search, self.sigma) if self.refuse_as_scene_error else search()
+        return beyond_range(search, self.sigma)
 
     def release_gap(self):
         return self.end_gap
