@@ -31,6 +31,7 @@ import warnings
 
 import numpy as np
 
+from ..reference import jkr as _jkr
 from .summits import SummitStatistics, _gauss_mass
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
@@ -62,7 +63,8 @@ class GWBranchSurface:
         self.attach_stretch = max(-self.delta_in, 0.0)
         self.loop_energy = law.loop_energy
         self.pull_off_force = law.pull_off_force
-        self.delta_c = (float(0.75 * (math.pi**2 * self.work_of_adhesion**2 * self.radius / self.e_star**2) ** (1 / 3))
+        # the JKR delta_c of these summits (the one kernel, continuum.reference.jkr): the scale of the panels
+        self.delta_c = (float(_jkr.critical_approach(self.radius, self.work_of_adhesion, self.e_star))
                         if self.adhesive else 0.0)
         self._edges = self._panel_edges()
         self.build_seconds = time.perf_counter() - start
