@@ -102,3 +102,20 @@ def test_the_dry_run_settles_a_pending_meniscus_decision_at_t_a():
     assert at.rerun and at.final_contact is None
     assert at.record()["dry_run_bounces"] == 1 and "used" not in at.record()    # the wet run's record says used
     assert dry_run_verdict(scene, [], "escaped").longest_contact_s == 0.0
+
+
+def test_discrete_summits_record_the_law_that_runs_and_what_the_map_suggests():
+    """Discrete summits run JKR where Johnson & Greenwood's map says Maugis-Dugdale: models.adhesion.law is
+    the law that runs (as models.contact_law says), map_suggests the map's, and a warning says so."""
+    from continuum.models import select_law
+    from continuum.scene import resolve_scene
+    from continuum.warnings import model_warnings
+
+    scene = resolve_scene("rough_silica", params="paper", overrides={
+        "surfaces.roughness.mode": "discrete", "surfaces.interaction_range": 3e-9,
+        "physics.adhesion_law": "auto"}).scene
+    law, models = select_law(scene, 1e-3)
+    assert models["adhesion"]["tabor_parameter"] < 5.0
+    assert (models["adhesion"]["law"], models["adhesion"]["map_suggests"]) == ("jkr", "maugis_dugdale")
+    assert "jkr" in law.name
+    assert any("maugis_dugdale" in w for w in model_warnings(models))

@@ -118,9 +118,9 @@ class AdhesionDecision:
                         "estimated_pull_fraction": self.estimated_pull_fraction,
                         "loop_energy_per_summit": self.loop_energy_per_summit,
                         "negligible_below": {"loss": NEGLIGIBLE_LOSS, "pull": NEGLIGIBLE_PULL}})
-        # where the geometry overrode the map, "law" still names the map's choice (as recorded since the override
-        # was introduced) and "map_suggests" repeats it; the law that runs is in models.contact_law
-        rec.update({"law": self.map_suggests or self.law, "decided_by": self.decided_by, "why": self.why})
+        # "law" is the law that runs; where the geometry overrode the map (discrete summits run JKR), "map_suggests"
+        # names the map's choice
+        rec.update({"law": self.law, "decided_by": self.decided_by, "why": self.why})
         if self.map_suggests is not None:
             rec["map_suggests"] = self.map_suggests
         return rec
