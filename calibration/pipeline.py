@@ -40,7 +40,7 @@ from .report import CalibrationReport, ValueRow
 from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
 from nanoimpact.errors import InputError
-from nanoimpact.fields import REQUIRED, Field
+from nanoimpact.fields import REQUIRED, Field, Resolved, frozen_dataclass
 from nanoimpact.fields import json_schema as json_schema_of
 
 log = logging.getLogger(__name__)
@@ -80,6 +80,32 @@ FIELDS = (
           high=int(SCENE_FIELDS["numerics.max_bounces"].high)),
 )
 FIELD_BY_KEY = {f.key: f for f in FIELDS}
+
+
+def _members(section: str) -> list[tuple[str, Field]]:
+    return [(f.key.rpartition(".")[2], f) for f in FIELDS if f.key.rpartition(".")[0] == section]
+
+
+def _as_dict(self) -> dict:
+    """The recipe as plain JSON-ready data (calibration.json's `calibration`)."""
+    import dataclasses
+
+    return dataclasses.asdict(self)
+
+
+#: A checked calibration recipe (`load_calibration`), generated from the key declarations above; the names of the
+#: parameter sets and the uncertainty scene are resolved to what was found (a shipped name stays a name).
+Uncertainty = frozen_dataclass(
+    "Uncertainty", [*_members("uncertainty"),
+                    ("ranges", Resolved(dict, "", "{dotted scene key: (low, high)}: user ranges (uniform), each "
+                                                  "checked by the scene key's own declaration.")),
+                    ("overrides", Resolved(dict, "", "{dotted scene key: value}: scene overrides of every sample."))],
+    doc="The [uncertainty] table of a calibration recipe: Latin-hypercube samples of one scene.", module=__name__)
+CalibrationRecipe = frozen_dataclass(
+    "CalibrationRecipe", [*_members(""),
+                          ("path", Resolved(str, "", "The recipe file read.")),
+                          ("uncertainty", Resolved(Uncertainty, "", "The [uncertainty] table."))],
+    doc="A checked calibration recipe (`load_calibration`).", module=__name__, namespace={"to_dict": _as_dict})
 
 
 def _get(table: dict, key: str, origin: str):
@@ -133,7 +159,7 @@ def _locate(find, spec: str, recipe: Path) -> Path:
         raise
 
 
-def load_calibration(spec: str | Path) -> dict:
+def load_calibration(spec: str | Path) -> CalibrationRecipe:
     """Read and check a calibration recipe, whole, before anything runs.
 
     `spec` is a path or a name (`quick` -> the user data folder's or the shipped
@@ -252,10 +278,11 @@ def load_calibration(spec: str | Path) -> dict:
                                    f"{origin}: MD recipe {recipe}, which the calibration needs"
                                    + (f" ({exc.origin})" if getattr(exc, "origin", "") else "")) from None
     # a base set given as a path is kept as the file found (it may have been found from the recipe's folder)
-    return {**raw, "path": str(path), "description": description,
-            "base": str(base_file) if data.is_path_spec(base) else base, "compare_sets": compare_files,
-            "uncertainty": {"samples": samples, "seed": seed, "scene": str(scene_file), "max_bounces": max_bounces,
-                            "ranges": ranges, "overrides": overrides}}
+    return CalibrationRecipe(
+        name=name, base=str(base_file) if data.is_path_spec(base) else base, description=description,
+        compare_sets=compare_files, path=str(path),
+        uncertainty=Uncertainty(samples=samples, seed=seed, scene=str(scene_file), max_bounces=max_bounces,
+                                ranges=ranges, overrides=overrides))
 
 
 def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, workers: int | None,
@@ -408,7 +435,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     progress = progress or log.info                 # library code logs; the CLI decides what is shown
     t_all = time.perf_counter()
     cal = load_calibration(recipe_path)             # the whole recipe and the options, before anything runs
-    paper_sets = cal["compare_sets"] if paper_sets is None else paper_sets
+    paper_sets = cal.compare_sets if paper_sets is None else paper_sets
     check_run_options(out, md_fidelity, executor_name, workers, scheduler, paper_sets)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -416,7 +443,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     # 1. MD jobs
     t = time.perf_counter()
     recipes = recipes_needed()
-    progress(f"calibrate {cal['name']}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}'")
+    progress(f"calibrate {cal.name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}'")
     ex = executor(executor_name, workers, scheduler)
     results, sources = {}, {}
     try:
@@ -430,31 +457,31 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         # 2. the set
         machine = {"cores": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}
         md_compute = {r: _md_wall(res) for r, res in results.items()}
-        table, rows = build_parameter_set(results, cal["base"], cal["name"], description=cal.get("description", ""),
+        table, rows = build_parameter_set(results, cal.base, cal.name, description=cal.description,
                                           extra_meta={"md_fidelity": md_fidelity, "machine": machine,
                                                       "pipeline_md_wall_s": timings["md_s"],
                                                       "md_compute_wall_s": md_compute,
                                                       "md_compute_total_s": sum(md_compute.values()),
-                                                      "created_by": f"nanoimpact calibrate {cal['path']}"})
-        set_path = Path(params_out) if params_out else data.writable_root() / "params" / f"{cal['name']}.toml"
+                                                      "created_by": f"nanoimpact calibrate {cal.path}"})
+        set_path = Path(params_out) if params_out else data.writable_root() / "params" / f"{cal.name}.toml"
         write_parameter_set(table, set_path, header=(
-            f"The `{cal['name']}` parameter set, written by `nanoimpact calibrate {cal['path']} --md-fidelity "
-            f"{md_fidelity}`: MD-measured values on the `{cal['base']}` base set; [meta.calibration] gives each "
+            f"The `{cal.name}` parameter set, written by `nanoimpact calibrate {cal.path} --md-fidelity "
+            f"{md_fidelity}`: MD-measured values on the `{cal.base}` base set; [meta.calibration] gives each "
             "value's stderr and MD run hash, [meta.rejected] what was not used and why."))
         progress(f"  wrote {set_path}")
         # 3. the paper's cases
         t = time.perf_counter()
         from continuum.paper.report import make_paper
 
-        sets = [cal["base"], *[s for s in paper_sets if s != cal["base"]], str(set_path)]
+        sets = [cal.base, *[s for s in paper_sets if s != cal.base], str(set_path)]
         paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None)   # the user's executor
         timings["paper_s"] = time.perf_counter() - t
         # 4. uncertainty
         t = time.perf_counter()
-        unc = cal["uncertainty"]
-        keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc["ranges"], unc["samples"], unc["seed"])
+        unc = cal.uncertainty
+        keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc.ranges, unc.samples, unc.seed)
         sample_out = [None] * len(samples)
-        tasks = [(unc["scene"], str(set_path), {**unc["overrides"], **smp}, unc["max_bounces"]) for smp in samples]
+        tasks = [(unc.scene, str(set_path), {**unc.overrides, **smp}, unc.max_bounces) for smp in samples]
         for i, s in ex.map(uncertainty_sample, tasks, on_error="collect"):
             # a sample whose job failed (a crash, a lost worker) is counted and reported like a refused one
             sample_out[i] = {"overrides": tasks[i][2], "error": s.reason} if isinstance(s, Failure) else s
@@ -466,14 +493,14 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
              "rebound_count": _band(s["rebound_count"] for s in sample_out if "error" not in s),
              "escape_velocity_m_per_s": _band(s.get("escape_velocity") for s in sample_out if "error" not in s),
              "covers": keys or ["(no input with an uncertainty: every band is a single point)"],
-             "max_bounces": unc["max_bounces"],
-             "rebound_count_capped": sum(s["rebound_count"] >= unc["max_bounces"] for s in sample_out
+             "max_bounces": unc.max_bounces,
+             "rebound_count_capped": sum(s["rebound_count"] >= unc.max_bounces for s in sample_out
                                          if "error" not in s),
              "samples": len(samples), "failed_samples": sum("error" in s for s in sample_out),
-             "seed": unc["seed"], "scene": unc["scene"]}
+             "seed": unc.seed, "scene": unc.scene}
     _write_uncertainty(out, keys, sample_out, bands)
     timings["total_s"] = time.perf_counter() - t_all
-    report = CalibrationReport(name=cal["name"], set_path=Path(set_path), out=out, calibration=cal,
+    report = CalibrationReport(name=cal.name, set_path=Path(set_path), out=out, calibration=cal,
                                rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources=sources, bands=bands,
                                paper_checks=tuple(paper["checks"]), timings=timings, machine=machine,
                                md_compute_total_s=sum(md_compute.values()))

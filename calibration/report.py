@@ -69,7 +69,8 @@ class CalibrationReport:
     name: str
     set_path: Path
     out: Path
-    calibration: Mapping[str, Any]
+    calibration: Any
+    """The checked recipe (`calibration.pipeline.CalibrationRecipe`)."""
     rows: tuple[ValueRow, ...]
     md_sources: Mapping[str, Mapping[str, Any]]
     bands: Mapping[str, Any]
@@ -93,7 +94,7 @@ class CalibrationReport:
         return tuple(c for c in self.paper_checks if c["set"] == name)
 
     def to_dict(self) -> dict:
-        return {"calibration": dict(self.calibration), "set": str(self.set_path),
+        return {"calibration": self.calibration.to_dict(), "set": str(self.set_path),
                 "rows": [r.to_dict() for r in self.rows], "md_sources": dict(self.md_sources),
                 "bands": dict(self.bands), "md_compute_total_s": self.md_compute_total_s,
                 "timings": dict(self.timings), "machine": dict(self.machine), "versions": dict(self.versions),
@@ -131,8 +132,8 @@ def _work_sentence(rows: tuple[ValueRow, ...]) -> str:
 
 def report_markdown(rec: CalibrationReport) -> str:
     cal, t, m = rec.calibration, rec.timings, rec.machine
-    lines = [f"# Calibration `{cal['name']}` (base `{cal['base']}`)", "",
-             f"Recipe `{cal['path']}`; machine: {m['cores']} cores, {m['platform']}, Python {m['python']}; "
+    lines = [f"# Calibration `{cal.name}` (base `{cal.base}`)", "",
+             f"Recipe `{cal.path}`; machine: {m['cores']} cores, {m['platform']}, Python {m['python']}; "
              f"nanoimpact {rec.versions.get('nanoimpact')}, NumPy {rec.versions.get('numpy')}, SciPy "
              f"{rec.versions.get('scipy')}. MD compute (the runs themselves, from their results): "
              f"{rec.md_compute_total_s:.0f} s. Pipeline wall time: MD jobs {t['md_s']:.1f} s "

@@ -232,6 +232,30 @@ def _fields(section: str, workflow: str) -> dict[str, RecipeField]:
     return out
 
 
+def _settings_dataclass(workflow: str) -> type:
+    members: dict[str, RecipeField] = {}
+    for section in ("system", "fidelity"):
+        for key, f in _fields(section, workflow).items():
+            members.setdefault(key, f)
+    title = "".join(part.title() for part in workflow.split("_"))
+    return fields.frozen_dataclass(
+        f"{title}Settings", list(members.items()), module=__name__,
+        doc=f"The resolved settings of a recipe of the {workflow!r} workflow at one fidelity ([system] overlaid with the fidelity's "
+            "table; `Recipe.typed_settings`), in the recipe's units (file units: Å, fs, K).")
+
+
+#: One frozen settings dataclass per workflow, generated from the key declarations (module attributes, so that
+#: pickle finds them): AdhesionSettings, PulloffSettings, ContactAngleSettings, SurfaceTensionSettings.
+SETTINGS_CLASSES: dict[str, type] = {w: _settings_dataclass(w) for w in WORKFLOWS}
+globals().update({cls.__name__: cls for cls in SETTINGS_CLASSES.values()})
+
+
+def settings_class(workflow: str) -> type:
+    """The frozen settings dataclass of `workflow` (its keys' declarations give each attribute's type, default,
+    unit and doc)."""
+    return SETTINGS_CLASSES[workflow]
+
+
 def _check(f: RecipeField, path: str, value: Any, origin: str) -> Any:
     return f.check(value, origin, error=RecipeError, name=path)
 
@@ -267,6 +291,11 @@ class Recipe:
     @property
     def origin(self) -> str:
         return str(self.path) if self.path else self.name
+
+    def typed_settings(self, fidelity: str):
+        """`settings(fidelity)` as the workflow's frozen settings dataclass (`settings_class`): attributes typed,
+        documented and defaulted from the key declarations, e.g. ``recipe.typed_settings("quick").timestep_fs``."""
+        return settings_class(self.workflow)(**self.settings(fidelity))
 
     def canonical(self, fidelity: str) -> dict[str, Any]:
         """What defines a run at ``fidelity``: workflow, name and the resolved settings (comments, key order

@@ -126,13 +126,16 @@ def test_angles_and_gamma_of_different_water_models_are_not_combined():
 
 
 def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
+    from calibration.pipeline import CalibrationRecipe, Uncertainty
     from calibration.report import CalibrationReport, ValueRow
 
     table, rows = build_parameter_set(_results(), "paper", "cal")
+    recipe = CalibrationRecipe(name="cal", base="paper", path="recipe.toml", compare_sets=[],
+                               uncertainty=Uncertainty(scene="s", ranges={}, overrides={}))
     band = {"median": 0.5, "p05": 0.4, "p95": 0.6, "n": 4}
     report = CalibrationReport(
         name="cal", set_path=tmp_path / "cal.toml", out=tmp_path / "out",
-        calibration={"name": "cal", "base": "paper", "path": "recipe.toml"},
+        calibration=recipe,
         rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources={"adhesion_silica": {"source": "committed"}},
         bands={"first_rebound_over_h0": band, "rebound_count": band, "escape_velocity_m_per_s": band,
                "covers": ["x"], "samples": 4, "failed_samples": 0, "seed": 0, "scene": "s", "max_bounces": 3},
@@ -150,6 +153,8 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     saved = json.loads((tmp_path / "out" / "calibration.json").read_text())
     assert saved["rows"][0] == rows[0] | {k: None for k in ValueRow.__dataclass_fields__ if k not in rows[0]}
     assert saved["versions"]["numpy"] == np.__version__
+    assert saved["calibration"]["uncertainty"]["samples"] == 16            # the declared default
+    assert "Calibration `cal` (base `paper`)" in text and "Recipe `recipe.toml`" in text
     assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
 
 

@@ -75,8 +75,8 @@ def test_data_folder_is_searched_first_for_scenes_and_calibration_recipes(tmp_pa
 def test_shipped_calibration_recipes_are_found_by_name(capsys):
     from calibration.pipeline import load_calibration
 
-    assert load_calibration("quick")["name"] == "calibrated"
-    assert load_calibration("smoke")["uncertainty"]["samples"] == 4
+    assert load_calibration("quick").name == "calibrated"
+    assert load_calibration("smoke").uncertainty.samples == 4
     assert main(["calibrate", "no_such_recipe"]) == EXIT_INPUT
     line = _one_line(capsys.readouterr().err)
     assert "recipe = 'no_such_recipe'" in line and "quick" in line and "smoke" in line

@@ -226,3 +226,22 @@ def test_scene_dataclass_attributes_are_in_si_units():
     resolved = scene.resolve_scene("rough_silica", params="paper",
                                    overrides={"surfaces.body.contact_angle": 30.0})
     assert resolved.scene.surfaces.body.contact_angle == pytest.approx(math.radians(30.0), rel=1e-15)
+
+
+@pytest.mark.parametrize("path", sorted((INPUTS / "md").glob("*.toml")), ids=lambda p: p.stem)
+def test_md_settings_dataclass_holds_every_resolved_setting(path):
+    """A recipe's resolved settings at every fidelity fill its workflow's generated settings dataclass exactly:
+    no key without an attribute, no attribute without a key of that workflow."""
+    import dataclasses
+    import pickle
+
+    from md.recipe import FIDELITIES, load_recipe, settings_class
+
+    recipe = load_recipe(path)
+    cls = settings_class(recipe.workflow)
+    declared = {f.key for f in RECIPE_FIELDS if f.section != "top" and recipe.workflow in f.workflows}
+    assert {f.name for f in dataclasses.fields(cls)} == declared
+    for fidelity in FIDELITIES:
+        typed = recipe.typed_settings(fidelity)
+        assert dataclasses.asdict(typed) == recipe.settings(fidelity)
+        assert pickle.loads(pickle.dumps(typed)) == typed
