@@ -634,3 +634,41 @@ def test_fit_circle_is_unbiased_on_a_short_noisy_arc():
     assert np.mean(radii) == rel(radius, 0.05)
     xc, zc, r = fit_circle([1.0, -1.0, 0.0], [2.0, 2.0, 3.0])      # exact circle through 3 points
     assert (xc, zc, r) == pytest.approx((0.0, 2.0, 1.0), abs=1e-9)
+
+
+# ---------------------------------------------------------------------- dispersion beyond the cutoff
+@pytest.mark.parametrize("d", [-30.0, -12.0, -5.0, 0.0, 3.0, 11.9, 12.0, 12.1, 20.0, 45.0])
+def test_tail_antiderivative_is_the_half_space_integral_beyond_the_cutoff(d):
+    """(pi/2) F(d) is the r^-6 sum of one site with a uniform half-space (unit density, unit C6) over the pairs
+    beyond r_c, done independently shell by shell: the part of a sphere of radius r about the site that lies in
+    the half-space (its plane d above the site) has area clip(2 pi r (r - d), 0, 4 pi r^2)."""
+    from scipy.integrate import quad
+
+    from md.analysis import tail_antiderivative
+
+    rc = 12.0
+
+    def shell(r):
+        return min(max(2.0 * np.pi * r * (r - d), 0.0), 4.0 * np.pi * r * r) * r**-6
+
+    points = [p for p in (abs(d),) if p > rc]
+    exact = quad(shell, rc, np.inf, epsabs=0, epsrel=1e-13, limit=200)[0] if not points else \
+        quad(shell, rc, points[0], epsabs=0, epsrel=1e-13)[0] + quad(shell, points[0], np.inf, epsabs=0, epsrel=1e-13)[0]
+    assert 0.5 * np.pi * float(tail_antiderivative(d, rc)) == pytest.approx(exact, rel=1e-10)
+
+
+def test_dispersion_tail_work_reaches_hamaker_for_a_solid_half_space_beyond_the_cutoff():
+    """A solid of uniform density starting D >= r_c below the liquid: no pair is cut, so dW is the whole
+    dispersion work, A_H / (12 pi D^2) with A_H = pi^2 C6 rho_s n (Israelachvili). Sites on a fine lattice
+    approximate the solid; the error is that of the midpoint rule in depth."""
+    from md.analysis import dispersion_tail_work
+
+    c6, rho_s, n, D, rc = 2.0e4, 0.03, 0.0334, 15.0, 12.0
+    dz, depth = 0.02, 4000.0
+    z = -(D + dz * (np.arange(int(depth / dz)) + 0.5))         # layers below the plane at z = 0
+    area = 1.0 / (rho_s * dz)                                   # one site per layer: density rho_s
+    w = dispersion_tail_work(z, c6, 0.0, n, rc, area)
+    hamaker = np.pi**2 * c6 * rho_s * n
+    expected = hamaker / (12.0 * np.pi) * (D**-2 - (D + depth) ** -2)
+    assert w == pytest.approx(expected, rel=1e-5)
+    assert 0.0 < dispersion_tail_work(z, c6, 0.0, n, 2.0 * D, area) < w   # a longer cutoff leaves less beyond it

@@ -28,7 +28,7 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.topology import System
 
-from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, TRAPPE_UA, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
                                  fresh_from_data, intersect_ids, minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed,
                                  silica_face_of, stage_list, steps_of, system_summary, surface_slab, thermostat_lines)
 
@@ -38,10 +38,6 @@ from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, Workflow, common_define
 #: accelerations, to atoms of different mass and tear the group apart)
 _BACK_RIGID = "fix back_rigid upper_back rigid single force * off off on torque * off off off"
 
-#: TraPPE-UA pseudo-atoms (Martin & Siepmann, J. Phys. Chem. B 102 (1998) 2569): any pair with one of them is a
-#: "TraPPE pair" whose dispersion beyond the cutoff is added (TraPPE was fitted with 14 A + analytic tails). The
-#: OTS head Si (SIH) carries IFF LJ and stays with IFF's plain cutoff.
-TRAPPE_UA = ("CH3", "CH2")
 #: explicit-sum radius of the static dispersion tail (smeared images beyond); the cutoff study in every adhesion
 #: result compares 20, 30 and 40 A
 TAIL_R_MAX_A = 20.0

@@ -124,6 +124,12 @@ def minimize_water_lines(settings: Mapping[str, Any], write: Path | None = None)
 #: silanol O-H bond (IFF OC24-HOY, 0.945 A): constrained where silanols are mobile at a 2 fs timestep
 SILANOL_OH = (("OC24", "HOY"),)
 
+#: TraPPE-UA pseudo-atoms (Martin & Siepmann, J. Phys. Chem. B 102 (1998) 2569): any pair with one of them is a
+#: "TraPPE pair" whose dispersion beyond the cutoff is added (TraPPE was fitted with 14 A + analytic tails): in the
+#: adhesion windows by explicit sums over the frames, on the water of a contact angle by the half-space form
+#: (md.analysis.dispersion_tail_work). The OTS head Si (SIH) carries IFF LJ and stays with IFF's plain cutoff.
+TRAPPE_UA = ("CH3", "CH2")
+
 
 def shake_lines(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[str]:
     """``fix shake`` on every bond/angle type the force field marks rigid (SPC/E), and on the bond types

@@ -24,7 +24,7 @@ from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.topology import System, remove_atoms
 
-from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
                                  fresh_from_data, held_deep, intersect_ids, minimize_lines, minimize_water_lines, quantity_record,
                                  restart_header_lines, derived_seed, shake_lines, silica_face_of, stage_list, steps_of, system_summary, surface_slab,
                                  thermostat_lines, water_forcefield_names)
@@ -91,6 +91,15 @@ class ContactAngleWorkflow(Workflow):
         else:
             ref = system.group("sam_ch3")
         water_o = np.intersect1d(system.group("water_O"), water)
+        # the SAM's TraPPE sites go into the frames too: the water-TraPPE dispersion beyond the cutoff is added
+        # in the analysis (issue 11, item 4); their C6 with the water O (4 eps sigma^6, kcal/mol A^6)
+        tail_sites = np.array([], int)
+        if s["surface"] == "ots":
+            sam = np.asarray(system.group("sam"), int)
+            tail_sites = sam[np.isin(np.asarray(system.types)[sam], TRAPPE_UA)]
+        ow = str(np.asarray(system.types)[water_o[0]])
+        c6 = [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(t)) for t in np.asarray(system.types)[tail_sites])]
+        framed = np.union1d(np.union1d(water_o, ref), tail_sites)
         n_sub, n = len(substrate), system.n_atoms
         dt = s["timestep_fs"]
         shake = shake_lines(ff, also=SILANOL_OH)
@@ -125,7 +134,7 @@ class ContactAngleWorkflow(Workflow):
             return restart_header_lines(s)(sub_dir / f"restart.{_total}") + [
                 f"timestep {dt:g}",
                 f"read_data {water_data.as_posix()} add append group water",
-                f"group framed id {id_ranges(np.union1d(water_o, ref))}",
+                f"group framed id {id_ranges(framed)}",
                 "group mobile subtract all frozen",
                 f"delete_atoms overlap {DROPLET_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
 
@@ -142,7 +151,8 @@ class ContactAngleWorkflow(Workflow):
                 "silica_face": silica_face_of(s),
                 "water_O_ids": (water_o + 1).tolist(), "surface_ref_ids": (ref + 1).tolist(),
                 "surface_ref": "top silanol O" if s["surface"] == "silica" else "OTS CH3 groups",
-                "water_model": s["water_model"], "type_ids": ids}
+                "water_model": s["water_model"], "type_ids": ids,
+                "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6}
         return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
                     seeds={"structure_substrate": seed, "structure_water": seed + 1,
                            "velocities_substrate": derived_seed(seed, 3, 0), "velocities": derived_seed(seed, 3, 1),
@@ -213,6 +223,19 @@ class ContactAngleWorkflow(Workflow):
                          f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
                          f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
         elif status == "measured":
+            tail = _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err)
+            if tail is not None:
+                q["contact_angle_as_simulated"] = dict(q["contact_angle"], kind="circle fit at the water's dividing "
+                                                       "plane, LJ truncated at the cutoff (as simulated)")
+                q["dispersion_tail_work_sl"] = quantity_record(tail["work"], tail["work_stderr"], "J/m^2",
+                                                               kind=tail["kind"])
+                angle, angle_err = tail["angle"], tail["angle_stderr"]
+                if tail["wets"]:
+                    status = "wets"
+                q["contact_angle"] = quantity_record(angle, angle_err, "deg", status=status, kind=(
+                    "circle fit at the water's dividing plane, plus the water-TraPPE dispersion beyond the cutoff "
+                    "(static: W_SL + dW_tail, md.analysis.dispersion_tail_work)"))
+                notes.append(tail["note"])
             wl = A.work_of_adhesion_sl(gamma, angle, None, angle_err)
             q["work_of_adhesion_sl"] = quantity_record(wl["value"], wl["stderr"], "J/m^2",
                                           kind="Young-Dupre W_SL = gamma_lv (1 + cos theta), this water model's gamma")
@@ -283,5 +306,48 @@ class ContactAngleWorkflow(Workflow):
                    "drift": drift, "wetting": wet, "fit_error": r.fit_error, "cap_height_A": r.cap_height_A,
                    "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames), "n_water_molecules": n_water,
                    "water_model": s["water_model"], "gamma_lv_N_m": gamma}
+        if status in ("measured", "wets") and "dispersion_tail_work_sl" in q:
+            details["dispersion_tail"] = tail["details"]
         return Analysis(quantities=q, curves=curves, figures={"density_map": figure_writer(draw)}, notes=notes,
                         details=details)
+
+
+def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
+    """The water-TraPPE dispersion beyond the cutoff on a measured angle (None where the substrate has no TraPPE
+    site, or a run planned before the sites were stored): dW per frame from the sites' heights under the water's
+    dividing plane (md.analysis.dispersion_tail_work, the water at its bulk density above the plane), then
+    Young-Dupre with it, cos theta' = cos theta + dW / gamma_lv. Returns the corrected angle and its stderr (first
+    order, the angle's and dW's errors independent), dW (J/m^2) with its stderr (statistical inefficiency of the
+    per-frame series), a note and the details."""
+    site_ids = info.get("tail_site_ids") or []
+    if not site_ids:
+        return None
+    is_site = np.isin(ids, site_ids)
+    if not is_site.any():
+        return None
+    order = {int(i): k for k, i in enumerate(site_ids)}
+    c6 = np.asarray(info["tail_site_c6_kcal_A6"], float)[[order[int(i)] for i in ids[is_site]]]
+    n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(A.WATER_MOLAR_MASS)
+    z_ref = float(r.reference_z)
+    per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, z_ref, n_w, s["cutoff_A"],
+                                                 float(box[k][0] * box[k][1])) for k in range(len(pos))])
+    st = A.timeseries_stats(per_frame, equilibrate=False)
+    dw = U.kcal_per_mol_A2_to_J_per_m2(st["mean"])
+    dw_err = U.kcal_per_mol_A2_to_J_per_m2(st["stderr"]) if np.isfinite(st["stderr"]) else None
+    th = np.radians(angle)
+    cos_new = np.cos(th) + dw / gamma
+    wets = bool(cos_new >= 1.0)
+    new = 0.0 if wets else float(np.degrees(np.arccos(max(cos_new, -1.0))))
+    new_err = None
+    if not wets and angle_err is not None:
+        var = (np.sin(th) * np.radians(angle_err)) ** 2 + ((dw_err or 0.0) / gamma) ** 2
+        new_err = float(np.degrees(np.sqrt(var) / max(np.sin(np.radians(new)), 1e-12)))
+    note = (f"water-TraPPE dispersion beyond the {s['cutoff_A']:g} A cutoff added statically: dW_SL = "
+            f"{dw * 1e3:.2f} mJ/m^2 ({int(is_site.sum())} CH2/CH3 sites under the water's dividing plane, water at its "
+            f"bulk density above it), so theta = {angle:.1f} deg as simulated -> {new:.1f} deg "
+            "(cos theta + dW/gamma_lv); the water-water and IFF pairs keep the plain cutoff.")
+    return {"angle": new, "angle_stderr": new_err, "wets": wets, "work": dw, "work_stderr": dw_err, "note": note,
+            "kind": "water-TraPPE dispersion beyond the cutoff, per area of wetted SAM (static half-space sum)",
+            "details": {"per_frame_J_m2": U.kcal_per_mol_A2_to_J_per_m2(per_frame).tolist(),
+                        "g": st["g"], "cutoff_A": s["cutoff_A"], "water_number_density_A3": n_w,
+                        "plane_z_A": z_ref, "sites": int(is_site.sum()), "angle_as_simulated_deg": angle}}
