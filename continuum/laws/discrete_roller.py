@@ -136,11 +136,9 @@ class DiscreteRoughRoller(RoughRollerBase):
         self.footprint_half_width = float(footprint_half_width if footprint_half_width is not None
                                           else self.datum["footprint_half_width"])
         # run-wide diagnostics
-        self.max_contacts = 0
+        self._start_run_counters(int)
         self.max_depth = 0.0
         self.max_deflection = 0.0
-        self.max_pressure = 0.0
-        self.edge_touched = False
         self.beyond_strip = False
         self.evaluations = 0
         self.deepened = 0

@@ -73,6 +73,14 @@ class RoughRollerBase(ContactLaw):
         raise NotImplementedError(f"{type(self).__name__} keeps no cached trial state")
 
     # ------------------------------------------------------------------ shared
+    def _start_run_counters(self, contact_count: type = float) -> None:
+        """The run-wide counters every roller's record reports, at their start: the most summits attached at once
+        (`contact_count`: float, an expected number, for the averaged laws; int, a count, for the discrete one),
+        the largest nominal pressure (Pa), and whether a contact reached the edge of the grid or footprint."""
+        self.max_contacts = contact_count(0)
+        self.max_pressure = 0.0
+        self.edge_touched = False
+
     def _take_surface(self, surface) -> None:
         """The lengths an averaged law reads from its `SummitSurface`."""
         self.surface = surface

@@ -60,9 +60,7 @@ class RigidRoughRoller(RoughRollerBase):
         self._r_in = min(self.attach_stretch, self.release_stretch)
         self.table_depth = 0.0
         self.build_seconds = 0.0
-        self.max_contacts = 0.0
-        self.max_pressure = 0.0
-        self.edge_touched = False
+        self._start_run_counters()
         self.depth_history: list[dict] = []
         #: accepted states deeper than the tables (evaluated by the integral itself)
         self.beyond_tables = 0

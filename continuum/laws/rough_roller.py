@@ -70,10 +70,8 @@ class RoughRoller(RoughRollerBase):
         self.n = grid_points
         self.depth_safety = depth_safety
         self.coupling_tol = coupling_tol
-        self.edge_touched = False
+        self._start_run_counters()
         self.max_deflection = 0.0                # largest |delta_e| seen (m)
-        self.max_contacts = 0.0                  # most summits attached at once
-        self.max_pressure = 0.0                  # largest nominal pressure on the grid (Pa)
         self.grid_history: list[dict] = []
         #: coupled pressure-deflection solves: how many, which solver produced each, worst residual
         #: (relative to the pressure scale max(max|p|, n P_c))
