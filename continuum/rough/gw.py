@@ -34,6 +34,9 @@ Gauss-Legendre quadrature in the JKR variable s = sqrt(a/a0) (layout: `gw_layout
 `summits`). The law is continuous where a threshold changes branch. Derivation, table errors
 (`table_error` against the adaptive quadrature of `gw_reference`) and costs: docs/rough-gw.md.
 States deeper than the tables (d < -20 sigma) are integrated on the fly with fixed Gauss-Legendre nodes.
+Values (pressure, energy, contact fraction) run compiled, one state at a time (`gw_kernel`: the footprint
+tables of the rigid roller evaluate ~1e5-1e7 states); derivatives and parts run in NumPy (`_integral_numpy`,
+the kernel's reference).
 
 Sources: J. A. Greenwood & J. B. P. Williamson, Proc. R. Soc. Lond. A 295 (1966) 300-319;
 K. N. G. Fuller & D. Tabor, Proc. R. Soc. Lond. A 345 (1975) 327-342; K. L. Johnson, K. Kendall &
@@ -55,8 +58,9 @@ from .gw_layout import (_BUILD_BLOCK, _DH, _DT_PANEL, _GL_W, _GL_X, _H_DEEP, _H_
 from .gw_reference import quadrature_contact_fraction, quadrature_energy, quadrature_pressure, table_error
 from ..physics.jkr_kernel import S_FOLD as _S_FOLD, S_LOAD as _S_LOAD, S_ZERO as _S_ZERO, dx_ds as _dx_ds
 from ..physics.jkr_kernel import reduced_curve as _q_of_s, reduced_curve_minus_hertz as _g_of_s, x_of_s as _x_of_s
-from .summits import (TENSILE_ONSET, SummitStatistics, _gauss_mass, _out, _phi, _s_of_x, expected_max_height,
-                      gw_integral)
+from .summits import (_GH_W, _GH_X, TENSILE_ONSET, SummitStatistics, _gauss_mass, _out, _phi, _s_of_x,
+                      expected_max_height, gw_integral)
+from . import gw_kernel
 
 __all__ = [
     "SummitStatistics",
@@ -70,6 +74,7 @@ __all__ = [
     "TENSILE_ONSET",
     "table_size",
 ]
+_NO_BRANCH = np.zeros(0, np.int8)      # `gw_kernel.integral` records no branches
 # ==============================================================================================
 # The surface
 # ==============================================================================================
@@ -450,7 +455,61 @@ class GWJKRSurface:
         return H, dH
 
     def _integral(self, j, d, zeta, deriv=False, parts=False):
-        """Quantity j (0 pressure, 1 energy, 2 area fraction) per unit area (SI) and d/dd, or parts."""
+        """Quantity j (0 pressure, 1 energy, 2 area fraction) per unit area (SI) and d/dd, or parts.
+
+        Values alone (the footprint tables' and most callers' case) come from the compiled kernel
+        (`gw_kernel.integral`, the same arithmetic one state at a time); with `deriv` or `parts` from
+        `_integral_numpy`, which is also the reference the kernel is tested against (tests/test_gw_kernel.py).
+        """
+        if deriv or parts:
+            return self._integral_numpy(j, d, zeta, deriv, parts)
+        d = np.asarray(d, dtype=float)
+        zeta = np.asarray(zeta, dtype=float)
+        if d.shape != zeta.shape:
+            d, zeta = np.broadcast_arrays(d, zeta)
+        shape = d.shape
+        return self._kernel_values(j, d.reshape(-1), zeta.reshape(-1)).reshape(shape), None
+
+    def _kernel_values(self, j, d, zeta, branch=None):
+        """`gw_kernel.integral` of quantity j at flat d, zeta (m); `branch`: an int8 array of d's size to record
+        each state's branch in (tests), or None."""
+        d = np.require(d, float, ["C", "W"])           # one compiled specialisation: contiguous, writeable
+        zeta = np.require(zeta, float, ["C", "W"])
+        P, t1q, *tables = self._kernel_tables(j)
+        e = gw_kernel.log_hertz(d, P, t1q)
+        np.exp(e, out=e)                                # NumPy's exp, as `_integral_numpy` takes it (gw_kernel)
+        return gw_kernel.integral(j, d, zeta, e, P, t1q, *tables, _NO_BRANCH if branch is None else branch)
+
+    def _kernel_tables(self, j):
+        """(P, t1q, wcoef, end, band, deep_t, deep_w, gh_x, gh_w) of quantity j for `gw_kernel.integral`: the
+        surface's scalars (`gw_kernel.P_*`) and its tables, as built (placeholders where a surface has none)."""
+        cache = self.__dict__.setdefault("_kernel_cache", {})
+        if j not in cache:
+            K = gw_kernel
+            P = np.zeros(K.P_SIZE)
+            P[K.P_INV_SIGMA], P[K.P_TRUNCATED], P[K.P_ADHESIVE] = self._inv_sigma, self.truncated, self.adhesive
+            P[K.P_TMAX], P[K.P_HLO], P[K.P_X10] = self._tmax, self._hlo, self._x10
+            P[K.P_INV_DX1], P[K.P_N1], P[K.P_NU] = self._inv_dx1, self._n1, _HERTZ_NU[j]
+            P[K.P_HS], P[K.P_AS] = self._hs[j], self._as[j]
+            P[K.P_DN], P[K.P_LAM], P[K.P_XR] = self._dn, self._lam, self._xr
+            none2 = np.zeros((4, 1))
+            wcoef, end, band = np.zeros((1, 16)), none2, none2
+            if self.adhesive:
+                t2 = self._t2[j]
+                P[K.P_INV_L] = 1.0 / self._L
+                P[K.P_W_A0], P[K.P_W_INV_DA], P[K.P_W_NA] = t2.a0, t2.inv_da, t2.na
+                P[K.P_W_B0], P[K.P_W_INV_DB], P[K.P_W_NB] = t2.b0, t2.inv_db, t2.nb
+                P[K.P_END_X0], P[K.P_END_INV_DX], P[K.P_END_N] = self._end_x0, self._end_inv_dx, self._end_n
+                wcoef, end = t2.coef, self._end[j]
+                if self.truncated:
+                    P[K.P_BAND_N], band = self._band_n, self._band[j]
+            tn, wphi = self._deep_nodes
+            tables = (self._t1q[j], wcoef, end, band, tn, wphi, _GH_X, _GH_W)
+            cache[j] = (P,) + tuple(np.require(a, float, ["C", "W"]) for a in tables)
+        return cache[j]
+
+    def _integral_numpy(self, j, d, zeta, deriv=False, parts=False):
+        """`_integral` in NumPy: every branch vectorised over the states (the reference of `gw_kernel.integral`)."""
         d = np.asarray(d, dtype=float)
         zeta = np.asarray(zeta, dtype=float)
         if d.shape != zeta.shape:
@@ -633,9 +692,8 @@ class GWJKRSurface:
         return _out(self._integral(0, d, zeta, deriv=True)[1])
 
     def pressure_and_stiffness(self, d, zeta):
-        """(p, dp/dd) in one pass (Pa, Pa/m)."""
-        p, k = self._integral(0, d, zeta, deriv=True)
-        return _out(p), _out(k)
+        """(p, dp/dd) (Pa, Pa/m): p as `pressure` gives it (compiled), dp/dd from the NumPy form (`stiffness`)."""
+        return _out(self._integral(0, d, zeta)[0]), _out(self._integral(0, d, zeta, deriv=True)[1])
 
     def pressure_parts(self, d, zeta):
         """(compressive, tensile) parts of p (Pa): summits with P_JKR > 0 and with P_JKR < 0."""
