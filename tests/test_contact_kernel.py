@@ -143,8 +143,11 @@ def test_compiled_rough_impacts_match_the_python_stepper(scene_file, bounces):
         pa, pb = a.profiles["pull_off"], b.profiles["pull_off"]
         assert pa["force"] == pytest.approx(pb["force"], rel=1e-5)
         assert pa["gap"] == pytest.approx(pb["gap"], rel=1e-3)
-    # the audit is the largest sampled energy error, O(rtol) on both paths
-    assert fast.audit["max_relative_error"] == pytest.approx(slow.audit["max_relative_error"], rel=0, abs=tol)
+    # the audit is the largest sampled energy error: set by the tables (~1e-6 of the turnover), not by rtol, and
+    # a maximum over samples, so a step flipped by round-off (numba's FMA use differs between CPUs) moves it by a
+    # fraction of itself (1.23e-6 -> 1.59e-6 seen with 1-ulp table noise): both small, and of the same size
+    fa, sa = fast.audit["max_relative_error"], slow.audit["max_relative_error"]
+    assert max(fa, sa) < 1e-5 and abs(fa - sa) <= 0.5 * max(fa, sa)
     # samples are taken per accepted step: a flipped acceptance changes the count by a few, not more
     assert abs(len(fast.trace.t) - len(slow.trace.t)) <= 0.02 * len(slow.trace.t)
 
