@@ -246,6 +246,14 @@ def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(md_sm
     assert study["trappe_20A_J_m2"] == pytest.approx(study["trappe_40A_J_m2"], rel=0.02)
     assert study["all_20A_J_m2"] >= study["trappe_20A_J_m2"] - 1e-9        # IFF pairs reported, not applied
     assert abs(tail["fep_minus_mean_J_m2"]) < 0.05 * tail["static_work_J_m2"]   # first order suffices
+    # window length: W_F of each window's two halves; trapezoid integration is linear in the mean forces, so the
+    # halves' average is the whole's but for the registries' weights and an odd sample count
+    wl = r["details"]["window_length_check"]
+    assert math.isfinite(wl["first_half_J_m2"]) and math.isfinite(wl["second_half_J_m2"])
+    assert wl["difference_J_m2"] == pytest.approx(wl["second_half_J_m2"] - wl["first_half_J_m2"], abs=1e-15)
+    assert isinstance(wl["converged"], bool) and wl["difference_stderr_J_m2"] > 0
+    assert 0.5 * (wl["first_half_J_m2"] + wl["second_half_J_m2"]) == pytest.approx(wl["whole_J_m2"], rel=0.02)
+    assert any(n.startswith("window length: W_F") for n in r["notes"])
 
 
 @pytest.mark.md

@@ -304,14 +304,19 @@ class Adhesion(Workflow):
         d_A = np.full((n_reg, len(suffixes)), np.nan)
         f_m, f_e = np.full_like(d_A, np.nan), np.full_like(d_A, np.nan)
         g_w, neff_w = np.full_like(d_A, np.nan), np.full_like(d_A, np.nan)
+        halves = np.full((2,) + d_A.shape, np.nan)          # mean force of each window's first and second half
         for r in range(n_reg):
             for k, suf in enumerate(suffixes):
                 win = ctx.samples(f"pmf_r{r}_{suf}")           # one read of the window's samples
                 st = A.timeseries_stats(win["fz"])
                 d_A[r, k] = float(np.mean(win["z_back"])) - zc
                 f_m[r, k], f_e[r, k], g_w[r, k], neff_w[r, k] = st["mean"], st["stderr"], st["g"], st["n_eff"]
+                fz = np.asarray(win["fz"], float)
+                if fz.size >= 2:
+                    halves[0, r, k], halves[1, r, k] = np.mean(fz[:fz.size // 2]), np.mean(fz[fz.size // 2:])
         order = np.argsort(d_A[0])
         d_A, f_m, f_e, g_w, neff_w = (a[:, order] for a in (d_A, f_m, f_e, g_w, neff_w))
+        halves = halves[:, :, order]
         suffixes = [suffixes[i] for i in order]
         dsep = d_A.mean(axis=0)
         avg = A.registry_average(f_m, f_e)
@@ -333,6 +338,10 @@ class Adhesion(Workflow):
         wf = ti["value"] - u_tail_last * conv
         wf_pchip = ti["value_pchip"] - u_tail_last * conv
         wf_err, wf_disc = ti["stderr"], ti["discretisation_error"]
+        # window length: W_F from each window's first half against its second half (the same grid, tail and
+        # registries); windows long enough for their decorrelation give the same W within the errors
+        w_half = [A.force_integration_work(dsep, np.nanmean(h, axis=0) + f_tail, ebar * math.sqrt(2.0),
+                                           area)["value"] - u_tail_last * conv for h in halves]
         per_reg = [A.force_integration_work(d_A[r], f_m[r], f_e[r], area) for r in range(n_reg)]
         w_reg = np.array([p["value"] for p in per_reg])
         if n_reg >= 2:
@@ -392,6 +401,14 @@ class Adhesion(Workflow):
             "registry_work_J_m2": w_reg.tolist(), "registry_offsets_A": info["registry_offsets_A"],
             "zero_force_separation_A": ti["zero_force_separation_A"], "repulsive_end": repulsive,
             "windows_with_few_samples": short, "cutoff_only_work_J_m2": ti_cut["value"]}
+        # the halves' errors are sqrt(2) of the whole's, so their difference has stderr 2 x the whole's
+        half_diff, half_err = w_half[1] - w_half[0], 2.0 * wf_err
+        details["window_length_check"] = {
+            "first_half_J_m2": w_half[0], "second_half_J_m2": w_half[1], "whole_J_m2": wf,
+            "difference_J_m2": half_diff, "difference_stderr_J_m2": half_err,
+            "converged": bool(abs(half_diff) <= 2.0 * half_err),
+            "what": "W_F from the first and the second half of every window's samples (same grid, tail, registries): "
+                    "a drift between them means the windows are too short for the force to settle"}
         tail_det.update(tail_energy_last_window_kcal=u_tail_last)
         details["dispersion_tail"] = tail_det
         pmf = ti["pmf_J_per_m2"]
@@ -412,6 +429,11 @@ class Adhesion(Workflow):
         if short:
             notes.append(f"windows with fewer than {MIN_WINDOW_NEFF} effectively independent samples: {short} "
                          f"(lengthen pmf_sample_steps).")
+        notes.append(f"window length: W_F from the first half of every window {w_half[0]:.4f}, from the second half "
+                     f"{w_half[1]:.4f} J/m^2 (difference {half_diff:+.4f} +/- {half_err:.4f}: "
+                     + ("within 2 stderr" if abs(half_diff) <= 2.0 * half_err else
+                        "MORE THAN 2 STDERR: the windows are too short for the mean force to settle; lengthen "
+                        "pmf_sample_steps") + ").")
         if tail_on:
             notes.append(f"dispersion beyond the {s['cutoff_A']:g} A cutoff for TraPPE pairs (any pair with a CH2/CH3 "
                          f"united atom) added as a static correction measured on this run's frames: "
