@@ -304,14 +304,16 @@ class Adhesion(Workflow):
         d_A = np.full((n_reg, len(suffixes)), np.nan)
         f_m, f_e = np.full_like(d_A, np.nan), np.full_like(d_A, np.nan)
         g_w, neff_w = np.full_like(d_A, np.nan), np.full_like(d_A, np.nan)
-        halves = np.full((2,) + d_A.shape, np.nan)          # mean force of each window's first and second half
+        # mean force of the first and the second half of each window's equilibrated samples (those after the
+        # detected start t0, as the mean itself)
+        halves = np.full((2,) + d_A.shape, np.nan)
         for r in range(n_reg):
             for k, suf in enumerate(suffixes):
                 win = ctx.samples(f"pmf_r{r}_{suf}")           # one read of the window's samples
                 st = A.timeseries_stats(win["fz"])
                 d_A[r, k] = float(np.mean(win["z_back"])) - zc
                 f_m[r, k], f_e[r, k], g_w[r, k], neff_w[r, k] = st["mean"], st["stderr"], st["g"], st["n_eff"]
-                fz = np.asarray(win["fz"], float)
+                fz = np.asarray(win["fz"], float)[int(st["t0"]):]     # the samples the mean uses (after t0)
                 if fz.size >= 2:
                     halves[0, r, k], halves[1, r, k] = np.mean(fz[:fz.size // 2]), np.mean(fz[fz.size // 2:])
         order = np.argsort(d_A[0])
@@ -407,8 +409,9 @@ class Adhesion(Workflow):
             "first_half_J_m2": w_half[0], "second_half_J_m2": w_half[1], "whole_J_m2": wf,
             "difference_J_m2": half_diff, "difference_stderr_J_m2": half_err,
             "converged": bool(abs(half_diff) <= 2.0 * half_err),
-            "what": "W_F from the first and the second half of every window's samples (same grid, tail, registries): "
-                    "a drift between them means the windows are too short for the force to settle"}
+            "what": "W_F from the first and the second half of every window's equilibrated samples (after the detected "
+                    "start, as W_F itself; same grid, tail, registries): a drift between them means the windows are "
+                    "too short for the force to settle"}
         tail_det.update(tail_energy_last_window_kcal=u_tail_last)
         details["dispersion_tail"] = tail_det
         pmf = ti["pmf_J_per_m2"]
