@@ -40,7 +40,7 @@ from .report import CalibrationReport, ValueRow
 from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
 from nanoimpact.errors import InputError
-from nanoimpact.fields import REQUIRED, Field, Resolved, frozen_dataclass
+from nanoimpact.fields import REQUIRED, Field, Resolved, frozen_dataclass, section_members
 from nanoimpact.fields import json_schema as json_schema_of
 
 log = logging.getLogger(__name__)
@@ -82,10 +82,6 @@ FIELDS = (
 FIELD_BY_KEY = {f.key: f for f in FIELDS}
 
 
-def _members(section: str) -> list[tuple[str, Field]]:
-    return [(f.key.rpartition(".")[2], f) for f in FIELDS if f.key.rpartition(".")[0] == section]
-
-
 def _as_dict(self) -> dict:
     """The recipe as plain JSON-ready data (calibration.json's `calibration`)."""
     import dataclasses
@@ -96,13 +92,13 @@ def _as_dict(self) -> dict:
 #: A checked calibration recipe (`load_calibration`), generated from the key declarations above; the names of the
 #: parameter sets and the uncertainty scene are resolved to what was found (a shipped name stays a name).
 Uncertainty = frozen_dataclass(
-    "Uncertainty", [*_members("uncertainty"),
+    "Uncertainty", [*section_members(FIELDS, "uncertainty"),
                     ("ranges", Resolved(dict, "", "{dotted scene key: (low, high)}: user ranges (uniform), each "
                                                   "checked by the scene key's own declaration.")),
                     ("overrides", Resolved(dict, "", "{dotted scene key: value}: scene overrides of every sample."))],
     doc="The [uncertainty] table of a calibration recipe: Latin-hypercube samples of one scene.", module=__name__)
 CalibrationRecipe = frozen_dataclass(
-    "CalibrationRecipe", [*_members(""),
+    "CalibrationRecipe", [*section_members(FIELDS, ""),
                           ("path", Resolved(str, "", "The recipe file read.")),
                           ("uncertainty", Resolved(Uncertainty, "", "The [uncertainty] table."))],
     doc="A checked calibration recipe (`load_calibration`).", module=__name__, namespace={"to_dict": _as_dict})

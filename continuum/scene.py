@@ -18,7 +18,7 @@ from pathlib import Path
 
 from nanoimpact import data
 from nanoimpact.errors import InputError
-from nanoimpact.fields import Resolved, frozen_dataclass, resolved
+from nanoimpact.fields import Resolved, frozen_dataclass, resolved, section_members
 
 from .reference.hertz import effective_modulus
 from .schema import FIDELITY, FIELD_BY_PATH, FIELDS, REQUIRED, Field, is_section, to_internal
@@ -38,13 +38,8 @@ class SceneError(InputError):
 # in radians). `Resolved` attributes are the ones `_build` computes from several keys or a preset. Keys that no
 # attribute holds are listed in FOLDED_KEYS with where they go.
 def _members(section: str, skip: tuple[str, ...] = ()) -> list[tuple[str, Field]]:
-    """(attribute, declaration) for the keys directly in `section` ('' for the top level), in declaration order."""
-    out = []
-    for f in FIELDS:
-        parent, _, leaf = f.path.rpartition(".")
-        if parent == section and leaf not in skip:
-            out.append((leaf, f))
-    return out
+    """(attribute, declaration) for the scene keys directly in `section` ('' for the top level)."""
+    return section_members(FIELDS, section, skip)
 
 
 def _replace_member(members: list, attr: str, member: Field | Resolved) -> list:

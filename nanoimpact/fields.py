@@ -20,7 +20,8 @@ from typing import Any, Callable, Iterable, Sequence
 
 from .errors import InputError
 
-__all__ = ["REQUIRED", "Field", "Resolved", "resolved", "frozen_dataclass", "markdown_table", "json_schema"]
+__all__ = ["REQUIRED", "Field", "Resolved", "resolved", "section_members", "frozen_dataclass", "markdown_table",
+           "json_schema"]
 
 JSON_SCHEMA_DIALECT = "https://json-schema.org/draft/2020-12/schema"
 
@@ -214,6 +215,18 @@ def resolved(f: Field, doc: str | None = None, unit: str | None = None) -> Resol
     built: e.g. a tolerance that defaults to the fidelity preset's)."""
     kind = list[f.item or float] if f.kind is list else f.kind
     return Resolved(kind, f.unit if unit is None else unit, f.doc if doc is None else doc, key=f.key)
+
+
+def section_members(fields: Iterable[Field], section: str, skip: Iterable[str] = ()) -> list[tuple[str, Field]]:
+    """(attribute, declaration) for the keys directly in the dotted table `section` ('' for the top level), in
+    declaration order, leaving out the names in `skip`: the members of that section's `frozen_dataclass`."""
+    skip = set(skip)
+    out = []
+    for f in fields:
+        parent, _, leaf = f.key.rpartition(".")
+        if parent == section and leaf not in skip:
+            out.append((leaf, f))
+    return out
 
 
 def _attribute(member: Field | Resolved, unit: Callable[[Field], str],
