@@ -12,6 +12,9 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.transforms import blended_transform_factory
 
+from nanoimpact.fileio import atomic_save_figure
+
+from ..plots import PNG_FAST
 from ..results import load_result
 
 
@@ -259,8 +262,7 @@ def fig8b(wet: dict, set_name: str, out: Path, ax=None):
 
 
 def save(ax, path: Path) -> None:
+    """Save the figure of `ax` as PNG, atomically (nanoimpact.fileio), with the run figures' fast compression."""
     fig = ax.figure
     fig.tight_layout()
-    tmp = path.with_name(path.stem + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
+    atomic_save_figure(fig, path, dpi=110, pil_kwargs=PNG_FAST)
