@@ -44,15 +44,24 @@ def cache(tmp_path_factory):
 # ------------------------------------------------------------------------------------ protocol (no LAMMPS)
 
 def test_protocol_versions_enter_the_run_hash():
+    """Adhesion version 4 changed bare silica pairs only: they follow version 4, SAM pairs keep version 3 (and the
+    hashes of their committed results)."""
     from md import workflows
-    assert workflows.WORKFLOWS["adhesion"].version == 3 and workflows.WORKFLOWS["pulloff"].version == 2
+    from md.workflows import run_hash
+    ad = workflows.get_workflow("adhesion")
+    assert ad.version == 4 and workflows.WORKFLOWS["pulloff"].version == 2
+    assert ad.protocol_version(_settings("adhesion_silica", "quick")) == 4
+    for name in ("adhesion_ots", "adhesion_silica_ots"):
+        assert ad.protocol_version(_settings(name, "quick")) == 3
+        _, doc = run_hash(name, "quick")
+        assert doc["workflow_version"] == 3
 
 
 def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path):
     """The generated commands: window 0 of every registry starts from the contact leg's last restart, moved
     laterally to the registry's offset; each further window reads its neighbour's last restart and moves the upper
     slab by the difference of the nominal separations -- inwards (compression) and outwards."""
-    from md.workflows.adhesion import Adhesion, _registry_offsets
+    from md.workflows.adhesion import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, Adhesion, _registry_offsets
     s = _settings("adhesion_silica", "quick")
     wf = Adhesion()
     plan = wf.plan(s, tmp_path)
@@ -76,12 +85,26 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
                 assert "legs/contact/restart." in head
                 if r == 0:
                     assert not move
-                else:
-                    assert move == [f"displace_atoms upper move {dx:.6f} {dy:.6f} 0.000000 units box"]
+                else:       # bare silica (version 4): lifted before the shift, lowered back quasi-statically
+                    assert move == [f"displace_atoms upper move {dx:.6f} {dy:.6f} {REGISTRY_LIFT_A:.6f} units box"]
+                    prep = legs[f"pmf_r{r}_{suf}"].prepare(tmp_path / "x")
+                    down = [c for c in prep if c.startswith("displace_atoms upper move")]
+                    assert len(down) == REGISTRY_LOWER_STEPS
+                    assert sum(float(c.split()[5]) for c in down) == pytest.approx(-REGISTRY_LIFT_A, abs=1e-9)
+                    assert sum(c.startswith("minimize") for c in prep) == REGISTRY_LOWER_STEPS
             else:
                 assert f"legs/pmf_r{r}_{prev}/restart." in head
                 assert move == [f"displace_atoms upper move 0.000000 0.000000 {d - nominal[prev]:.6f} units box"]
             assert not any(c.startswith("velocity") for st in legs[f"pmf_r{r}_{suf}"].stages for c in st.begin)
+    # a SAM pair keeps version 3's start: shifted at contact, no lift, nothing before the stages
+    so = _settings("adhesion_silica_ots", "quick")
+    (tmp_path / "so").mkdir()
+    plan_so = wf.plan(so, tmp_path / "so")
+    legs_so = {l.name: l for l in plan_so.legs}
+    off = plan_so.system_info["registry_offsets_A"][1]
+    assert [c for c in legs_so["pmf_r1_o00"].fresh(tmp_path / "y") if c.startswith("displace_atoms")] == \
+        [f"displace_atoms upper move {off[0]:.6f} {off[1]:.6f} 0.000000 units box"]
+    assert legs_so["pmf_r1_o00"].prepare(tmp_path / "y") == ["reset_timestep 0"]
     # the chain order: every leg runs after the one it continues from
     order = [l.name for l in plan.legs]
     for l in plan.legs:

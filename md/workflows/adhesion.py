@@ -59,14 +59,24 @@ class Adhesion(Workflow):
     equilibration detection; z0 and sigma0 come from the flat-slab curve; dispersion beyond the cutoff is added for
     TraPPE pairs (``dispersion_tail``). Version 2 started every window from the contact (1 + 3-5 ps each) at one
     registry and integrated from the first window; version 1 started them from the minimised build, 2.8 A wider
-    than the 300 K contact (W_F 0.006 against dE/A 0.123 J/m^2 for silica)."""
+    than the 300 K contact (W_F 0.006 against dE/A 0.123 J/m^2 for silica).
+
+    Version 4 changes bare silica pairs only (`protocol_version`; SAM pairs keep version 3, plans and hashes
+    unchanged): a registry's first window no longer shifts the upper slab laterally while in contact, which on
+    the quick (111) cells put interlocked silanols onto each other (potential energy ~1e8 kcal/mol, LAMMPS lost
+    atoms at the first step). It lifts the slab by REGISTRY_LIFT_A, shifts it, and lowers it back in
+    REGISTRY_LOWER_STEPS steps, minimising after each with the backs held: a quasi-static approach at the new
+    registry (:func:`registry_approach_lines`)."""
     name = "adhesion"
-    version = 3
+    version = 4
     yields = {"work_of_adhesion": "J/m^2", "work_of_adhesion_free_energy": "J/m^2",
               "entropic_term_TdS": "J/m^2", "interface_area": "m^2"}
 
     def forcefield_files(self, s):
         return ["silica_interface"] + (["ots_trappe_ua"] if "ots" in s["surfaces"] else [])
+
+    def protocol_version(self, s) -> int:
+        return self.version if _lifts_registries(s) else 3
 
     def windows(self, s) -> np.ndarray:
         """Nominal separations from contact (A): the compressed chain (negative, innermost first) and the outward
@@ -186,12 +196,16 @@ class Adhesion(Workflow):
             for r, (dx, dy) in enumerate(registries):
                 for suffix, d_nom, prev in self.chains(s):
                     name = f"pmf_r{r}_{suffix}"
-                    if prev is None:
+                    prepare = lambda _d: ["reset_timestep 0"]
+                    if prev is None and r > 0 and _lifts_registries(s):
+                        fresh = from_leg(contact_dir, contact.total_steps, (dx, dy, d_nom + REGISTRY_LIFT_A))
+                        prepare = lambda _d: registry_approach_lines(s)
+                    elif prev is None:
                         fresh = from_leg(contact_dir, contact.total_steps, (dx, dy, d_nom))
                     else:
                         fresh = from_leg(run_dir / "legs" / f"pmf_r{r}_{prev}", total, (0.0, 0.0, d_nom - nominal[prev]))
                     nominal[suffix] = d_nom
-                    legs.append(Leg(name=name, fresh=fresh, prepare=lambda _d: ["reset_timestep 0"], stages=stages,
+                    legs.append(Leg(name=name, fresh=fresh, prepare=prepare, stages=stages,
                                     frames=frames("pmf_sample_steps", TAIL_FRAMES_WINDOW, tail and r == 0),
                                     info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
                                           "continues": f"pmf_r{r}_{prev}" if prev else "contact"},
@@ -476,6 +490,28 @@ def _tail_pair_table(ff: ForceField, mode: str):
             inc[i, j] = mode == "all" or a in TRAPPE_UA or b in TRAPPE_UA
     return names, eps, sig, inc & (eps > 0)
 
+
+
+#: A registry's first window on bare silica (version 4): lift (A) before the lateral shift, and the number of
+#: equal steps that lower the slab back, each followed by a minimisation (backs held)
+REGISTRY_LIFT_A = 4.0
+REGISTRY_LOWER_STEPS = 8
+
+
+def _lifts_registries(s: Mapping[str, Any]) -> bool:
+    """Bare silica on bare silica: interlocked silanols cannot be sheared at contact (version 4 lifts first)."""
+    return all(surface == "silica" for surface in s["surfaces"])
+
+
+def registry_approach_lines(s: Mapping[str, Any]) -> list[str]:
+    """LAMMPS commands that lower the (lifted, shifted) upper slab by REGISTRY_LIFT_A in REGISTRY_LOWER_STEPS equal
+    steps, minimising after each (the window's fixes hold both backs), then reset the step counter."""
+    step = REGISTRY_LIFT_A / REGISTRY_LOWER_STEPS
+    cmds: list[str] = []
+    for _ in range(REGISTRY_LOWER_STEPS):
+        cmds.append(f"displace_atoms upper move 0.0 0.0 {-step:.6f} units box")
+        cmds += minimize_lines(s)
+    return cmds
 
 
 def _coprime_step(n: int) -> int:

@@ -221,10 +221,15 @@ def surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mappin
 
 class Workflow:
     """``version`` counts changes of a workflow's simulation protocol; above 1 it enters the run hash.
+    ``protocol_version(settings)`` is the version a run with those settings follows (``version`` unless a change
+    touched only some systems: then the others keep the version of their unchanged plans, and their hashes).
     ``yields``: the quantities every result of the workflow reports (name -> SI units); some report more."""
     name = ""
     version = 1
     yields: dict[str, str] = {}
+
+    def protocol_version(self, settings: Mapping[str, Any]) -> int:
+        return self.version
 
     def forcefield_files(self, settings: Mapping[str, Any]) -> list[str]:
         raise NotImplementedError

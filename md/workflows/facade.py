@@ -89,7 +89,7 @@ def job_for(recipe: Recipe, fidelity: str) -> Job:
     settings = recipe.settings(fidelity)
     return Job(name=recipe.name, workflow=recipe.workflow, description=recipe.description, fidelity=fidelity,
                settings=settings, canonical=recipe.canonical(fidelity),
-               forcefield_files=tuple(wf.forcefield_files(settings)), workflow_version=wf.version,
+               forcefield_files=tuple(wf.forcefield_files(settings)), workflow_version=wf.protocol_version(settings),
                source=str(recipe.path) if recipe.path else recipe.name, file_sha256=recipe.file_sha256,
                content_sha256=recipe.canonical_sha256(fidelity))
 
@@ -104,7 +104,8 @@ def run_hash(recipe: Recipe | str | Path, fidelity: str,
     wf = get_workflow(recipe.workflow)
     if forcefield_files is None:
         forcefield_files = wf.forcefield_files(recipe.settings(fidelity))
-    return hashing.run_hash(recipe.canonical(fidelity), fidelity, forcefield_files, wf.version)
+    return hashing.run_hash(recipe.canonical(fidelity), fidelity, forcefield_files,
+                            wf.protocol_version(recipe.settings(fidelity)))
 
 
 def run_recipe(recipe: Recipe | str | Path, fidelity: str = "quick", *, out: str | Path | None = None,
