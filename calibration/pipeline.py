@@ -10,8 +10,8 @@ Steps (each timed in the report):
 3. The paper's dry, wet and SAM cases for the base set, the recipe's `compare_sets` (default: the literature
    `silicon` set) and the new set
    (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper.
-4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr) and the
-   user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
+4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr, truncated to each
+   key's allowed range) and the user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
    scene, giving first rebound heights, rebound counts and the escape velocity as median and
    5-95 % bands (OUT/uncertainty.csv, OUT/uncertainty.png); every band says which inputs it covers.
 5. OUT/report.md.
@@ -346,20 +346,56 @@ def latin_hypercube(n: int, dims: int, rng: np.random.Generator) -> np.ndarray:
     return u
 
 
-def sample_inputs(calibration: dict, ranges: dict, n: int, seed: int) -> tuple[list[str], list[dict]]:
-    """Latin-hypercube samples of the calibrated values (normal, MD stderr) and user ranges (uniform)."""
+def sampling_bounds(key: str) -> tuple[float, float]:
+    """The interval a calibrated value of scene `key` is sampled on: the key's own allowed range
+    (continuum.schema), or the real line for a key without one."""
+    f = SCENE_FIELDS.get(key)
+    lo = -math.inf if f is None or f.low is None else float(f.low)
+    hi = math.inf if f is None or f.high is None else float(f.high)
+    return lo, hi
+
+
+def truncation(calibration: dict) -> dict[str, dict]:
+    """{key: {low, high, outside}} for every calibrated value whose normal (MD mean, MD stderr) puts more than
+    1e-4 of its probability outside the key's allowed range, i.e. where :func:`sample_inputs` truncates."""
     from scipy.stats import norm
 
-    normal = {k: (v["value"], v["stderr"]) for k, v in calibration.items() if v.get("stderr")}
+    out = {}
+    for key, v in calibration.items():
+        if not v.get("stderr"):
+            continue
+        lo, hi = sampling_bounds(key)
+        mu, sd = float(v["value"]), float(v["stderr"])
+        outside = float(norm.cdf((lo - mu) / sd) + norm.sf((hi - mu) / sd))
+        if outside > 1e-4:
+            out[key] = {"low": lo if math.isfinite(lo) else None, "high": hi if math.isfinite(hi) else None,
+                        "outside": outside}
+    return out
+
+
+def sample_inputs(calibration: dict, ranges: dict, n: int, seed: int) -> tuple[list[str], list[dict]]:
+    """Latin-hypercube samples of the calibrated values and user ranges (uniform).
+
+    A calibrated value is drawn from the normal with its MD mean and stderr, truncated to the scene key's allowed
+    range (:func:`sampling_bounds`; ``scipy.stats.truncnorm``): a work of adhesion or an interaction range z0 whose
+    stderr is a large fraction of its mean (z0 of bare silica, 0.21 +- 0.14 nm over three registries) would
+    otherwise be sampled negative, and the scene would refuse that sample, so the band would silently lose its
+    low tail. Far from the bounds this is the plain normal; :func:`truncation` reports where it is not."""
+    from scipy.stats import truncnorm
+
+    normal = {k: (float(v["value"]), float(v["stderr"])) for k, v in calibration.items() if v.get("stderr")}
     keys = list(normal) + list(ranges)
     u = latin_hypercube(n, len(keys), np.random.default_rng(seed)) if keys else np.zeros((n, 0))
+    dists = {}
+    for key, (mu, sd) in normal.items():
+        lo, hi = sampling_bounds(key)
+        dists[key] = truncnorm((lo - mu) / sd, (hi - mu) / sd, loc=mu, scale=sd)
     samples = []
     for row in u:
         s = {}
         for j, key in enumerate(keys):
             if key in normal:
-                mu, sd = normal[key]
-                s[key] = float(mu + sd * norm.ppf(min(max(row[j], 1e-9), 1 - 1e-9)))
+                s[key] = float(dists[key].ppf(min(max(row[j], 1e-9), 1 - 1e-9)))
             else:
                 lo, hi = ranges[key]
                 s[key] = float(lo + (hi - lo) * row[j])
@@ -493,6 +529,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
              "rebound_count_capped": sum(s["rebound_count"] >= unc.max_bounces for s in sample_out
                                          if "error" not in s),
              "samples": len(samples), "failed_samples": sum("error" in s for s in sample_out),
+             "truncated": truncation(table["meta"].get("calibration", {})),
              "seed": unc.seed, "scene": unc.scene}
     _write_uncertainty(out, keys, sample_out, bands)
     timings["total_s"] = time.perf_counter() - t_all

@@ -171,6 +171,7 @@ def report_markdown(rec: CalibrationReport) -> str:
               f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "
               f"{', '.join(b['covers'])}; failed samples: {b['failed_samples']}.", "",
               "| output | median | 5 % | 95 % | n |", "|---|---|---|---|---|"]
+    trunc = b.get("truncated") or {}
     for key in ("first_rebound_over_h0", "rebound_count", "escape_velocity_m_per_s"):
         v = b[key]
         lines.append(f"| {key} | {_fmt(v['median'])} | {_fmt(v['p05'])} | {_fmt(v['p95'])} | {v['n']} |")
@@ -178,6 +179,11 @@ def report_markdown(rec: CalibrationReport) -> str:
         lines += ["", f"**rebound_count is a lower bound:** {b['rebound_count_capped']} of {b['rebound_count']['n']} "
                       f"samples reached the `max_bounces` cap ({b['max_bounces']}) without sticking; raise "
                       "`[uncertainty] max_bounces` for the full count."]
+    if trunc:
+        lines += ["", "**Truncated inputs:** each calibrated value is sampled from its MD normal truncated to the "
+                      "key's allowed range; for " + "; ".join(
+                          f"`{k}` ({v['outside']:.1%} of the normal lay outside [{_fmt(v['low'])}, {_fmt(v['high'])}])"
+                          for k, v in trunc.items()) + " the truncation moves the samples (the others are normal)."]
     lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`; data: `uncertainty.csv`, "
               "`calibration.json`, `paper/checks.json`.", ""]
     return "\n".join(lines)

@@ -265,3 +265,32 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     saved = json.loads((out / "calibration.json").read_text())
     assert saved["bands"]["samples"] == 2 and saved == json.loads(json.dumps(report.to_dict(), default=str))
     assert saved["versions"]["nanoimpact"] and saved["rows"][0]["key"] == report.rows[0].key
+
+
+def test_uncertainty_samples_stay_inside_each_keys_allowed_range():
+    """A calibrated value with a large stderr (z0 = 0.21 +- 0.14 nm) is sampled from its normal truncated to the
+    key's allowed range: no sample is refused by the scene, and where the bounds are far the samples are the plain
+    normal's quantiles."""
+    from scipy.stats import norm
+
+    from calibration.pipeline import latin_hypercube, sample_inputs, sampling_bounds, truncation
+
+    cal = {"surfaces.interaction_range": {"value": 0.21e-9, "stderr": 0.14e-9},
+           "surfaces.work_of_adhesion": {"value": 0.196, "stderr": 0.039}}
+    n, seed = 64, 5
+    keys, samples = sample_inputs(cal, {}, n, seed)
+    lo, hi = sampling_bounds("surfaces.interaction_range")
+    assert lo == pytest.approx(5e-11)
+    z0 = np.array([s["surfaces.interaction_range"] for s in samples])
+    assert z0.min() >= lo and z0.max() <= hi
+    # the plain normal would have put some of the 64 strata below the bound (P = 12.7 %)
+    u = latin_hypercube(n, len(keys), np.random.default_rng(seed))
+    plain = 0.21e-9 + 0.14e-9 * norm.ppf(u[:, 0])
+    assert (plain < lo).sum() >= 4
+    # far from its bounds (0 is 5 sigma away: 3e-7 of the normal cut) the work of adhesion is the plain normal, to
+    # that cut's shift of the quantiles (3e-6 relative in the tail strata)
+    w = np.array([s["surfaces.work_of_adhesion"] for s in samples])
+    np.testing.assert_allclose(w, 0.196 + 0.039 * norm.ppf(u[:, 1]), rtol=1e-4)
+    t = truncation(cal)
+    assert set(t) == {"surfaces.interaction_range"}
+    assert t["surfaces.interaction_range"]["outside"] == pytest.approx(norm.cdf((5e-11 - 0.21e-9) / 0.14e-9), rel=1e-9)
