@@ -16,6 +16,8 @@ from typing import Any, Mapping
 from nanoimpact import __version__
 from nanoimpact.fileio import atomic_write_text
 
+from .targets import target_figure, target_of, verdict
+
 __all__ = ["ValueRow", "CalibrationReport", "versions"]
 
 
@@ -101,10 +103,13 @@ class CalibrationReport:
                 "paper_checks": list(self.paper_checks)}
 
     def write(self, out: str | Path | None = None) -> Path:
-        """calibration.json and report.md in `out` (default: the run's folder), each written atomically."""
+        """calibration.json, md_vs_literature.png and report.md in `out` (default: the run's folder), each written
+    atomically."""
         out = Path(out or self.out)
         out.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out / "calibration.json", json.dumps(self.to_dict(), indent=1, default=str) + "\n")
+        target_figure(self.rows, out / "md_vs_literature.png",
+                      title=f"calibration `{self.name}`: MD values (+- stderr) against published ranges")
         atomic_write_text(out / "report.md", report_markdown(self))
         return out / "report.md"
 
@@ -130,6 +135,33 @@ def _work_sentence(rows: tuple[ValueRow, ...]) -> str:
     return ("Work of adhesion: " + "; ".join(parts) + " (docs/calibration.md).") if parts else ""
 
 
+def _target_sentences(rows: tuple[ValueRow, ...]) -> list[str]:
+    """Which used values lie inside their published range (calibration.targets), which miss it, and the sources."""
+    used = [r for r in rows if r.status == "used" and r.value is not None]
+    inside, near, miss, none = [], [], [], []
+    for r in used:
+        tgt = target_of(r.key)
+        if tgt is None:
+            none.append(r)
+            continue
+        v = verdict(r.value, r.stderr, tgt)
+        (inside if v.inside else near if v.inside_2sigma else miss).append((r, v))
+    out = ["", f"**Against the published ranges** (`calibration/targets.py`, figure `md_vs_literature.png`): "
+               f"{len(inside)} of {len(used)} used values inside"
+           + (f"; within 2 stderr of the range: {', '.join(f'`{r.key}` ({v.text})' for r, v in near)}" if near else "")
+           + (f"; **outside** by more than 2 stderr: {', '.join(f'`{r.key}` ({v.text})' for r, v in miss)} -- "
+              "measured with the published force fields, not tuned (docs/md.md says why)" if miss else "")
+           + (f"; no published range quoted for {', '.join(f'`{r.key}`' for r in none)}" if none else "") + "."]
+    sources = {}
+    for r in used:
+        tgt = target_of(r.key)
+        if tgt is not None:
+            sources.setdefault(tgt.source, []).append(r.key)
+    out += ["", "Ranges: " + "; ".join(f"{', '.join(f'`{k}`' for k in keys)}: {src}" for src, keys in sources.items())
+            + "."] if sources else []
+    return out
+
+
 def report_markdown(rec: CalibrationReport) -> str:
     cal, t, m = rec.calibration, rec.timings, rec.machine
     lines = [f"# Calibration `{cal.name}` (base `{cal.base}`)", "",
@@ -140,11 +172,16 @@ def report_markdown(rec: CalibrationReport) -> str:
              "(cached or committed runs cost nothing), paper cases "
              f"{t['paper_s']:.1f} s, uncertainty {t['uncertainty_s']:.1f} s, total "
              f"{t['total_s']:.1f} s. Set written to `{rec.set_path}`.", "",
-             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | status | why / run |",
-             "|---|---|---|---|---|---|---|"]
+             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | published range | against it "
+             "| status | why / run |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rec.rows:
+        tgt = target_of(r.key)
+        rng = f"{_fmt(tgt.low)}-{_fmt(tgt.high)} {tgt.unit}" if tgt else "none quoted"
+        against = verdict(r.value, r.stderr, tgt).text if tgt and r.value is not None else "-"
         lines.append(f"| `{r.key}` | {r.recipe} | {r.quantity or '-'} | {_fmt(r.value)} "
-                     f"{r.units} | {_fmt(r.stderr)} | {r.status} | {r.why or str(r.run_hash or '')[:16]} |")
+                     f"{r.units} | {_fmt(r.stderr)} | {rng} | {against} | {r.status} | "
+                     f"{r.why or str(r.run_hash or '')[:16]} |")
+    lines += _target_sentences(rec.rows)
     sets = sorted({c["set"] for c in rec.paper_checks})
     lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec.md_sources.items()), "",
               "A rejected or missing value keeps the base set's value (its [meta.sources] entry says so).",
@@ -184,6 +221,6 @@ def report_markdown(rec: CalibrationReport) -> str:
                       "key's allowed range; for " + "; ".join(
                           f"`{k}` ({v['outside']:.1%} of the normal lay outside [{_fmt(v['low'])}, {_fmt(v['high'])}])"
                           for k, v in trunc.items()) + " the truncation moves the samples (the others are normal)."]
-    lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`; data: `uncertainty.csv`, "
-              "`calibration.json`, `paper/checks.json`.", ""]
+    lines += ["", "Figures: `paper/` (Figs 4-8b per set), `uncertainty.png`, `md_vs_literature.png`; data: "
+              "`uncertainty.csv`, `calibration.json`, `paper/checks.json`.", ""]
     return "\n".join(lines)

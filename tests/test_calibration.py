@@ -149,7 +149,13 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     md = report.write()
     text = md.read_text()
     assert "1 of 2 claims hold" in text and "`claim_b`: needs t2" in text
-    assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 |" in text
+    assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 | 0.03 | " \
+           "none quoted | - |" in text
+    # the fixture's silica angle, 31 +- 3 deg, lies 0.3 stderr above the 0-30 deg range; OTS 108 deg inside
+    assert "| 31 deg | 3 | 0-30 deg | 0.3 sigma above |" in text and "| 108 deg | 4 | 105-120 deg | inside |" in text
+    assert "**Against the published ranges**" in text and "4 of 8 used values inside" in text
+    assert "Wasserman et al., Langmuir 5 (1989) 1074" in text
+    assert (tmp_path / "out" / "md_vs_literature.png").stat().st_size > 0
     saved = json.loads((tmp_path / "out" / "calibration.json").read_text())
     assert saved["rows"][0] == rows[0] | {k: None for k in ValueRow.__dataclass_fields__ if k not in rows[0]}
     assert saved["versions"]["numpy"] == np.__version__
@@ -294,3 +300,22 @@ def test_uncertainty_samples_stay_inside_each_keys_allowed_range():
     t = truncation(cal)
     assert set(t) == {"surfaces.interaction_range"}
     assert t["surfaces.interaction_range"]["outside"] == pytest.approx(norm.cdf((5e-11 - 0.21e-9) / 0.14e-9), rel=1e-9)
+
+
+def test_a_value_is_placed_against_its_published_range_in_its_own_stderr():
+    from calibration.targets import TARGETS, Target, target_of, verdict
+
+    t = Target("k", 1.0, 2.0, "m", "src")
+    assert verdict(1.5, 0.1, t).inside and verdict(1.5, 0.1, t).distance_sigma == 0.0
+    above = verdict(2.3, 0.2, t)
+    assert not above.inside and above.distance_sigma == pytest.approx(1.5) and above.inside_2sigma
+    assert above.text == "1.5 sigma above"
+    below = verdict(0.5, 0.1, t)
+    assert below.distance_sigma == pytest.approx(-5.0) and not below.inside_2sigma and below.text == "5.0 sigma below"
+    assert verdict(2.5, None, t).text == "above (no stderr)" and not verdict(2.5, 0.0, t).inside_2sigma
+    # every target names a scene key the continuum declares, in that key's SI unit, low < high, with a source
+    from continuum.schema import FIELD_BY_PATH
+    for tgt in TARGETS:
+        f = FIELD_BY_PATH[tgt.key]
+        assert tgt.unit == f.unit and tgt.low < tgt.high and f.low <= tgt.low and tgt.high <= f.high and tgt.source
+    assert target_of("surfaces.work_of_adhesion") is None        # no published Dupre work for this IFF surface
