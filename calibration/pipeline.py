@@ -10,6 +10,9 @@ Steps (each timed in the report):
 3. The paper's dry, wet and SAM cases for the base set, the recipe's `compare_sets` (default: the literature
    `silicon` set) and the new set
    (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper.
+   3b. Claim attribution (calibration.attribution): when a claim holds with the base set and fails with the new
+   one, each group of MD values is put back to the base values alone and the paper's cases run again (no
+   figures), into OUT/attribution; the claims that hold again name the value that broke them.
 4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr, truncated to each
    key's allowed range) and the user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
    scene, giving first rebound heights, rebound counts and the escape velocity as median and
@@ -34,6 +37,7 @@ import numpy as np
 from nanoimpact.executors import Failure, executor
 from nanoimpact.fileio import atomic_save_figure, atomic_write_text
 
+from .attribution import attribute_claims
 from .mdset import build_parameter_set, committed_result, recipes_needed, write_parameter_set
 from .report import CalibrationReport, ValueRow
 
@@ -508,6 +512,11 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         sets = [cal.base, *[s for s in paper_sets if s != cal.base], str(set_path)]
         paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None)   # the user's executor
         timings["paper_s"] = time.perf_counter() - t
+        # 3b. why a claim that holds with the base set fails with the new one: each MD value put back alone
+        t = time.perf_counter()
+        attribution = attribute_claims(table, rows, paper["checks"], Path(set_path).stem, Path(cal.base).stem,
+                                       out / "attribution", executor=ex, progress=progress)
+        timings["attribution_s"] = time.perf_counter() - t
         # 4. uncertainty
         t = time.perf_counter()
         unc = cal.uncertainty
@@ -536,7 +545,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     report = CalibrationReport(name=cal.name, set_path=Path(set_path), out=out, calibration=cal,
                                rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources=sources, bands=bands,
                                paper_checks=tuple(paper["checks"]), timings=timings, machine=machine,
-                               md_compute_total_s=sum(md_compute.values()))
+                               md_compute_total_s=sum(md_compute.values()), claim_attribution=attribution)
     progress(f"calibrate: report {report.write()}; total {timings['total_s']:.1f} s")
     return report
 

@@ -80,6 +80,8 @@ class CalibrationReport:
     timings: Mapping[str, float]
     machine: Mapping[str, Any]
     md_compute_total_s: float
+    claim_attribution: Mapping[str, Any] = field(default_factory=dict)
+    """Why each claim that fails with the calibrated set fails (`calibration.attribution.attribute_claims`)."""
     versions: Mapping[str, str] = field(default_factory=versions)
 
     @property
@@ -100,7 +102,7 @@ class CalibrationReport:
                 "rows": [r.to_dict() for r in self.rows], "md_sources": dict(self.md_sources),
                 "bands": dict(self.bands), "md_compute_total_s": self.md_compute_total_s,
                 "timings": dict(self.timings), "machine": dict(self.machine), "versions": dict(self.versions),
-                "paper_checks": list(self.paper_checks)}
+                "paper_checks": list(self.paper_checks), "claim_attribution": dict(self.claim_attribution)}
 
     def write(self, out: str | Path | None = None) -> Path:
         """calibration.json, md_vs_literature.png and report.md in `out` (default: the run's folder), each written
@@ -200,8 +202,12 @@ def report_markdown(rec: CalibrationReport) -> str:
     lines += ["", f"**Where the calibrated physics agrees with the paper:** {len(agree)} of {len(mine)} claims hold "
               f"with the `{name}` set.", ""]
     if differ:
-        lines += [f"**Where it does not** ({len(differ)}):", ""]
+        why = {w["claim"]: w for w in (rec.claim_attribution or {}).get("claims", [])}
+        lines += [f"**Where it does not** ({len(differ)}), and why: each MD value put back to the base set's "
+                  "value alone, the paper's cases run again, and the claims that hold again name it "
+                  "(`attribution/`):", ""]
         lines += [f"- `{c['name']}`: needs {c['threshold']}; got {json.dumps(c['values'], default=str)[:300]}"
+                  + (f". **Why:** {why[c['name']]['text']}." if c["name"] in why else "")
                   for c in differ]
     b = rec.bands
     lines += ["", "## Uncertainty", "",

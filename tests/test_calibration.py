@@ -143,12 +143,15 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
                       {"set": "cal", "name": "claim_b", "pass": False, "threshold": "t2", "values": {"v": 1}},
                       {"set": "paper", "name": "claim_a", "pass": True, "threshold": "t", "values": {}}),
         timings={"md_s": 1.0, "paper_s": 2.0, "uncertainty_s": 3.0, "total_s": 6.0},
-        machine={"cores": 2, "platform": "p", "python": "3.11"}, md_compute_total_s=10.0)
+        machine={"cores": 2, "platform": "p", "python": "3.11"}, md_compute_total_s=10.0,
+        claim_attribution={"claims": [{"claim": "claim_b", "cause": "single", "restored_by": ["r"],
+                                       "text": "holds again when only W is put back"}]})
     assert len(report.used) == 8 and report.not_used == ()
     assert [c["name"] for c in report.claims()] == ["claim_a", "claim_b"]
     md = report.write()
     text = md.read_text()
     assert "1 of 2 claims hold" in text and "`claim_b`: needs t2" in text
+    assert '`claim_b`: needs t2; got {"v": 1}. **Why:** holds again when only W is put back.' in text
     assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 | 0.03 | " \
            "none quoted | - |" in text
     # the fixture's silica angle, 31 +- 3 deg, lies 0.3 stderr above the 0-30 deg range; OTS 108 deg inside
@@ -159,6 +162,7 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     saved = json.loads((tmp_path / "out" / "calibration.json").read_text())
     assert saved["rows"][0] == rows[0] | {k: None for k in ValueRow.__dataclass_fields__ if k not in rows[0]}
     assert saved["versions"]["numpy"] == np.__version__
+    assert saved["claim_attribution"]["claims"][0]["cause"] == "single"
     assert saved["calibration"]["uncertainty"]["samples"] == 16            # the declared default
     assert "Calibration `cal` (base `paper`)" in text and "Recipe `recipe.toml`" in text
     assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
@@ -266,6 +270,9 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
     assert len(report.used) + len(report.not_used) == 8
+    # every claim that fails with the new set is explained (the attribution's revert runs are on Dask too)
+    failing = {c["name"] for c in report.claims() if not c["pass"]}
+    assert {w["claim"] for w in report.claim_attribution["claims"]} == failing and "attribution_s" in report.timings
     scene = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params=str(tmp_path / "calibrated_smoke.toml"))
     assert scene.scene.surfaces.roughness.summit_modulus == 10e9
     saved = json.loads((out / "calibration.json").read_text())

@@ -118,8 +118,11 @@ def _of_set(collected: dict, set_name: str) -> tuple[dict, dict, dict]:
 
 def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
                executor_name: str = "processes", scheduler: str | None = None, executor=None,
-               progress: Callable[[str], None] = print) -> dict:
+               progress: Callable[[str], None] = print, draw_figures: bool = True) -> dict:
     """Run every case for every set into `out`; returns {"checks": [...], "wall_s": ...}.
+
+    `draw_figures=False` draws none of Figs 4-8b (the claims, summary.md and checks.json are the same): for callers
+    that want the claims alone, such as the calibration's claim attribution.
 
     Where the runs go: `executor` (an open nanoimpact.executors object, e.g. the calibration's), else a new
     `executor_name` executor with `workers` and `scheduler` (default: a local pool of CPU-count processes)."""
@@ -141,7 +144,8 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
         figures.save(figures.fig8b(wet, set_name, out), out / f"fig8b_{set_name}.png")
 
     collected = run_paper(sets, out, fidelity=fidelity, workers=workers, executor_name=executor_name,
-                          scheduler=scheduler, executor=executor, progress=progress, on_set_done=draw)
+                          scheduler=scheduler, executor=executor, progress=progress,
+                          on_set_done=draw if draw_figures else None)
     all_checks, summary = [], ["# nanoimpact paper: dry, wet and SAM cases", "",
                                f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
                                "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]

@@ -1,0 +1,193 @@
+"""Why a paper claim fails with the calibrated set: each MD value put back to its base value alone.
+
+The calibrated set is the base set with the MD values written over it. A claim of the founding paper that holds
+with the base set and fails with the calibrated one therefore fails because of one MD value, or of several together.
+Which one is measured, not guessed. Each *revert* puts one group of MD values back to the base set's values,
+with everything else calibrated. The group is the keys fed by one quantity of one MD run, such as the two silica
+contact angles from `contact_angle_silica`. The paper's cases then run with each revert set, and the claims that hold
+again name the values that broke them. This is a one-at-a-time sensitivity analysis (Saltelli et al., *Global
+Sensitivity Analysis: The Primer*, Wiley 2008, section 1.2.2), done on the pass/fail outcome of each claim.
+
+It answers "which value", not "which interaction of values". A claim that no single revert restores needs
+several values together, and the report says so. A claim that fails with the base set too is not the
+calibration's doing, and no revert is run for it.
+
+Cost: one run of the paper's cases per group that differs from the base, only when some claim needs it. With the
+shipped quick recipe that is up to seven sets of the paper's cases, each a few seconds of CPU
+(docs/benchmarks.md). The runs go to the calibration's executor.
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping
+
+from .mdset import _get_nested, _set_nested, write_parameter_set
+
+__all__ = ["Revert", "ClaimWhy", "reverts", "revert_table", "explain_claims", "attribute_claims"]
+
+
+@dataclass(frozen=True)
+class Revert:
+    """One group of MD values put back to the base set's values: the keys one quantity of one MD run feeds."""
+
+    recipe: str
+    quantity: str
+    keys: tuple[str, ...]
+    calibrated: tuple[Any, ...]
+    base: tuple[Any, ...]
+    """The base set's values (None: the base set has no such key, so the scene's default applies)."""
+    units: str
+    set_name: str
+    """Name (file stem) of the parameter set with this group reverted."""
+
+    @property
+    def label(self) -> str:
+        return f"{self.recipe} {self.quantity}"
+
+    def describe(self) -> str:
+        """`key` calibrated -> base, for every key of the group."""
+        def fmt(v):
+            return "the scene default" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
+        return ", ".join(f"`{k}` {fmt(c)} -> {fmt(b)} {self.units}".rstrip()
+                         for k, c, b in zip(self.keys, self.calibrated, self.base))
+
+    def to_dict(self) -> dict:
+        return {"recipe": self.recipe, "quantity": self.quantity, "keys": list(self.keys),
+                "calibrated": list(self.calibrated), "base": list(self.base), "units": self.units,
+                "set": self.set_name}
+
+
+@dataclass(frozen=True)
+class ClaimWhy:
+    """Why one claim fails with the calibrated set.
+
+    `cause`: 'base fails too' (not the calibration's doing), 'single' (`restored_by` lists each revert that
+    alone makes the claim hold again), 'several' (no single revert restores it) or 'not run' (`text` says why).
+    """
+
+    claim: str
+    cause: str
+    restored_by: tuple[str, ...]
+    text: str
+
+    def to_dict(self) -> dict:
+        return {"claim": self.claim, "cause": self.cause, "restored_by": list(self.restored_by), "text": self.text}
+
+
+def reverts(rows: Iterable[Mapping[str, Any]], set_name: str) -> tuple[Revert, ...]:
+    """The groups to revert: the used rows whose value differs from the base set's, grouped by (recipe,
+    quantity), in row order. `rows` are the calibration's value rows (dicts or ValueRow.to_dict())."""
+    groups: dict[tuple[str, str], list[Mapping[str, Any]]] = {}
+    for row in rows:
+        if row.get("status") != "used" or row.get("value") == row.get("base_value"):
+            continue
+        groups.setdefault((row["recipe"], row.get("quantity") or ""), []).append(row)
+    out = []
+    for (recipe, quantity), members in groups.items():
+        out.append(Revert(recipe=recipe, quantity=quantity, keys=tuple(r["key"] for r in members),
+                          calibrated=tuple(r.get("value") for r in members),
+                          base=tuple(r.get("base_value") for r in members), units=members[0].get("units") or "",
+                          set_name=f"{set_name}--{recipe}--{quantity}"))
+    return tuple(out)
+
+
+def _delete_nested(table: dict, key: str) -> None:
+    *parents, leaf = key.split(".")
+    node = table
+    for p in parents:
+        node = node.get(p)
+        if not isinstance(node, dict):
+            return
+    node.pop(leaf, None)
+
+
+def revert_table(table: Mapping[str, Any], revert: Revert) -> dict:
+    """The calibrated set's table with `revert`'s keys back at their base values (a base without the key: the key
+    removed, so the scene's default applies), and its [meta] saying so."""
+    out = copy.deepcopy(dict(table))
+    for key, base in zip(revert.keys, revert.base):
+        if base is None:
+            _delete_nested(out, key)
+        else:
+            _set_nested(out, key, base)
+    meta = out.setdefault("meta", {})
+    meta["description"] = (f"{meta.get('description', 'calibrated set')}, with {revert.label} put back to the base "
+                           "set's values (claim attribution)")
+    meta["reverted"] = {k: {"calibrated": c, "base": "scene default" if b is None else b}
+                        for k, c, b in zip(revert.keys, revert.calibrated, revert.base)}
+    for key in revert.keys:
+        (meta.get("calibration") or {}).pop(key, None)
+        (meta.get("sources") or {}).pop(key, None)
+    return out
+
+
+def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],
+                   by_revert: Mapping[str, Iterable[Mapping]], groups: Iterable[Revert]) -> tuple[ClaimWhy, ...]:
+    """One ClaimWhy per claim that fails with the calibrated set, from the claims of the calibrated set, the base
+    set and each revert set (`by_revert`: revert set name -> its claims). Pure: no run here."""
+    base_pass = {c["name"]: bool(c["pass"]) for c in base}
+    groups = tuple(groups)
+    restored = {g.set_name: {c["name"] for c in by_revert.get(g.set_name, ()) if c["pass"]} for g in groups}
+    out = []
+    for c in calibrated:
+        if c["pass"]:
+            continue
+        name = c["name"]
+        if name not in base_pass:
+            out.append(ClaimWhy(name, "not run", (), "the base set's cases did not evaluate this claim"))
+            continue
+        if not base_pass[name]:
+            out.append(ClaimWhy(name, "base fails too", (),
+                                "fails with the base set too: not caused by the calibrated values"))
+            continue
+        ran = [g for g in groups if g.set_name in by_revert]
+        if not ran:
+            out.append(ClaimWhy(name, "not run", (), "no MD value differs from the base set's, or no revert ran"))
+            continue
+        hit = [g for g in ran if name in restored[g.set_name]]
+        if hit:
+            text = ("holds again when only " + "; or only ".join(g.describe() for g in hit)
+                    + (" is put back to the base value" if len(hit) == 1 else " are put back to the base values")
+                    + ": " + ("that value is" if len(hit) == 1 else "each of these is") + " enough to break it")
+            out.append(ClaimWhy(name, "single", tuple(g.label for g in hit), text))
+        else:
+            out.append(ClaimWhy(name, "several", (),
+                                f"no single MD value put back restores it ({len(ran)} tried: "
+                                + ", ".join(g.label for g in ran) + "): it fails through several values together"))
+    return tuple(out)
+
+
+def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]], paper_checks: Iterable[Mapping],
+                     set_name: str, base_name: str, out: str | Path, *, executor=None,
+                     progress: Callable[[str], None] | None = None) -> dict:
+    """Run the reverts a failing claim needs and explain every claim that fails with `set_name`.
+
+    `table` is the calibrated set as written, `rows` its value rows, `paper_checks` the claims of the paper step
+    (with `set_name` and `base_name` among their sets). Revert sets go to OUT/sets/, their paper cases to
+    OUT/paper/ (no figures). Returns {"reverts": [...], "claims": [ClaimWhy.to_dict()...], "ran": bool}."""
+    from continuum.paper.report import make_paper
+
+    checks = list(paper_checks)
+    cal = [c for c in checks if c["set"] == set_name]
+    base = [c for c in checks if c["set"] == base_name]
+    base_pass = {c["name"] for c in base if c["pass"]}
+    needed = [c for c in cal if not c["pass"] and c["name"] in base_pass]
+    groups = reverts(rows, set_name)
+    by_revert: dict[str, list] = {}
+    if needed and groups:
+        out = Path(out)
+        paths = [str(write_parameter_set(revert_table(table, g), out / "sets" / f"{g.set_name}.toml",
+                                         header=f"Claim attribution: the `{set_name}` set with {g.label} put "
+                                                f"back to the `{base_name}` set's values."))
+                 for g in groups]
+        if progress:
+            progress(f"  claims: {len(needed)} fail with {set_name} and hold with {base_name}; running "
+                     f"{len(groups)} revert sets")
+        record = make_paper(paths, out / "paper", executor=executor, progress=lambda m: None, draw_figures=False)
+        for c in record["checks"]:
+            by_revert.setdefault(c["set"], []).append(c)
+    whys = explain_claims(cal, base, by_revert, groups)
+    return {"reverts": [g.to_dict() for g in groups], "claims": [w.to_dict() for w in whys],
+            "ran": bool(by_revert)}
