@@ -32,13 +32,14 @@ from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circ
                                        block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
                                        dispersion_tail_work, tail_antiderivative)
 from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
-from md.analysis.stats import (block_average, block_analysis, statistical_inefficiency, detect_equilibration,
-                               timeseries_stats)
+from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
+                               detect_equilibration, timeseries_stats)
 from md.analysis.surface_tension import surface_tension, lj_tail_correction, density_profile, slab_density
 
 __all__ = [
     "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M", "WATER_MOLAR_MASS",
-    "block_average", "block_analysis", "statistical_inefficiency", "detect_equilibration", "timeseries_stats",
+    "block_average", "block_analysis", "blocking_stderr", "statistical_inefficiency", "detect_equilibration",
+    "timeseries_stats",
     "force_integration_work", "registry_average", "traction_peak", "flat_slab_range", "lj_tail_between",
     "MAUGIS_LJ93",
     "energy_separation_work", "work_from_energy_curve",

@@ -22,7 +22,8 @@ def surface_tension(pxx_atm, pyy_atm, pzz_atm, lz_A, tail_correction_N_per_m: fl
     gamma = (Lz / 2) (<Pzz> - (<Pxx> + <Pyy>) / 2), pressures in atm (LAMMPS real), ``lz_A`` in A (a
     number or a series like the pressures).  The mean of the instantaneous gamma(t) and its stderr come from
     :func:`timeseries_stats` (automated equilibration detection and the statistical inefficiency, Chodera
-    2016), so correlations between the components enter the error; ``n_blocks`` (optional) adds the old
+    2016, checked by blocking: the pressure tensor's autocorrelation oscillates, and there the blocking estimate
+    is the larger one), so correlations between the components enter the error; ``n_blocks`` (optional) adds the old
     fixed-block estimate as ``stderr_blocks`` for comparison only.  ``tail_correction_N_per_m`` (e.g. from
     :func:`lj_tail_correction`) is added to ``value``; ``value_uncorrected`` omits it.
     """
@@ -35,7 +36,8 @@ def surface_tension(pxx_atm, pyy_atm, pzz_atm, lz_A, tail_correction_N_per_m: fl
     mean, err = st["mean"], st["stderr"]
     tail = float(tail_correction_N_per_m)
     out = {"value": mean + tail, "stderr": err, "tail_correction": tail, "value_uncorrected": mean,
-           "units": "N/m", "statistical_inefficiency": st["g"], "t0": st["t0"], "n_eff": st["n_eff"]}
+           "units": "N/m", "statistical_inefficiency": st["g"], "t0": st["t0"], "n_eff": st["n_eff"],
+           "error_method": st["error_method"]}
     if n_blocks:
         out["stderr_blocks"] = block_average(g, n_blocks)[1]
     return out
