@@ -148,6 +148,21 @@ def test_an_oscillating_autocorrelation_does_not_hide_a_slow_one():
     assert covered >= 50                                          # of 60, at 95 % intervals
 
 
+def test_a_fluctuation_slower_than_the_window_does_not_make_the_detection_keep_only_a_tail():
+    """A window whose mean force wanders over more than the window (a sinusoid of 2/3 the window's frequency,
+    amplitude 8x the fast noise): unbounded, the detection keeps the last few percent, where the series looks
+    flat, and its stderr there would be far too small. Capped at half, the mean is taken over at least the last
+    half and the stderr covers the true mean (0) in all 20 seeded phases."""
+    rng = np.random.default_rng(1992)
+    n = 1500
+    t = np.arange(n)
+    for _ in range(20):
+        x = 4.0 * np.sin(2 * np.pi * t / 1000 + rng.uniform(0, 2 * np.pi)) + rng.normal(0.0, 0.5, n)
+        assert detect_equilibration(x, max_discard=0.999)["t0"] > 0.8 * n          # the failure, unbounded
+        st = timeseries_stats(x)
+        assert st["t0"] <= n // 2 and abs(st["mean"]) < 2.0 * st["stderr"]
+
+
 def test_blocking_stderr_of_white_noise_and_of_a_series_too_short_to_block():
     rng = np.random.default_rng(461)
     x = rng.normal(size=4096)
