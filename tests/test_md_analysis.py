@@ -284,6 +284,30 @@ def test_registry_average_carries_the_spread_between_registries():
     assert agree["stderr"] == rel(0.3 / math.sqrt(3), 1e-12) and agree["registry_spread"] == 0.0
 
 
+def test_registry_consistency_flags_the_windows_where_registries_disagree_beyond_their_stderrs():
+    """Three registries drawn around one curve with their stated stderrs: chi^2/dof follows its distribution,
+    about 1 % of 2000 points flagged at p < 0.01. Shift one registry by 8 stderrs at 5 points: exactly those are
+    flagged. One registry: nothing to compare."""
+    from md.analysis import registry_consistency
+
+    rng = np.random.default_rng(5)
+    e = rng.uniform(0.1, 1.0, (3, 2000))
+    v = np.sin(np.linspace(0, 6, 2000)) + e * rng.normal(size=e.shape)
+    c = registry_consistency(v, e)
+    assert c["dof"] == 2 and np.mean(c["chi2_per_dof"]) == rel(1.0, 0.1)
+    assert 0.002 < np.mean(c["inconsistent"]) < 0.025
+    clean = registry_consistency(e[:, :40] * rng.normal(size=(3, 40)), e[:, :40])
+    v2 = e[:, :40] * 0.0
+    v2[1, [3, 9, 17, 25, 33]] += 8.0 * e[1, [3, 9, 17, 25, 33]]
+    shifted = registry_consistency(v2, e[:, :40])
+    assert sorted(np.flatnonzero(shifted["inconsistent"]).tolist()) == [3, 9, 17, 25, 33]
+    assert clean["inconsistent"].sum() <= 2
+    one = registry_consistency(v[:1], e[:1])
+    assert one["dof"] == 0 and not one["inconsistent"].any()
+    with pytest.raises(ValueError, match="shape"):
+        registry_consistency(v, e[:, :5])
+
+
 def test_z0_and_sigma0_from_a_coarse_noisy_flat_slab_curve():
     """sigma0 from the quadratic through the three windows around the peak, z0 = 1.026 W / sigma0: on the 9-3
     law (seeded noise, 30 draws) both come back within their stated errors, the stated noise error is the scatter's

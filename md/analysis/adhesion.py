@@ -153,6 +153,36 @@ def registry_average(values, stderrs) -> dict:
             "registry_spread": pick(spread), "n": int(n)}
 
 
+def registry_consistency(values, stderrs, p_min: float = 0.01) -> dict:
+    """Do the lateral registries agree within their own stderrs, point by point?
+
+    ``values``, ``stderrs``: shape (n_registries, n_points), e.g. each window's mean force per registry. At each
+    point chi^2 = sum_r (v_r - m)^2 / e_r^2 with m the inverse-variance weighted mean, chi^2-distributed with
+    n - 1 degrees of freedom when the registries measure one value (Bevington & Robinson, *Data Reduction and Error Analysis*, 3rd ed., section 11.1, with the
+    registries as repeated measurements of one quantity). A point is ``inconsistent`` where the chi^2
+    tail probability is below ``p_min``. There, either the quantity depends on the registry (a crystalline
+    contact), or each registry's stderr is too small for what its window really resolves (a mean not converged in
+    the window). Either way the registries' spread, which `registry_average` puts into the error, is what
+    carries the error there. Fewer than two registries: nothing to compare (all points consistent, chi^2 nan).
+    Returns ``chi2_per_dof`` and ``p`` (arrays), ``inconsistent`` (bool array), ``dof``."""
+    from scipy.stats import chi2 as chi2_dist
+
+    v = np.asarray(values, float)
+    e = np.asarray(stderrs, float)
+    if v.ndim != 2 or v.shape != e.shape:
+        raise ValueError(f"values and stderrs must both have shape (registries, points); got {v.shape}, {e.shape}")
+    n = v.shape[0]
+    if n < 2:
+        nan = np.full(v.shape[1], np.nan)
+        return {"chi2_per_dof": nan, "p": np.ones(v.shape[1]), "inconsistent": np.zeros(v.shape[1], bool), "dof": 0}
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = 1.0 / e ** 2
+        m = np.sum(w * v, axis=0) / np.sum(w, axis=0)
+        chi2 = np.sum(w * (v - m) ** 2, axis=0)
+    p = chi2_dist.sf(chi2, n - 1)
+    return {"chi2_per_dof": chi2 / (n - 1), "p": p, "inconsistent": p < p_min, "dof": n - 1}
+
+
 def traction_peak(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA, area_A2: float) -> dict:
     """Peak tensile traction sigma0 (Pa) of a flat-slab mean-force curve, with its standard error.
 

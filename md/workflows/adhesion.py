@@ -408,6 +408,14 @@ class Adhesion(Workflow):
             zsig["lj93_fit"] = {"error": str(exc)}
         details["flat_slab_law"] = zsig
         short = [suffixes[k] for k in range(len(suffixes)) if np.nanmin(neff_w[:, k]) < MIN_WINDOW_NEFF]
+        cons = A.registry_consistency(f_m, f_e)
+        disagree = [suffixes[k] for k in np.flatnonzero(cons["inconsistent"])]
+        if disagree:
+            notes.append(
+                f"registries disagree beyond their own stderrs (chi^2 p < 0.01) at {len(disagree)} of {len(suffixes)} "
+                f"windows ({', '.join(disagree)}; chi^2/dof up to {np.nanmax(cons['chi2_per_dof']):.3g}): there the "
+                "force depends on the registry or a window is too short for its mean, and the registries' spread, "
+                "not a window's own stderr, is its error (W_F's stderr takes the larger per window)")
         details["pmf_windows"] = {
             "separation_A": dsep.tolist(), "mean_force_kcal_mol_A": fbar.tolist(), "stderr_kcal_mol_A": ebar.tolist(),
             "tail_force_kcal_mol_A": f_tail.tolist(), "window": suffixes,
@@ -416,7 +424,8 @@ class Adhesion(Workflow):
             "decorrelation_time_ps": ((g_w - 1) / 2 * s["sample_interval"] * dt * 1e-3).tolist(),
             "registry_work_J_m2": w_reg.tolist(), "registry_offsets_A": info["registry_offsets_A"],
             "zero_force_separation_A": ti["zero_force_separation_A"], "repulsive_end": repulsive,
-            "windows_with_few_samples": short, "cutoff_only_work_J_m2": ti_cut["value"]}
+            "windows_with_few_samples": short, "cutoff_only_work_J_m2": ti_cut["value"],
+            "registry_chi2_per_dof": cons["chi2_per_dof"].tolist(), "registries_disagree": disagree}
         # the halves' errors are sqrt(2) of the whole's, so their difference has stderr 2 x the whole's
         half_diff, half_err = w_half[1] - w_half[0], 2.0 * wf_err
         details["window_length_check"] = {
