@@ -16,6 +16,8 @@ are checked. A few keys may appear in ``[system]`` (the paper value) and be over
 """
 from __future__ import annotations
 
+import math
+
 import hashlib
 import json
 import tomllib
@@ -365,6 +367,12 @@ def parse_recipe(table: Mapping[str, Any], *, name: str = "recipe", origin: str 
                   file_sha256=file_sha256, raw=MappingProxyType(dict(table)))
 
 
+#: the deepest rigid step one compression window may take from its neighbour (A). The shipped recipes step 0.5-1.0 A;
+#: one 4 A step into two OTS SAMs overlapped chains (potential energy 6.5e6 kcal/mol, LAMMPS "Bond atoms missing"
+#: at step 1), found 2026-11-25 with a cut-down quick recipe.
+MAX_COMPRESS_STEP_A = 1.0
+
+
 def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fname: str, origin: str) -> None:
     p = f"fidelity.{fname}"
     if fid["chunk_steps"] % fid["sample_interval"]:
@@ -378,6 +386,15 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
         raise RecipeError("system.separation_A", system["separation_A"],
                           f"must exceed the cutoff + 2 A = {fid['cutoff_A'] + 2.0:g} A of {p} (separated slabs "
                           f"must not interact through the Lennard-Jones term)", origin)
+    if wf == "adhesion" and fid["free_energy"] == "pmf" and fid["pmf_compress_windows"] >= 1:
+        step = fid["pmf_compress_A"] / fid["pmf_compress_windows"]
+        if step > MAX_COMPRESS_STEP_A:
+            need = math.ceil(fid["pmf_compress_A"] / MAX_COMPRESS_STEP_A)
+            raise RecipeError(f"{p}.pmf_compress_A", fid["pmf_compress_A"],
+                              f"over pmf_compress_windows = {fid['pmf_compress_windows']} presses {step:g} A per "
+                              f"window; allowed <= {MAX_COMPRESS_STEP_A:g} A (each window moves the slab rigidly "
+                              f"from its neighbour: 4 A at once overlapped OTS chains and LAMMPS lost bond atoms); "
+                              f"use pmf_compress_windows >= {need} or a smaller pmf_compress_A", origin)
     if wf == "pulloff":
         speeds = fid["retract_speeds_m_s"]
         if len(speeds) > 1 and fname != "production":

@@ -83,6 +83,18 @@ def test_separated_slabs_must_be_beyond_the_cutoff():
         parse_recipe(t)
 
 
+def test_a_compression_window_may_not_press_more_than_1_A_beyond_its_neighbour():
+    t = json.loads(json.dumps(dict(load_recipe("adhesion_ots").raw), default=dict))
+    t["fidelity"]["quick"].update(pmf_compress_windows=1, pmf_compress_A=4.0)
+    with pytest.raises(RecipeError, match=r"fidelity\.quick\.pmf_compress_A = 4\.0: over pmf_compress_windows = 1 "
+                                          r"presses 4 A per window; allowed <= 1 A .*pmf_compress_windows >= 4"):
+        parse_recipe(t)
+    t["fidelity"]["quick"].update(pmf_compress_windows=4)               # 1.0 A per window: allowed
+    parse_recipe(t)
+    t["fidelity"]["quick"].update(pmf_compress_windows=0)               # no compression chain: nothing to check
+    parse_recipe(t)
+
+
 def test_unit_conversions_use_codata_and_agree_with_the_analysis_module():
     from md import analysis as A
     assert U.kcal_per_mol_to_J(1.0) == pytest.approx(4184.0 / 6.02214076e23, rel=1e-15, abs=0)
