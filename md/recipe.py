@@ -140,8 +140,9 @@ FIELDS: tuple[Field, ...] = (
           high=20.0),
     Field("kspace_accuracy", "fidelity", float, "1", "PPPM relative force accuracy.", 1e-5, low=1e-8,
           high=1e-3),
-    Field("n_blocks", "fidelity", int, "1", "Blocks of the block-wise fits (contact-angle maps, density "
-          "profiles); time-series errors use the statistical inefficiency instead (md.analysis.timeseries_stats).",
+    Field("n_blocks", "fidelity", int, "1", "Blocks of the block-wise fits (contact-angle maps: the most, fewer "
+          "when the droplet's shape decorrelates fewer times; density profiles); time-series errors use the "
+          "statistical inefficiency instead (md.analysis.timeseries_stats).",
           5, low=2, high=1000),
     # ---------------------------------------------------------------- fidelity: adhesion
     Field("nx", "fidelity", int, "cells", "Surface cells along x (cristobalite (001): 7.16 A; (111): 5.06 A).",

@@ -652,6 +652,49 @@ def test_contact_angle_of_uniform_circular_cap(mda, theta, straddle):
     assert np.all(res.interface_points[:, 1] > s + 5.0)
 
 
+def wobbling_cap(mda, theta_series, area, box, s, rng):
+    """A cylindrical cap of fixed cross-section ``area`` (A^2) whose angle follows ``theta_series`` frame by frame:
+    a droplet whose shape relaxes over many frames. A fixed number of uniform atoms per frame."""
+    from MDAnalysis.coordinates.memory import MemoryReader
+
+    lx, ly, lz = box
+    n_atoms = int(0.9 * WATER_N * area * ly)
+    frames = []
+    for th_deg in theta_series:
+        th = math.radians(th_deg)
+        radius = math.sqrt(area / (th - math.sin(th) * math.cos(th)))
+        zc = s - radius * math.cos(th)
+        xw = radius if th_deg >= 90 else radius * math.sin(th)
+        pts = np.zeros((0, 2))
+        while len(pts) < n_atoms:
+            x, z = rng.uniform(-xw, xw, 4 * n_atoms), rng.uniform(s, zc + radius, 4 * n_atoms)
+            inside = np.hypot(x, z - zc) < radius
+            pts = np.vstack([pts, np.column_stack([x[inside], z[inside]])])
+        p = pts[:n_atoms]
+        frames.append(np.column_stack([(p[:, 0] + lx / 2) % lx, rng.uniform(0, ly, n_atoms), p[:, 1]]))
+    u = mda.Universe.empty(n_atoms, trajectory=True)
+    u.load_new(np.array(frames, dtype=np.float32), format=MemoryReader,
+               dimensions=np.array([lx, ly, lz, 90.0, 90.0, 90.0]))
+    return u
+
+
+def test_contact_angle_blocks_are_sized_by_how_often_the_droplet_shape_decorrelates(mda):
+    """Frames whose angle is independent keep the recipe's 5 blocks; a droplet still relaxing through the run
+    (its angle a half sine over 120 frames, +-6 deg, under 1 deg of noise) gets the fewest blocks (3), and the
+    run says they are not independent: its stderr is then a lower bound, not an error bar."""
+    box, area = (160.0, 30.0, 100.0), math.pi * 35.0 ** 2 / 2
+    rng = np.random.default_rng(3)
+    free = ContactAngle(wobbling_cap(mda, 90.0 + rng.normal(0, 2.0, 60), area, box, 10.0, rng).atoms,
+                        surface_z=10.0, n_blocks=5).run().results
+    assert free.n_blocks_used == 5 and free.blocks_independent and free.shape_statistical_inefficiency < 2.0
+    assert free.angle_deg == pytest.approx(90.0, abs=1.5) and len(free.block_angles_deg) == 5
+    theta = 90.0 + 6.0 * np.cos(np.pi * np.arange(120) / 119) + rng.normal(0, 1.0, 120)
+    slow = ContactAngle(wobbling_cap(mda, theta, area, box, 10.0, rng).atoms, surface_z=10.0,
+                        n_blocks=5).run().results
+    assert slow.n_blocks_used == 3 and not slow.blocks_independent
+    assert slow.shape_statistical_inefficiency > 10.0 and len(slow.shape_series_A) == 120
+
+
 def test_contact_angle_with_diffuse_interface_wall_layering_and_vapour(mda):
     rng = np.random.default_rng(21)
     s = 10.0

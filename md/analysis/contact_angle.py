@@ -11,6 +11,7 @@ import numpy as np
 from md import units as _units
 
 from md.analysis.common import WATER_MOLAR_MASS
+from md.analysis.stats import timeseries_stats
 
 
 # -------------------------------------------------------------------------------------- contact angle
@@ -344,7 +345,12 @@ if _AnalysisBase is not None:
         exclude_layer : float
             Interface points below the reference plane + ``exclude_layer`` (A) are left out of the circle fit.
         n_blocks : int
-            Contiguous blocks of frames whose maps are fitted separately for the error and the drift check.
+            The most contiguous blocks of frames whose maps are fitted separately for the error and the drift
+            check. Fewer are used when the droplet's shape decorrelates fewer times: the blocks are sized from
+            the statistical inefficiency g of a per-frame shape observable (the water's mean height above
+            ``z_min``), so that each spans about 2 g frames (``n_blocks_used`` = clamp(N_eff / 2, 3, n_blocks),
+            N_eff = frames / g). Blocks shorter than the correlation would be correlated, and their scatter
+            would understate the error.
         z_max : float, optional
             Top of the map (A); default the box height of the first frame.
         z_min : float, optional
@@ -356,7 +362,9 @@ if _AnalysisBase is not None:
         Each frame the droplet is centred in u on the circular mean of its atoms (then corrected by the
         arithmetic mean of the unwrapped coordinates), so a droplet straddling the periodic boundary or
         drifting is handled.  ``results``: ``angle_deg`` (from the full map; nan when no circle can be fitted
-        -- see ``wetting``), ``stderr_deg`` (std of the block angles / sqrt(n_blocks)), ``block_angles_deg``,
+        -- see ``wetting``), ``stderr_deg`` (std of the block angles / sqrt(n_blocks_used)), ``n_blocks_used``,
+        ``shape_series_A`` (the per-frame mean height), ``shape_statistical_inefficiency`` (its g, in frames),
+        ``blocks_independent`` (each block spans at least 2 g frames), ``block_angles_deg``,
         ``block_frames`` (mean frame index of each block), ``drift`` (:func:`block_drift` of the block angles
         against ``block_frames``), ``circle`` (xc, zc, r in A, xc in the centred frame), ``reference_z``,
         ``density_map`` (g/cm^3, shape (n_u, n_z)), ``edges`` (u_edges, z_edges in A), ``interface_points``
@@ -387,8 +395,8 @@ if _AnalysisBase is not None:
         def _prepare(self):
             self._edges = None
             self._sum = None
-            self._block_sum = None
-            self._block_count = None
+            self._frames_rho: list[np.ndarray] = []
+            self._shape: list[float] = []
 
         def _setup_grid(self, dims):
             lu = float(dims[self._iu])
@@ -398,12 +406,7 @@ if _AnalysisBase is not None:
             self._u_edges = np.linspace(-lu / 2, lu / 2, nu + 1)
             self._z_edges = self.z_min + self.bin_size * np.arange(nz + 1)
             self._edges = (self._u_edges, self._z_edges)
-            nb = max(1, min(self.n_blocks, self.n_frames))
-            self._nb = nb
             self._sum = np.zeros((nu, nz))
-            self._block_sum = np.zeros((nb, nu, nz))
-            self._block_count = np.zeros(nb, dtype=int)
-            self._block_frame_sum = np.zeros(nb)
 
         def _single_frame(self):
             dims = self._ts.dimensions
@@ -425,10 +428,10 @@ if _AnalysisBase is not None:
             rho = _units.kg_per_m3_to_g_per_cm3(                     # g/cm^3
                 _units.amu_per_A3_to_kg_per_m3(number_density * WATER_MOLAR_MASS))
             self._sum += rho
-            b = min(self._frame_index * self._nb // self.n_frames, self._nb - 1)
-            self._block_sum[b] += rho
-            self._block_count[b] += 1
-            self._block_frame_sum[b] += self._frame_index
+            self._frames_rho.append(rho.astype(np.float32))
+            z = pos[:, 2].astype(float)
+            z = z[(z >= self.z_min) & (z < self._z_edges[-1])]
+            self._shape.append(float(z.mean()) - self.z_min if z.size else float("nan"))
 
         def _fit(self, rho):
             return fit_contact_angle(rho, self._u_edges, self._z_edges, self.surface_z, self.exclude_layer,
@@ -437,26 +440,32 @@ if _AnalysisBase is not None:
         def _conclude(self):
             if self._edges is None:
                 raise ValueError("no frames analysed")
-            nf = int(self._block_count.sum())
+            nf = len(self._frames_rho)
             rho = self._sum / nf
+            shape = np.asarray(self._shape, float)
+            g_shape = timeseries_stats(shape[np.isfinite(shape)], equilibrate=False)["g"] \
+                if np.isfinite(shape).sum() >= 2 else 1.0
+            nb = int(min(self.n_blocks, max(3, (nf / g_shape) // 2), nf))
+            nb = max(1, nb)
+            bounds = np.linspace(0, nf, nb + 1).round().astype(int)
+            block_rho = [np.mean(self._frames_rho[a:b], axis=0) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+            block_frames = [0.5 * (a + b - 1) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
             fit, fit_error = None, None
             try:
                 fit = self._fit(rho)
             except ValueError as exc:               # too flat to fit: see wetting
                 fit_error = str(exc)
             block_angles = []
-            for b in range(self._nb):
-                if self._block_count[b] == 0:
-                    continue
+            for brho in block_rho:
                 try:
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore", RuntimeWarning)
-                        fb = self._fit(self._block_sum[b] / self._block_count[b])
+                        fb = self._fit(brho)
                     block_angles.append(fb["angle_deg"])
                 except ValueError:
                     block_angles.append(float("nan"))
             ba = np.array(block_angles, float)
-            bf = (self._block_frame_sum / np.maximum(self._block_count, 1))[self._block_count > 0]
+            bf = np.array(block_frames, float)
             good = ba[np.isfinite(ba)]
             stderr = float(good.std(ddof=1) / math.sqrt(good.size)) if good.size >= 2 else float("nan")
             if good.size < ba.size and fit is not None:
@@ -481,6 +490,10 @@ if _AnalysisBase is not None:
             r.stderr_deg = stderr
             r.block_angles_deg = ba
             r.block_frames = bf
+            r.n_blocks_used = len(block_rho)
+            r.shape_series_A = shape
+            r.shape_statistical_inefficiency = float(g_shape)
+            r.blocks_independent = bool(nf / max(len(block_rho), 1) >= 2.0 * g_shape)
             r.drift = block_drift(ba, bf)
             r.circle = fit["circle"] if fit else (nan, nan, nan)
             r.reference = self.reference

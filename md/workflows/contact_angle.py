@@ -254,6 +254,11 @@ class ContactAngleWorkflow(Workflow):
                              f"{drift['stderr']:.0f} deg/ns ({drift['change']:+.1f} deg over the sampled "
                              f"{np.ptp(t_blocks) * 1e3:.0f} ps, |slope| > 2 stderr): not equilibrated; the mean "
                              f"depends on where the run stopped.")
+            if not r.blocks_independent:
+                notes.append(f"the droplet's shape (its water's mean height) has a statistical inefficiency of "
+                             f"{r.shape_statistical_inefficiency:.0f} frames in {r.n_frames}: the {r.n_blocks_used} "
+                             f"block maps are not independent, so the angle's stderr is a lower bound; a longer run "
+                             f"is what makes it an error bar.")
             h = float(r.cap_height_A)
             if h < 3 * 5.0:
                 notes.append(f"the cap is {h:.1f} A high, less than 3x the 5 A excluded layer: few interface "
@@ -305,7 +310,12 @@ class ContactAngleWorkflow(Workflow):
                    "block_times_ns": t_blocks.tolist(), "block_work_of_adhesion_sl_J_m2": block_w,
                    "drift": drift, "wetting": wet, "fit_error": r.fit_error, "cap_height_A": r.cap_height_A,
                    "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames), "n_water_molecules": n_water,
-                   "water_model": s["water_model"], "gamma_lv_N_m": gamma}
+                   "water_model": s["water_model"], "gamma_lv_N_m": gamma,
+                   "blocks": {"n_blocks_used": int(r.n_blocks_used), "n_blocks_most": int(s["n_blocks"]),
+                              "shape_statistical_inefficiency_frames": float(r.shape_statistical_inefficiency),
+                              "independent": bool(r.blocks_independent),
+                              "what": "blocks of frames sized to span 2 g of the water's mean height (g its "
+                                      "statistical inefficiency), 3 at least, n_blocks at most"}}
         if status in ("measured", "wets") and "dispersion_tail_work_sl" in q:
             details["dispersion_tail"] = tail["details"]
         return Analysis(quantities=q, curves=curves, figures={"density_map": figure_writer(draw)}, notes=notes,
