@@ -321,6 +321,29 @@ def current_hash(recipe_name: str, fidelity: str) -> str:
     return run_hash(recipe, fidelity, wf.forcefield_files(recipe.settings(fidelity)))[0]
 
 
+def md_plan(recipes, fidelity: str, cache: str | None = None, results_dir: str | Path | None = None) -> dict[str, str]:
+    """Where each recipe's result will come from, decided before anything runs (hashes and files only): 'committed'
+    (a committed result at the current hash), 'md cache' (a finished run in the cache), 'resumes' (an unfinished
+    run of the current hash in the cache: it goes on from its last restart) or 'runs' (from the start)."""
+    from md.engine.store import cache_root
+    from md.recipe import load_recipe
+
+    out = {}
+    for name in recipes:
+        digest = current_hash(name, fidelity)
+        committed = committed_result(name, fidelity, None if results_dir is None else Path(results_dir))
+        run_dir = cache_root(cache) / f"{load_recipe(name).name}-{fidelity}-{digest[:16]}"
+        if committed is not None and committed.get("run_hash") == digest:
+            out[name] = "committed"
+        elif (run_dir / "result.json").is_file():
+            out[name] = "md cache"
+        elif run_dir.is_dir() and any(run_dir.iterdir()):
+            out[name] = "resumes"
+        else:
+            out[name] = "runs"
+    return out
+
+
 def md_job(task: tuple) -> dict:
     """One MD recipe: the committed result if its hash is current, else md's engine (cached). Picklable."""
     recipe_name, fidelity, cache, results_dir = task
@@ -480,6 +503,13 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     t = time.perf_counter()
     recipes = recipes_needed()
     progress(f"calibrate {cal.name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}'")
+    plan = md_plan(recipes, md_fidelity, md_cache, results_dir)
+    todo = [r for r, how in plan.items() if how in ("runs", "resumes")]
+    progress("  MD plan: " + "; ".join(f"{how}: {', '.join(r for r, h in plan.items() if h == how)}"
+                                       for how in ("committed", "md cache", "resumes", "runs")
+                                       if how in plan.values())
+             + (f" ({len(todo)} to run: minutes to hours each at quick, docs/md.md has their cost)" if todo else
+                " (no MD to run)"))
     ex = executor(executor_name, workers, scheduler)
     results, sources = {}, {}
     try:

@@ -173,6 +173,27 @@ def test_recipes_needed_are_the_seven_mapped_ones():
                                 "surface_tension_spce", "pulloff_silica", "pulloff_ots"]
 
 
+def test_the_md_plan_says_before_anything_runs_where_each_result_will_come_from(tmp_path):
+    """Committed at the current hash, finished in the md cache, unfinished in the cache (resumes), or not there
+    (runs): decided from hashes and files alone."""
+    from calibration.pipeline import current_hash, md_plan
+
+    results, cache = tmp_path / "results", tmp_path / "cache"
+    (results / "adhesion_ots-smoke").mkdir(parents=True)
+    (results / "adhesion_ots-smoke" / "result.json").write_text(
+        json.dumps({"run_hash": current_hash("adhesion_ots", "smoke")}))
+    (results / "adhesion_silica-smoke").mkdir(parents=True)                        # a stale committed result
+    (results / "adhesion_silica-smoke" / "result.json").write_text(json.dumps({"run_hash": "0" * 64}))
+    done = cache / f"adhesion_silica-smoke-{current_hash('adhesion_silica', 'smoke')[:16]}"
+    done.mkdir(parents=True)
+    (done / "result.json").write_text("{}")
+    partial = cache / f"pulloff_ots-smoke-{current_hash('pulloff_ots', 'smoke')[:16]}"
+    (partial / "legs").mkdir(parents=True)
+    plan = md_plan(["adhesion_ots", "adhesion_silica", "pulloff_ots", "pulloff_silica"], "smoke", str(cache), results)
+    assert plan == {"adhesion_ots": "committed", "adhesion_silica": "md cache", "pulloff_ots": "resumes",
+                    "pulloff_silica": "runs"}
+
+
 def test_latin_hypercube_hits_every_stratum_once_per_dimension():
     u = latin_hypercube(50, 4, np.random.default_rng(3))
     assert u.shape == (50, 4) and np.all((u >= 0) & (u < 1))
