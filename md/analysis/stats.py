@@ -117,7 +117,8 @@ def detect_equilibration(x, nskip: int | None = None, min_samples: int = 10,
     about 100 candidates); at least ``min_samples`` are kept. Returns ``t0``, ``g`` (of x[t0:]) and ``n_eff``.
 
     Why the cap: a fluctuation slower than the series makes a late tail look stationary, and N_eff(t0) then
-    peaks there. In a 15 ps OTS-OTS force window held at contact, the force wanders over ~10 ps. Unbounded, the
+    peaks there. In a 15 ps OTS-OTS force window held at contact (a cut-down quick run, 2026-11-25), the force
+    wanders over ~10 ps. Unbounded, the
     detection kept the last 90 of 1500 samples and gave a stderr 10x below the blocking estimate over the whole
     window. A mean is therefore never taken over less than the last half, the usual warm-up convention
     (Gelman & Rubin, Statist. Sci. 7 (1992) 457). A slow drift then shows in the stderr instead of vanishing from it."""
@@ -161,9 +162,9 @@ def timeseries_stats(x, *, equilibrate: bool = True, mintime: int = 3) -> dict:
     n = y.size
     g_si = statistical_inefficiency(y, mintime)
     if n < 2:
-        return {"mean": float(y.mean()), "stderr": float("nan"), "g": 1.0, "g_si": 1.0, "stderr_blocking": float("nan"),
-                "error_method": "statistical inefficiency", "tau": 0.0, "t0": t0, "n": n, "n_eff": float(n),
-                "std": float("nan")}
+        return {"mean": float(y.mean()), "stderr": float("nan"), "g": 1.0, "g_si": 1.0,
+                "stderr_blocking": float("nan"), "error_method": "statistical inefficiency", "tau": 0.0, "t0": t0,
+                "n": n, "n_eff": float(n), "std": float("nan")}
     sd = float(y.std(ddof=1))
     se_si, se_b = sd * math.sqrt(g_si / n), blocking_stderr(y)
     blocked = se_b > se_si
