@@ -160,11 +160,12 @@ def registry_consistency(values, stderrs, p_min: float = 0.01) -> dict:
     point chi^2 = sum_r (v_r - m)^2 / e_r^2 with m the inverse-variance weighted mean, chi^2-distributed with
     n - 1 degrees of freedom when the registries measure one value (Bevington & Robinson, *Data Reduction and
     Error Analysis*, 3rd ed., section 11.1, with the registries as repeated measurements of one quantity). A
-    point is ``inconsistent`` where the chi^2 tail probability is below ``p_min``. There, either the quantity depends on the registry (a crystalline
-    contact), or each registry's stderr is too small for what its window really resolves (a mean not converged in
-    the window). Either way the registries' spread, which `registry_average` puts into the error, is what
-    carries the error there. Fewer than two registries: nothing to compare (all points consistent, chi^2 nan).
-    Returns ``chi2_per_dof`` and ``p`` (arrays), ``inconsistent`` (bool array), ``dof``."""
+    point is ``inconsistent`` where the chi^2 tail probability is below ``p_min``. There, either the quantity
+    depends on the registry (a crystalline contact), or each registry's stderr is too small for what its window
+    really resolves (a mean not converged in the window). Either way the registries' spread, which
+    `registry_average` puts into the error, is what carries the error there. Fewer than two registries: nothing to
+    compare (all points consistent, chi^2 nan). Returns ``chi2_per_dof`` and ``p`` (arrays), ``inconsistent``
+    (bool array), ``dof``."""
     from scipy.stats import chi2 as chi2_dist
 
     v = np.asarray(values, float)
