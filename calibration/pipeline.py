@@ -325,14 +325,14 @@ def md_plan(recipes, fidelity: str, cache: str | None = None, results_dir: str |
     """Where each recipe's result will come from, decided before anything runs (hashes and files only): 'committed'
     (a committed result at the current hash), 'md cache' (a finished run in the cache), 'resumes' (an unfinished
     run of the current hash in the cache: it goes on from its last restart) or 'runs' (from the start)."""
-    from md.engine.store import cache_root
+    from md.engine.store import run_dir_for
     from md.recipe import load_recipe
 
     out = {}
     for name in recipes:
         digest = current_hash(name, fidelity)
         committed = committed_result(name, fidelity, None if results_dir is None else Path(results_dir))
-        run_dir = cache_root(cache) / f"{load_recipe(name).name}-{fidelity}-{digest[:16]}"
+        run_dir = run_dir_for(load_recipe(name).name, fidelity, digest, cache)
         if committed is not None and committed.get("run_hash") == digest:
             out[name] = "committed"
         elif (run_dir / "result.json").is_file():

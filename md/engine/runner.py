@@ -54,7 +54,7 @@ from md import units
 from md.engine.hashing import forcefield_hashes, lammps_version, package_version, run_hash
 from md.engine.lammps import InProcess, MpiRun
 from md.engine.plan import Job, Leg, Plan, Planner
-from md.engine.store import (RunContext, RunOutcome, cache_root, clean_json, export, leg_state, parse_ave_time,
+from md.engine.store import (RunContext, RunOutcome, run_dir_for, clean_json, export, leg_state, parse_ave_time,
                              parse_dump, truncate_samples, write_csv)
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_text
 from nanoimpact.lock import run_lock
@@ -229,7 +229,7 @@ def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache
             echo(line)
 
     digest, hashed = run_hash(job.canonical, job.fidelity, job.forcefield_files, job.workflow_version)
-    run_dir = cache_root(cache) / f"{job.name}-{job.fidelity}-{digest[:16]}"
+    run_dir = run_dir_for(job.name, job.fidelity, digest, cache)
     with run_lock(run_dir, wait=wait, timeout=wait_timeout,
                   hint="wait for it to finish and run again, or leave out --no-wait to wait for it"):
         return _run_locked(job, workflow, digest, hashed, run_dir, out=out, resume=resume, np_=np_,

@@ -34,6 +34,12 @@ def cache_root(cache: str | Path | None = None) -> Path:
     return Path(env).expanduser().resolve() if env else DEFAULT_CACHE.expanduser()
 
 
+def run_dir_for(name: str, fidelity: str, digest: str, cache: str | Path | None = None) -> Path:
+    """The run directory of recipe ``name`` at ``fidelity`` with run hash ``digest`` in the cache (the one place
+    that names it)."""
+    return cache_root(cache) / f"{name}-{fidelity}-{digest[:16]}"
+
+
 def read_samples(path: Path) -> dict[str, np.ndarray]:
     """samples.csv -> {column: array}; empty dict if the file does not exist."""
     path = Path(path)
