@@ -31,6 +31,8 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
+from nanoimpact.interrupt import raise_if_interrupted
+
 from .laws.base import ContactLaw
 
 
@@ -216,6 +218,7 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
 
         # ---------------- contact (adaptive, events) ----------------
         outcome = _contact(law, mass, gravity, t, gap, v, settings, index, record)
+        raise_if_interrupted()
         booked += outcome["booked"]
         b = outcome["bounce"]
         if b is not None:

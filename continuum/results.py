@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, json_leaf
+from nanoimpact.interrupt import raise_if_interrupted
 
 #: Bump the major number on incompatible changes to result.json.
 SCHEMA_VERSION = "2.0"
@@ -213,6 +214,7 @@ def write_run(out_dir: str | Path, result: dict, trace: dict, figures: dict | No
         write_timeseries(tmp / "timeseries.csv", trace)
         for name, draw in (figures or {}).items():
             draw(tmp / name)
+        raise_if_interrupted()              # Ctrl-C before this line leaves no output folder
         if not out.exists():
             os.replace(tmp, out)
         else:

@@ -94,8 +94,12 @@ def run_command(fn, *args, prog: str = "nanoimpact", stream=None) -> int:
     """
     import sys
 
+    from nanoimpact.interrupt import raise_if_interrupted, sigint_guard
+
     try:
-        code = fn(*args)
+        with sigint_guard():
+            code = fn(*args)
+            raise_if_interrupted()            # an interrupt that foreign code swallowed still ends in 130
     except SystemExit as exc:                 # argparse's --help / --version, or an explicit sys.exit
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_FAILED)
     except (NanoimpactError, KeyboardInterrupt) as exc:

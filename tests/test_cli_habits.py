@@ -305,3 +305,62 @@ def test_library_chatter_is_hidden_unless_verbose(monkeypatch, capsys):
     assert "netCDF4" not in err and "a real MDAnalysis error" in err
     assert main(["-v", "impact", "x"]) == 0
     assert "netCDF4" in capsys.readouterr().err
+
+
+def _sigint_swallowed_by_a_ctypes_callback() -> None:
+    """Deliver SIGINT while a ctypes callback runs (as numba's object-cache hook does during JIT compilation):
+    ctypes prints 'Exception ignored' and returns normally, so the KeyboardInterrupt never reaches the caller."""
+    import ctypes
+
+    libc = ctypes.CDLL(None)
+    cmp_t = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int))
+
+    def compare(a, b):
+        signal.raise_signal(signal.SIGINT)
+        return a[0] - b[0]
+
+    values = (ctypes.c_int * 2)(2, 1)
+    libc.qsort(values, 2, ctypes.sizeof(ctypes.c_int), cmp_t(compare))
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # ctypes' "Exception ignored"
+def test_an_interrupt_swallowed_by_foreign_code_still_exits_130(capsys):
+    from nanoimpact.errors import run_command
+
+    def command():
+        _sigint_swallowed_by_a_ctypes_callback()
+        return 0                                  # the command itself never saw the interrupt
+
+    assert run_command(command) == EXIT_INTERRUPTED
+    assert _one_line(capsys.readouterr().err).endswith("nanoimpact: interrupted")
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler    # the guard put the handler back
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # ctypes' "Exception ignored"
+def test_an_interrupt_swallowed_by_foreign_code_writes_no_output_folder(tmp_path):
+    """write_run's commit point re-raises an interrupt that arrived while the run was being computed."""
+    from continuum.results import write_run
+    from nanoimpact.interrupt import sigint_guard
+
+    with pytest.raises(KeyboardInterrupt), sigint_guard():
+        _sigint_swallowed_by_a_ctypes_callback()
+        write_run(tmp_path / "o", {"status": "ok"}, {"t": [0.0], "gap": [0.0], "velocity": [0.0],
+                                                     "force": [0.0], "phase": [0], "energy": [0.0]})
+    assert not (tmp_path / "o").exists() and list(tmp_path.iterdir()) == []
+
+
+def test_sigint_inside_numba_is_deferred_to_the_next_safe_point():
+    """Inside numba/llvmlite the handler only remembers (raising there leaves numba's compiled-library state
+    half-built: 'no compiled object yet' on the next call); raise_if_interrupted raises it afterwards."""
+    from nanoimpact import interrupt
+
+    namespace = {"__name__": "numba.core.fake_compiler", "sys": sys, "interrupt": interrupt, "signal": signal}
+    exec("def compile_step():\n    interrupt.handler(signal.SIGINT, sys._getframe())\n    return 'finished'\n",
+         namespace)
+    with interrupt.sigint_guard():
+        assert namespace["compile_step"]() == "finished"           # not raised inside numba
+        with pytest.raises(KeyboardInterrupt):
+            interrupt.raise_if_interrupted()                        # but not forgotten
+        with pytest.raises(KeyboardInterrupt):
+            interrupt.handler(signal.SIGINT, sys._getframe())      # elsewhere it raises at once
+    interrupt.raise_if_interrupted()                                # the guard's exit forgets it
