@@ -575,7 +575,8 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     report = CalibrationReport(name=cal.name, set_path=Path(set_path), out=out, calibration=cal,
                                rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources=sources, bands=bands,
                                paper_checks=tuple(paper["checks"]), timings=timings, machine=machine,
-                               md_compute_total_s=sum(md_compute.values()), claim_attribution=attribution)
+                               md_compute_total_s=sum(md_compute.values()), claim_attribution=attribution,
+                               validation=table["meta"].get("validation", {}))
     progress(f"calibrate: report {report.write()}; total {timings['total_s']:.1f} s")
     return report
 

@@ -145,7 +145,10 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
         timings={"md_s": 1.0, "paper_s": 2.0, "uncertainty_s": 3.0, "total_s": 6.0},
         machine={"cores": 2, "platform": "p", "python": "3.11"}, md_compute_total_s=10.0,
         claim_attribution={"claims": [{"claim": "claim_b", "cause": "single", "restored_by": ["r"],
-                                       "text": "holds again when only W is put back"}]})
+                                       "text": "holds again when only W is put back"}]},
+        validation={"pulloff_ots": {"F_over_2piR": 0.05, "F_over_2piR_stderr": 0.01, "W_F": 0.04, "W_F_stderr": None,
+                                    "ratio": 1.25, "difference_in_stderr": 1.0, "adhesion_recipe": "adhesion_ots",
+                                    "residual_drag_N": None}})
     assert len(report.used) == 8 and report.not_used == ()
     assert [c["name"] for c in report.claims()] == ["claim_a", "claim_b"]
     md = report.write()
@@ -163,6 +166,8 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     assert saved["rows"][0] == rows[0] | {k: None for k in ValueRow.__dataclass_fields__ if k not in rows[0]}
     assert saved["versions"]["numpy"] == np.__version__
     assert saved["claim_attribution"]["claims"][0]["cause"] == "single"
+    assert "**Pull-off validation" in text and "| pulloff_ots (vs adhesion_ots) |" in text
+    assert saved["validation"]["pulloff_ots"]["ratio"] == 1.25
     assert saved["calibration"]["uncertainty"]["samples"] == 16            # the declared default
     assert "Calibration `cal` (base `paper`)" in text and "Recipe `recipe.toml`" in text
     assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
@@ -347,3 +352,27 @@ def test_a_value_is_placed_against_its_published_range_in_its_own_stderr():
         f = FIELD_BY_PATH[tgt.key]
         assert tgt.unit == f.unit and tgt.low < tgt.high and f.low <= tgt.low and tgt.high <= f.high and tgt.source
     assert target_of("surfaces.work_of_adhesion") is None        # no published Dupre work for this IFF surface
+
+
+def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_path):
+    """F / (2 pi R) of each pull-off beside W_F of the same pair (DMT at MD scale): ratio, combined stderrs, and a
+    sentence when the two differ by more than 2 of them. 0.09 +- 0.004 against 0.18 +- 0.03: ratio 0.50,
+    -0.09 / hypot(0.004, 0.03) = -3.0 sigma; OTS 0.05 +- 0.01 against 0.04 (no stderr): +1.0 sigma."""
+    from calibration.mdset import pulloff_validation
+    from calibration.report import _validation_lines
+
+    res = _results()
+    res["pulloff_silica"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.09, "stderr": 0.004,
+                                                                       "units": "J/m^2"}
+    res["pulloff_ots"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.05, "stderr": 0.01, "units": "J/m^2"}
+    res["pulloff_silica"]["quantities"]["residual_drag_force"] = {"value": 1.5e-12, "units": "N"}
+    v = pulloff_validation(res)
+    assert v["pulloff_silica"]["ratio"] == pytest.approx(0.5, rel=1e-12)
+    assert v["pulloff_silica"]["difference_in_stderr"] == pytest.approx(-0.09 / math.hypot(0.004, 0.03), rel=1e-12)
+    text = "\n".join(_validation_lines(v))
+    assert "| pulloff_silica (vs adhesion_silica) | 0.09 +- 0.004 | 0.18 +- 0.03 | 0.50 | -3.0 sigma | +0.002 |" in text
+    assert "| pulloff_ots (vs adhesion_ots) | 0.05 +- 0.01 | 0.04 +- - | 1.25 | +1.0 sigma | - |" in text
+    assert "Beyond 2 combined stderrs: pulloff_silica." in text
+    assert _validation_lines({}) == []
+    table, _ = build_parameter_set(res, "paper", "cal")
+    assert table["meta"]["validation"] == v                 # the set records what the report shows
