@@ -64,5 +64,6 @@ def sigint_guard() -> Iterator[None]:
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        # None: the previous handler was not installed from Python; Python's default is the closest restorable one
+        signal.signal(signal.SIGINT, signal.default_int_handler if previous is None else previous)
         _pending = False
