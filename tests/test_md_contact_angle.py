@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from md.analysis import (ContactAngle, block_drift, cap_angle_for_base, cap_angle_for_height, dividing_plane,
-                         fit_contact_angle, wetting_bound, work_of_adhesion_sl)
+                         fit_contact_angle, shape_check, wetting_bound, work_of_adhesion_sl)
 from md.build import cap_radius, water_cap
 from md.recipe import load_recipe
 
@@ -188,6 +188,62 @@ def test_a_cap_too_flat_to_fit_gives_a_resolvable_bound_above_its_true_angle():
     assert not w["spans_box"]
     assert w["area_A2"] == pytest.approx(math.pi * 15.0 ** 2, rel=0.02)
     assert 6.0 < w["theta_resolvable_deg"] < 40.0
+
+
+# ------------------------------------------------------------------------------------ is it a circle?
+
+def elongated_cap_map(theta_deg, a, stretch, plane_z, bin_A=1.0, z_lo=0.0, sub=6):
+    """Exact-coverage map (bulk 1, no layering) of an elliptical cylinder cut by ``plane_z``: horizontal semi-axis
+    ``a``, vertical ``stretch * a``, centred so that the *circle* of radius a would meet the plane at
+    ``theta_deg``. Laplace forbids this shape at rest; it is what a sheared or still-relaxing mean droplet looks like."""
+    b = stretch * a
+    zc = plane_z - b * math.cos(math.radians(theta_deg))
+    lx = 2 * a + 30.0
+    ue = np.arange(-lx / 2, lx / 2 + 1e-9, bin_A)
+    ze = np.arange(z_lo, zc + b + 8.0 + 1e-9, bin_A)
+    frac = (np.arange(sub) + 0.5) / sub * bin_A
+    uu, zz = ue[:-1, None] + frac, ze[:-1, None] + frac
+    inside = ((uu[:, None, :, None] / a) ** 2 + ((zz[None, :, None, :] - zc) / b) ** 2 < 1) & \
+        (zz[None, :, None, :] > plane_z)
+    return inside.astype(float).mean(axis=(2, 3)), ue, ze
+
+
+@pytest.mark.parametrize("theta,radius", [(40.0, 60.0), (116.0, 25.0), (134.0, 32.0)])
+def test_shape_check_passes_a_circular_cap_at_the_quick_bin(theta, radius):
+    """A circle gives one angle from every band and from its area and height: on 1 A bins with a layered wall the
+    readings agree within 1.2 deg (measured 0.5-0.9), inside the 2 deg floor of the tolerance."""
+    rho, ue, ze, _ = depleted_cap_map(theta, radius, 12.2, 1.0, z_lo=7.0)
+    sc = shape_check(rho, ue, ze, 7.0, angle_stderr_deg=0.3)
+    assert sc["circular"] is True and sc["spread_deg"] < 1.2 and not sc["failed"]
+    assert set(sc["angles_by_exclude_deg"]) == {"3", "5", "10"}
+    for a in sc["angles_by_exclude_deg"].values():
+        assert a == pytest.approx(theta, abs=1.0)
+
+
+def test_shape_check_flags_an_elongated_cap_and_scales_its_tolerance_with_the_stderr():
+    """A cap 25 % taller than wide (the R0 = 3 nm OTS droplet's mean map was of this kind) reads a higher angle the
+    higher the band: flagged. The same map passes once the blocks' stderr makes 3 stderr exceed the spread."""
+    rho, ue, ze = elongated_cap_map(120.0, 30.0, 1.25, 12.0, z_lo=7.0)
+    sc = shape_check(rho, ue, ze, 7.0, angle_stderr_deg=0.5)
+    by = sc["angles_by_exclude_deg"]
+    assert by["10"] > by["5"] > by["3"]
+    assert sc["spread_deg"] > 3.0 and sc["tolerance_deg"] == 2.0 and sc["circular"] is False
+    loose = shape_check(rho, ue, ze, 7.0, angle_stderr_deg=sc["spread_deg"])
+    assert loose["tolerance_deg"] == pytest.approx(3 * sc["spread_deg"]) and loose["circular"] is True
+    assert shape_check(rho, ue, ze, 7.0)["tolerance_deg"] == 2.0        # no stderr: the floor
+
+
+def test_shape_check_of_the_committed_ots_map_is_circular():
+    """The committed R0 = 2 nm OTS map (version 2) reads 116.8, 116.3, 116.5 deg by band and 114.1 from its area
+    and height: circular within max(3 x 1.46, 2) deg."""
+    from md.workflows.contact_angle import MAP_FLOOR_A
+    rho, ue, ze = _committed_ots_map()
+    res = json.loads((COMMITTED_OTS / "result.json").read_text())
+    stderr = res["quantities"]["contact_angle_as_simulated"]["stderr"]
+    sc = shape_check(rho, ue, ze, res["details"]["surface_z_A"] - MAP_FLOOR_A, stderr)
+    assert sc["angles_by_exclude_deg"]["5"] == pytest.approx(res["quantities"]["contact_angle_as_simulated"]["value"],
+                                                            abs=0.01)
+    assert sc["circular"] is True and sc["spread_deg"] < sc["tolerance_deg"]
 
 
 # ------------------------------------------------------------------------------------ drift and W_SL

@@ -30,6 +30,7 @@ from md.analysis.adhesion import (force_integration_work, registry_average, regi
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M, WATER_MOLAR_MASS
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
                                        block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
+                                       shape_check,
                                        dispersion_tail_work, tail_antiderivative)
 from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
 from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
@@ -45,7 +46,7 @@ __all__ = [
     "MAUGIS_LJ93",
     "energy_separation_work", "work_from_energy_curve",
     "ContactAngle", "fit_contact_angle", "fit_circle", "dividing_plane", "wetting_bound", "block_drift",
-    "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "dispersion_tail_work", "tail_antiderivative",
+    "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work", "tail_antiderivative",
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
     "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
 ]

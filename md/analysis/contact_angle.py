@@ -209,6 +209,55 @@ def cap_angle_for_height(area_A2: float, height_A: float) -> float:
     return math.degrees(brentq(lambda t: h(t) - height_A, 1e-4, math.pi))
 
 
+#: excluded layers (A above the reference plane) of the shape check's circle fits
+SHAPE_CHECK_EXCLUDE_A = (3.0, 5.0, 10.0)
+
+
+def shape_check(density_map, u_edges, z_edges, surface_z: float, angle_stderr_deg: float | None = None,
+                exclude_layers=SHAPE_CHECK_EXCLUDE_A, reference: str = "dividing_surface") -> dict:
+    """Is the mean droplet a circular cap? The same map read three more ways; a spread beyond the statistics
+    means the angle depends on how it is read, not only on the sampling.
+
+    A cylindrical droplet at rest has one curvature (Laplace, no gravity at nm scale), so its liquid-vapour
+    contour is a circle and every band of it gives the same angle. Pinned or still-moving contact lines, a
+    sheared or elongated mean shape, and the wall-layered foot break that. Checks:
+
+    * ``angles_by_exclude_deg``: circle fits (:func:`fit_contact_angle`) above the reference plane + each of
+      ``exclude_layers`` (default 3, 5, 10 A); a circle gives the same angle from each.
+    * ``angle_from_height_deg``: the cap of the map's liquid cross-section whose height is the fitted cap
+      height (:func:`cap_angle_for_height`) -- area and height only, no contour shape.
+    * ``spread_deg``: max - min of those angles; ``circular`` is False when the spread exceeds
+      ``max(3 stderr, 2 deg)`` (``angle_stderr_deg`` the blocks' stderr of the angle; 2 deg when not given),
+      the resolution a 1 A map gives a 3 nm cap; None when fewer than two readings exist.
+
+    Fits that fail (too few points above a thick excluded layer) are left out and listed in ``failed``.
+    """
+    angles: dict[str, float] = {}
+    failed: dict[str, str] = {}
+    height = None
+    area = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for ex in exclude_layers:
+            try:
+                f = fit_contact_angle(density_map, u_edges, z_edges, surface_z, float(ex), reference=reference)
+            except ValueError as exc:
+                failed[f"{float(ex):g}"] = str(exc)
+                continue
+            angles[f"{float(ex):g}"] = float(f["angle_deg"])
+            if height is None or float(ex) == 5.0:
+                height, area = float(f["cap_height_A"]), float(f["area_A2"])
+    from_height = cap_angle_for_height(area, height) if area and height and area > 0 and height > 0 else float("nan")
+    values = [a for a in angles.values() if np.isfinite(a)] + ([from_height] if np.isfinite(from_height) else [])
+    spread = float(np.ptp(values)) if len(values) >= 2 else float("nan")
+    tol = max(3.0 * float(angle_stderr_deg), 2.0) if angle_stderr_deg is not None and np.isfinite(angle_stderr_deg) \
+        else 2.0
+    return {"angles_by_exclude_deg": angles, "angle_from_height_deg": from_height, "spread_deg": spread,
+            "tolerance_deg": tol, "circular": bool(spread <= tol) if np.isfinite(spread) else None, "failed": failed,
+            "what": "circle fits above the water's plane + each excluded layer, and the cap of the map's area at "
+                    "the fitted height; a circular cap gives one angle from all"}
+
+
 def wetting_bound(density_map, u_edges, z_edges, bulk_density: float, reference_z: float,
                   exclude_layer: float = 5.0, min_arc_bins: int = 2, band_A: float = 3.0) -> dict:
     """Is the droplet too flat to give an angle? Then the measurable statement is an upper bound ("wets").

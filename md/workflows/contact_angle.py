@@ -259,6 +259,15 @@ class ContactAngleWorkflow(Workflow):
                              f"{r.shape_statistical_inefficiency:.0f} frames in {r.n_frames}: the {r.n_blocks_used} "
                              f"block maps are not independent, so the angle's stderr is a lower bound; a longer run "
                              f"is what makes it an error bar.")
+            shape = A.shape_check(r.density_map, *r.edges, floor, r.stderr_deg)
+            if shape["circular"] is False:
+                by = ", ".join(f"{v:.1f} ({k} A)" for k, v in shape["angles_by_exclude_deg"].items())
+                notes.append(f"NOT A CIRCULAR CAP: the same map reads {by} above the water's plane and "
+                             f"{shape['angle_from_height_deg']:.1f} deg from its area and height; the spread "
+                             f"{shape['spread_deg']:.1f} deg exceeds max(3 stderr, 2 deg) = "
+                             f"{shape['tolerance_deg']:.1f} deg, so the angle depends on how it is read "
+                             f"(pinned or moving contact lines, a sheared mean shape): a systematic the stderr "
+                             f"does not hold.")
             h = float(r.cap_height_A)
             if h < 3 * 5.0:
                 notes.append(f"the cap is {h:.1f} A high, less than 3x the 5 A excluded layer: few interface "
@@ -316,6 +325,8 @@ class ContactAngleWorkflow(Workflow):
                               "independent": bool(r.blocks_independent),
                               "what": "blocks of frames sized to span 2 g of the water's mean height (g its "
                                       "statistical inefficiency), 3 at least, n_blocks at most"}}
+        if status == "measured":
+            details["shape_check"] = shape
         if status in ("measured", "wets") and "dispersion_tail_work_sl" in q:
             details["dispersion_tail"] = tail["details"]
         return Analysis(quantities=q, curves=curves, figures={"density_map": figure_writer(draw)}, notes=notes,
