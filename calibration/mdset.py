@@ -210,9 +210,17 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             if qname == "contact_angle_upper_bound":
                 entry["note"] = (f"MD: the water wets (theta < {2 * value:.3g} deg, no angle measurable); entered as "
                                  f"uniform on [0, {2 * value:.3g}] deg: mean and stderr of that interval")
+            flags = []
             if qname == "contact_angle" and (qs.get("contact_angle_drift") or {}).get("drifting"):
                 entry["drifting"] = True
-                entry["note"] = "the block angles still drift (see the MD result's notes): not equilibrated"
+                flags.append("the block angles still drift (see the MD result's notes): not equilibrated")
+            shape = (res.get("details") or {}).get("shape_check") or {}
+            if qname == "contact_angle" and shape.get("circular") is False:
+                entry["not_circular"] = True
+                flags.append(f"the mean droplet is not a circular cap: its readings spread by "
+                             f"{shape.get('spread_deg', float('nan')):.1f} deg, a systematic the stderr does not hold")
+            if flags:
+                entry["note"] = "; ".join(flags)
             if qname == "interaction_range_z0":
                 q = qs[qname]
                 if src.note:

@@ -108,6 +108,25 @@ def test_a_wetting_droplet_enters_as_the_uniform_interval_below_its_bound():
     assert "surfaces.body.contact_angle" in table["meta"]["rejected"]
 
 
+def test_a_drifting_or_non_circular_droplet_is_flagged_on_its_calibrated_angle():
+    """The MD result's drift flag and its shape check (details.shape_check.circular) travel with the angle into the
+    set's meta, so a reader of calibrated.toml sees that the stderr does not hold the whole error."""
+    ca = _result("contact_angle_ots", {"contact_angle": (125.0, 0.3, "deg")})
+    ca["quantities"]["contact_angle_drift"] = {"value": 27.0, "stderr": 18.0, "units": "deg/ns", "drifting": False}
+    ca["details"] = {"shape_check": {"circular": False, "spread_deg": 5.4}}
+    table, _ = build_parameter_set(_results(contact_angle_ots=ca), "paper", "cal")
+    cal = table["meta"]["calibration"]["surfaces.sam.contact_angle"]
+    assert table["surfaces"]["sam"]["contact_angle"] == 125.0
+    assert cal["not_circular"] is True and "drifting" not in cal and "5.4 deg" in cal["note"]
+    ca["quantities"]["contact_angle_drift"]["drifting"] = True
+    ca["details"]["shape_check"]["circular"] = True
+    cal = build_parameter_set(_results(contact_angle_ots=ca), "paper", "cal")[0]["meta"]["calibration"][
+        "surfaces.sam.contact_angle"]
+    assert cal["drifting"] is True and "not_circular" not in cal and "drift" in cal["note"]
+    cal = build_parameter_set(_results(), "paper", "cal")[0]["meta"]["calibration"]["surfaces.sam.contact_angle"]
+    assert "note" not in cal and "drifting" not in cal and "not_circular" not in cal
+
+
 def test_angles_and_gamma_of_different_water_models_are_not_combined():
     res = _results()
     for r, model in (("contact_angle_silica", "tip4p2005"), ("contact_angle_ots", "tip4p2005"),
