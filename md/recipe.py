@@ -37,7 +37,7 @@ __all__ = ["RecipeError", "Recipe", "Field", "RecipeField", "FIELDS", "WORKFLOWS
 #: The shipped MD recipes (inputs/md, installed as package data); names are looked up in the user data
 #: folder first (nanoimpact.data).
 RECIPE_DIR = shipped_data.shipped_root() / "md"
-WORKFLOWS = ("adhesion", "pulloff", "contact_angle", "surface_tension")
+WORKFLOWS = ("adhesion", "pulloff", "contact_angle", "surface_tension", "wsl_ti")
 FIDELITIES = ("smoke", "quick", "production")
 SURFACES = ("silica", "ots")
 THERMOSTATS = ("nose-hoover", "langevin")
@@ -68,7 +68,7 @@ def Field(key: str, section: str, kind: type, unit: str, doc: str, default: Any 
                        item=item, length=length, section=section, workflows=workflows)
 
 
-_ADH, _PULL, _CA, _ST = ("adhesion",), ("pulloff",), ("contact_angle",), ("surface_tension",)
+_ADH, _PULL, _CA, _ST, _TI = ("adhesion",), ("pulloff",), ("contact_angle",), ("surface_tension",), ("wsl_ti",)
 _SURF = ("adhesion", "pulloff", "contact_angle")
 
 FIELDS: tuple[Field, ...] = (
@@ -81,14 +81,14 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces", "system", list, "", "Adhesion: the lower and the upper surface (the upper slab is flipped "
           "to face the lower one).", REQUIRED, choices=SURFACES, workflows=_ADH, item=str, length=(2,)),
     Field("surface", "system", str, "", "Pull-off: the coating of both the asperity and the flat; contact "
-          "angle: the substrate.", REQUIRED, choices=SURFACES, workflows=_PULL + _CA),
+          "angle and W_SL by TI: the substrate (TI: silica only).", REQUIRED, choices=SURFACES, workflows=_PULL + _CA + _TI),
     Field("silica_face", "system", str, "", "Cristobalite face of every bare silica surface: '111' = isolated Q3 "
           "silanols at 4.50 OH/nm^2 (nearest silanol O-O 5.06 A), IFF's hydrophilic Q3 surface and the shared "
           "default of all recipes; '001' = geminal/vicinal pairs 2.53 A apart, 3.9-7.8 OH/nm^2 (silanol_density). "
-          "OTS is always grafted on (111).", "111", choices=("111", "001"), workflows=_SURF),
+          "OTS is always grafted on (111).", "111", choices=("111", "001"), workflows=_SURF + _TI),
     Field("silanol_density", "system", float, "OH/nm^2", "Silanol density requested on the (001) face "
           "(silica_face = '001'); the (111) face has 4.50 fixed.", 4.7, low=3.9, high=7.8,
-          workflows=_SURF),
+          workflows=_SURF + _TI),
     Field("sam_coverage", "system", float, "chains/nm^2", "OTS grafting density (cristobalite (111) holds at "
           "most 4.50).", 4.5, low=0.5, high=4.5, workflows=_SURF),
     Field("chain_length", "system", int, "carbons", "OTS alkyl chain length (C18 for OTS).", 18, low=2, high=30,
@@ -115,7 +115,7 @@ FIELDS: tuple[Field, ...] = (
           "cylindrical cap with this angle on the substrate (90 = half-cylinder); start near the expected angle.",
           90.0, low=10.0, high=170.0, workflows=_CA),
     Field("water_model", "system", str, "", "Water model; one model throughout a calibration (the contact "
-          "angles and gamma_lv must come from the same water).", "spce", choices=("spce",), workflows=_CA + _ST),
+          "angles and gamma_lv must come from the same water).", "spce", choices=("spce",), workflows=_CA + _ST + _TI),
     # ---------------------------------------------------------------- fidelity: numerics shared by all
     Field("timestep_fs", "fidelity", float, "fs", "MD timestep.", REQUIRED, low=0.1, high=4.0),
     Field("thermostat", "fidelity", str, "", "NVT thermostat.", "nose-hoover", choices=THERMOSTATS),
@@ -146,11 +146,11 @@ FIELDS: tuple[Field, ...] = (
           5, low=2, high=1000),
     # ---------------------------------------------------------------- fidelity: adhesion
     Field("nx", "fidelity", int, "cells", "Surface cells along x (cristobalite (001): 7.16 A; (111): 5.06 A).",
-          REQUIRED, low=1, high=200, workflows=_ADH + _CA),
+          REQUIRED, low=1, high=200, workflows=_ADH + _CA + _TI),
     Field("ny", "fidelity", int, "cells", "Surface cells along y ((001): 7.16 A; (111): 8.77 A).", REQUIRED,
-          low=1, high=200, workflows=_ADH + _CA),
+          low=1, high=200, workflows=_ADH + _CA + _TI),
     Field("slab_thickness_A", "fidelity", float, "A", "Silica slab thickness (outermost Si planes).", REQUIRED,
-          low=2.0, high=200.0, workflows=_ADH + _CA),
+          low=2.0, high=200.0, workflows=_ADH + _CA + _TI),
     Field("free_energy", "fidelity", str, "", "Adhesion: 'pmf' also integrates the mean force between the "
           "slabs over separation (free energy of separation, hence T dS); 'none' reports the energy only.",
           "none", choices=("none", "pmf"), workflows=_ADH),
@@ -205,8 +205,8 @@ FIELDS: tuple[Field, ...] = (
     # ---------------------------------------------------------------- fidelity: contact angle
     Field("substrate_equilibrate_steps", "fidelity", int, "steps", "Contact angle: NVT steps of the substrate "
           "alone (minimised with nothing held, then its deep Si and bridging O held) before the droplet is "
-          "placed: equilibrates the SAM / silanols the water lands on.", 1000, low=1, high=100_000_000,
-          workflows=_CA),
+          "placed: equilibrates the SAM / silanols the water lands on (W_SL by TI: before the film).", 1000,
+          low=1, high=100_000_000, workflows=_CA + _TI),
     Field("bin_A", "fidelity", float, "A", "Contact angle / surface tension: bin size of density maps and "
           "profiles.", 1.0, low=0.1, high=10.0, workflows=_CA + _ST),
     # ---------------------------------------------------------------- fidelity: surface tension
@@ -214,10 +214,20 @@ FIELDS: tuple[Field, ...] = (
           workflows=_ST),
     Field("ly_A", "fidelity", float, "A", "Surface tension: water film box y.", REQUIRED, low=10.0, high=500.0,
           workflows=_ST),
-    Field("film_thickness_A", "fidelity", float, "A", "Surface tension: water film thickness.", REQUIRED,
-          low=10.0, high=500.0, workflows=_ST),
+    Field("film_thickness_A", "fidelity", float, "A", "Surface tension / W_SL by TI: water film thickness.",
+          REQUIRED, low=8.0, high=500.0, workflows=_ST + _TI),
     Field("vacuum_A", "fidelity", float, "A", "Surface tension: vacuum above and below the film.", 25.0,
           low=10.0, high=500.0, workflows=_ST),
+    # ---------------------------------------------------------------- fidelity: W_SL by thermodynamic integration
+    Field("ti_charge_nodes", "fidelity", int, "1", "W_SL by TI: Gauss-Legendre nodes of the charge stage (the "
+          "solid's charges scaled 1 -> 0; run on the film and on the solid alone).", 5, low=1, high=32,
+          workflows=_TI),
+    Field("ti_lj_nodes", "fidelity", int, "1", "W_SL by TI: Gauss-Legendre nodes of the dispersion stage (the "
+          "solid-water Lennard-Jones pairs switched off through a soft core).", 7, low=1, high=32, workflows=_TI),
+    Field("ti_equilibrate_steps", "fidelity", int, "steps", "W_SL by TI: steps per node discarded (each node "
+          "continues from the previous one).", 1000, low=0, high=100_000_000, workflows=_TI),
+    Field("ti_sample_steps", "fidelity", int, "steps", "W_SL by TI: steps per node sampled (dU/dlambda every "
+          "sample_interval steps).", 5000, low=1, high=100_000_000, workflows=_TI),
 )
 
 
@@ -403,6 +413,10 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
                               "a rate scan (more than one speed) is run only at production; give one speed", origin)
         if len(set(speeds)) != len(speeds):
             raise RecipeError(f"{p}.retract_speeds_m_s", speeds, "speeds must be distinct", origin)
+    if wf == "wsl_ti" and system["surface"] != "silica":
+        raise RecipeError("system.surface", system["surface"], "W_SL by TI supports 'silica' only (on OTS the "
+                          "water-TraPPE dispersion beyond the cutoff would have to be added; use contact_angle)",
+                          origin)
     if wf == "contact_angle" and system["surface"] == "ots" and fid["nx"] < 2:
         raise RecipeError(f"{p}.nx", fid["nx"], "must be >= 2", origin)
 

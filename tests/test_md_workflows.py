@@ -21,7 +21,7 @@ from md import units as U
 from md.recipe import RECIPE_DIR, RecipeError, load_recipe, parse_recipe
 
 RECIPES = ("adhesion_silica", "adhesion_ots", "adhesion_silica_ots", "pulloff_silica", "pulloff_ots",
-           "contact_angle_silica", "contact_angle_ots", "surface_tension_spce")
+           "contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica")
 
 #: quantities each workflow must report, with their SI units
 EXPECTED = {
@@ -31,9 +31,11 @@ EXPECTED = {
                 "work_of_adhesion_eff_jkr": "J/m^2", "work_of_adhesion_eff_dmt": "J/m^2"},
     "contact_angle": {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"},
     "surface_tension": {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"},
+    "wsl_ti": {"work_of_adhesion_sl": "J/m^2", "contact_angle": "deg", "spreading_coefficient": "J/m^2",
+               "surface_tension_lv": "N/m"},
 }
 FIGURES = {"adhesion": "energy_timeseries.png", "pulloff": "pulloff_curve.png", "contact_angle": "density_map.png",
-           "surface_tension": "density_profile.png"}
+           "surface_tension": "density_profile.png", "wsl_ti": "dudl.png"}
 # Smoke wall times are measured by benchmarks/md_cost.py --measure, never asserted here: a timed test fails
 # on a loaded or slower machine while the code is right.
 

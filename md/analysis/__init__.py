@@ -5,7 +5,8 @@ Inputs are what LAMMPS ``units real`` writes (kcal/mol, angstrom, atm, g/mol); e
 maps).  Every conversion factor comes from :mod:`md.units`.
 
 One analysis per module: :mod:`~md.analysis.stats`, :mod:`~md.analysis.adhesion`, :mod:`~md.analysis.contact_angle`,
-:mod:`~md.analysis.surface_tension`, :mod:`~md.analysis.pulloff`; the unit factors in :mod:`~md.analysis.common`.
+:mod:`~md.analysis.surface_tension`, :mod:`~md.analysis.pulloff`,
+:mod:`~md.analysis.free_energy` (W_SL by thermodynamic integration); the unit factors in :mod:`~md.analysis.common`.
 
 Sources (details and measured accuracies: ``docs/md-analysis.md``):
 
@@ -32,6 +33,8 @@ from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circ
                                        block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
                                        shape_check,
                                        dispersion_tail_work, tail_antiderivative)
+from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
+                                     angle_from_work_of_adhesion_sl)
 from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
 from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
                                detect_equilibration, timeseries_stats)
@@ -48,5 +51,6 @@ __all__ = [
     "ContactAngle", "fit_contact_angle", "fit_circle", "dividing_plane", "wetting_bound", "block_drift",
     "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work", "tail_antiderivative",
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
+    "gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
     "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
 ]

@@ -195,11 +195,30 @@ def _forcefield_from_name(name: str) -> ForceField:
     return load_forcefield(parts[0]) if len(parts) == 1 else combine(*parts)
 
 
+#: soft core of ``pair="long/soft"``: (n, alpha_LJ, alpha_C in A^2) -- Beutler et al., Chem. Phys. Lett. 222 (1994)
+#: 529 (n = 1, alpha = 0.5); alpha_C only matters for charged pairs at lambda < 1, which no workflow uses
+SOFT_CORE = (1, 0.5, 10.0)
+
+
+def _soft_coeff(line: str) -> str:
+    """``pair_coeff I J eps sigma  # c`` -> ``pair_coeff I J eps sigma' 1.0  # c`` (sigma' = 1 where eps = 0 and
+    sigma = 0)."""
+    text, _, comment = line.partition("#")
+    w = text.split()
+    if float(w[3]) == 0.0 and float(w[4]) == 0.0:
+        w[4] = "1.0"
+    return " ".join(w + ["1.0"]) + (f"  # {comment.strip()}" if comment else "")
+
+
 def lammps_setup_commands(forcefield: ForceField, data_path: str | Path, *, boundary: str = "p p f",
                           pair: str = "long", cutoff: float = 12.0, kspace_accuracy: float = 1e-5) -> list[str]:
     """Commands that define the styles, read the data file and set pair coefficients from ``forcefield``.
 
     ``pair="long"``: ``lj/cut/coul/long`` + ``pppm`` (``kspace_modify slab 3.0`` if z is not periodic);
+    ``pair="long/soft"``: ``lj/cut/coul/long/soft`` with every pair's lambda = 1 (the same energies as "long" to
+    the real-space table's precision; a free-energy run scales chosen pairs' lambda with ``fix adapt/fep``), soft
+    core n = 1, alpha_LJ = 0.5, alpha_C = 10 A^2 (:data:`SOFT_CORE`); pairs with epsilon = 0 get sigma = 1 A there
+    (sigma = 0 makes the soft-core form 0/0);
     ``pair="cut"``: ``lj/cut/coul/cut`` (quick check, no k-space).
     """
     cmds = ["units real", "atom_style full", f"boundary {boundary}"]
@@ -210,14 +229,20 @@ def lammps_setup_commands(forcefield: ForceField, data_path: str | Path, *, boun
             cmds.append(f"{kind}_style {style}")
     if pair == "long":
         cmds.append(f"pair_style lj/cut/coul/long {cutoff:g}")
+    elif pair == "long/soft":
+        n, a_lj, a_c = SOFT_CORE
+        cmds.append(f"pair_style lj/cut/coul/long/soft {n:g} {a_lj:g} {a_c:g} {cutoff:g}")
     elif pair == "cut":
         cmds.append(f"pair_style lj/cut/coul/cut {cutoff:g}")
     else:
-        raise ValueError(f"pair must be 'long' or 'cut', got {pair!r}")
+        raise ValueError(f"pair must be 'long', 'long/soft' or 'cut', got {pair!r}")
     cmds.append(f"read_data {Path(data_path).as_posix()}")
-    cmds += lammps_pair_coeffs(forcefield)
+    coeffs = lammps_pair_coeffs(forcefield)
+    if pair == "long/soft":
+        coeffs = [_soft_coeff(c) for c in coeffs]
+    cmds += coeffs
     cmds.append(forcefield.special_bonds.lammps())
-    if pair == "long":
+    if pair in ("long", "long/soft"):
         cmds.append(f"kspace_style pppm {kspace_accuracy:g}")
         if boundary.split()[2] != "p":
             cmds.append("kspace_modify slab 3.0")

@@ -60,8 +60,9 @@ def neighbor_lines() -> list[str]:
     return ["neighbor 2.0 bin", "neigh_modify delay 0 every 1 check yes"]
 
 
-def fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], groups: Mapping[str, Any]) -> list[str]:
-    cmds = lammps_setup_commands(ff, data, boundary="p p f", pair="long", cutoff=settings["cutoff_A"],
+def fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], groups: Mapping[str, Any],
+                    pair: str = "long") -> list[str]:
+    cmds = lammps_setup_commands(ff, data, boundary="p p f", pair=pair, cutoff=settings["cutoff_A"],
                                  kspace_accuracy=settings["kspace_accuracy"])
     cmds += neighbor_lines()
     cmds += [f"timestep {settings['timestep_fs']:g}"]

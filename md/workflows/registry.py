@@ -6,11 +6,13 @@ from md.workflows.common import Workflow
 from md.workflows.contact_angle import ContactAngleWorkflow
 from md.workflows.pulloff import PullOff
 from md.workflows.surface_tension import SurfaceTension
+from md.workflows.wsl_ti import WslTI
 
 __all__ = ["WORKFLOWS", "get_workflow"]
 
 WORKFLOWS: dict[str, type[Workflow]] = {"adhesion": Adhesion, "pulloff": PullOff,
-                                        "contact_angle": ContactAngleWorkflow, "surface_tension": SurfaceTension}
+                                        "contact_angle": ContactAngleWorkflow, "surface_tension": SurfaceTension,
+                                        "wsl_ti": WslTI}
 
 
 def get_workflow(name: str) -> Workflow:
