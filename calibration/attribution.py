@@ -4,7 +4,7 @@ The calibrated set is the base set with the MD values written over it. A claim o
 with the base set and fails with the calibrated one therefore fails because of one MD value, or of several together.
 Which one is measured, not guessed. Each *revert* puts one group of MD values back to the base set's values,
 with everything else calibrated. The group is the keys fed by one quantity of one MD run, such as the two silica
-contact angles from `contact_angle_silica`. The paper's cases then run with each revert set, and the claims that hold
+contact angles from `wsl_silica`. The paper's cases then run with each revert set, and the claims that hold
 again name the values that broke them. This is a one-at-a-time sensitivity analysis (Saltelli et al., *Global
 Sensitivity Analysis: The Primer*, Wiley 2008, section 1.2.2), done on the pass/fail outcome of each claim.
 

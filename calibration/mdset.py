@@ -62,11 +62,18 @@ _PULLOFF_Z0 = ("fallback: the adhesion result has no flat-slab z0; this z0 is a 
                "pull-off curve against the rigid holder's travel, so it absorbs the asperity's compliance (an "
                "overestimate)")
 
+_DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this is the droplet's angle, and the quick "
+            "silica droplet keeps the angle it is started at (pinned contact line: 18 deg from a 20 deg start, 39 deg "
+            "from 40 deg), so it measures the start, not the surface")
+
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),
     Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion_free_energy", "work_of_adhesion")),
-    Source("surfaces.body.contact_angle", "contact_angle_silica", ("contact_angle",)),
-    Source("surfaces.substrate.contact_angle", "contact_angle_silica", ("contact_angle",)),
+    Source("surfaces.body.contact_angle", "wsl_silica", ("contact_angle",),
+           fallback=Source("surfaces.body.contact_angle", "contact_angle_silica", ("contact_angle",), note=_DROPLET)),
+    Source("surfaces.substrate.contact_angle", "wsl_silica", ("contact_angle",),
+           fallback=Source("surfaces.substrate.contact_angle", "contact_angle_silica", ("contact_angle",),
+                           note=_DROPLET)),
     Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",)),
     Source("menisci.surface_tension", "surface_tension_spce", ("surface_tension",)),
     Source("surfaces.interaction_range", "adhesion_silica", ("interaction_range_z0",),
@@ -89,7 +96,7 @@ def recipes_needed(mapping=MAPPING) -> list[str]:
 
 
 #: Recipes whose result depends on the water model (settings.water_model); one model throughout a calibration.
-WATER_RECIPES = ("contact_angle_silica", "contact_angle_ots", "surface_tension_spce")
+WATER_RECIPES = ("contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica")
 
 
 def water_model_mismatch(results: dict[str, dict]) -> str | None:
@@ -136,7 +143,16 @@ def _pick(result: dict, source: Source):
     return None, f"none of {source.quantities} is finite in the result"
 
 
-def _rejection(key: str, value: float, quantity: str) -> str | None:
+def _ti_wets(result: dict) -> bool:
+    """A W_SL by thermodynamic integration at or above 2 gamma_lv: theta = 0 is then Young-Dupre's answer (complete
+    wetting, a measured spreading coefficient), not a droplet analysis's film mark."""
+    return result.get("workflow") == "wsl_ti" and \
+        (result.get("quantities", {}).get("contact_angle") or {}).get("status") == "wets"
+
+
+def _rejection(key: str, value: float, quantity: str, result: dict | None = None) -> str | None:
+    if quantity == "contact_angle" and value <= 0.0 and result is not None and _ti_wets(result):
+        return None
     if quantity == "contact_angle" and (value <= 0.0 or value >= 180.0):
         return f"{value:g} deg is the analysis's 'no droplet contact / film' mark, not a measured angle"
     try:
@@ -194,7 +210,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
         qname, value, stderr, units = picked
         row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
                    fidelity=res.get("fidelity"))
-        why = water_mismatch if water_mismatch and src.recipe in WATER_RECIPES else _rejection(src.key, value, qname)
+        why = water_mismatch if water_mismatch and src.recipe in WATER_RECIPES else _rejection(src.key, value, qname, res)
         if why:
             row.update(status="rejected", why=why)
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "quantity": qname,
@@ -208,8 +224,19 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
                 entry["stderr"] = stderr
             qs = res.get("quantities", {})
             if qname == "contact_angle_upper_bound":
-                entry["note"] = (f"MD: the water wets (theta < {2 * value:.3g} deg, no angle measurable); entered as "
+                how = ("W_SL by thermodynamic integration reaches 2 gamma_lv within 2 stderr" if _ti_wets(res) else
+                       "no angle measurable")
+                entry["note"] = (f"MD: the water wets (theta < {2 * value:.3g} deg, {how}); entered as "
                                  f"uniform on [0, {2 * value:.3g}] deg: mean and stderr of that interval")
+            if qname == "contact_angle" and value <= 0.0:
+                entry["note"] = ("MD: W_SL by thermodynamic integration exceeds 2 gamma_lv by more than 2 stderr: the "
+                                 "water wets completely, theta = 0 (Young-Dupre)")
+            if src.recipe == "wsl_silica":
+                ws = qs.get("work_of_adhesion_sl") or {}
+                entry["work_of_adhesion_sl"] = {"value": ws.get("value"), "stderr": ws.get("stderr"),
+                                                "discretisation_error": ws.get("discretisation_error"),
+                                                "units": "J/m^2", "note": "W_SL by thermodynamic integration; "
+                                                "theta = arccos(W_SL / gamma_lv - 1) of the same water model"}
             flags = []
             if qname == "contact_angle" and (qs.get("contact_angle_drift") or {}).get("drifting"):
                 entry["drifting"] = True
@@ -221,6 +248,8 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
                              f"{shape.get('spread_deg', float('nan')):.1f} deg, a systematic the stderr does not hold")
             if flags:
                 entry["note"] = "; ".join(flags)
+            if src.note and qname in ("contact_angle", "contact_angle_upper_bound"):
+                entry["note"] = src.note + ("; " + entry["note"] if "note" in entry else "")
             if qname == "interaction_range_z0":
                 q = qs[qname]
                 if src.note:

@@ -192,9 +192,47 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
 
 
-def test_recipes_needed_are_the_seven_mapped_ones():
-    assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "contact_angle_silica", "contact_angle_ots",
-                                "surface_tension_spce", "pulloff_silica", "pulloff_ots"]
+def test_recipes_needed_are_the_eight_mapped_ones():
+    assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "contact_angle_ots",
+                                "surface_tension_spce", "contact_angle_silica", "pulloff_silica", "pulloff_ots"]
+
+
+def _ti(theta, theta_err, status="measured", w=0.09, bound=None):
+    r = _result("wsl_silica", {"contact_angle": (theta, theta_err, "deg"), "work_of_adhesion_sl": (w, 0.003, "J/m^2")})
+    r["workflow"] = "wsl_ti"
+    r["quantities"]["contact_angle"]["status"] = status
+    if bound is not None:
+        r["quantities"]["contact_angle_upper_bound"] = {"value": bound, "stderr": None, "units": "deg"}
+    return r
+
+
+def test_silica_angles_come_from_the_ti_and_fall_back_to_the_droplet_with_a_note():
+    """W_SL by TI (wsl_silica) sets both silica angles; without it the droplet's angle is used, and the set says
+    that a pinned droplet measures its start."""
+    table, rows = build_parameter_set(_results(wsl_silica=_ti(24.0, 2.0)), "paper", "cal")
+    assert table["surfaces"]["body"]["contact_angle"] == table["surfaces"]["substrate"]["contact_angle"] == 24.0
+    e = table["meta"]["calibration"]["surfaces.body.contact_angle"]
+    assert e["recipe"] == "wsl_silica" and e["work_of_adhesion_sl"]["value"] == 0.09 and "note" not in e
+    table, _ = build_parameter_set(_results(), "paper", "cal")              # no TI result: the droplet
+    e = table["meta"]["calibration"]["surfaces.body.contact_angle"]
+    assert e["recipe"] == "contact_angle_silica" and e["value"] == 31.0 and "pinned contact line" in e["note"]
+
+
+def test_a_ti_that_wets_enters_as_zero_or_as_its_bound_never_as_a_film_mark():
+    # W_SL - 2 stderr still >= 2 gamma: theta = 0 is Young-Dupre's answer, used (a droplet's 0 would be rejected)
+    table, rows = build_parameter_set(_results(wsl_silica=_ti(0.0, None, "wets", w=0.15, bound=0.0)), "paper", "cal")
+    assert table["surfaces"]["body"]["contact_angle"] == 0.0
+    assert "wets completely" in table["meta"]["calibration"]["surfaces.body.contact_angle"]["note"]
+    # within 2 stderr of 2 gamma: uniform on [0, bound]
+    table, _ = build_parameter_set(_results(wsl_silica=_ti(0.0, None, "wets", w=0.13, bound=18.0)), "paper", "cal")
+    e = table["meta"]["calibration"]["surfaces.body.contact_angle"]
+    assert e["value"] == 9.0 and e["stderr"] == pytest.approx(18.0 / math.sqrt(12.0))
+    assert "thermodynamic integration reaches 2 gamma_lv" in e["note"]
+    # a droplet's 0 (film mark) is still rejected
+    wet = _result("contact_angle_silica", {"contact_angle": (0.0, None, "deg")})
+    wet["quantities"]["contact_angle"]["status"] = "wets"
+    _, rows = build_parameter_set(_results(contact_angle_silica=wet), "paper", "cal")
+    assert {r["key"]: r["status"] for r in rows}["surfaces.body.contact_angle"] == "rejected"
 
 
 def test_the_md_plan_says_before_anything_runs_where_each_result_will_come_from(tmp_path):
@@ -311,7 +349,7 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
     assert sorted(p.name for p in (out / "paper" / "cases").iterdir()) == ["hertz", "rough_ots", "rough_silica"]
-    assert len(report.md_sources) == 7 and len(report.rows) == 8
+    assert len(report.md_sources) == 8 and len(report.rows) == 8
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
     assert len(report.used) + len(report.not_used) == 8

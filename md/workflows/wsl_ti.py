@@ -254,19 +254,32 @@ class WslTI(Workflow):
             stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
         w = A.ti_work_of_adhesion_sl(stages["charge_film"], stages["lj_film"], stages["charge_reference"],
                                      info["area_A2"])
-        ang = A.angle_from_work_of_adhesion_sl(w["value"], w["stderr"], gamma)
+        w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
+        ang = A.angle_from_work_of_adhesion_sl(w["value"], w_err, gamma)
+        # the quadrature's share of the angle's error, first order (reported apart from the statistical one)
+        th_disc = th_stat = None
+        if ang["status"] == "measured":
+            th_disc = math.degrees(w["discretisation_error"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
+            th_stat = math.degrees(w["stderr"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
         kinds = {"measured": "Young-Dupre from the TI W_SL: theta = arccos(W_SL / gamma_lv - 1)",
                  "wets": "0 = wets (W_SL >= 2 gamma_lv; mark, not a measurement): see spreading_coefficient",
                  "dewets": "180 = W_SL <= 0 (mark, not a measurement)"}
         q = {"work_of_adhesion_sl": quantity_record(
                 w["value"], w["stderr"], "J/m^2", kind="thermodynamic integration: film decoupled from the solid "
                 "(charges, then soft-core LJ) minus the solid-alone charge stage", discretisation_error=w["discretisation_error"]),
-             "contact_angle": quantity_record(ang["theta_deg"], ang["stderr_deg"], "deg", status=ang["status"],
-                                              kind=kinds[ang["status"]], upper_one_stderr_deg=ang["theta_upper_deg"]),
+             "contact_angle": quantity_record(ang["theta_deg"], th_stat, "deg",
+                                              status=ang["status"], kind=kinds[ang["status"]],
+                                              discretisation_error=th_disc,
+                                              upper_one_stderr_deg=ang["theta_upper_deg"]),
              "spreading_coefficient": quantity_record(ang["spreading_coefficient"], w["stderr"], "J/m^2",
                                                       kind="S = W_SL - 2 gamma_lv (>= 0: wets)"),
              "surface_tension_lv": quantity_record(gamma, None, "N/m",
                                                    kind=f"the water model's published gamma_lv ({model['gamma_source']})")}
+        if ang["status"] == "wets":
+            # W_SL - 2 sigma (statistical and quadrature together): the largest angle the run does not exclude
+            bound = A.angle_from_work_of_adhesion_sl(w["value"] - 2.0 * w_err, 0.0, gamma)["theta_deg"]
+            q["contact_angle_upper_bound"] = quantity_record(bound, None, "deg", kind="wets: theta below this "
+                                                             "bound (Young-Dupre at W_SL - 2 stderr, quadrature included)")
         if ang["status"] == "measured":
             wl = A.work_of_adhesion_sl(gamma, ang["theta_deg"], None, ang["stderr_deg"])
             q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",

@@ -1,0 +1,236 @@
+"""W_SL by thermodynamic integration (md.workflows.wsl_ti, md.analysis.free_energy).
+
+What must hold, each against a closed form or an exact identity, never against numbers a run produced:
+
+* Gauss-Legendre on [0, 1] integrates polynomials of degree 2n - 1 exactly; its error estimate sees a kink;
+* the signs of the assembly: a film bound by attraction has W_SL > 0, and W_SL A = I_q(ref) - I_q(film) - I_lj;
+* Young-Dupre inverted is the inverse of md.analysis.work_of_adhesion_sl, and W_SL >= 2 gamma_lv is "wets";
+* LAMMPS: ``compute fep`` central differences are the derivative of the energy (charges and soft-core lambda);
+  the soft-core pair style at lambda = 1 gives the plain style's energy; and with the workflow's fixed PPPM mesh
+  the film's charge-stage integrand minus the solid alone's is lambda-independent (U is quadratic in the solid's
+  charges, so the difference is the solid-water Coulomb energy at unit charge): the held atoms' solid-solid share
+  cancels exactly -- with LAMMPS's own charge-dependent PPPM estimates it does not;
+* the plan: the charge stage scales only the solid's types, the LJ stage only solid-water pairs with the solid's
+  charges at zero, the reference runs the charge nodes on the solid alone, and every leg uses one PPPM line.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from md.analysis import (KCALMOL_PER_A2_TO_J_PER_M2, angle_from_work_of_adhesion_sl, gauss_legendre_unit, ti_integral,
+                         ti_work_of_adhesion_sl, work_of_adhesion_sl)
+from md.recipe import RecipeError, load_recipe, parse_recipe
+from conftest import require_backend
+
+
+# ------------------------------------------------------------------------------------ quadrature and assembly
+
+@pytest.mark.parametrize("n", [1, 2, 5, 7])
+def test_gauss_legendre_is_exact_to_degree_2n_minus_1(n):
+    x, w = gauss_legendre_unit(n)
+    assert np.all(np.diff(x) < 0) and 0 < x.min() and x.max() < 1          # descending, no end point
+    for deg in range(2 * n):
+        assert np.dot(w, x**deg) == pytest.approx(1.0 / (deg + 1), rel=1e-12, abs=1e-14)
+    # and not beyond: x^(2n) is missed, by far more than round-off (so the test can fail)
+    assert abs(np.dot(w, x**(2 * n)) - 1.0 / (2 * n + 1)) > 1e-12
+
+
+def test_ti_integral_value_error_and_discretisation_estimate():
+    x, _ = gauss_legendre_unit(5)
+    f = 3.0 * x**2 - 2.0 * x + 1.0                                       # integral 1 - 1 + 1 = 1
+    se = np.full_like(x, 0.5)
+    r = ti_integral(x, f, se)
+    assert r["value"] == pytest.approx(1.0, rel=1e-12)
+    assert r["stderr"] == pytest.approx(0.5 * math.sqrt(np.sum(gauss_legendre_unit(5)[1] ** 2)), rel=1e-12)
+    assert r["discretisation_error"] < 0.02                              # smooth: the two rules agree
+    kinked = np.where(x < 0.3, 40.0, 0.0)                                # a step the nodes barely resolve
+    assert ti_integral(x, kinked, se)["discretisation_error"] > 0.1
+    with pytest.raises(ValueError, match="not the 5-point Gauss-Legendre nodes"):
+        ti_integral(np.linspace(0.1, 0.9, 5), f, se)
+
+
+def test_assembly_signs_and_units():
+    area = 800.0
+    one = lambda v, e=0.0: {"value": v, "stderr": e, "discretisation_error": 0.0}   # noqa: E731
+    # film: charges give -500 more than the solid alone does, LJ -60 (attraction): W A = 500 + 60 kcal/mol
+    w = ti_work_of_adhesion_sl(one(-30500.0, 3.0), one(-60.0, 4.0), one(-30000.0, 0.0), area)
+    conv = KCALMOL_PER_A2_TO_J_PER_M2 / area
+    assert w["value"] == pytest.approx(560.0 * conv) and w["value"] > 0
+    assert w["electrostatic"] == pytest.approx(500.0 * conv) and w["dispersion"] == pytest.approx(60.0 * conv)
+    assert w["stderr"] == pytest.approx(5.0 * conv)
+
+
+@pytest.mark.parametrize("theta", [5.0, 30.0, 90.0, 125.0, 170.0])
+def test_young_dupre_inversion_round_trip(theta):
+    g = 0.0636
+    wl = work_of_adhesion_sl(g, theta, None, 1.0)
+    back = angle_from_work_of_adhesion_sl(wl["value"], wl["stderr"], g)
+    assert back["status"] == "measured"
+    assert back["theta_deg"] == pytest.approx(theta, abs=1e-9)
+    assert back["stderr_deg"] == pytest.approx(1.0, rel=1e-9)            # first order both ways
+
+
+def test_wetting_and_dewetting_marks():
+    g = 0.0636
+    wets = angle_from_work_of_adhesion_sl(0.140, 0.004, g)
+    assert wets["status"] == "wets" and wets["theta_deg"] == 0.0 and wets["stderr_deg"] is None
+    assert wets["spreading_coefficient"] == pytest.approx(0.140 - 2 * g)
+    assert wets["theta_upper_deg"] == 0.0                                 # one stderr below is still >= 2 gamma
+    near = angle_from_work_of_adhesion_sl(0.128, 0.005, g)
+    assert near["status"] == "wets" and 0 < near["theta_upper_deg"] < 25
+    assert angle_from_work_of_adhesion_sl(-0.001, 0.0, g)["status"] == "dewets"
+
+
+def test_recipe_keys_and_the_silica_only_rule():
+    s = load_recipe("wsl_silica").settings("quick")
+    assert s["surface"] == "silica" and s["silica_face"] == "111" and s["water_model"] == "spce"
+    assert s["slab_thickness_A"] == load_recipe("contact_angle_silica").settings("quick")["slab_thickness_A"]
+    raw = load_recipe("wsl_silica").raw
+    t = {k: (dict(v) if isinstance(v, dict) else v) for k, v in raw.items()}
+    t["system"] = dict(t["system"], surface="ots")
+    with pytest.raises(RecipeError, match=r"system\.surface = 'ots': W_SL by TI supports 'silica' only"):
+        parse_recipe(t)
+
+
+# ------------------------------------------------------------------------------------ the plan
+
+def _plan(tmp_path):
+    from md.workflows import get_workflow
+    s = load_recipe("wsl_silica").settings("smoke")
+    return s, get_workflow("wsl_ti").plan(s, tmp_path)
+
+
+def _cmds(leg, tmp_path):
+    d = tmp_path / "legs" / leg.name
+    return leg.fresh(d) + leg.define(0) + leg.prepare(d)
+
+
+def test_plan_legs_scale_the_right_things(tmp_path):
+    s, plan = _plan(tmp_path)
+    names = [leg.name for leg in plan.legs]
+    nq, nl = s["ti_charge_nodes"], s["ti_lj_nodes"]
+    assert names == (["substrate", "film"] + [f"q{k}" for k in range(nq)] + [f"lj{k}" for k in range(nl)]
+                     + [f"ref_q{k}" for k in range(nq)])
+    ids = plan.system_info["type_ids"]
+    solid = {str(ids[t]) for t in ("SC4", "OC23", "OC24", "HOY")}
+    water = {str(ids["OW"]), str(ids["HW"])}
+    pppm = {c for leg in plan.legs for c in _cmds(leg, tmp_path) if c.startswith("kspace_modify slab 3.0 gewald")}
+    assert len(pppm) == 1                                                 # one G and one mesh for every leg
+    for leg in plan.legs[2:]:
+        cmds = _cmds(leg, tmp_path)
+        adapt = next(c for c in cmds if " adapt/fep " in c).split()
+        charged = {adapt[i + 2] for i, w in enumerate(adapt) if w == "atom"}
+        assert charged == solid                                           # only the solid's charges
+        pairs = {(adapt[i + 3], adapt[i + 4]) for i, w in enumerate(adapt) if w == "pair"}
+        fep = [c for c in cmds if " fep " in c and c.startswith("compute")]
+        assert len(fep) == 2
+        lam = {c.split()[1]: float(c.split()[-1]) for c in cmds if c.startswith("variable l")}
+        if leg.name.startswith("ref"):
+            text = " ".join(cmds)
+            assert not pairs and "tether" not in text and "read_data" not in text and leg.n_atoms < plan.n_atoms
+        else:
+            assert pairs == {(i, j) for i in solid for j in water}        # only solid-water pairs
+        if leg.name.startswith("lj"):
+            assert lam["lq"] == 0.0 and 0 < lam["ll"] < 1 and all(" pair " in c for c in fep)
+        else:
+            assert 0 < lam["lq"] < 1 and lam["ll"] == 1.0 and all(" atom charge " in c for c in fep)
+
+
+# ------------------------------------------------------------------------------------ LAMMPS identities
+
+def _lammps_pair(tmp_path, fixed_pppm: bool):
+    """(film, solid alone) LAMMPS instances on the smoke build, soft-core pair style, nothing run yet."""
+    require_backend("lammps", "LAMMPS")
+    from md.lammps_loader import new_lammps
+    from md.system.lammps_data import lammps_setup_commands, write_data
+    from md.system.topology import remove_atoms
+    from md.workflows.common import forcefield_of
+    from md.workflows.wsl_ti import WslTI, pppm_lines
+    s = load_recipe("wsl_silica").settings("smoke")
+    wf = WslTI()
+    _, _, system = wf.build(s)
+    ff = forcefield_of(wf.forcefield_files(s))
+    write_data(system, ff, tmp_path / "film.data")
+    write_data(remove_atoms(system, system.group("adsorbate")), ff, tmp_path / "solid.data")
+    out = []
+    for name in ("film", "solid"):
+        lmp = new_lammps()
+        for c in lammps_setup_commands(ff, tmp_path / f"{name}.data", pair="long/soft", kspace_accuracy=1e-4):
+            lmp.command(c)
+        if fixed_pppm:
+            lmp.command(pppm_lines(s, system.cell)[0])
+        out.append(lmp)
+    return out
+
+
+def _dudl_q(lmp, lam, delta=0.002):
+    """central-difference dU/dlambda_q by compute fep at solid charges lam x q0, as the workflow samples it"""
+    q0 = {1: 1.1, 2: -0.55, 3: -0.675, 4: 0.4}
+    for t, q in q0.items():
+        lmp.command(f"set type {t} charge {q * lam:.12g}")
+    plus = " ".join(f"atom charge {t} v_p{t}" for t in q0)
+    minus = " ".join(f"atom charge {t} v_m{t}" for t in q0)
+    for t, q in q0.items():
+        lmp.command(f"variable p{t} equal {q * delta:.12g}")
+        lmp.command(f"variable m{t} equal {-q * delta:.12g}")
+    lmp.command(f"compute fp all fep 300 {plus}")
+    lmp.command(f"compute fm all fep 300 {minus}")
+    lmp.command("thermo_style custom step pe c_fp[1] c_fm[1]")
+    lmp.command("run 0")
+    d = (lmp.extract_compute("fp", 0, 1)[0] - lmp.extract_compute("fm", 0, 1)[0]) / (2 * delta)
+    pe = lmp.get_thermo("pe")
+    lmp.command("uncompute fp")
+    lmp.command("uncompute fm")
+    return d, pe
+
+
+def test_compute_fep_is_the_energy_derivative_and_the_solid_solid_share_cancels(tmp_path):
+    film, solid = _lammps_pair(tmp_path, fixed_pppm=True)
+    # the derivative: U(lambda) is quadratic in the solid's charges, so a wide central difference of energies
+    # must equal compute fep's narrow one
+    d_mid, _ = _dudl_q(film, 0.5)
+    _, u_hi = _dudl_q(film, 0.6)
+    _, u_lo = _dudl_q(film, 0.4)
+    assert d_mid == pytest.approx((u_hi - u_lo) / 0.2, rel=1e-6, abs=1e-3)
+    # the cancellation: film minus solid alone is the solid-water Coulomb energy, the same at every lambda
+    diffs = [_dudl_q(film, lam)[0] - _dudl_q(solid, lam)[0] for lam in (0.2, 0.5, 0.9)]
+    big = abs(_dudl_q(solid, 0.9)[0])
+    assert big > 100 * abs(diffs[0])                                       # what cancels is large
+    assert np.ptp(diffs) < 1e-6 * big + 1e-3, diffs
+
+
+def test_without_one_pppm_mesh_the_solid_solid_share_does_not_cancel(tmp_path):
+    """The reason pppm_lines exists: LAMMPS's own G and mesh depend on the charges present (film vs solid alone),
+    and the difference then drifts with lambda by more than it does with the fixed mesh."""
+    film, solid = _lammps_pair(tmp_path, fixed_pppm=False)
+    diffs = [_dudl_q(film, lam)[0] - _dudl_q(solid, lam)[0] for lam in (0.2, 0.9)]
+    big = abs(_dudl_q(solid, 0.9)[0])
+    assert abs(diffs[1] - diffs[0]) > 1e-6 * big + 1e-3, diffs
+
+
+def test_soft_core_at_lambda_one_is_the_plain_pair_style(tmp_path):
+    require_backend("lammps", "LAMMPS")
+    from md.lammps_loader import new_lammps
+    from md.system.lammps_data import lammps_setup_commands, write_data
+    from md.workflows.common import forcefield_of
+    from md.workflows.wsl_ti import WslTI
+    s = load_recipe("wsl_silica").settings("smoke")
+    wf = WslTI()
+    _, _, system = wf.build(s)
+    ff = forcefield_of(wf.forcefield_files(s))
+    write_data(system, ff, tmp_path / "film.data")
+    e = {}
+    for pair in ("long", "long/soft"):
+        lmp = new_lammps()
+        for c in lammps_setup_commands(ff, tmp_path / "film.data", pair=pair, kspace_accuracy=1e-5):
+            lmp.command(c)
+        lmp.command("thermo_style custom step pe evdwl ecoul elong")
+        lmp.command("run 0")
+        e[pair] = {k: lmp.get_thermo(k) for k in ("evdwl", "ecoul", "elong")}
+    assert e["long/soft"]["evdwl"] == pytest.approx(e["long"]["evdwl"], rel=1e-9, abs=1e-9)
+    assert e["long/soft"]["elong"] == pytest.approx(e["long"]["elong"], rel=1e-9, abs=1e-9)
+    # real-space Coulomb: the plain style tabulates erfc (pair_modify table 12), the soft style does not
+    assert e["long/soft"]["ecoul"] == pytest.approx(e["long"]["ecoul"], rel=1e-5)
