@@ -238,22 +238,31 @@ class WslTI(Workflow):
         model = WATER_MODELS[s["water_model"]]
         gamma = model["gamma_lv_N_m"]
         nodes = {k: np.asarray(v, float) for k, v in info["nodes"].items()}
-        stages, per_node = {}, {}
+        stages, per_node, halves = {}, {}, {0: {}, 1: {}}
         for key, prefix, lam in (("charge_film", "q", nodes["q"]), ("lj_film", "lj", nodes["lj"]),
                                  ("charge_reference", "ref_q", nodes["q"])):
-            rows = []
+            rows, half_means = [], ([], [])
             for k, x in enumerate(lam):
                 d = ctx.samples(f"{prefix}{k}")
                 st = A.timeseries_stats(d["dudl"])
                 row = {"lambda": float(x), "mean_kcal_mol": st["mean"], "stderr_kcal_mol": st["stderr"],
-                       "g": st["g"], "n_eff": st["n_eff"], "n": int(len(d["dudl"]))}
+                       "g": st["g"], "n_eff": st["n_eff"], "n": int(len(d["dudl"])), "t0": int(st["t0"])}
                 if "z_film" in d and len(d["z_film"]):
                     row["z_film_A"] = float(np.mean(d["z_film"]))
                 rows.append(row)
+                used = np.asarray(d["dudl"], float)[int(st["t0"]):]          # the samples the mean uses
+                for h, part in enumerate((used[:used.size // 2], used[used.size // 2:])):
+                    half_means[h].append(float(np.mean(part)) if part.size else float("nan"))
             per_node[key] = rows
             stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
+            for h in (0, 1):
+                halves[h][key] = A.ti_integral(lam, half_means[h], [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
         w = A.ti_work_of_adhesion_sl(stages["charge_film"], stages["lj_film"], stages["charge_reference"],
                                      info["area_A2"])
+        # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
+        w_half = [A.ti_work_of_adhesion_sl(halves[h]["charge_film"], halves[h]["lj_film"],
+                                           halves[h]["charge_reference"], info["area_A2"])["value"] for h in (0, 1)]
+        half_sigma = w["stderr"] * 2.0                  # each half has sqrt(2) x the stderr; their difference 2 x
         w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
         ang = A.angle_from_work_of_adhesion_sl(w["value"], w_err, gamma)
         # the quadrature's share of the angle's error, first order (reported apart from the statistical one)
@@ -285,7 +294,13 @@ class WslTI(Workflow):
             q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
                                                       kind="gamma_lv cos theta = W_SL - gamma_lv")
         conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / info["area_A2"]
-        notes = [f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
+        half_ok = bool(abs(w_half[1] - w_half[0]) <= 2.0 * half_sigma)
+        notes = [f"window length: W_SL from the first halves of the nodes' samples {w_half[0] * 1e3:.1f}, from the "
+                 f"second halves {w_half[1] * 1e3:.1f} mJ/m^2 (difference {(w_half[1] - w_half[0]) * 1e3:+.1f}, 2 sigma "
+                 f"= {2 * half_sigma * 1e3:.1f}): " + ("consistent, the nodes are long enough for their decorrelation."
+                                                      if half_ok else "NOT consistent: the nodes still relax; longer "
+                                                      "nodes are needed."),
+                 ] + [f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
                  f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
                  f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
                  f"{w['dispersion_stderr'] * 1e3:.1f} mJ/m^2.",
@@ -326,6 +341,8 @@ class WslTI(Workflow):
             ax.set_title(f"W_SL = {w['value'] * 1e3:.0f} ± {w['stderr'] * 1e3:.0f} mJ/m², {title}")
             ax.legend(fontsize=7)
         details = {"stages": stages, "nodes": per_node, "parts_J_m2": w, "angle": ang, "gamma_lv_N_m": gamma,
+                   "window_halves_J_m2": {"first": w_half[0], "second": w_half[1], "consistent": half_ok,
+                                          "difference_sigma": 2.0 * half_sigma},
                    "water_model": s["water_model"]}
         return Analysis(quantities=q, curves=curves, figures={"dudl": figure_writer(draw)}, notes=notes,
                         details=details)
