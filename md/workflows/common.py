@@ -145,6 +145,13 @@ def shake_lines(ff: ForceField, also: tuple[tuple[str, str], ...] = ()) -> list[
     return [f"fix rigidwater all shake 1.0e-5 50 0{args} kbond 2.0e5"]
 
 
+def substrate_water_seeds(seed: int) -> dict[str, int]:
+    """The seeds of a plan that equilibrates a substrate and then adds water to it (contact angle, W_SL by TI):
+    structures, both velocity draws and the thermostat's base, as result.json records them."""
+    return {"structure_substrate": seed, "structure_water": seed + 1, "velocities_substrate": derived_seed(seed, 3, 0),
+            "velocities": derived_seed(seed, 3, 1), "thermostat_base": seed}
+
+
 def round_up(n: float, k: int) -> int:
     return int(max(k, k * math.ceil(float(n) / k - 1e-9)))
 

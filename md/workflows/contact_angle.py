@@ -26,7 +26,7 @@ from md.system.topology import System, remove_atoms
 
 from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
                                  fresh_from_data, held_deep, intersect_ids, minimize_lines, minimize_water_lines, quantity_record,
-                                 restart_header_lines, derived_seed, shake_lines, silica_face_of, stage_list, steps_of, system_summary, surface_slab,
+                                 restart_header_lines, derived_seed, shake_lines, silica_face_of, stage_list, steps_of, substrate_water_seeds, system_summary, surface_slab,
                                  thermostat_lines, water_forcefield_names)
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
@@ -154,9 +154,7 @@ class ContactAngleWorkflow(Workflow):
                 "water_model": s["water_model"], "type_ids": ids,
                 "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6}
         return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
-                    seeds={"structure_substrate": seed, "structure_water": seed + 1,
-                           "velocities_substrate": derived_seed(seed, 3, 0), "velocities": derived_seed(seed, 3, 1),
-                           "thermostat_base": seed}, forcefield_files=self.forcefield_files(s), system_info=info)
+                    seeds=substrate_water_seeds(seed), forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
         import MDAnalysis as mda

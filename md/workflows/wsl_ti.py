@@ -27,7 +27,8 @@ from md.system.topology import remove_atoms
 from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, common_define, derived_seed, figure_writer,
                                  forcefield_of, fresh_from_data, held_deep, minimize_lines, minimize_water_lines,
                                  quantity_record, restart_header_lines, shake_lines, silica_face_of, stage_list,
-                                 steps_of, surface_slab, system_summary, thermostat_lines, water_forcefield_names)
+                                 steps_of, substrate_water_seeds, surface_slab, system_summary, thermostat_lines,
+                                 water_forcefield_names)
 
 #: gap between the solid's highest atom and the film's lowest one when the film is placed (A)
 FILM_GAP_A = 2.5
@@ -227,9 +228,7 @@ class WslTI(Workflow):
                 "soft_core": "lj/cut/coul/long/soft n = 1, alpha_LJ = 0.5 (Beutler et al. 1994)",
                 "nodes": {k: v.tolist() for k, v in nodes.items()}, "pppm": kspace[0]}
         return Plan(legs=legs, timestep_fs=dt, n_atoms=system.n_atoms,
-                    seeds={"structure_substrate": seed, "structure_water": seed + 1,
-                           "velocities_substrate": derived_seed(seed, 3, 0), "velocities": derived_seed(seed, 3, 1),
-                           "thermostat_base": seed}, forcefield_files=self.forcefield_files(s), system_info=info)
+                    seeds=substrate_water_seeds(seed), forcefield_files=self.forcefield_files(s), system_info=info)
 
     # ------------------------------------------------------------------------------------------ analysis
     def analyse(self, ctx):
