@@ -20,8 +20,8 @@ import math
 import numpy as np
 import pytest
 
-from md.analysis import (KCALMOL_PER_A2_TO_J_PER_M2, angle_from_work_of_adhesion_sl, gauss_legendre_unit, ti_integral,
-                         ti_work_of_adhesion_sl, work_of_adhesion_sl)
+from md.analysis import (KCALMOL_PER_A2_TO_J_PER_M2, angle_from_work_of_adhesion_sl, gauss_legendre_unit,
+                         tether_correction, ti_integral, ti_work_of_adhesion_sl, work_of_adhesion_sl)
 from md.recipe import RecipeError, load_recipe, parse_recipe
 from conftest import require_backend
 
@@ -61,6 +61,18 @@ def test_assembly_signs_and_units():
     assert w["value"] == pytest.approx(560.0 * conv) and w["value"] > 0
     assert w["electrostatic"] == pytest.approx(500.0 * conv) and w["dispersion"] == pytest.approx(60.0 * conv)
     assert w["stderr"] == pytest.approx(5.0 * conv)
+
+
+def test_the_tether_adds_its_energy_at_full_coupling():
+    """A film bound 1.7 A below the spring's anchor carries k/2 (1.7)^2 that decoupling releases: the integral is
+    short by that much, so it is added (positive), whichever side of the anchor the film sits on."""
+    rng = np.random.default_rng(3)
+    for offset in (-1.7, 1.7):
+        z = 33.0 + offset + 0.1 * rng.standard_normal(4000)
+        tc = tether_correction(z, 33.0, 1.0, 800.0)
+        assert tc["energy_kcal_mol"] == pytest.approx(0.5 * (1.7**2 + 0.01), rel=0.03)
+        assert tc["value"] == pytest.approx(tc["energy_kcal_mol"] * KCALMOL_PER_A2_TO_J_PER_M2 / 800.0)
+        assert tc["offset_A"] == pytest.approx(offset, abs=0.01) and tc["value"] > 0
 
 
 @pytest.mark.parametrize("theta", [5.0, 30.0, 90.0, 125.0, 170.0])

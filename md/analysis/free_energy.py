@@ -28,6 +28,9 @@ The path (a decoupling; :class:`md.workflows.wsl_ti.WslTI`)
     difference between the Gauss-Legendre sum and the monotone-cubic (PCHIP) integral through the same nodes,
     linearly extrapolated to 0 and 1.
 
+The film's centre of mass is held by a spring along z (decoupled, it would drift); the spring's energy at full
+coupling is added back (:func:`tether_correction`), an O(kT) translational term is not.
+
 Then the angle: Young-Dupre, cos theta = W_SL / gamma_lv - 1; W_SL >= 2 gamma_lv (spreading coefficient S =
 W_SL - 2 gamma_lv >= 0) means the water wets: theta = 0, reported as "wets" with S.
 """
@@ -41,7 +44,8 @@ from scipy.interpolate import PchipInterpolator
 
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2
 
-__all__ = ["gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl"]
+__all__ = ["gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
+           "tether_correction"]
 
 
 def gauss_legendre_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -102,6 +106,21 @@ def ti_work_of_adhesion_sl(charge_film: dict, lj_film: dict, charge_reference: d
             "electrostatic": electro * conv, "dispersion": disp * conv,
             "electrostatic_stderr": math.hypot(charge_reference["stderr"], charge_film["stderr"]) * conv,
             "dispersion_stderr": lj_film["stderr"] * conv, "units": "J/m^2"}
+
+
+def tether_correction(z_coupled_A, z0_A: float, k_kcal_mol_A2: float, area_A2: float) -> dict:
+    """What a centre-of-mass spring on the film adds to W_SL A (kcal/mol) and W_SL (J/m^2).
+
+    The spring S = k/2 (z - z0)^2 is on at every lambda, so the integral measures F(decoupled) - F(coupled) of the
+    system *with* it. Bound, the film's centre of mass sits in the interface's well, far stiffer than k, so the
+    spring adds its energy there, S(z_b) = <S>_coupled to first order; decoupled, it only confines a free film,
+    kT ln(sqrt(2 pi kT / k) / L): an O(kT) translational term that has no per-area limit and is left out. Hence
+    W_SL A = I + <S>_coupled, with ``z_coupled_A`` the film's centre-of-mass heights at full coupling."""
+    z = np.asarray(z_coupled_A, float)
+    s = 0.5 * float(k_kcal_mol_A2) * (z - float(z0_A)) ** 2
+    e = float(np.mean(s)) if s.size else 0.0
+    return {"energy_kcal_mol": e, "value": e * KCALMOL_PER_A2_TO_J_PER_M2 / float(area_A2),
+            "offset_A": float(np.mean(z) - float(z0_A)) if z.size else float("nan"), "units": "J/m^2"}
 
 
 def angle_from_work_of_adhesion_sl(w: float, w_stderr: float, gamma_lv: float) -> dict:

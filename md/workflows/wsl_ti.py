@@ -37,9 +37,9 @@ FILM_OVERLAP_A = 2.0
 #: vacuum above the film (A); kspace_modify slab 3.0 triples the box for the long-range sum
 FILM_VACUUM_A = 20.0
 #: the film's centre of mass is tethered along z to where it was placed by this spring (kcal/mol/A^2; LAMMPS
-#: ``fix spring tether``): decoupled, the film would otherwise drift. The spring acts on one degree of freedom:
-#: its free-energy share differs between the bound and the free film by O(kT) = 0.6 kcal/mol, against W_SL A of
-#: ~100 kcal/mol on the quick interface; recorded, not subtracted.
+#: ``fix spring tether``): decoupled, the film would otherwise drift. Bound, the film sits below that height (1.7 A
+#: at quick), so the spring's energy there is added back (:func:`md.analysis.tether_correction`); what remains is
+#: an O(kT) translational term, 0.6 kcal/mol against W_SL A of ~170 kcal/mol on the quick interface.
 TETHER_K = 1.0
 #: central-difference step of lambda for dU/dlambda (``compute fep`` at lambda +- delta)
 FEP_DELTA = 0.002
@@ -258,9 +258,16 @@ class WslTI(Workflow):
                 halves[h][key] = A.ti_integral(lam, half_means[h], [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
         w = A.ti_work_of_adhesion_sl(stages["charge_film"], stages["lj_film"], stages["charge_reference"],
                                      info["area_A2"])
+        # the tether's energy at full coupling (the film leg's second half), added back
+        zf = np.asarray(ctx.samples("film", False).get("z_film", []), float)
+        tc = A.tether_correction(zf[zf.size // 2:], info["tether"]["z_A"], info["tether"]["k_kcal_mol_A2"],
+                                 info["area_A2"])
+        w["value"] += tc["value"]
+        w["tether_correction"] = tc
         # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
         w_half = [A.ti_work_of_adhesion_sl(halves[h]["charge_film"], halves[h]["lj_film"],
-                                           halves[h]["charge_reference"], info["area_A2"])["value"] for h in (0, 1)]
+                                           halves[h]["charge_reference"], info["area_A2"])["value"] + tc["value"]
+                  for h in (0, 1)]
         half_sigma = w["stderr"] * 2.0                  # each half has sqrt(2) x the stderr; their difference 2 x
         w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
         ang = A.angle_from_work_of_adhesion_sl(w["value"], w_err, gamma)
@@ -302,7 +309,7 @@ class WslTI(Workflow):
                  ] + [f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
                  f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
                  f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
-                 f"{w['dispersion_stderr'] * 1e3:.1f} mJ/m^2.",
+                 f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f} mJ/m^2.",
                  {"measured": f"theta = {ang['theta_deg']:.1f} deg from Young-Dupre with gamma_lv = "
                               f"{gamma * 1e3:.1f} mN/m ({model['name']}).",
                   "wets": f"WETS: W_SL exceeds 2 gamma_lv = {2 * gamma * 1e3:.1f} mJ/m^2 by "
@@ -311,9 +318,12 @@ class WslTI(Workflow):
                  "no droplet and no contact line: the film covers the periodic solid; the decoupled film is "
                  "free-standing, so F(decoupled) - F(coupled) = A W_SL with nothing estimated at the end state "
                  "(md.analysis.free_energy).",
-                 f"the film's centre of mass is tethered along z (k = {TETHER_K:g} kcal/mol/A^2): its free-energy "
-                 f"share is O(kT) = {U.kT_kcal_per_mol(s['temperature_K']):.2f} kcal/mol = "
-                 f"{U.kT_kcal_per_mol(s['temperature_K']) * conv * 1e3:.1f} mJ/m^2 here, not subtracted.",
+                 f"the film's centre of mass is tethered along z (k = {TETHER_K:g} kcal/mol/A^2) to where it was "
+                 f"placed; bound at full coupling it sits {tc['offset_A']:+.2f} A from there, and the spring's "
+                 f"energy there ({tc['energy_kcal_mol']:.2f} kcal/mol = {tc['value'] * 1e3:.1f} mJ/m^2) is added "
+                 f"to W_SL (md.analysis.tether_correction); the O(kT) translational term it leaves, "
+                 f"{U.kT_kcal_per_mol(s['temperature_K']):.2f} kcal/mol = "
+                 f"{U.kT_kcal_per_mol(s['temperature_K']) * conv * 1e3:.1f} mJ/m^2 here, is not.",
                  "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
                  f"mobile (O-H by SHAKE); water rigid {model['name']} (SHAKE); PPPM throughout (the charge stage "
                  "scales the solid's charges, the reference subtracts their solid-solid part)."]
