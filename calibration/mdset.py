@@ -277,6 +277,11 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
                     "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
                                              if src.recipe.startswith("adhesion") else
                                              "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
+            if src.recipe == "wsl_silica" and "work_of_adhesion_sl" in entry:
+                ws = entry["work_of_adhesion_sl"]
+                w_err = math.hypot(ws.get("stderr") or 0.0, ws.get("discretisation_error") or 0.0)
+                kind = (f"Young-Dupre from W_SL = {ws['value']:.4g} +- {w_err:.2g} J/m^2 by thermodynamic integration"
+                        + (", >= 2 gamma_lv: the water wets" if _ti_wets(res) else ""))
             err = f"+- {stderr:.3g}" if stderr is not None else "(no stderr)"
             sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}, "
                                 f"run {str(res.get('run_hash'))[:16]}")
