@@ -52,6 +52,23 @@ def test_ti_integral_value_error_and_discretisation_estimate():
         ti_integral(np.linspace(0.1, 0.9, 5), f, se)
 
 
+def test_the_charge_quadrature_error_is_judged_on_film_minus_reference():
+    """A huge term exactly quadratic in lambda (the held atoms' solid-solid share) sits in both charge integrands:
+    Gauss-Legendre integrates it exactly, PCHIP does not, so judged apart each shows a large spurious error; their
+    difference (what is integrated) is smooth and shows a small one."""
+    x, _ = gauss_legendre_unit(5)
+    se = np.full_like(x, 1.0)
+    quad = -60000.0 * x**2                                              # the shared solid-solid term
+    interface = -400.0 * x**1.5
+    film, ref = ti_integral(x, quad + interface, se), ti_integral(x, quad, se)
+    lj = ti_integral(x, np.zeros_like(x), se)
+    assert film["discretisation_error"] > 30 and ref["discretisation_error"] > 30
+    w = ti_work_of_adhesion_sl(film, lj, ref, 800.0)
+    conv = KCALMOL_PER_A2_TO_J_PER_M2 / 800.0
+    assert w["value"] == pytest.approx(400.0 / 2.5 * conv, rel=2e-3)      # int x^1.5 = 1/2.5
+    assert w["discretisation_error"] < 1.0 * conv < film["discretisation_error"] * conv
+
+
 def test_assembly_signs_and_units():
     area = 800.0
     one = lambda v, e=0.0: {"value": v, "stderr": e, "discretisation_error": 0.0}   # noqa: E731
