@@ -231,7 +231,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             if qname == "contact_angle" and value <= 0.0:
                 entry["note"] = ("MD: W_SL by thermodynamic integration exceeds 2 gamma_lv by more than 2 stderr: the "
                                  "water wets completely, theta = 0 (Young-Dupre)")
-            if src.recipe == "wsl_silica":
+            if res.get("workflow") == "wsl_ti":
                 ws = qs.get("work_of_adhesion_sl") or {}
                 entry["work_of_adhesion_sl"] = {"value": ws.get("value"), "stderr": ws.get("stderr"),
                                                 "discretisation_error": ws.get("discretisation_error"),
@@ -277,7 +277,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
                     "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
                                              if src.recipe.startswith("adhesion") else
                                              "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
-            if src.recipe == "wsl_silica" and "work_of_adhesion_sl" in entry:
+            if res.get("workflow") == "wsl_ti" and "work_of_adhesion_sl" in entry:
                 ws = entry["work_of_adhesion_sl"]
                 w_err = math.hypot(ws.get("stderr") or 0.0, ws.get("discretisation_error") or 0.0)
                 kind = (f"Young-Dupre from W_SL = {ws['value']:.4g} +- {w_err:.2g} J/m^2 by thermodynamic integration"

@@ -567,12 +567,14 @@ def lammps_type_ids(ff: ForceField) -> dict[str, int]:
 
 
 def lammps_pair_coeffs(ff: ForceField, type_ids: Mapping[str, int] | None = None, *,
-                       substyle: str | None = None, comments: bool = True) -> list[str]:
+                       substyle: str | None = None, comments: bool = True, soft_core: bool = False) -> list[str]:
     """``pair_coeff I J eps sigma`` lines (I <= J) for every pair of atom types in ``type_ids``.
 
     ``type_ids`` maps atom-type name -> LAMMPS type number (default :func:`lammps_type_ids`); types not in
     it are skipped. ``substyle`` inserts a pair sub-style name (for ``pair_style hybrid``). The same two
-    coefficients serve lj/cut, lj/cut/coul/long, lj/charmm/coul/long and lj/cut/tip4p/long.
+    coefficients serve lj/cut, lj/cut/coul/long, lj/charmm/coul/long and lj/cut/tip4p/long. ``soft_core`` adds
+    lambda = 1 for the soft-core styles (``lj/cut/coul/long/soft``) and gives sigma = 1 A to the pairs with
+    epsilon = sigma = 0 (the soft-core form is 0/0 there; epsilon = 0 keeps them without LJ).
     """
     ids = dict(type_ids) if type_ids is not None else lammps_type_ids(ff)
     for n in ids:
@@ -586,7 +588,8 @@ def lammps_pair_coeffs(ff: ForceField, type_ids: Mapping[str, int] | None = None
         if i > j:
             i, j, ti, tj = j, i, tj, ti
         style = f" {substyle}" if substyle else ""
-        text = f"pair_coeff {i} {j}{style} {p.epsilon:.6f} {p.sigma:.6f}"
+        sigma = 1.0 if soft_core and p.epsilon == 0.0 and p.sigma == 0.0 else p.sigma
+        text = f"pair_coeff {i} {j}{style} {p.epsilon:.6f} {sigma:.6f}" + (" 1.0" if soft_core else "")
         if comments:
             text += f"  # {ti}-{tj} {p.rule}"
         lines.append((i, j, text))

@@ -200,16 +200,6 @@ def _forcefield_from_name(name: str) -> ForceField:
 SOFT_CORE = (1, 0.5, 10.0)
 
 
-def _soft_coeff(line: str) -> str:
-    """``pair_coeff I J eps sigma  # c`` -> ``pair_coeff I J eps sigma' 1.0  # c`` (sigma' = 1 where eps = 0 and
-    sigma = 0)."""
-    text, _, comment = line.partition("#")
-    w = text.split()
-    if float(w[3]) == 0.0 and float(w[4]) == 0.0:
-        w[4] = "1.0"
-    return " ".join(w + ["1.0"]) + (f"  # {comment.strip()}" if comment else "")
-
-
 def lammps_setup_commands(forcefield: ForceField, data_path: str | Path, *, boundary: str = "p p f",
                           pair: str = "long", cutoff: float = 12.0, kspace_accuracy: float = 1e-5) -> list[str]:
     """Commands that define the styles, read the data file and set pair coefficients from ``forcefield``.
@@ -237,10 +227,7 @@ def lammps_setup_commands(forcefield: ForceField, data_path: str | Path, *, boun
     else:
         raise ValueError(f"pair must be 'long', 'long/soft' or 'cut', got {pair!r}")
     cmds.append(f"read_data {Path(data_path).as_posix()}")
-    coeffs = lammps_pair_coeffs(forcefield)
-    if pair == "long/soft":
-        coeffs = [_soft_coeff(c) for c in coeffs]
-    cmds += coeffs
+    cmds += lammps_pair_coeffs(forcefield, soft_core=pair == "long/soft")
     cmds.append(forcefield.special_bonds.lammps())
     if pair in ("long", "long/soft"):
         cmds.append(f"kspace_style pppm {kspace_accuracy:g}")
