@@ -44,6 +44,15 @@ THERMOSTATS = ("nose-hoover", "langevin")
 ALL = WORKFLOWS
 
 
+#: Keys that define a run of a workflow only on some systems: workflow -> {key: (system key, value)}; elsewhere the
+#: key keeps its default in the settings but stays out of the run's identity (`Recipe.canonical`, hence the run
+#: hash). W_SL by TI learned OTS after its silica result was committed: on silica the SAM keys change nothing, and
+#: leaving them out keeps that result's hash. (The other workflows hash their SAM keys on every surface, as their
+#: committed results were hashed.)
+CONDITIONAL_KEYS: dict[str, dict[str, tuple[str, Any]]] = {
+    "wsl_ti": {"sam_coverage": ("surface", "ots"), "chain_length": ("surface", "ots")}}
+
+
 class RecipeError(InputError):
     """An invalid recipe: names the key, the value and what is allowed."""
 
@@ -90,9 +99,9 @@ FIELDS: tuple[Field, ...] = (
           "(silica_face = '001'); the (111) face has 4.50 fixed.", 4.7, low=3.9, high=7.8,
           workflows=_SURF + _TI),
     Field("sam_coverage", "system", float, "chains/nm^2", "OTS grafting density (cristobalite (111) holds at "
-          "most 4.50).", 4.5, low=0.5, high=4.5, workflows=_SURF),
+          "most 4.50).", 4.5, low=0.5, high=4.5, workflows=_SURF + _TI),
     Field("chain_length", "system", int, "carbons", "OTS alkyl chain length (C18 for OTS).", 18, low=2, high=30,
-          workflows=_SURF),
+          workflows=_SURF + _TI),
     Field("separation_A", "system", float, "A", "Adhesion: distance the upper slab is moved away for the "
           "separated state; must exceed the cutoff.", 20.0, low=5.0, high=60.0, workflows=_ADH),
     Field("contact_gap_A", "system", float, "A", "Adhesion: initial gap between the two slabs before "
@@ -312,9 +321,13 @@ class Recipe:
 
     def canonical(self, fidelity: str) -> dict[str, Any]:
         """What defines a run at ``fidelity``: workflow, name and the resolved settings (comments, key order
-        and the other fidelity tables do not matter)."""
-        return {"name": self.name, "workflow": self.workflow, "fidelity": fidelity,
-                "settings": self.settings(fidelity)}
+        and the other fidelity tables do not matter), less the keys that do not apply to this system
+        (:data:`CONDITIONAL_KEYS`)."""
+        settings = self.settings(fidelity)
+        for key, (when, value) in CONDITIONAL_KEYS.get(self.workflow, {}).items():
+            if settings.get(when) != value:
+                settings.pop(key, None)
+        return {"name": self.name, "workflow": self.workflow, "fidelity": fidelity, "settings": settings}
 
     def canonical_sha256(self, fidelity: str) -> str:
         text = json.dumps(self.canonical(fidelity), sort_keys=True, separators=(",", ":"))
@@ -413,10 +426,6 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
                               "a rate scan (more than one speed) is run only at production; give one speed", origin)
         if len(set(speeds)) != len(speeds):
             raise RecipeError(f"{p}.retract_speeds_m_s", speeds, "speeds must be distinct", origin)
-    if wf == "wsl_ti" and system["surface"] != "silica":
-        raise RecipeError("system.surface", system["surface"], "W_SL by TI supports 'silica' only (on OTS the "
-                          "water-TraPPE dispersion beyond the cutoff would have to be added; use contact_angle)",
-                          origin)
     if wf == "contact_angle" and system["surface"] == "ots" and fid["nx"] < 2:
         raise RecipeError(f"{p}.nx", fid["nx"], "must be >= 2", origin)
 

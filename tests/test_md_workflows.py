@@ -21,7 +21,7 @@ from md import units as U
 from md.recipe import RECIPE_DIR, RecipeError, load_recipe, parse_recipe
 
 RECIPES = ("adhesion_silica", "adhesion_ots", "adhesion_silica_ots", "pulloff_silica", "pulloff_ots",
-           "contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica")
+           "contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica", "wsl_ots")
 
 #: quantities each workflow must report, with their SI units
 EXPECTED = {

@@ -117,11 +117,28 @@ def test_recipe_keys_and_the_silica_only_rule():
     s = load_recipe("wsl_silica").settings("quick")
     assert s["surface"] == "silica" and s["silica_face"] == "111" and s["water_model"] == "spce"
     assert s["slab_thickness_A"] == load_recipe("contact_angle_silica").settings("quick")["slab_thickness_A"]
-    raw = load_recipe("wsl_silica").raw
+
+
+def _with_system(name, **system):
+    raw = load_recipe(name).raw
     t = {k: (dict(v) if isinstance(v, dict) else v) for k, v in raw.items()}
-    t["system"] = dict(t["system"], surface="ots")
-    with pytest.raises(RecipeError, match=r"system\.surface = 'ots': W_SL by TI supports 'silica' only"):
-        parse_recipe(t)
+    t["system"] = dict(t["system"], **system)
+    return parse_recipe(t, name=name)
+
+
+def test_the_sam_keys_define_a_ti_run_only_on_ots():
+    """On silica the SAM keys change nothing, so they stay out of the run's identity (the committed wsl_silica
+    result keeps its hash); on OTS they are part of it, and a wrong one is refused by name."""
+    silica = load_recipe("wsl_silica")
+    assert "sam_coverage" not in silica.canonical("quick")["settings"]
+    assert _with_system("wsl_silica", sam_coverage=3.0).canonical_sha256("quick") == silica.canonical_sha256("quick")
+    ots = load_recipe("wsl_ots")
+    assert ots.canonical("quick")["settings"]["sam_coverage"] == 4.5
+    assert _with_system("wsl_ots", sam_coverage=3.0).canonical_sha256("quick") != ots.canonical_sha256("quick")
+    with pytest.raises(RecipeError, match=r"system\.sam_coverage = 5\.0"):
+        _with_system("wsl_ots", sam_coverage=5.0)
+    # the other workflows hash their SAM keys on every surface, as their committed results were hashed
+    assert "sam_coverage" in load_recipe("contact_angle_silica").canonical("quick")["settings"]
 
 
 # ------------------------------------------------------------------------------------ the plan

@@ -34,7 +34,8 @@ from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circ
                                        shape_check,
                                        dispersion_tail_work, tail_antiderivative)
 from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
-                                     angle_from_work_of_adhesion_sl, tether_correction)
+                                     angle_from_work_of_adhesion_sl, tether_correction,
+                                     film_lower_dividing_plane)
 from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
 from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
                                detect_equilibration, timeseries_stats)
@@ -52,5 +53,5 @@ __all__ = [
     "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work", "tail_antiderivative",
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
     "gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
-    "tether_correction", "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
+    "tether_correction", "film_lower_dividing_plane", "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
 ]

@@ -45,7 +45,7 @@ from scipy.interpolate import PchipInterpolator
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2
 
 __all__ = ["gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
-           "tether_correction"]
+           "tether_correction", "film_lower_dividing_plane"]
 
 
 def gauss_legendre_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -155,3 +155,32 @@ def angle_from_work_of_adhesion_sl(w: float, w_stderr: float, gamma_lv: float) -
     th = math.acos(c)
     return {"status": "measured", "theta_deg": math.degrees(th), "stderr_deg": math.degrees(se / (g * math.sin(th))),
             "spreading_coefficient": spreading, "theta_upper_deg": upper, "cos_theta": c}
+
+
+def film_lower_dividing_plane(z_A, area_A2: float, n_frames: int, bin_A: float = 0.5) -> dict:
+    """The lower dividing plane of a liquid film from its molecules' heights (one site per molecule, all frames
+    together): the height where the number density first rises through half its bulk value, linearly
+    interpolated between bins. The bulk is the mean over the bins within the middle half of the film's extent
+    (first and last bins above half the maximum), clear of both interfaces' layering.
+
+    Returns ``z_A`` (the plane), ``number_density_A3`` (bulk, molecules per A^3), ``film_thickness_A`` (between
+    the two half-bulk crossings). Used for the static water-TraPPE dispersion tail of W_SL on OTS
+    (:func:`md.analysis.dispersion_tail_work`, which takes the liquid uniform above this plane)."""
+    z = np.asarray(z_A, float).ravel()
+    if z.size == 0 or n_frames < 1:
+        raise ValueError("film_lower_dividing_plane: no heights")
+    edges = np.arange(z.min() - bin_A, z.max() + 2 * bin_A, bin_A)
+    counts, edges = np.histogram(z, edges)
+    rho = counts / (float(area_A2) * bin_A * int(n_frames))
+    zc = 0.5 * (edges[1:] + edges[:-1])
+    above = np.flatnonzero(rho >= 0.5 * rho.max())
+    lo, hi = zc[above[0]], zc[above[-1]]
+    core = (zc >= lo + 0.25 * (hi - lo)) & (zc <= hi - 0.25 * (hi - lo))
+    bulk = float(rho[core].mean())
+    half = 0.5 * bulk
+    up = np.flatnonzero(rho >= half)
+    k = int(up[0])
+    z_low = float(zc[k] if k == 0 else np.interp(half, [rho[k - 1], rho[k]], [zc[k - 1], zc[k]]))
+    j = int(up[-1])
+    z_high = float(zc[j] if j == len(rho) - 1 else np.interp(half, [rho[j + 1], rho[j]], [zc[j + 1], zc[j]]))
+    return {"z_A": z_low, "number_density_A3": bulk, "film_thickness_A": z_high - z_low}

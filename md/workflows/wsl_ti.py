@@ -19,12 +19,12 @@ import numpy as np
 from md import analysis as A
 from md import units as U
 from md.build import place_on, water_slab
-from md.engine.plan import Analysis, Leg, Plan, Stage
+from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
 from md.system.lammps_data import write_data
 from md.system.topology import remove_atoms
-from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, common_define, derived_seed, figure_writer,
+from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, derived_seed, figure_writer,
                                  forcefield_of, fresh_from_data, held_deep, minimize_lines, minimize_water_lines,
                                  quantity_record, restart_header_lines, shake_lines, silica_face_of, stage_list,
                                  steps_of, substrate_water_seeds, surface_slab, system_summary, thermostat_lines,
@@ -49,8 +49,22 @@ FEP_DELTA = 0.002
 #: charges in both, so the held atoms' huge, constant solid-solid share cancels exactly in I_q(ref) - I_q(film).
 PPPM_G_RC = 2.625
 PPPM_MESH_A = 1.5
-#: silica atom types whose charges the charge stage scales
+#: silica atom types, in the order the charge stage lists them; an OTS substrate adds its SAM's types after them
+#: (:func:`solid_types`)
 SOLID_TYPES = ("SC4", "OC23", "OC24", "HOY")
+#: configurations of the water O and the SAM's TraPPE sites are stored every this many samples of the film leg's
+#: second half (OTS only), for the water-TraPPE dispersion beyond the cutoff
+FRAME_EVERY_SAMPLES = 4
+
+
+def solid_types(system, ff) -> tuple[list[str], list[str]]:
+    """(every atom type of the substrate, the charged ones), silica's in :data:`SOLID_TYPES` order first, then the
+    SAM's (TraPPE CH2/CH3 and the head Si) in force-field order. The charge stage scales the charged ones, the
+    dispersion stage switches off every one of them against the water."""
+    sub = set(np.asarray(system.types)[np.asarray(system.group("substrate"), int)].tolist())
+    order = list(SOLID_TYPES) + [a.name for a in ff.atom_types if a.name not in SOLID_TYPES]
+    present = [t for t in order if t in sub]
+    return present, [t for t in present if ff.atom_type(t).charge != 0.0]
 
 
 def _fft_size(n: int) -> int:
@@ -91,7 +105,8 @@ class WslTI(Workflow):
               "surface_tension_lv": "N/m"}
 
     def forcefield_files(self, s):
-        return ["silica_interface"] + water_forcefield_names(s["water_model"])
+        return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else []) + \
+            water_forcefield_names(s["water_model"])
 
     def build(self, s):
         seed = int(s["seed"])
@@ -116,9 +131,19 @@ class WslTI(Workflow):
         write_data(remove_atoms(system, water), ff, sub_data, title="wsl_ti substrate")
         write_data(remove_atoms(system, substrate), ff, water_data, title="wsl_ti water film")
         ids = lammps_type_ids(ff)
-        solid_t = [ids[t] for t in SOLID_TYPES]
+        all_types, charged_types = solid_types(system, ff)
+        solid_t, charged_t = [ids[t] for t in all_types], [ids[t] for t in charged_types]
         water_t = sorted(ids[a.name] for a in forcefield_of(water_forcefield_names(s["water_model"])).atom_types)
-        charge = {ids[t]: ff.atom_type(t).charge for t in SOLID_TYPES}
+        charge = {ids[t]: ff.atom_type(t).charge for t in charged_types}
+        # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
+        # dispersion beyond the cutoff (analysis: md.analysis.film_dividing_plane + dispersion_tail_work)
+        tail_sites = np.array([], int)
+        if s["surface"] == "ots":
+            sam = np.asarray(system.group("sam"), int)
+            tail_sites = sam[np.isin(np.asarray(system.types)[sam], TRAPPE_UA)]
+        water_o = np.intersect1d(system.group("water_O"), water)
+        ow = str(np.asarray(system.types)[water_o[0]])
+        c6 = [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(x)) for x in np.asarray(system.types)[tail_sites])]
         z_film = float(system.positions[water, 2].mean())
         area = float(system.cell[0] * system.cell[1])
         dt, t = s["timestep_fs"], s["temperature_K"]
@@ -137,7 +162,7 @@ class WslTI(Workflow):
             ``stage`` ('q' or 'lj') by central differences of two compute fep"""
             cmds = [f"variable lq equal {lam_q:.12g}", f"variable ll equal {lam_lj:.12g}"]
             args = []
-            for k in solid_t:
+            for k in charged_t:
                 cmds += [f"variable q{k} equal {charge[k]:.8g}*v_lq",
                          f"variable dqp{k} equal {charge[k] * FEP_DELTA:.8g}",
                          f"variable dqm{k} equal {-charge[k] * FEP_DELTA:.8g}"]
@@ -147,8 +172,8 @@ class WslTI(Workflow):
             cmds.append(f"fix couple all adapt/fep 0 {' '.join(args)} reset no")
             cmds += [f"variable dlp equal {FEP_DELTA:g}", f"variable dlm equal {-FEP_DELTA:g}"]
             if stage == "q":
-                plus = " ".join(f"atom charge {k} v_dqp{k}" for k in solid_t)
-                minus = " ".join(f"atom charge {k} v_dqm{k}" for k in solid_t)
+                plus = " ".join(f"atom charge {k} v_dqp{k}" for k in charged_t)
+                minus = " ".join(f"atom charge {k} v_dqm{k}" for k in charged_t)
             else:
                 plus = " ".join(f"pair lj/cut/coul/long/soft lambda {i} {j} v_dlp" for i, j in pairs)
                 minus = " ".join(f"pair lj/cut/coul/long/soft lambda {i} {j} v_dlm" for i, j in pairs)
@@ -178,16 +203,27 @@ class WslTI(Workflow):
         def fresh_film(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
             return head(sub_dir / f"restart.{_total}") + [
                 f"timestep {dt:g}", f"read_data {water_data.as_posix()} add append group water",
-                "group mobile subtract all frozen",
-                f"delete_atoms overlap {FILM_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
+                "group mobile subtract all frozen"] + \
+                ([f"group framed type {ids[ow]} " + " ".join(str(ids[x]) for x in TRAPPE_UA if x in all_types)]
+                 if len(tail_sites) else []) + \
+                [f"delete_atoms overlap {FILM_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
 
+        begin = (f"velocity mobile create {t:g} {derived_seed(seed, 3, 1)} mom yes rot no dist gaussian",)
+        if len(tail_sites):
+            # the equilibration's second half is framed (a sampled stage; its samples are the same series as
+            # before). Silica keeps its single unsampled stage: its plan, and its committed result, are unchanged.
+            n_eq = steps_of(s, "equilibrate_steps")
+            half = (n_eq // 2) // s["chunk_steps"] * s["chunk_steps"] or n_eq // 2
+            film_stages = stage_list(Stage("equilibrate", n_eq - half, begin, sampled=False),
+                                     Stage("sample", half))
+            film_frames = Frames("framed", s["sample_interval"] * FRAME_EVERY_SAMPLES)
+        else:
+            film_stages = [Stage("equilibrate", steps_of(s, "equilibrate_steps"), begin, sampled=False)]
+            film_frames = None
         film_leg = Leg(name="film", fresh=fresh_film, define=lambda step: base(True, step, 1),
-                       prepare=lambda d: minimize_water_lines(s),
-                       stages=[Stage("equilibrate", steps_of(s, "equilibrate_steps"),
-                                     (f"velocity mobile create {t:g} {derived_seed(seed, 3, 1)} mom yes rot no "
-                                      f"dist gaussian",), sampled=False)],
+                       prepare=lambda d: minimize_water_lines(s), stages=film_stages,
                        columns={"pe": "v_pe", "temp": "v_temp", "z_film": "v_zw"}, n_atoms=system.n_atoms,
-                       **common)
+                       frames=film_frames, **common)
         legs = [sub_leg, film_leg]
 
         def window(name: str, prev: Leg, prev_dir: Path, lam_q: float, lam_lj: float, stage: str,
@@ -223,7 +259,8 @@ class WslTI(Workflow):
                 "area_A2": area, "n_substrate": int(len(substrate)), "n_water_molecules_built": int(len(water) // 3),
                 "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
                 "silica_face": silica_face_of(s), "water_model": s["water_model"], "type_ids": ids,
-                "solid_types": list(SOLID_TYPES), "solid_charges_e": {t: ff.atom_type(t).charge for t in SOLID_TYPES},
+                "solid_types": all_types, "solid_charges_e": {x: ff.atom_type(x).charge for x in charged_types},
+                "surface": s["surface"], "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6,
                 "tether": {"k_kcal_mol_A2": TETHER_K, "z_A": z_film}, "fep_delta": FEP_DELTA,
                 "soft_core": "lj/cut/coul/long/soft n = 1, alpha_LJ = 0.5 (Beutler et al. 1994)",
                 "nodes": {k: v.tolist() for k, v in nodes.items()}, "pppm": kspace[0]}
@@ -264,10 +301,17 @@ class WslTI(Workflow):
                                  info["area_A2"])
         w["value"] += tc["value"]
         w["tether_correction"] = tc
+        # OTS: the water-TraPPE dispersion beyond the cutoff, static, at full coupling (the film leg's framed half)
+        tail = _dispersion_tail(ctx, info, s) if info.get("tail_site_ids") else None
+        if tail is not None:
+            w["value"] += tail["value"]
+            w["stderr"] = math.hypot(w["stderr"], tail["stderr"])
+            w["dispersion_tail"] = tail
+        dw_tail = tail["value"] if tail is not None else 0.0
         # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
         w_half = [A.ti_work_of_adhesion_sl(halves[h]["charge_film"], halves[h]["lj_film"],
                                            halves[h]["charge_reference"], info["area_A2"])["value"] + tc["value"]
-                  for h in (0, 1)]
+                  + dw_tail for h in (0, 1)]
         half_sigma = w["stderr"] * 2.0                  # each half has sqrt(2) x the stderr; their difference 2 x
         w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
         ang = A.angle_from_work_of_adhesion_sl(w["value"], w_err, gamma)
@@ -288,6 +332,11 @@ class WslTI(Workflow):
                                               upper_one_stderr_deg=ang["theta_upper_deg"]),
              "spreading_coefficient": quantity_record(ang["spreading_coefficient"], w["stderr"], "J/m^2",
                                                       kind="S = W_SL - 2 gamma_lv (>= 0: wets)"),
+             **({"dispersion_tail_work_sl": quantity_record(
+                 tail["value"], tail["stderr"], "J/m^2", kind="water-TraPPE dispersion beyond the cutoff, static: "
+                 "the SAM's CH2/CH3 sites under the film's lower dividing plane, the water uniform at its bulk "
+                 "density above it (md.analysis.dispersion_tail_work); included in work_of_adhesion_sl")}
+                if tail is not None else {}),
              "surface_tension_lv": quantity_record(gamma, None, "N/m",
                                                    kind=f"the water model's published gamma_lv ({model['gamma_source']})")}
         if ang["status"] == "wets":
@@ -309,7 +358,9 @@ class WslTI(Workflow):
                  ] + [f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
                  f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
                  f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
-                 f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f} mJ/m^2.",
+                 f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f}"
+                 + (f", water-TraPPE dispersion beyond the {s['cutoff_A']:g} A cutoff {dw_tail * 1e3:+.1f} +/- "
+                    f"{tail['stderr'] * 1e3:.1f}" if tail is not None else "") + " mJ/m^2.",
                  {"measured": f"theta = {ang['theta_deg']:.1f} deg from Young-Dupre with gamma_lv = "
                               f"{gamma * 1e3:.1f} mN/m ({model['name']}).",
                   "wets": f"WETS: W_SL exceeds 2 gamma_lv = {2 * gamma * 1e3:.1f} mJ/m^2 by "
@@ -327,6 +378,13 @@ class WslTI(Workflow):
                  "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
                  f"mobile (O-H by SHAKE); water rigid {model['name']} (SHAKE); PPPM throughout (the charge stage "
                  "scales the solid's charges, the reference subtracts their solid-solid part)."]
+        if tail is not None:
+            notes.append(
+                f"the water-TraPPE dispersion beyond the {s['cutoff_A']:g} A cutoff (which TraPPE was fitted with) is "
+                f"added statically: {tail['sites']} CH2/CH3 sites under the film's lower dividing plane "
+                f"(z = {tail['plane_z_A']:.2f} A, bulk {tail['number_density_A3']:.4f} molecules/A^3), "
+                f"{tail['frames']} frames of the film leg's second half; the IFF pairs and water-water keep the "
+                "plain cutoff, as in every recipe.")
         curves, rows = {}, []
         for key, code in (("charge_film", 0), ("lj_film", 1), ("charge_reference", 2)):
             for r in per_node[key]:
@@ -353,5 +411,33 @@ class WslTI(Workflow):
                    "window_halves_J_m2": {"first": w_half[0], "second": w_half[1], "consistent": half_ok,
                                           "difference_sigma": 2.0 * half_sigma},
                    "water_model": s["water_model"]}
+        if tail is not None:
+            details["dispersion_tail"] = tail
         return Analysis(quantities=q, curves=curves, figures={"dudl": figure_writer(draw)}, notes=notes,
                         details=details)
+
+
+def _dispersion_tail(ctx, info, s) -> dict | None:
+    """The water-TraPPE dispersion beyond the cutoff (J/m^2, > 0 = more adhesion) per frame of the film leg's
+    framed half: the film's lower dividing plane and bulk density from all frames' water O
+    (:func:`md.analysis.film_lower_dividing_plane`), each frame's TraPPE sites under it
+    (:func:`md.analysis.dispersion_tail_work`); mean and stderr from the statistical inefficiency. None when the
+    film leg stored no frames."""
+    steps, ids, pos, box = ctx.frames("film")
+    if not len(steps):
+        return None
+    site_ids = [int(i) for i in info["tail_site_ids"]]
+    order = {i: k for k, i in enumerate(site_ids)}
+    is_site = np.isin(ids, site_ids)
+    c6 = np.asarray(info["tail_site_c6_kcal_A6"], float)[[order[int(i)] for i in ids[is_site]]]
+    area = float(info["area_A2"])
+    plane = A.film_lower_dividing_plane(pos[:, ~is_site, 2], area, len(steps))
+    per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, plane["z_A"], plane["number_density_A3"],
+                                                 s["cutoff_A"], area) for k in range(len(steps))])
+    st = A.timeseries_stats(per_frame, equilibrate=False)
+    err = st["stderr"] if np.isfinite(st["stderr"]) else float(np.std(per_frame, ddof=1) if len(per_frame) > 1 else 0.0)
+    return {"value": U.kcal_per_mol_A2_to_J_per_m2(st["mean"]), "stderr": U.kcal_per_mol_A2_to_J_per_m2(err),
+            "per_frame_J_m2": U.kcal_per_mol_A2_to_J_per_m2(per_frame).tolist(), "g": st["g"],
+            "plane_z_A": plane["z_A"], "number_density_A3": plane["number_density_A3"],
+            "film_thickness_A": plane["film_thickness_A"], "sites": int(is_site.sum()), "frames": int(len(steps)),
+            "cutoff_A": s["cutoff_A"]}
