@@ -90,7 +90,7 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces", "system", list, "", "Adhesion: the lower and the upper surface (the upper slab is flipped "
           "to face the lower one).", REQUIRED, choices=SURFACES, workflows=_ADH, item=str, length=(2,)),
     Field("surface", "system", str, "", "Pull-off: the coating of both the asperity and the flat; contact "
-          "angle and W_SL by TI: the substrate (TI: silica only).", REQUIRED, choices=SURFACES, workflows=_PULL + _CA + _TI),
+          "angle and W_SL by TI: the substrate.", REQUIRED, choices=SURFACES, workflows=_PULL + _CA + _TI),
     Field("silica_face", "system", str, "", "Cristobalite face of every bare silica surface: '111' = isolated Q3 "
           "silanols at 4.50 OH/nm^2 (nearest silanol O-O 5.06 A), IFF's hydrophilic Q3 surface and the shared "
           "default of all recipes; '001' = geminal/vicinal pairs 2.53 A apart, 3.9-7.8 OH/nm^2 (silanol_density). "

@@ -20,8 +20,8 @@ import math
 import numpy as np
 import pytest
 
-from md.analysis import (KCALMOL_PER_A2_TO_J_PER_M2, angle_from_work_of_adhesion_sl, gauss_legendre_unit,
-                         tether_correction, ti_integral, ti_work_of_adhesion_sl, work_of_adhesion_sl)
+from md.analysis import (KCALMOL_PER_A2_TO_J_PER_M2, angle_from_work_of_adhesion_sl, film_lower_dividing_plane,
+                         gauss_legendre_unit, tether_correction, ti_integral, ti_work_of_adhesion_sl, work_of_adhesion_sl)
 from md.recipe import RecipeError, load_recipe, parse_recipe
 from conftest import require_backend
 
@@ -143,10 +143,15 @@ def test_the_sam_keys_define_a_ti_run_only_on_ots():
 
 # ------------------------------------------------------------------------------------ the plan
 
-def _plan(tmp_path):
+def _plan(tmp_path, recipe="wsl_silica"):
     from md.workflows import get_workflow
-    s = load_recipe("wsl_silica").settings("smoke")
+    s = load_recipe(recipe).settings("smoke")
     return s, get_workflow("wsl_ti").plan(s, tmp_path)
+
+
+#: recipe -> (the charged solid types the charge stage scales, every solid type the dispersion stage decouples)
+_SOLIDS = {"wsl_silica": (("SC4", "OC23", "OC24", "HOY"), ("SC4", "OC23", "OC24", "HOY")),
+           "wsl_ots": (("SC4", "OC23", "OC24", "HOY", "SIH"), ("SC4", "OC23", "OC24", "HOY", "SIH", "CH2", "CH3"))}
 
 
 def _cmds(leg, tmp_path):
@@ -154,14 +159,17 @@ def _cmds(leg, tmp_path):
     return leg.fresh(d) + leg.define(0) + leg.prepare(d)
 
 
-def test_plan_legs_scale_the_right_things(tmp_path):
-    s, plan = _plan(tmp_path)
+@pytest.mark.parametrize("recipe", sorted(_SOLIDS))
+def test_plan_legs_scale_the_right_things(tmp_path, recipe):
+    s, plan = _plan(tmp_path, recipe)
     names = [leg.name for leg in plan.legs]
     nq, nl = s["ti_charge_nodes"], s["ti_lj_nodes"]
     assert names == (["substrate", "film"] + [f"q{k}" for k in range(nq)] + [f"lj{k}" for k in range(nl)]
                      + [f"ref_q{k}" for k in range(nq)])
     ids = plan.system_info["type_ids"]
-    solid = {str(ids[t]) for t in ("SC4", "OC23", "OC24", "HOY")}
+    charged_types, all_types = _SOLIDS[recipe]
+    solid = {str(ids[t]) for t in charged_types}
+    every = {str(ids[t]) for t in all_types}
     water = {str(ids["OW"]), str(ids["HW"])}
     pppm = {c for leg in plan.legs for c in _cmds(leg, tmp_path) if c.startswith("kspace_modify slab 3.0 gewald")}
     assert len(pppm) == 1                                                 # one G and one mesh for every leg
@@ -169,7 +177,7 @@ def test_plan_legs_scale_the_right_things(tmp_path):
         cmds = _cmds(leg, tmp_path)
         adapt = next(c for c in cmds if " adapt/fep " in c).split()
         charged = {adapt[i + 2] for i, w in enumerate(adapt) if w == "atom"}
-        assert charged == solid                                           # only the solid's charges
+        assert charged == solid                          # the solid's charged types, nothing else
         pairs = {(adapt[i + 3], adapt[i + 4]) for i, w in enumerate(adapt) if w == "pair"}
         fep = [c for c in cmds if " fep " in c and c.startswith("compute")]
         assert len(fep) == 2
@@ -178,11 +186,46 @@ def test_plan_legs_scale_the_right_things(tmp_path):
             text = " ".join(cmds)
             assert not pairs and "tether" not in text and "read_data" not in text and leg.n_atoms < plan.n_atoms
         else:
-            assert pairs == {(i, j) for i in solid for j in water}        # only solid-water pairs
+            assert pairs == {(i, j) for i in every for j in water}        # every solid-water pair, no other
         if leg.name.startswith("lj"):
             assert lam["lq"] == 0.0 and 0 < lam["ll"] < 1 and all(" pair " in c for c in fep)
         else:
             assert 0 < lam["lq"] < 1 and lam["ll"] == 1.0 and all(" atom charge " in c for c in fep)
+
+
+def test_only_the_ots_film_leg_frames_the_water_and_the_trappe_sites(tmp_path):
+    """OTS: the film leg's second half is sampled and frames the water O and CH2/CH3 (for the dispersion tail);
+    silica keeps its single unsampled film stage and no frames (its plan, and committed result, unchanged)."""
+    (tmp_path / "s").mkdir()
+    (tmp_path / "o").mkdir()
+    _, silica = _plan(tmp_path / "s")
+    film = silica.legs[1]
+    assert film.frames is None and [st.sampled for st in film.stages] == [False]
+    assert not silica.system_info["tail_site_ids"]
+    s, ots = _plan(tmp_path / "o", "wsl_ots")
+    film = ots.legs[1]
+    assert film.frames is not None and [st.sampled for st in film.stages] == [False, True]
+    assert film.total_steps == s["equilibrate_steps"]
+    ids = ots.system_info["type_ids"]
+    group = next(c for c in _cmds(film, tmp_path / "o") if c.startswith("group framed")).split()
+    assert group[2] == "type" and set(group[3:]) == {str(ids[t]) for t in ("OW", "CH2", "CH3")}
+    n_sites = len(ots.system_info["tail_site_ids"])
+    assert n_sites == len(ots.system_info["tail_site_c6_kcal_A6"]) > 0
+
+
+def test_film_dividing_plane_of_a_uniform_slab():
+    """Molecules uniform between z = 10 and 30 A at 0.0334 /A^3: the plane at 10 (within half a bin), the bulk
+    density and the thickness recovered; a denser first layer (wall layering) does not move the plane."""
+    rng = np.random.default_rng(7)
+    area, rho, frames = 400.0, 0.0334, 50
+    n = int(rho * area * 20.0)
+    z = rng.uniform(10.0, 30.0, size=(frames, n))
+    r = film_lower_dividing_plane(z, area, frames)
+    assert abs(r["z_A"] - 10.0) < 0.25 and abs(r["number_density_A3"] / rho - 1) < 0.02
+    assert abs(r["film_thickness_A"] - 20.0) < 0.5
+    layer = rng.uniform(10.0, 11.0, size=(frames, int(rho * area)))      # doubles the density of the first angstrom
+    r2 = film_lower_dividing_plane(np.concatenate([z, layer], axis=1), area, frames)
+    assert abs(r2["z_A"] - 10.0) < 0.25 and abs(r2["number_density_A3"] / rho - 1) < 0.03
 
 
 # ------------------------------------------------------------------------------------ LAMMPS identities
