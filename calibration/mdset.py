@@ -66,6 +66,9 @@ _DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this i
             "silica droplet keeps the angle it is started at (pinned contact line: 18 deg from a 20 deg start, 39 deg "
             "from 40 deg), so it measures the start, not the surface")
 
+_DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the R0 = 2 nm droplet's angle, "
+                "which is not size-converged (109.2 deg at R0 = 2 nm, 125.0 deg at 3 nm: docs/md.md)")
+
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),
     Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion_free_energy", "work_of_adhesion")),
@@ -74,7 +77,8 @@ MAPPING: tuple[Source, ...] = (
     Source("surfaces.substrate.contact_angle", "wsl_silica", ("contact_angle",),
            fallback=Source("surfaces.substrate.contact_angle", "contact_angle_silica", ("contact_angle",),
                            note=_DROPLET)),
-    Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",)),
+    Source("surfaces.sam.contact_angle", "wsl_ots", ("contact_angle",),
+           fallback=Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",), note=_DROPLET_OTS)),
     Source("menisci.surface_tension", "surface_tension_spce", ("surface_tension",)),
     Source("surfaces.interaction_range", "adhesion_silica", ("interaction_range_z0",),
            fallback=Source("surfaces.interaction_range", "pulloff_silica", ("interaction_range_z0",),
@@ -96,7 +100,7 @@ def recipes_needed(mapping=MAPPING) -> list[str]:
 
 
 #: Recipes whose result depends on the water model (settings.water_model); one model throughout a calibration.
-WATER_RECIPES = ("contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica")
+WATER_RECIPES = ("contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica", "wsl_ots")
 
 
 def water_model_mismatch(results: dict[str, dict]) -> str | None:

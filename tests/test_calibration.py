@@ -124,7 +124,8 @@ def test_a_drifting_or_non_circular_droplet_is_flagged_on_its_calibrated_angle()
         "surfaces.sam.contact_angle"]
     assert cal["drifting"] is True and "not_circular" not in cal and "drift" in cal["note"]
     cal = build_parameter_set(_results(), "paper", "cal")[0]["meta"]["calibration"]["surfaces.sam.contact_angle"]
-    assert "note" not in cal and "drifting" not in cal and "not_circular" not in cal
+    # no flag: the note is only the fallback's (the droplet stands in for W_SL by TI on OTS)
+    assert cal["note"].startswith("fallback: no W_SL") and "drifting" not in cal and "not_circular" not in cal
 
 
 def test_angles_and_gamma_of_different_water_models_are_not_combined():
@@ -192,9 +193,9 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
 
 
-def test_recipes_needed_are_the_eight_mapped_ones():
-    assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "contact_angle_ots",
-                                "surface_tension_spce", "contact_angle_silica", "pulloff_silica", "pulloff_ots"]
+def test_recipes_needed_are_the_nine_mapped_ones():
+    assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
+                                "contact_angle_silica", "contact_angle_ots", "pulloff_silica", "pulloff_ots"]
 
 
 def _ti(theta, theta_err, status="measured", w=0.09, bound=None):
@@ -216,6 +217,17 @@ def test_silica_angles_come_from_the_ti_and_fall_back_to_the_droplet_with_a_note
     table, _ = build_parameter_set(_results(), "paper", "cal")              # no TI result: the droplet
     e = table["meta"]["calibration"]["surfaces.body.contact_angle"]
     assert e["recipe"] == "contact_angle_silica" and e["value"] == 31.0 and "pinned contact line" in e["note"]
+
+
+def test_the_ots_angle_comes_from_the_ti_and_falls_back_to_the_droplet_with_a_note():
+    ti = _ti(112.0, 1.5, w=0.04)
+    ti["recipe"] = "wsl_ots"
+    table, _ = build_parameter_set(_results(wsl_ots=ti), "paper", "cal")
+    e = table["meta"]["calibration"]["surfaces.sam.contact_angle"]
+    assert table["surfaces"]["sam"]["contact_angle"] == 112.0 and e["recipe"] == "wsl_ots" and "note" not in e
+    table, _ = build_parameter_set(_results(), "paper", "cal")              # no TI result: the droplet
+    e = table["meta"]["calibration"]["surfaces.sam.contact_angle"]
+    assert e["recipe"] == "contact_angle_ots" and e["value"] == 108.0 and "not size-converged" in e["note"]
 
 
 def test_a_ti_that_wets_enters_as_zero_or_as_its_bound_never_as_a_film_mark():
@@ -349,7 +361,7 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
     assert sorted(p.name for p in (out / "paper" / "cases").iterdir()) == ["hertz", "rough_ots", "rough_silica"]
-    assert len(report.md_sources) == 8 and len(report.rows) == 8
+    assert len(report.md_sources) == 9 and len(report.rows) == 8          # 9 recipes (fallbacks too), 8 keys
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
     assert len(report.used) + len(report.not_used) == 8
