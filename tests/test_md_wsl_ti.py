@@ -326,3 +326,18 @@ def test_soft_core_at_lambda_one_is_the_plain_pair_style(tmp_path):
     assert e["long/soft"]["elong"] == pytest.approx(e["long"]["elong"], rel=1e-8, abs=1e-8)
     # real-space Coulomb: the plain style tabulates erfc (pair_modify table 12), the soft style does not
     assert e["long/soft"]["ecoul"] == pytest.approx(e["long"]["ecoul"], rel=1e-5)
+
+
+@pytest.mark.md
+def test_the_ots_result_adds_the_dispersion_tail_into_w_sl(md_smoke):
+    """On OTS the water-TraPPE dispersion beyond the cutoff is positive (it only attracts), reported apart and
+    included in W_SL: W_SL = electrostatic + dispersion + tether + tail (J/m^2); silica has no such part."""
+    r = md_smoke("wsl_ots").outcome.result
+    q, d = r["quantities"], r["details"]
+    tail = q["dispersion_tail_work_sl"]["value"]
+    assert tail > 0 and d["dispersion_tail"]["frames"] >= 1 and d["dispersion_tail"]["sites"] > 0
+    parts = d["parts_J_m2"]
+    total = parts["electrostatic"] + parts["dispersion"] + parts["tether_correction"]["value"] + tail
+    assert q["work_of_adhesion_sl"]["value"] == pytest.approx(total, rel=1e-12, abs=1e-15)
+    assert any("beyond the 12 A cutoff" in n for n in r["notes"])
+    assert "dispersion_tail_work_sl" not in md_smoke("wsl_silica").outcome.result["quantities"]

@@ -14,7 +14,7 @@ The workflows (each module's docstring says what it builds, runs and measures):
 ``pulloff``          a hemispherical asperity retracted from a flat: pull-off force (validation)
 ``contact_angle``    a cylindrical droplet on silica or OTS: the angle at the water's plane, W_SL, or "wets"
 ``surface_tension``  a free-standing water film: gamma_lv from the pressure tensor, with the LJ tail
-``wsl_ti``           a water film decoupled from silica: W_SL by thermodynamic integration, theta or "wets"
+``wsl_ti``           a water film decoupled from silica or OTS: W_SL by thermodynamic integration, theta or "wets"
 """
 from md.workflows.common import ENERGY_NOT_FREE_ENERGY, Workflow
 from md.workflows.facade import MDResult, job_for, run_hash, run_recipe

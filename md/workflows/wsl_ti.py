@@ -1,13 +1,15 @@
 """The solid-liquid work of adhesion W_SL by thermodynamic integration (:class:`WslTI`): no droplet, no contact line.
 
 wsl_ti
-    A water film on (111) silica (isolated Q3 silanols, the surface every silica recipe shares) is decoupled
-    from the solid in two stages -- the solid's charges scaled to zero, then the solid-water Lennard-Jones pairs
-    switched off through a soft core -- and the solid alone (vacuum above) goes through the same charge stage
-    as the reference. W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which
+    A water film on (111) silica (isolated Q3 silanols, the surface every silica recipe shares) or on the OTS SAM
+    of every OTS recipe is decoupled from the solid in two stages -- the solid's charges scaled to zero, then the
+    solid-water Lennard-Jones pairs switched off through a soft core -- and the solid alone (vacuum above) goes
+    through the same charge stage as the reference. On OTS the water-TraPPE dispersion beyond the cutoff is added
+    statically from the film leg's framed second half, as on the OTS droplets. W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which
     derives it), then theta from Young-Dupre, or "wets" with the spreading coefficient when W_SL >= 2 gamma_lv.
-    Why: a quick droplet on this surface keeps the angle it was started at (the contact line is pinned over
-    120 ps), so a droplet cannot say whether the surface wets; issue 11 asks for W_SL measured directly.
+    Why: a quick droplet on silica keeps the angle it was started at (the contact line is pinned over 120 ps), so
+    a droplet cannot say whether the surface wets; issue 11 asks for W_SL measured directly. On OTS the quick
+    droplets are not size-converged (109 deg at R0 = 2 nm, 125 deg at 3 nm); W_SL has no droplet size.
 """
 from __future__ import annotations
 
@@ -90,10 +92,11 @@ def pppm_lines(settings, box_A) -> list[str]:
 
 
 class WslTI(Workflow):
-    """W_SL of water on silica by decoupling a film (charges, then soft-core LJ) minus the solid-alone charge stage.
+    """W_SL of water on silica or OTS by decoupling a film (charges, then soft-core LJ) minus the solid-alone charge stage.
 
     Legs: *substrate* (the slab minimised with nothing held, then deep Si and bridging O held, equilibrated);
-    *film* (the water film added on the substrate's last state, minimised, equilibrated at full coupling);
+    *film* (the water film added on the substrate's last state, minimised, equilibrated at full coupling; on OTS
+    the second half is a sampled stage framing the water O and the CH2/CH3 sites, for the dispersion tail);
     *q0..* (the solid's charges at each Gauss-Legendre node, 1 -> 0, each leg continuing from the last);
     *lj0..* (solid charges 0, solid-water LJ lambda at each node, 1 -> 0); *ref_q0..* (the solid alone from the
     substrate's last state, the charge nodes again). Every node equilibrates ``ti_equilibrate_steps`` and samples
