@@ -187,6 +187,9 @@ def test_plan_legs_scale_the_right_things(tmp_path, recipe):
             assert not pairs and "tether" not in text and "read_data" not in text and leg.n_atoms < plan.n_atoms
         else:
             assert pairs == {(i, j) for i in every for j in water}        # every solid-water pair, no other
+        thermostats = [c.split()[2] for c in cmds if c.startswith("fix thermostat")]
+        # version 2: the water and the solid's mobile atoms each have their own thermostat; the solid alone one
+        assert thermostats == (["mobile"] if leg.name.startswith("ref") else ["water", "solidmobile"]), leg.name
         if leg.name.startswith("lj"):
             assert lam["lq"] == 0.0 and 0 < lam["ll"] < 1 and all(" pair " in c for c in fep)
         else:
@@ -211,6 +214,33 @@ def test_only_the_ots_film_leg_frames_the_water_and_the_trappe_sites(tmp_path):
     assert group[2] == "type" and set(group[3:]) == {str(ids[t]) for t in ("OW", "CH2", "CH3")}
     n_sites = len(ots.system_info["tail_site_ids"])
     assert n_sites == len(ots.system_info["tail_site_c6_kcal_A6"]) > 0
+
+
+class _Ctx:
+    """the part of an analysis context _temperatures reads: legs and their samples"""
+    def __init__(self, series):
+        from md.engine.plan import Stage
+        self.series = series
+        self.legs = [type("L", (), {"name": n, "stages": [Stage("s", 1)]})() for n in series]
+
+    def samples(self, name, sampled_only=True):
+        return self.series[name]
+
+
+def test_leg_temperatures_are_reported_and_an_off_target_leg_is_flagged():
+    from md.workflows.wsl_ti import TEMPERATURE_TOLERANCE_K, _temperatures
+    ok = {"temp_water": np.full(40, 301.0), "temp_solid": np.full(40, 299.0)}
+    hot = {"temp_water": np.r_[np.full(20, 500.0), np.full(20, 420.0)], "temp_solid": np.full(40, 165.0)}
+    ctx = _Ctx({"film": hot, "q0": ok})
+    r = _temperatures(ctx, ctx.legs, 300.0)
+    assert r["per_leg"]["film"]["water"] == 420.0                     # the film leg: its second half only
+    assert r["off_target_legs"] == ["film"] and "OFF TARGET on film (420 / 165 K)" in r["note"]
+    assert r["max_deviation_K"]["solid"] == 135.0
+    ctx = _Ctx({"film": ok, "q0": {"temp_water": np.full(40, 300.0 + TEMPERATURE_TOLERANCE_K - 0.5),
+                                   "temp_solid": np.full(40, 300.0)}})
+    r = _temperatures(ctx, ctx.legs, 300.0)
+    assert not r["off_target_legs"] and "within" in r["note"]
+    assert _temperatures(_Ctx({"film": {"pe": np.ones(3)}}), _Ctx({"film": {}}).legs, 300.0) == {}   # version 1
 
 
 def test_film_dividing_plane_of_a_uniform_slab():
