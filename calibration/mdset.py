@@ -93,10 +93,25 @@ VALIDATION = (("pulloff_silica", "adhesion_silica"), ("pulloff_ots", "adhesion_o
 
 
 def recipes_needed(mapping=MAPPING) -> list[str]:
-    """MD recipes a calibration needs, in mapping order, each once (fallback recipes -- the pull-offs, also the
+    """MD recipes a calibration may need, in mapping order, each once (fallback recipes -- the pull-offs, also the
     validation runs -- after the first ones)."""
     first = [s.recipe for s in mapping]
     return list(dict.fromkeys(first + [s.fallback.recipe for s in mapping if s.fallback is not None]))
+
+
+def recipes_first(mapping=MAPPING, validation=VALIDATION) -> list[str]:
+    """The recipes every calibration runs: the preferred recipe of every key and the validation runs (the
+    pull-offs), in :func:`recipes_needed` order. A fallback recipe runs only when :func:`fallbacks_needed` asks."""
+    want = {s.recipe for s in mapping} | {pull for pull, _ in validation}
+    return [r for r in recipes_needed(mapping) if r in want]
+
+
+def fallbacks_needed(results: dict[str, dict], mapping=MAPPING) -> list[str]:
+    """The fallback recipes whose preferred result (in ``results``) has none of the key's quantities -- the same
+    test :func:`build_parameter_set` applies -- and that ``results`` does not hold yet."""
+    out = [s.fallback.recipe for s in mapping if s.fallback is not None and
+           not any(q in (results.get(s.recipe) or {}).get("quantities", {}) for q in s.quantities)]
+    return [r for r in dict.fromkeys(out) if r not in results]
 
 
 #: Recipes whose result depends on the water model (settings.water_model); one model throughout a calibration.

@@ -38,7 +38,8 @@ from nanoimpact.executors import Failure, executor
 from nanoimpact.fileio import atomic_save_figure, atomic_write_text
 
 from .attribution import attribute_claims
-from .mdset import build_parameter_set, committed_result, recipes_needed, write_parameter_set
+from .mdset import (build_parameter_set, committed_result, fallbacks_needed, recipes_first, recipes_needed,
+                    write_parameter_set)
 from .report import CalibrationReport, ValueRow
 
 from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
@@ -501,8 +502,9 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     timings = {}
     # 1. MD jobs
     t = time.perf_counter()
-    recipes = recipes_needed()
-    progress(f"calibrate {cal.name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}'")
+    recipes = recipes_first()
+    progress(f"calibrate {cal.name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}' (a fallback "
+             f"recipe runs only where its preferred result lacks the quantity)")
     plan = md_plan(recipes, md_fidelity, md_cache, results_dir)
     todo = [r for r, how in plan.items() if how in ("runs", "resumes")]
     progress("  MD plan: " + "; ".join(f"{how}: {', '.join(r for r, h in plan.items() if h == how)}"
@@ -513,12 +515,18 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     ex = executor(executor_name, workers, scheduler)
     results, sources = {}, {}
     try:
-        tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir)) for r in recipes]
-        for _, job in ex.map(md_job, tasks):
-            results[job["recipe"]] = job["result"]
-            sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],
-                                      "run_hash": job["result"].get("run_hash")}
-            progress(f"  MD {job['recipe']}: {job['source']} ({job['wall_s']:.1f} s)")
+        def run_md(names):
+            tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir)) for r in names]
+            for _, job in ex.map(md_job, tasks):
+                results[job["recipe"]] = job["result"]
+                sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],
+                                          "run_hash": job["result"].get("run_hash")}
+                progress(f"  MD {job['recipe']}: {job['source']} ({job['wall_s']:.1f} s)")
+        run_md(recipes)
+        extra = fallbacks_needed(results)
+        if extra:                   # a preferred result without the key's quantity (an older protocol)
+            progress(f"  MD fallbacks needed: {', '.join(extra)}")
+            run_md(extra)
         timings["md_s"] = time.perf_counter() - t
         # 2. the set
         machine = {"cores": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}

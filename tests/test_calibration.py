@@ -193,9 +193,19 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     assert not list((tmp_path / "out").glob("*.tmp*"))                   # atomic: nothing half-written left
 
 
-def test_recipes_needed_are_the_nine_mapped_ones():
+def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_needed():
+    from calibration.mdset import fallbacks_needed, recipes_first
     assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
                                 "contact_angle_silica", "contact_angle_ots", "pulloff_silica", "pulloff_ots"]
+    # every calibration runs the preferred recipes and the validation pull-offs; the droplets only as fallbacks
+    assert recipes_first() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
+                               "pulloff_silica", "pulloff_ots"]
+    ti = _ti(0.0, None, "wets", w=0.15, bound=0.0)
+    both = {"wsl_silica": ti, "wsl_ots": ti, **{k: v for k, v in _results().items() if k in recipes_first()}}
+    assert fallbacks_needed(both) == []
+    no_angle = {**both, "wsl_ots": _result("wsl_ots", {"work_of_adhesion_sl": (0.04, 0.003, "J/m^2")})}
+    assert fallbacks_needed(no_angle) == ["contact_angle_ots"]
+    assert fallbacks_needed({**no_angle, "contact_angle_ots": _results()["contact_angle_ots"]}) == []
 
 
 def _ti(theta, theta_err, status="measured", w=0.09, bound=None):
@@ -315,7 +325,7 @@ def test_sweep_validates_first_then_resumes_without_rerunning(tmp_path):
 
 #: the recipe whose smoke MD runs on a Dask worker in the pipeline test (the others come from the session's shared
 #: smoke runs or, surface_tension_spce, from its committed result)
-RUN_ON_WORKER = "contact_angle_silica"
+RUN_ON_WORKER = "wsl_silica"
 
 
 @pytest.mark.md
@@ -332,12 +342,12 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     from dataclasses import replace
 
     from calibration import CalibrationReport, calibrate
-    from calibration.mdset import recipes_needed
+    from calibration.mdset import recipes_first
     from continuum.paper import run
 
     cache = tmp_path / "md"
     cache.mkdir()
-    shared = [r for r in recipes_needed() if r not in (RUN_ON_WORKER, "surface_tension_spce")]
+    shared = [r for r in recipes_first() if r not in (RUN_ON_WORKER, "surface_tension_spce")]
     for name in shared:
         run_dir = md_smoke(name).outcome.run_dir
         shutil.copytree(run_dir, cache / run_dir.name)
@@ -361,7 +371,8 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
     assert sorted(p.name for p in (out / "paper" / "cases").iterdir()) == ["hertz", "rough_ots", "rough_silica"]
-    assert len(report.md_sources) == 9 and len(report.rows) == 8          # 9 recipes (fallbacks too), 8 keys
+    # the 7 recipes every calibration runs (the droplets are fallbacks: the smoke TIs give angles), 8 keys
+    assert len(report.md_sources) == 7 and len(report.rows) == 8
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
     assert len(report.used) + len(report.not_used) == 8

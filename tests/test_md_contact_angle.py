@@ -418,8 +418,24 @@ def test_contact_angle_protocol_change_raised_the_workflow_version():
     _, doc = run_hash(rec, "quick", ContactAngleWorkflow().forcefield_files(rec.settings("quick")))
     assert doc["workflow_version"] == ContactAngleWorkflow.version
     committed = json.loads((COMMITTED_OTS / "result.json").read_text())
-    # the committed OTS result (2026-11-26) was run with the current protocol: its hash is the current one
-    assert run_hash(rec, "quick", ContactAngleWorkflow().forcefield_files(rec.settings("quick")))[0] == committed["run_hash"]
+    # the committed OTS result (2026-11-26) ran version 3 (one thermostat over water and SAM): its hash is that
+    # version's, not the current one, so it is stale and a calibration does not take it as current
+    from md.engine import hashing
+    ff = ContactAngleWorkflow().forcefield_files(rec.settings("quick"))
+    assert hashing.run_hash(rec.canonical("quick"), "quick", ff, 3)[0] == committed["run_hash"]
+    assert run_hash(rec, "quick", ff)[0] != committed["run_hash"] and ContactAngleWorkflow.version == 4
+
+
+@pytest.mark.parametrize("name", ["contact_angle_silica", "contact_angle_ots"])
+def test_the_water_and_the_substrate_have_a_thermostat_each(name, tmp_path):
+    """Version 4: one thermostat over water and solid kept only their mean at T (the v3 OTS droplets' water ran at
+    366-375 K, the SAM's CH2 at 208-229 K); the droplet leg thermostats the water and the solid's mobile atoms
+    apart and samples both temperatures; the substrate alone keeps one."""
+    wf, plan, s = _plan(name, tmp_path)
+    sub, drop = plan.legs
+    fixes = lambda leg: [c.split()[2] for c in leg.define(0) if c.startswith("fix thermostat")]  # noqa: E731
+    assert fixes(sub) == ["mobile"] and fixes(drop) == ["water", "solidmobile"]
+    assert {"temp_water", "temp_solid"} <= set(drop.columns)
 
 
 # ------------------------------------------------------------------------------------ LAMMPS (smoke)

@@ -217,7 +217,7 @@ def test_only_the_ots_film_leg_frames_the_water_and_the_trappe_sites(tmp_path):
 
 
 class _Ctx:
-    """the part of an analysis context _temperatures reads: legs and their samples"""
+    """the part of an analysis context leg_temperatures reads: legs and their samples"""
     def __init__(self, series):
         from md.engine.plan import Stage
         self.series = series
@@ -228,19 +228,19 @@ class _Ctx:
 
 
 def test_leg_temperatures_are_reported_and_an_off_target_leg_is_flagged():
-    from md.workflows.wsl_ti import TEMPERATURE_TOLERANCE_K, _temperatures
+    from md.workflows.common import TEMPERATURE_TOLERANCE_K, leg_temperatures
     ok = {"temp_water": np.full(40, 301.0), "temp_solid": np.full(40, 299.0)}
     hot = {"temp_water": np.r_[np.full(20, 500.0), np.full(20, 420.0)], "temp_solid": np.full(40, 165.0)}
     ctx = _Ctx({"film": hot, "q0": ok})
-    r = _temperatures(ctx, ctx.legs, 300.0)
+    r = leg_temperatures(ctx, ctx.legs, 300.0, second_half=("film",))
     assert r["per_leg"]["film"]["water"] == 420.0                     # the film leg: its second half only
     assert r["off_target_legs"] == ["film"] and "OFF TARGET on film (420 / 165 K)" in r["note"]
     assert r["max_deviation_K"]["solid"] == 135.0
     ctx = _Ctx({"film": ok, "q0": {"temp_water": np.full(40, 300.0 + TEMPERATURE_TOLERANCE_K - 0.5),
                                    "temp_solid": np.full(40, 300.0)}})
-    r = _temperatures(ctx, ctx.legs, 300.0)
+    r = leg_temperatures(ctx, ctx.legs, 300.0, second_half=("film",))
     assert not r["off_target_legs"] and "within" in r["note"]
-    assert _temperatures(_Ctx({"film": {"pe": np.ones(3)}}), _Ctx({"film": {}}).legs, 300.0) == {}   # version 1
+    assert leg_temperatures(_Ctx({"film": {"pe": np.ones(3)}}), _Ctx({"film": {}}).legs, 300.0) == {}   # version 1
 
 
 def test_film_dividing_plane_of_a_uniform_slab():

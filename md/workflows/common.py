@@ -105,6 +105,50 @@ def split_thermostat_lines(groups: Sequence[str], union: str, settings: Mapping[
         [f"fix integrate {union} nve"]
 
 
+#: sampled columns of :func:`water_solid_thermostat_lines`: the water's and the solid's mobile atoms' temperatures
+WATER_SOLID_COLUMNS = {"temp_water": "v_tw", "temp_solid": "v_ts"}
+
+
+def water_solid_thermostat_lines(settings: Mapping[str, Any], step: int, salt: int = 0) -> list[str]:
+    """Groups ``water`` and ``mobile`` given: the solid's mobile atoms as group ``solidmobile``, their and the
+    water's temperatures (variables ``tw``, ``ts``: :data:`WATER_SOLID_COLUMNS`) and a thermostat each
+    (:func:`split_thermostat_lines`)."""
+    return ["group solidmobile subtract mobile water", "compute twater water temp", "compute tsolid solidmobile temp",
+            "variable tw equal c_twater", "variable ts equal c_tsolid"] + \
+        split_thermostat_lines(("water", "solidmobile"), "mobile", settings, step, salt)
+
+
+#: a leg's mean water or solid temperature further than this from the thermostat's is flagged (K): 2 % at 300 K,
+#: where the per-sample scatter of the quick film's water is ~7 K and a leg's mean carries ~0.5 K
+TEMPERATURE_TOLERANCE_K = 6.0
+
+
+def leg_temperatures(ctx, legs, target: float, second_half: tuple[str, ...] = ()) -> dict:
+    """Each leg's mean water and solid temperature (sampled columns ``temp_water``, ``temp_solid``: the sampled
+    stages, or the second half of the legs named in ``second_half``), the largest deviations from ``target`` and a
+    note that flags any beyond :data:`TEMPERATURE_TOLERANCE_K`. {} for a run planned before the two temperatures
+    were sampled (one thermostat over water and solid)."""
+    per_leg = {}
+    for leg in legs:
+        d = ctx.samples(leg.name, leg.name not in second_half)
+        if "temp_water" not in d or not len(d["temp_water"]):
+            return {}
+        skip = len(d["temp_water"]) // 2 if leg.name in second_half else 0
+        per_leg[leg.name] = {"water": float(np.mean(d["temp_water"][skip:])),
+                             "solid": float(np.mean(d["temp_solid"][skip:]))}
+    dev = {k: max((abs(v[k] - target) for v in per_leg.values()), default=0.0) for k in ("water", "solid")}
+    bad = [f"{name} ({v['water']:.0f} / {v['solid']:.0f} K)" for name, v in per_leg.items()
+           if max(abs(v["water"] - target), abs(v["solid"] - target)) > TEMPERATURE_TOLERANCE_K]
+    lo = {k: min(v[k] for v in per_leg.values()) for k in ("water", "solid")}
+    hi = {k: max(v[k] for v in per_leg.values()) for k in ("water", "solid")}
+    note = (f"temperatures (a thermostat each on the water and on the solid's mobile atoms): the legs' mean water "
+            f"temperature {lo['water']:.1f}-{hi['water']:.1f} K, solid {lo['solid']:.1f}-{hi['solid']:.1f} K "
+            f"(target {target:g} K): " + ("within " + f"{TEMPERATURE_TOLERANCE_K:g} K on every leg." if not bad else
+                                         "OFF TARGET on " + ", ".join(bad) + "."))
+    return {"per_leg": per_leg, "max_deviation_K": dev, "off_target_legs": [b.split(" ")[0] for b in bad],
+            "tolerance_K": TEMPERATURE_TOLERANCE_K, "note": note}
+
+
 def common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
     return ["fix zwalls all wall/reflect zlo EDGE zhi EDGE",
             f"compute tmob {mobile} temp",

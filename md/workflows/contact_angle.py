@@ -26,7 +26,8 @@ from md.system.topology import System, remove_atoms
 
 from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
                                  fresh_from_data, held_deep, intersect_ids, minimize_lines, minimize_water_lines, quantity_record,
-                                 restart_header_lines, derived_seed, shake_lines, silica_face_of, stage_list, steps_of, substrate_water_seeds, system_summary, surface_slab,
+                                 restart_header_lines, derived_seed, shake_lines, leg_temperatures, water_solid_thermostat_lines,
+                                 WATER_SOLID_COLUMNS, silica_face_of, stage_list, steps_of, substrate_water_seeds, system_summary, surface_slab,
                                  thermostat_lines, water_forcefield_names)
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
@@ -48,14 +49,19 @@ class ContactAngleWorkflow(Workflow):
     overlapping the substrate deleted), minimised, equilibrated and sampled. The angle is read at the water's own
     dividing plane (half the bulk density under the droplet).
 
-    Version 3 (this protocol): the substrate's FIRE minimisation runs at 1 fs; version 2 ran it at the MD
+    Version 4 (this protocol): the water and the substrate's mobile atoms have a thermostat each
+    (:func:`md.workflows.common.water_solid_thermostat_lines`), both temperatures sampled and reported. Version 3
+    thermostatted them together, and at the end of the quick OTS droplets the water ran at 375 K (R0 = 2 nm) and
+    366 K (3 nm) with the SAM's CH2 at 229 and 208 K (measured from their last restarts, 2026-11-26); the silica
+    droplet's water read 305 K.
+    Version 3: the substrate's FIRE minimisation runs at 1 fs; version 2 ran it at the MD
     timestep, 2 fs on silica, where FIRE's steps (up to 20 fs) made the unconstrained silanol O-H diverge (the
     quick silica run lost an H at FIRE step 46: "Bond atoms missing"). Version 1 froze the whole silica (silanol H
     included) before minimising it, used the (001) face's silanol pairs, started a full cylinder on an
     unequilibrated SAM and read the angle at the plane of the solid's atoms (OTS: 140 deg there against 129 deg at
     the water's plane, same map)."""
     name = "contact_angle"
-    version = 3
+    version = 4
     yields = {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"}
 
     def forcefield_files(self, s):
@@ -115,8 +121,8 @@ class ContactAngleWorkflow(Workflow):
             def d(step: int) -> list[str]:
                 return common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake + \
                     ["fix hold frozen setforce 0.0 0.0 0.0"] + \
-                    (["variable nw equal count(water)/3"] if with_water else []) + \
-                    thermostat_lines("mobile", s, step, salt)
+                    (["variable nw equal count(water)/3"] + water_solid_thermostat_lines(s, step, salt)
+                     if with_water else thermostat_lines("mobile", s, step, salt))
             return d
 
         t = s["temperature_K"]
@@ -141,7 +147,7 @@ class ContactAngleWorkflow(Workflow):
         drop_leg = Leg(name="droplet", fresh=fresh_droplet, define=define(1, True),
                        prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
                        stages=stage_list(equilibrate_stage(s, "mobile", 1), Stage("sample", steps_of(s, "sample_steps"))),
-                       columns={"pe": "v_pe", "temp": "v_temp", "n_water": "v_nw"},
+                       columns={"pe": "v_pe", "temp": "v_temp", "n_water": "v_nw"} | WATER_SOLID_COLUMNS,
                        sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"], n_atoms=n,
                        frames=Frames("framed", s["frame_interval"] or s["sample_interval"]))
         ids = lammps_type_ids(ff)
@@ -282,6 +288,9 @@ class ContactAngleWorkflow(Workflow):
                   "a cylindrical droplet has a straight contact line: no line-tension correction.",
                   f"W_SL and gamma_lv cos theta use gamma_lv = {gamma * 1e3:.1f} mN/m of the same water model "
                   f"({s['water_model']}); combine the angle only with a gamma_lv of that model."]
+        temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "droplet"], s["temperature_K"])
+        if temps:
+            notes.append(temps["note"])
         ue, ze = r.edges
         rho = r.density_map
         curves = {"density_map": (["u_m", "z_m", "density_kg_m3"],
@@ -327,6 +336,8 @@ class ContactAngleWorkflow(Workflow):
             details["shape_check"] = shape
         if status in ("measured", "wets") and "dispersion_tail_work_sl" in q:
             details["dispersion_tail"] = tail["details"]
+        if temps:
+            details["temperatures_K"] = temps
         return Analysis(quantities=q, curves=curves, figures={"density_map": figure_writer(draw)}, notes=notes,
                         details=details)
 

@@ -28,7 +28,7 @@ from md.system.lammps_data import write_data
 from md.system.topology import remove_atoms
 from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, derived_seed, figure_writer,
                                  forcefield_of, fresh_from_data, held_deep, minimize_lines, minimize_water_lines,
-                                 quantity_record, split_thermostat_lines, restart_header_lines, shake_lines, silica_face_of, stage_list,
+                                 leg_temperatures, quantity_record, water_solid_thermostat_lines, WATER_SOLID_COLUMNS, restart_header_lines, shake_lines, silica_face_of, stage_list,
                                  steps_of, substrate_water_seeds, surface_slab, system_summary, thermostat_lines,
                                  water_forcefield_names)
 
@@ -165,10 +165,7 @@ class WslTI(Workflow):
             return (common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake +
                     ["fix hold frozen setforce 0.0 0.0 0.0"] +
                     ([f"fix tether water spring tether {TETHER_K:g} NULL NULL {z_film:.4f} 0.0",
-                      "variable zw equal xcm(water,z)", "group solidmobile subtract mobile water",
-                      "compute twater water temp", "compute tsolid solidmobile temp",
-                      "variable tw equal c_twater", "variable ts equal c_tsolid"] +
-                     split_thermostat_lines(("water", "solidmobile"), "mobile", s, step, salt)
+                      "variable zw equal xcm(water,z)"] + water_solid_thermostat_lines(s, step, salt)
                      if with_water else thermostat_lines("mobile", s, step, salt)))
 
         def coupling(lam_q: float, lam_lj: float, stage: str, with_water: bool) -> list[str]:
@@ -236,8 +233,8 @@ class WslTI(Workflow):
             film_frames = None
         film_leg = Leg(name="film", fresh=fresh_film, define=lambda step: base(True, step, 1),
                        prepare=lambda d: minimize_water_lines(s), stages=film_stages,
-                       columns={"pe": "v_pe", "temp": "v_temp", "z_film": "v_zw", "temp_water": "v_tw",
-                                "temp_solid": "v_ts"}, n_atoms=system.n_atoms, frames=film_frames, **common)
+                       columns={"pe": "v_pe", "temp": "v_temp", "z_film": "v_zw"} | WATER_SOLID_COLUMNS,
+                       n_atoms=system.n_atoms, frames=film_frames, **common)
         legs = [sub_leg, film_leg]
 
         def window(name: str, prev: Leg, prev_dir: Path, lam_q: float, lam_lj: float, stage: str,
@@ -245,7 +242,7 @@ class WslTI(Workflow):
             def fresh(leg_dir: Path, _total=prev.total_steps) -> list[str]:
                 return head(prev_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
             cols = {"dudl": "v_dudl", "pe": "v_pe", "temp": "v_temp"} | (
-                {"z_film": "v_zw", "temp_water": "v_tw", "temp_solid": "v_ts"} if with_water else {})
+                {"z_film": "v_zw"} | WATER_SOLID_COLUMNS if with_water else {})
             return Leg(name=name, fresh=fresh,
                        define=lambda step: base(with_water, step, salt) + coupling(lam_q, lam_lj, stage, with_water),
                        prepare=lambda d: ["reset_timestep 0"],
@@ -308,8 +305,8 @@ class WslTI(Workflow):
             stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
             for h in (0, 1):
                 halves[h][key] = A.ti_integral(lam, half_means[h], [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
-        temps = _temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "film" or
-                                    leg.name.startswith(("q", "lj"))], s["temperature_K"])
+        temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "film" or
+                                       leg.name.startswith(("q", "lj"))], s["temperature_K"], second_half=("film",))
         w = A.ti_work_of_adhesion_sl(stages["charge_film"], stages["lj_film"], stages["charge_reference"],
                                      info["area_A2"])
         # the tether's energy at full coupling (the film leg's second half), added back
@@ -462,33 +459,3 @@ def _dispersion_tail(ctx, info, s) -> dict | None:
             "plane_z_A": plane["z_A"], "number_density_A3": plane["number_density_A3"],
             "film_thickness_A": plane["film_thickness_A"], "sites": int(is_site.sum()), "frames": int(len(steps)),
             "cutoff_A": s["cutoff_A"]}
-
-
-#: a leg's mean water or solid temperature further than this from the thermostat's is flagged (K): 2 % at 300 K,
-#: where the per-sample scatter of the quick film's water is ~7 K and a leg's mean carries ~0.5 K
-TEMPERATURE_TOLERANCE_K = 6.0
-
-
-def _temperatures(ctx, legs, target: float) -> dict:
-    """Each leg's mean water and solid temperature (the sampled part of the TI nodes, the film leg's second half), the
-    largest deviations from ``target`` and a note that flags any beyond :data:`TEMPERATURE_TOLERANCE_K`. {} for a run
-    planned before the temperatures were sampled (version 1)."""
-    per_leg = {}
-    for leg in legs:
-        d = ctx.samples(leg.name, leg.name != "film")
-        if "temp_water" not in d or not len(d["temp_water"]):
-            return {}
-        skip = len(d["temp_water"]) // 2 if leg.name == "film" else 0       # the film leg: its second half
-        per_leg[leg.name] = {"water": float(np.mean(d["temp_water"][skip:])),
-                             "solid": float(np.mean(d["temp_solid"][skip:]))}
-    dev = {k: max((abs(v[k] - target) for v in per_leg.values()), default=0.0) for k in ("water", "solid")}
-    bad = [f"{name} ({v['water']:.0f} / {v['solid']:.0f} K)" for name, v in per_leg.items()
-           if max(abs(v["water"] - target), abs(v["solid"] - target)) > TEMPERATURE_TOLERANCE_K]
-    lo = {k: min(v[k] for v in per_leg.values()) for k in ("water", "solid")}
-    hi = {k: max(v[k] for v in per_leg.values()) for k in ("water", "solid")}
-    note = (f"temperatures (a thermostat each on the water and on the solid's mobile atoms): the legs' mean water "
-            f"temperature {lo['water']:.1f}-{hi['water']:.1f} K, solid {lo['solid']:.1f}-{hi['solid']:.1f} K "
-            f"(target {target:g} K): " + ("within " + f"{TEMPERATURE_TOLERANCE_K:g} K on every leg." if not bad else
-                                         "OFF TARGET on " + ", ".join(bad) + "."))
-    return {"per_leg": per_leg, "max_deviation_K": dev, "off_target_legs": [b.split(" ")[0] for b in bad],
-            "tolerance_K": TEMPERATURE_TOLERANCE_K, "note": note}
