@@ -368,6 +368,8 @@ def test_the_ots_result_adds_the_dispersion_tail_into_w_sl(md_smoke):
     assert tail > 0 and d["dispersion_tail"]["frames"] >= 1 and d["dispersion_tail"]["sites"] > 0
     parts = d["parts_J_m2"]
     total = parts["electrostatic"] + parts["dispersion"] + parts["tether_correction"]["value"] + tail
+    # the same four floats summed in another grouping: a few roundings of terms within 10x of the sum, so 1e-12
+    # relative holds on any IEEE-754 CPU (a missing or doubled part would miss by > 1e-2)
     assert q["work_of_adhesion_sl"]["value"] == pytest.approx(total, rel=1e-12, abs=1e-15)
     assert any("beyond the 12 A cutoff" in n for n in r["notes"])
     assert "dispersion_tail_work_sl" not in md_smoke("wsl_silica").outcome.result["quantities"]

@@ -105,6 +105,26 @@ def split_thermostat_lines(groups: Sequence[str], union: str, settings: Mapping[
         [f"fix integrate {union} nve"]
 
 
+def trappe_tail_sites(system: System, ff: ForceField, water_o) -> tuple[np.ndarray, list[float]]:
+    """The SAM's TraPPE united atoms (0-based indices; none on bare silica) and their C6 = 4 eps sigma^6 with the
+    water O (kcal/mol A^6): what the water-TraPPE dispersion beyond the cutoff sums (``dispersion_tail_work``)."""
+    sites = np.array([], int)
+    if "sam" in system.groups:
+        sam = np.asarray(system.group("sam"), int)
+        sites = sam[np.isin(np.asarray(system.types)[sam], TRAPPE_UA)]
+    ow = str(np.asarray(system.types)[np.asarray(water_o, int)[0]])
+    return sites, [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(x)) for x in np.asarray(system.types)[sites])]
+
+
+def framed_tail_sites(info: Mapping[str, Any], ids) -> tuple[np.ndarray, np.ndarray]:
+    """(mask of the frames' atom ``ids`` that are tail sites, their C6 in the frames' order) from a plan's
+    ``tail_site_ids`` (1-based) and ``tail_site_c6_kcal_A6``."""
+    site_ids = [int(i) for i in info.get("tail_site_ids") or []]
+    order = {i: k for k, i in enumerate(site_ids)}
+    is_site = np.isin(ids, site_ids)
+    return is_site, np.asarray(info.get("tail_site_c6_kcal_A6") or [], float)[[order[int(i)] for i in ids[is_site]]]
+
+
 #: sampled columns of :func:`water_solid_thermostat_lines`: the water's and the solid's mobile atoms' temperatures
 WATER_SOLID_COLUMNS = {"temp_water": "v_tw", "temp_solid": "v_ts"}
 

@@ -24,10 +24,10 @@ from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.topology import System, remove_atoms
 
-from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
                                  fresh_from_data, held_deep, intersect_ids, minimize_lines, minimize_water_lines, quantity_record,
                                  restart_header_lines, derived_seed, shake_lines, leg_temperatures, water_solid_thermostat_lines,
-                                 WATER_SOLID_COLUMNS, silica_face_of, stage_list, steps_of, substrate_water_seeds, system_summary, surface_slab,
+                                 WATER_SOLID_COLUMNS, framed_tail_sites, trappe_tail_sites, silica_face_of, stage_list, steps_of, substrate_water_seeds, system_summary, surface_slab,
                                  thermostat_lines, water_forcefield_names)
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
@@ -99,12 +99,7 @@ class ContactAngleWorkflow(Workflow):
         water_o = np.intersect1d(system.group("water_O"), water)
         # the SAM's TraPPE sites go into the frames too: the water-TraPPE dispersion beyond the cutoff is added
         # in the analysis (issue 11, item 4); their C6 with the water O (4 eps sigma^6, kcal/mol A^6)
-        tail_sites = np.array([], int)
-        if s["surface"] == "ots":
-            sam = np.asarray(system.group("sam"), int)
-            tail_sites = sam[np.isin(np.asarray(system.types)[sam], TRAPPE_UA)]
-        ow = str(np.asarray(system.types)[water_o[0]])
-        c6 = [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(t)) for t in np.asarray(system.types)[tail_sites])]
+        tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
         framed = np.union1d(np.union1d(water_o, ref), tail_sites)
         n_sub, n = len(substrate), system.n_atoms
         dt = s["timestep_fs"]
@@ -352,11 +347,9 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
     site_ids = info.get("tail_site_ids") or []
     if not site_ids:
         return None
-    is_site = np.isin(ids, site_ids)
+    is_site, c6 = framed_tail_sites(info, ids)
     if not is_site.any():
         return None
-    order = {int(i): k for k, i in enumerate(site_ids)}
-    c6 = np.asarray(info["tail_site_c6_kcal_A6"], float)[[order[int(i)] for i in ids[is_site]]]
     n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(A.WATER_MOLAR_MASS)
     z_ref = float(r.reference_z)
     per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, z_ref, n_w, s["cutoff_A"],

@@ -26,7 +26,7 @@ from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
 from md.system.lammps_data import write_data
 from md.system.topology import remove_atoms
-from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, Workflow, common_define, derived_seed, figure_writer,
+from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, framed_tail_sites, trappe_tail_sites, Workflow, common_define, derived_seed, figure_writer,
                                  forcefield_of, fresh_from_data, held_deep, minimize_lines, minimize_water_lines,
                                  leg_temperatures, quantity_record, water_solid_thermostat_lines, WATER_SOLID_COLUMNS, restart_header_lines, shake_lines, silica_face_of, stage_list,
                                  steps_of, substrate_water_seeds, surface_slab, system_summary, thermostat_lines,
@@ -144,14 +144,10 @@ class WslTI(Workflow):
         water_t = sorted(ids[a.name] for a in forcefield_of(water_forcefield_names(s["water_model"])).atom_types)
         charge = {ids[t]: ff.atom_type(t).charge for t in charged_types}
         # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
-        # dispersion beyond the cutoff (analysis: md.analysis.film_dividing_plane + dispersion_tail_work)
-        tail_sites = np.array([], int)
-        if s["surface"] == "ots":
-            sam = np.asarray(system.group("sam"), int)
-            tail_sites = sam[np.isin(np.asarray(system.types)[sam], TRAPPE_UA)]
+        # dispersion beyond the cutoff (analysis: md.analysis.film_lower_dividing_plane + dispersion_tail_work)
         water_o = np.intersect1d(system.group("water_O"), water)
+        tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
         ow = str(np.asarray(system.types)[water_o[0]])
-        c6 = [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(x)) for x in np.asarray(system.types)[tail_sites])]
         z_film = float(system.positions[water, 2].mean())
         area = float(system.cell[0] * system.cell[1])
         dt, t = s["timestep_fs"], s["temperature_K"]
@@ -222,7 +218,7 @@ class WslTI(Workflow):
         begin = (f"velocity mobile create {t:g} {derived_seed(seed, 3, 1)} mom yes rot no dist gaussian",)
         if len(tail_sites):
             # the equilibration's second half is framed (a sampled stage; its samples are the same series as
-            # before). Silica keeps its single unsampled stage: its plan, and its committed result, are unchanged.
+            # before); silica, with no tail to add, keeps a single unsampled stage
             n_eq = steps_of(s, "equilibrate_steps")
             half = (n_eq // 2) // s["chunk_steps"] * s["chunk_steps"] or n_eq // 2
             film_stages = stage_list(Stage("equilibrate", n_eq - half, begin, sampled=False),
@@ -444,10 +440,7 @@ def _dispersion_tail(ctx, info, s) -> dict | None:
     steps, ids, pos, box = ctx.frames("film")
     if not len(steps):
         return None
-    site_ids = [int(i) for i in info["tail_site_ids"]]
-    order = {i: k for k, i in enumerate(site_ids)}
-    is_site = np.isin(ids, site_ids)
-    c6 = np.asarray(info["tail_site_c6_kcal_A6"], float)[[order[int(i)] for i in ids[is_site]]]
+    is_site, c6 = framed_tail_sites(info, ids)
     area = float(info["area_A2"])
     plane = A.film_lower_dividing_plane(pos[:, ~is_site, 2], area, len(steps))
     per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, plane["z_A"], plane["number_density_A3"],
