@@ -147,6 +147,66 @@ def test_ots_asperity_is_grafted_at_sam_density():
     assert dist.min() >= g["min_spacing_A"] - 1e-6
 
 
+def test_offset_heads_keep_their_anchor_bond_and_refuse_to_lean_too_far():
+    from md.build.sam import MAX_ANCHOR_TILT_DEG, chain_geometry, head_offset_disk, head_shifts
+    tpos, _ = chain_geometry(18, 0.0, 0.0)
+    centre, radius = head_offset_disk(18, 0.0, 0.0)
+    ang = np.linspace(0.0, 2 * np.pi, 13)
+    d = centre + 0.999 * radius * np.column_stack([np.cos(ang), np.sin(ang)])
+    si = tpos[0] + head_shifts(d, 18, 0.0, 0.0)             # the head Si after the shift
+    assert np.allclose(np.linalg.norm(si, axis=1), np.linalg.norm(tpos[0]), rtol=1e-12)
+    assert np.degrees(np.arccos(si[:, 2] / np.linalg.norm(si, axis=1))).max() <= MAX_ANCHOR_TILT_DEG + 1e-6
+    assert np.allclose(head_shifts(np.zeros((1, 2)), 18, 0.0, 0.0), 0.0, atol=1e-12)
+    with pytest.raises(ValueError, match="tilts the anchor bond beyond 60 deg"):
+        head_shifts(centre + [[1.01 * radius, 0.0]], 18, 0.0, 0.0)
+
+
+def test_spread_chains_parts_a_close_pair_within_the_disk_or_says_it_cannot():
+    from md.workflows.pulloff import _spread_chains
+    cell = (40.0, 40.0)
+    pair = np.array([[10.0, 10.0], [12.9, 10.0]])
+    d = _spread_chains(pair, cell, 4.4, np.zeros(2), 1.0)
+    p = pair + d
+    assert np.hypot(*(p[0] - p[1])) >= 4.4 and np.hypot(d[:, 0], d[:, 1]).max() <= 1.0 + 1e-12
+    # three sites 1 A apart cannot stand 4.4 A apart with offsets of at most 1 A
+    assert _spread_chains(np.array([[10.0, 10.0], [11.0, 10.0], [10.5, 10.9]]), cell, 4.4, np.zeros(2), 1.0) is None
+
+
+def test_production_ots_asperity_reaches_sam_density_with_leaning_chains():
+    """The production dome (R = 3 nm) has its silanols in pairs 2.5-3.9 A apart in projection: chains standing on
+    their sites stopped at 92 = 3.5 per nm^2 of cap (and that tip's minimisation lost atoms: 1.5 A head contacts).
+    Leaning heads (anchor bond up to 60 deg off the vertical) reach >= 4 per nm^2 with the chains 4.4 A apart and
+    no head atom within 1.7 A of a heavy atom but its anchor O."""
+    from scipy.spatial import cKDTree
+    from md.build import silica_asperity
+    from md.build.sam import MAX_ANCHOR_TILT_DEG
+    from md.workflows.pulloff import HEAD_CLEARANCE_A, _graft_dome
+    s = _settings("pulloff_ots", "production")
+    asp = silica_asperity.system(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
+                                 margin=s["asperity_margin_A"], silanol_density=4.5, face="111", seed=int(s["seed"]))
+    sam, g = _graft_dome(asp, s, int(s["seed"]) + 30)
+    assert g["chains_per_projected_nm2"] >= 4.0 and g["chain_offset_max_A"] > 0.0
+    si = np.asarray(sam.group("sam_head_si"), int)
+    anchor = np.asarray(sam.group("sam_anchor_O"), int)
+    bond = sam.positions[si] - sam.positions[anchor]
+    r = np.linalg.norm(bond, axis=1)
+    assert np.allclose(r, 1.68, atol=1e-9)                           # IFF Si-O r0, kept while leaning
+    assert np.degrees(np.arccos(bond[:, 2] / r)).max() <= MAX_ANCHOR_TILT_DEG + 1e-6
+    ch3 = sam.positions[np.asarray(sam.group("sam_ch3"), int), :2]   # the chains stand 4.4 A apart
+    v = ch3[:, None, :] - ch3[None, :, :]
+    v -= sam.cell[:2] * np.round(v / sam.cell[:2])
+    assert (np.hypot(v[..., 0], v[..., 1]) + 99 * np.eye(len(ch3))).min() >= g["min_spacing_A"] - 1e-6
+    per = len(sam.group("sam")) // len(si)
+    head = (si[:, None] + np.arange(7)[None, :]).ravel()              # head Si, 2 x (O, H), first two CH2
+    head = head[sam.types[head] != "HOY"]
+    heavy = np.flatnonzero(sam.types != "HOY")
+    tree = cKDTree(sam.positions[heavy])
+    own = {int(a): set(range(int(h), int(h) + per)) | {int(a)} for a, h in zip(anchor, si)}
+    owner = {int(h) + k: int(a) for a, h in zip(anchor, si) for k in range(per)}
+    for i, hits in zip(head, tree.query_ball_point(sam.positions[head], HEAD_CLEARANCE_A - 1e-6)):
+        assert all(int(heavy[k]) in own[owner[int(i)]] for k in hits)
+
+
 def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
     from calibration.mdset import build_parameter_set, recipes_needed
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -17,6 +18,51 @@ from md.build.silica import silica_slab
 from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, sam_forcefield
 
 # ================================================================================================ OTS monolayer
+
+#: the largest angle between the anchor O -> head Si bond and the vertical that a laterally offset head may take
+#: (``ots_sam(head_offsets=...)``); IFF's Si-O-Si theta0 is 149 deg, so a head up to 60 deg off a vertical surface
+#: Si-O bond starts within 30 deg of it and the minimiser takes it the rest of the way
+MAX_ANCHOR_TILT_DEG = 60.0
+
+
+def chain_geometry(chain_length: int = 18, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
+                   forcefield: ForceField | None = None) -> tuple[np.ndarray, list[str]]:
+    """Positions (A, relative to the anchor O) and types of one chain as :func:`ots_sam` places it: head Si, two
+    head OH, then the carbons."""
+    tpos, types, _ = _chain_template(forcefield or sam_forcefield(), chain_length, tilt_deg, tilt_azimuth_deg)
+    return tpos, types
+
+
+def head_offset_disk(chain_length: int = 18, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
+                     forcefield: ForceField | None = None) -> tuple[np.ndarray, float]:
+    """The lateral offsets (A) a chain may take from its place above the anchor O in :func:`ots_sam` (its
+    ``head_offsets``): the disk of centre ``-s_xy`` and radius ``r sin(MAX_ANCHOR_TILT_DEG)``, where ``s`` is the
+    template's anchor O -> head Si bond (length r) -- the head Si stays on its bond sphere, at most
+    :data:`MAX_ANCHOR_TILT_DEG` off the vertical."""
+    tpos, _ = chain_geometry(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)
+    r = float(np.linalg.norm(tpos[0]))
+    return -tpos[0, :2].copy(), r * math.sin(math.radians(MAX_ANCHOR_TILT_DEG))
+
+
+def head_shifts(offsets: np.ndarray, chain_length: int = 18, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
+                forcefield: ForceField | None = None) -> np.ndarray:
+    """Rigid shifts (n x 3, A) of chains moved laterally by ``offsets`` (n x 2, A): the head Si turns on its bond
+    sphere about the anchor O, so the shift's z keeps the O -> Si bond length. ValueError for an offset outside
+    :func:`head_offset_disk`."""
+    offsets = np.asarray(offsets, float).reshape(-1, 2)
+    tpos, _ = chain_geometry(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)
+    centre, radius = head_offset_disk(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)
+    far = np.hypot(*(offsets - centre).T) > radius + 1e-9
+    if far.any():
+        d = offsets[np.flatnonzero(far)[0]]
+        raise ValueError(f"head offset ({d[0]:.3f}, {d[1]:.3f}) A tilts the anchor bond beyond "
+                         f"{MAX_ANCHOR_TILT_DEG:g} deg: allowed within {radius:.3f} A of ({centre[0]:.3f}, "
+                         f"{centre[1]:.3f})")
+    s0 = tpos[0]
+    lateral = s0[:2] + offsets
+    dz = np.sqrt(float(s0 @ s0) - (lateral ** 2).sum(axis=1)) - s0[2]
+    return np.column_stack([offsets, dz])
+
 
 def _xy_spacing_ok(p: np.ndarray, accepted: list[np.ndarray], cell: np.ndarray, dmin: float) -> bool:
     if not accepted:
@@ -71,7 +117,8 @@ def _chain_template(ff: ForceField, chain_length: int, tilt_deg: float, azimuth_
 @atoms_builder
 def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg: float = 15.0,
             tilt_azimuth_deg: float = 0.0, chain_length: int = 18, seed: int = 0, min_spacing: float = 4.4,
-            site_group: str = "silanol_O_top", vacuum: float = 10.0, forcefield: ForceField | None = None) -> System:
+            site_group: str = "silanol_O_top", vacuum: float = 10.0, forcefield: ForceField | None = None,
+            head_offsets: Mapping[int, Sequence[float]] | None = None) -> System:
     """Graft an OTS monolayer (C``chain_length`` united-atom chains on Si(OH)2 heads) onto a flat silica slab.
 
     Grafting sites are drawn (seeded, random order) from the substrate's top silanol O (group ``site_group``)
@@ -85,6 +132,11 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
     0.825 + 2 (-0.675 + 0.4) = +0.275, net 0 (inputs/forcefields/README.md). No lateral Si-O-Si cross-links
     between heads (simplification).
     Chains start all-trans with their axis tilted ``tilt_deg`` towards ``tilt_azimuth_deg``.
+
+    ``head_offsets`` (substrate atom index of a site -> lateral offset in A) moves a chain sideways from its place
+    above the anchor O: the head Si turns on its bond sphere about the O (the bond keeps its length) and the chain
+    follows rigidly; the spacing rule applies to the offset chains. Offsets must lie in :func:`head_offset_disk`
+    (ValueError otherwise). Used where a curved surface's silanols sit closer than chains pack (the pull-off dome).
 
     Groups added: 'sam' (all chain atoms incl. head OH), 'sam_head_si', 'sam_ch3', 'sam_anchor_O'.
     ``info``: chains, coverage (nm^-2), thickness (mean CH3 height above the mean anchor-O plane, A), sites.
@@ -103,7 +155,10 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
         raise ValueError(f"substrate group {site_group!r} is empty: nothing to graft on")
     area = float(substrate.cell[0] * substrate.cell[1])
     target = int(round(coverage * area / 100.0))
-    pos = substrate.positions
+    pos = substrate.positions.copy()
+    offsets = {int(i): np.asarray(v, float) for i, v in (head_offsets or {}).items()}
+    for i, v in offsets.items():
+        pos[i, :2] += v                      # the spacing rule applies to where the chains stand
     accepted: list[int] = []
     acc_pos: list[np.ndarray] = []
     for k in rng.permutation(len(sites)).tolist():
@@ -143,13 +198,17 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
     anchors = np.asarray(base.group("sam_anchor_O"), int)
     # chains
     tpos, ttypes, tbonds = _chain_template(ff, chain_length, tilt_deg, tilt_azimuth_deg)
+    shifts = np.zeros((len(accepted), 3))
+    if offsets:                              # anchors keep the order of ``accepted`` through remove_atoms
+        shifts = head_shifts(np.array([offsets.get(i, np.zeros(2)) for i in accepted]), chain_length, tilt_deg,
+                             tilt_azimuth_deg, ff)
     n0 = base.n_atoms
     per = len(ttypes)
     mol0 = int(base.mol_ids.max())
     all_pos, all_types, all_mol, bonds = [], [], [], []
     for c, o in enumerate(anchors.tolist()):
         off = n0 + c * per
-        all_pos.append(base.positions[o] + tpos)
+        all_pos.append(base.positions[o] + tpos + shifts[c])
         all_types += ttypes
         all_mol += [mol0 + 1 + c] * per
         bonds += [(off + i, off + j) for i, j in tbonds]
@@ -185,4 +244,6 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
         "source": SOURCES["ots"], "substrate": sub_info,
         "omitted_zero_dihedrals": merged.info.get("omitted_zero_dihedrals", 0),
     }
+    if offsets:
+        info["head_offset_max_A"] = float(np.hypot(shifts[:, 0], shifts[:, 1]).max())
     return replace(merged, info=_plain(info))

@@ -388,6 +388,12 @@ def _z0_mean(rs: list[Mapping[str, Any]]) -> dict[str, Any]:
 GRAFT_SPACINGS_A = (4.4, 4.35, 4.3)
 #: the dome's chains stand along the pulling axis (the flat SAM's builder default is 15 deg off it)
 DOME_CHAIN_TILT_DEG = 0.0
+#: when a chain is added to the offset dome (:func:`_offset_sites`), the chains within this lateral distance of it
+#: may move to make room (two spacings: farther chains would only pass on a push they have room to absorb)
+LOCAL_SPREAD_A = 9.0
+#: least distance (A) of an offset chain's head atoms from any heavy atom but its anchor O (the flat SAM's builder
+#: starts with none closer than 2.6 A)
+HEAD_CLEARANCE_A = 1.7
 
 
 def _independent_sites(xy: np.ndarray, cell_xy, spacing: float, order: np.ndarray, exact_max: int = 60,
@@ -433,12 +439,13 @@ def _independent_sites(xy: np.ndarray, cell_xy, spacing: float, order: np.ndarra
     return sorted(best_set, key=lambda i: rank[i])
 
 
-def _chain_clearance(asp: System, sites: np.ndarray, chain_length: int, tilt_deg: float = 0.0,
-                     clearance_A: float = 2.6) -> np.ndarray:
-    """True for the sites whose chain -- straight, ``tilt_deg`` from +z towards +x, as :func:`md.build.ots_sam`
-    grafts it -- keeps ``clearance_A`` from every heavy atom of the asperity from 4 A above the anchor O to the
-    chain's end. Near the rim of a stepped dome a chain along the pulling axis can run into the dome above its site
-    (an 80 deg cap at smoke without this check: an overlap the minimiser cannot undo)."""
+def _clearance_check(asp: System, chain_length: int, tilt_deg: float = 0.0, clearance_A: float = 2.6):
+    """A function ``(sites, offsets=None) -> bool array``: True for the sites whose chain -- straight, ``tilt_deg``
+    from +z towards +x, as :func:`md.build.ots_sam` grafts it, moved laterally by ``offsets`` (n x 2, A; see
+    ``ots_sam(head_offsets=...)``) -- keeps ``clearance_A`` from every heavy atom of the asperity from 4 A above
+    the anchor O to the chain's end. Near the rim of a stepped dome a chain along the pulling axis can run into the
+    dome above its site (an 80 deg cap at smoke without this check: an overlap the minimiser cannot undo). The
+    asperity's neighbour tree is built once per call of this factory."""
     from scipy.spatial import cKDTree
 
     t = math.radians(tilt_deg)
@@ -446,20 +453,123 @@ def _chain_clearance(asp: System, sites: np.ndarray, chain_length: int, tilt_deg
     heavy = np.flatnonzero(~np.isin(asp.types, ["HOY"]))
     tree = cKDTree(asp.positions[heavy])
     length = 1.54 * math.cos(math.radians(33.0)) * (chain_length + 1)     # all-trans axial length, A
-    ts = np.arange(4.0, length + 0.5, 0.7)
-    ok = np.ones(len(sites), bool)
-    for k, site in enumerate(sites):
-        pts = asp.positions[site] + ts[:, None] * axis[None, :]
-        hits = tree.query_ball_point(pts, clearance_A)
-        ok[k] = not any(heavy[h] != site for hs in hits for h in hs)
-    return ok
+    line = np.arange(4.0, length + 0.5, 0.7)[:, None] * axis[None, :]
 
+    def check(sites: np.ndarray, offsets: np.ndarray | None = None) -> np.ndarray:
+        ok = np.ones(len(sites), bool)
+        for k, site in enumerate(np.asarray(sites, int)):
+            base = asp.positions[site].copy()
+            if offsets is not None:
+                base[:2] += offsets[k]
+            hits = tree.query_ball_point(base + line, clearance_A)
+            ok[k] = not any(heavy[h] != site for hs in hits for h in hs)
+        return ok
+    return check
+
+
+def _chain_clearance(asp: System, sites: np.ndarray, chain_length: int, tilt_deg: float = 0.0,
+                     clearance_A: float = 2.6) -> np.ndarray:
+    """:func:`_clearance_check` for the chains standing on their sites."""
+    return _clearance_check(asp, chain_length, tilt_deg, clearance_A)(sites)
+
+
+def _spread_chains(xy: np.ndarray, cell_xy, spacing: float, centre: np.ndarray, radius: float,
+                   start: np.ndarray | None = None, free: np.ndarray | None = None,
+                   iterations: int = 200) -> np.ndarray | None:
+    """Lateral offsets (n x 2, A) inside the disk (``centre``, ``radius``) that put the chains standing on the
+    sites ``xy`` at least ``spacing`` apart laterally (periodic), or None if ``iterations`` rounds of pairwise
+    pushes (each chain pushed half the overlap away from every chain too close, then projected back onto the disk)
+    do not get there. Starts from the offsets ``start`` (zero if None); only the chains flagged in ``free`` (all
+    if None) move. Deterministic: no random numbers."""
+    cell = np.asarray(cell_xy, float)[None, None, :]
+    d = np.zeros(xy.shape, float) if start is None else np.array(start, float)
+    idx = np.arange(len(xy)) if free is None else np.flatnonzero(free)
+    target = spacing + 0.02                       # a little beyond, so that the last push does not stop short
+
+    def gaps(p, rows):
+        v = p[rows, None, :] - p[None, :, :]
+        v -= cell * np.round(v / cell)
+        r = np.hypot(v[..., 0], v[..., 1])
+        r[np.arange(len(rows)), rows] = np.inf
+        return v, r
+
+    for _ in range(iterations):
+        v, r = gaps(xy + d, idx)
+        if r.min() >= spacing:
+            break
+        over = np.where(r < target, 0.5 * (target - r), 0.0)
+        push = (over[..., None] * v / np.maximum(r, 1e-9)[..., None]).sum(axis=1)
+        rel = d[idx] + push - centre
+        n = np.hypot(rel[:, 0], rel[:, 1])
+        d[idx] = centre + rel * np.minimum(1.0, radius / np.maximum(n, 1e-12))[:, None]
+    _, r = gaps(xy + d, np.arange(len(xy)))
+    return d if r.min() >= spacing else None
+
+
+def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: int, s: Mapping[str, Any],
+                  spacing: float) -> tuple[list[int], np.ndarray]:
+    """Sites (indices into ``sites``, apex first) and lateral chain offsets for a dome whose silanols sit closer
+    than chains pack: sites are taken apex first and kept when the chains so far, the ones within
+    :data:`LOCAL_SPREAD_A` of the new one moved within :func:`md.build.sam.head_offset_disk`
+    (:func:`_spread_chains`), still stand ``spacing`` apart, clear of the dome (:func:`_clearance_check`), with
+    every head atom (head Si, its two O, the first two CH2) :data:`HEAD_CLEARANCE_A` from every heavy atom but its
+    anchor O -- until ``n_target`` chains stand."""
+    from scipy.spatial import cKDTree
+    from md.build.sam import chain_geometry, head_offset_disk, head_shifts
+
+    L = s["chain_length"]
+    centre, radius = head_offset_disk(L, DOME_CHAIN_TILT_DEG, 0.0)
+    tpos, ttypes = chain_geometry(L, DOME_CHAIN_TILT_DEG, 0.0)
+    head = tpos[[k for k, t in enumerate(ttypes) if t in ("SIH", "OC24")] + [5, 6]]
+    clear = _clearance_check(asp, L, DOME_CHAIN_TILT_DEG)
+    heavy = np.flatnonzero(asp.types != "HOY")
+    tree = cKDTree(asp.positions[heavy])
+    cell = np.asarray(asp.cell[:2], float)
+
+    def heads(trial, d):
+        return asp.positions[sites[trial]][:, None, :] + head[None, :, :] + head_shifts(d, L, DOME_CHAIN_TILT_DEG)[:, None, :]
+
+    def head_room(trial, d, moved) -> bool:
+        h = heads(trial, d)
+        for m in moved:                                   # against the dome
+            site = int(sites[trial[m]])
+            for hit in tree.query_ball_point(h[m], HEAD_CLEARANCE_A):
+                if any(int(heavy[k]) != site for k in hit):
+                    return False
+        v = h[moved][:, :, None, None, :] - h[None, None, :, :, :]    # against the other chains' heads
+        v[..., :2] -= cell * np.round(v[..., :2] / cell)
+        r = np.linalg.norm(v, axis=-1)
+        r[np.arange(len(moved)), :, moved, :] = np.inf
+        return bool(r.min() >= HEAD_CLEARANCE_A)
+
+    xy = asp.positions[sites, :2]
+    chosen: list[int] = []
+    offsets = np.zeros((0, 2))
+    for k in order.tolist():
+        trial = chosen + [int(k)]
+        near = xy[trial] - xy[k]
+        near -= cell * np.round(near / cell)
+        d = _spread_chains(xy[trial], cell, spacing, centre, radius, start=np.vstack([offsets, [0.0, 0.0]]),
+                           free=np.hypot(near[:, 0], near[:, 1]) < LOCAL_SPREAD_A)
+        if d is None:
+            continue
+        moved = np.flatnonzero(np.hypot(*(d - np.vstack([offsets, [np.inf, np.inf]])).T) > 1e-9)
+        if not clear(sites[np.array(trial)[moved]], d[moved]).all() or not head_room(trial, d, moved):
+            continue
+        chosen, offsets = trial, d
+        if len(chosen) == n_target:
+            break
+    return chosen, offsets
 
 def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, dict[str, Any]]:
     """OTS chains on the dome silanols within ``graft_max_polar_deg`` of the apex (asperity tip up), at the SAM's
     coverage ``sam_coverage`` per nm^2 of the cap's projected area (the chains point along the pulling axis, so
     their lateral packing is what counts): the sites are a largest set no two closer than the spacing laterally
     (:data:`GRAFT_SPACINGS_A`, tried in order until one holds the target), the ones nearest the apex kept.
+    Where chains standing on their sites fall short of the target (the production R = 3 nm dome: 92 = 3.5 per
+    nm^2, its silanols paired 2.5-3.9 A apart), the chains lean off their sites (:func:`_offset_sites`, at
+    4.4 A) if that holds more: 112 = 4.25 per nm^2 there (smoke: 8 = 4.27 instead of 7). Quick reaches its target
+    standing, so its tip is what it was.
     Version 1 drew sites in random order at 4.4 A and reached 2.65 chains/nm^2 on the quick R = 1.2 nm dome."""
     R = float(s["asperity_radius_A"])
     centre = np.array(asp.info["centre_A"])
@@ -468,6 +578,7 @@ def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, d
     cosang = p[:, 2] / np.maximum(np.linalg.norm(p, axis=1), 1e-9)
     keep = cosang >= math.cos(math.radians(s["graft_max_polar_deg"]))
     sites, cos_k = dome[keep], cosang[keep]
+    all_sites, all_cos = sites, cos_k
     clear = _chain_clearance(asp, sites, s["chain_length"], DOME_CHAIN_TILT_DEG)
     n_blocked = int((~clear).sum())
     sites, cos_k = sites[clear], cos_k[clear]
@@ -484,13 +595,24 @@ def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, d
         if len(chosen) >= n_target:
             break
     chosen = chosen[:n_target]
+    grafts = [sites[np.array(chosen[:n], int)] for n in range(len(chosen), 0, -1)]
+    offsets: dict[int, np.ndarray] = {}
+    if len(chosen) < n_target:
+        # the dome's silanols pair up closer than chains pack: let the chains lean off their sites
+        picked, d = _offset_sites(asp, all_sites, np.argsort(-all_cos, kind="stable"), n_target, s,
+                                  GRAFT_SPACINGS_A[0])
+        if len(picked) > len(chosen):
+            grp = all_sites[np.array(picked, int)]
+            grafts, spacing = [grp], GRAFT_SPACINGS_A[0]
+            offsets = {int(i): d[k] for k, i in enumerate(grp)}
     last = None
-    for n in range(len(chosen), 0, -1):
-        grp = sites[np.array(chosen[:n], int)]
+    for grp in grafts:
+        n = len(grp)
         try:
             sam = as_system(ots_sam(with_groups(asp, graft_sites=grp), coverage=(n + 0.49) / (cell_area / 100.0),
                                     chain_length=s["chain_length"], seed=seed, site_group="graft_sites",
-                                    min_spacing=spacing - 1e-6, tilt_deg=DOME_CHAIN_TILT_DEG))
+                                    min_spacing=spacing - 1e-6, tilt_deg=DOME_CHAIN_TILT_DEG,
+                                    head_offsets=offsets or None))
             break
         except ValueError as exc:
             last = exc
@@ -499,4 +621,5 @@ def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, d
     chains = int(sam.info["chains"])
     return sam, {"chains": chains, "requested_chains": n_target, "cap_projected_area_nm2": cap / 100.0,
                  "chains_per_projected_nm2": chains / (cap / 100.0), "sites": int(len(sites)),
-                 "sites_blocked_by_the_dome": n_blocked, "min_spacing_A": float(spacing)}
+                 "sites_blocked_by_the_dome": n_blocked, "min_spacing_A": float(spacing),
+                 "chain_offset_max_A": float(sam.info.get("head_offset_max_A", 0.0))}
