@@ -196,6 +196,26 @@ def test_plan_legs_scale_the_right_things(tmp_path, recipe):
             assert 0 < lam["lq"] < 1 and lam["ll"] == 1.0 and all(" atom charge " in c for c in fep)
 
 
+@pytest.mark.parametrize("recipe", sorted(_SOLIDS))
+def test_each_reference_node_starts_from_its_film_nodes_start_without_the_water(tmp_path, recipe):
+    """Version 3: the solid-alone node k reads the restart film node k reads and deletes the water, so both start
+    from one solid configuration (version 2 chained the reference from the substrate leg: the OTS solid-solid
+    share did not cancel, -5.5 +- 2.7 mJ/m^2 of electrostatics under 2 nm of uncharged chains)."""
+    s, plan = _plan(tmp_path, recipe)
+    legs = {leg.name: leg for leg in plan.legs}
+    reads = set()
+    for k in range(s["ti_charge_nodes"]):
+        film = legs[f"q{k}"].fresh(tmp_path / "legs" / f"q{k}")
+        ref = legs[f"ref_q{k}"].fresh(tmp_path / "legs" / f"ref_q{k}")
+        read = [c for c in film if c.startswith("read_restart")]
+        assert len(read) == 1 and [c for c in ref if c.startswith("read_restart")] == read
+        reads.add(read[0])
+        i = ref.index(read[0])
+        assert "delete_atoms group water mol yes bond yes compress no" in ref[i + 1:]
+        assert legs[f"ref_q{k}"].info["start"].startswith(("film", "q"))
+    assert len(reads) == s["ti_charge_nodes"] and not any("/substrate/" in r for r in reads)
+
+
 def test_only_the_ots_film_leg_frames_the_water_and_the_trappe_sites(tmp_path):
     """OTS: the film leg's second half is sampled and frames the water O and CH2/CH3 (for the dispersion tail);
     silica keeps its single unsampled film stage and no frames (its plan, and committed result, unchanged)."""

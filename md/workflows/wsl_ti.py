@@ -98,17 +98,24 @@ class WslTI(Workflow):
     *film* (the water film added on the substrate's last state, minimised, equilibrated at full coupling; on OTS
     the second half is a sampled stage framing the water O and the CH2/CH3 sites, for the dispersion tail);
     *q0..* (the solid's charges at each Gauss-Legendre node, 1 -> 0, each leg continuing from the last);
-    *lj0..* (solid charges 0, solid-water LJ lambda at each node, 1 -> 0); *ref_q0..* (the solid alone from the
-    substrate's last state, the charge nodes again). Every node equilibrates ``ti_equilibrate_steps`` and samples
+    *lj0..* (solid charges 0, solid-water LJ lambda at each node, 1 -> 0); *ref_q0..* (the solid alone, the charge
+    nodes again, each starting from the state its film node starts from with the water deleted). Every node equilibrates ``ti_equilibrate_steps`` and samples
     ``ti_sample_steps``; dU/dlambda is sampled every ``sample_interval`` steps by two ``compute fep``.
 
-    Version 2 (this protocol): with the water present, the water and the solid's mobile atoms have a thermostat
+    Version 2: with the water present, the water and the solid's mobile atoms have a thermostat
     each (:func:`md.workflows.common.split_thermostat_lines`), and both temperatures are sampled and reported.
     Version 1 thermostatted them together: on the OTS film the water ran at 420 K and the SAM at 165 K after the
     film leg, and at the LJ stage's small lambda, where film and solid barely interact, nothing could equalise
-    them (the silica film's water read 307 K)."""
+    them (the silica film's water read 307 K).
+
+    Version 3 (this protocol): each reference node starts from its film node's starting state, water deleted.
+    Version 2 ran the reference nodes in a chain from the substrate leg's last state: the two solids then sat in
+    different slow configurations (silanol orientations, SAM head groups), and their solid-solid share of
+    dU/dlambda_q, tens of thousands of kcal/mol, no longer cancelled to the few kcal/mol W_SL needs: on OTS, under
+    2 nm of uncharged chains, the electrostatic part read -5.5 +- 2.7 mJ/m^2, all of it from one node (film
+    minus reference +21 +- 7 kcal/mol at lambda_q = 0.89)."""
     name = "wsl_ti"
-    version = 2
+    version = 3
     yields = {"work_of_adhesion_sl": "J/m^2", "contact_angle": "deg", "spreading_coefficient": "J/m^2",
               "surface_tension_lv": "N/m"}
 
@@ -234,9 +241,9 @@ class WslTI(Workflow):
         legs = [sub_leg, film_leg]
 
         def window(name: str, prev: Leg, prev_dir: Path, lam_q: float, lam_lj: float, stage: str,
-                   with_water: bool, salt: int, info: dict) -> Leg:
+                   with_water: bool, salt: int, info: dict, extra: tuple[str, ...] = ()) -> Leg:
             def fresh(leg_dir: Path, _total=prev.total_steps) -> list[str]:
-                return head(prev_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
+                return head(prev_dir / f"restart.{_total}") + [f"timestep {dt:g}", *extra]
             cols = {"dudl": "v_dudl", "pe": "v_pe", "temp": "v_temp"} | (
                 {"z_film": "v_zw"} | WATER_SOLID_COLUMNS if with_water else {})
             return Leg(name=name, fresh=fresh,
@@ -257,12 +264,18 @@ class WslTI(Workflow):
                          {"stage": "dispersion", "lambda": float(lam), "system": "film"})
             legs.append(leg)
             prev, salt = leg, salt + 1
-        prev = sub_leg
+        # version 3: each reference node starts from the state its film node starts from, the water deleted, so
+        # that the solid's slow configuration (silanols, SAM heads) is the same in both and its solid-solid share
+        # of dU/dlambda_q cancels in the difference
+        film_starts = [film_leg] + legs[2:2 + len(nodes["q"]) - 1]
         for k, lam in enumerate(nodes["q"]):
-            leg = window(f"ref_q{k}", prev, run_dir / "legs" / prev.name, float(lam), 1.0, "q", False, salt,
-                         {"stage": "charges", "lambda": float(lam), "system": "solid alone"})
+            start = film_starts[k]
+            leg = window(f"ref_q{k}", start, run_dir / "legs" / start.name, float(lam), 1.0, "q", False, salt,
+                         {"stage": "charges", "lambda": float(lam), "system": "solid alone",
+                          "start": f"{start.name}'s last state, water deleted"},
+                         extra=("delete_atoms group water mol yes bond yes compress no",))
             legs.append(leg)
-            prev, salt = leg, salt + 1
+            salt += 1
         info = {"substrate": system_summary(sub), "film": dict(film.info), "box_A": system.cell.tolist(),
                 "area_A2": area, "n_substrate": int(len(substrate)), "n_water_molecules_built": int(len(water) // 3),
                 "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
