@@ -520,7 +520,8 @@ def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: i
     L = s["chain_length"]
     centre, radius = head_offset_disk(L, DOME_CHAIN_TILT_DEG, 0.0)
     tpos, ttypes = chain_geometry(L, DOME_CHAIN_TILT_DEG, 0.0)
-    head = tpos[[k for k, t in enumerate(ttypes) if t in ("SIH", "OC24")] + [5, 6]]
+    head = tpos[[k for k, t in enumerate(ttypes) if t in ("SIH", "OC24")] +
+                [k for k, t in enumerate(ttypes) if t == "CH2"][:2]]
     clear = _clearance_check(asp, L, DOME_CHAIN_TILT_DEG)
     heavy = np.flatnonzero(asp.types != "HOY")
     tree = cKDTree(asp.positions[heavy])
