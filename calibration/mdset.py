@@ -67,7 +67,8 @@ _DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this i
             "from 40 deg), so it measures the start, not the surface")
 
 _DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the R0 = 2 nm droplet's angle, "
-                "which is not size-converged (109.2 deg at R0 = 2 nm, 125.0 deg at 3 nm: docs/md.md)")
+                "which is not size-converged at quick (116.8 deg at R0 = 2 nm, 107.8 deg and still rising at 3 nm, "
+                "contact-angle version 4: docs/md.md)")
 
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),
