@@ -418,12 +418,13 @@ def test_contact_angle_protocol_change_raised_the_workflow_version():
     _, doc = run_hash(rec, "quick", ContactAngleWorkflow().forcefield_files(rec.settings("quick")))
     assert doc["workflow_version"] == ContactAngleWorkflow.version
     committed = json.loads((COMMITTED_OTS / "result.json").read_text())
-    # the committed OTS result (2026-11-26) ran version 3 (one thermostat over water and SAM): its hash is that
-    # version's, not the current one, so it is stale and a calibration does not take it as current
+    # the committed OTS result was rerun at version 4 (2026-11-26, a thermostat each on water and SAM): its hash is
+    # the current one; version 3's (one thermostat; the run it named is in git history) differs, so a result of that
+    # version is stale and a calibration does not take it as current
     from md.engine import hashing
     ff = ContactAngleWorkflow().forcefield_files(rec.settings("quick"))
-    assert hashing.run_hash(rec.canonical("quick"), "quick", ff, 3)[0] == committed["run_hash"]
-    assert run_hash(rec, "quick", ff)[0] != committed["run_hash"] and ContactAngleWorkflow.version == 4
+    assert run_hash(rec, "quick", ff)[0] == committed["run_hash"] and ContactAngleWorkflow.version == 4
+    assert hashing.run_hash(rec.canonical("quick"), "quick", ff, 3)[0] != committed["run_hash"]
 
 
 @pytest.mark.parametrize("name", ["contact_angle_silica", "contact_angle_ots"])
