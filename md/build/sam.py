@@ -33,32 +33,36 @@ def chain_geometry(chain_length: int = 18, tilt_deg: float = 15.0, tilt_azimuth_
     return tpos, types
 
 
+def _disk(bond: np.ndarray) -> tuple[np.ndarray, float]:
+    """centre and radius of :func:`head_offset_disk` for the template's anchor O -> head Si vector ``bond``"""
+    return -bond[:2].copy(), float(np.linalg.norm(bond)) * math.sin(math.radians(MAX_ANCHOR_TILT_DEG))
+
+
 def head_offset_disk(chain_length: int = 18, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
                      forcefield: ForceField | None = None) -> tuple[np.ndarray, float]:
     """The lateral offsets (A) a chain may take from its place above the anchor O in :func:`ots_sam` (its
     ``head_offsets``): the disk of centre ``-s_xy`` and radius ``r sin(MAX_ANCHOR_TILT_DEG)``, where ``s`` is the
     template's anchor O -> head Si bond (length r) -- the head Si stays on its bond sphere, at most
     :data:`MAX_ANCHOR_TILT_DEG` off the vertical."""
-    tpos, _ = chain_geometry(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)
-    r = float(np.linalg.norm(tpos[0]))
-    return -tpos[0, :2].copy(), r * math.sin(math.radians(MAX_ANCHOR_TILT_DEG))
+    return _disk(chain_geometry(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)[0][0])
 
 
 def head_shifts(offsets: np.ndarray, chain_length: int = 18, tilt_deg: float = 15.0, tilt_azimuth_deg: float = 0.0,
-                forcefield: ForceField | None = None) -> np.ndarray:
+                forcefield: ForceField | None = None, *, template: np.ndarray | None = None) -> np.ndarray:
     """Rigid shifts (n x 3, A) of chains moved laterally by ``offsets`` (n x 2, A): the head Si turns on its bond
     sphere about the anchor O, so the shift's z keeps the O -> Si bond length. ValueError for an offset outside
-    :func:`head_offset_disk`."""
+    :func:`head_offset_disk`. ``template``: the positions :func:`chain_geometry` gives for these arguments, when the
+    caller has them (they are then not rebuilt, nor the force field re-read)."""
     offsets = np.asarray(offsets, float).reshape(-1, 2)
-    tpos, _ = chain_geometry(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)
-    centre, radius = head_offset_disk(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)
+    tpos = chain_geometry(chain_length, tilt_deg, tilt_azimuth_deg, forcefield)[0] if template is None else template
+    s0 = tpos[0]
+    centre, radius = _disk(s0)
     far = np.hypot(*(offsets - centre).T) > radius + 1e-9
     if far.any():
         d = offsets[np.flatnonzero(far)[0]]
         raise ValueError(f"head offset ({d[0]:.3f}, {d[1]:.3f}) A tilts the anchor bond beyond "
                          f"{MAX_ANCHOR_TILT_DEG:g} deg: allowed within {radius:.3f} A of ({centre[0]:.3f}, "
                          f"{centre[1]:.3f})")
-    s0 = tpos[0]
     lateral = s0[:2] + offsets
     dz = np.sqrt(float(s0 @ s0) - (lateral ** 2).sum(axis=1)) - s0[2]
     return np.column_stack([offsets, dz])
@@ -200,8 +204,7 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
     tpos, ttypes, tbonds = _chain_template(ff, chain_length, tilt_deg, tilt_azimuth_deg)
     shifts = np.zeros((len(accepted), 3))
     if offsets:                              # anchors keep the order of ``accepted`` through remove_atoms
-        shifts = head_shifts(np.array([offsets.get(i, np.zeros(2)) for i in accepted]), chain_length, tilt_deg,
-                             tilt_azimuth_deg, ff)
+        shifts = head_shifts(np.array([offsets.get(i, np.zeros(2)) for i in accepted]), template=tpos)
     n0 = base.n_atoms
     per = len(ttypes)
     mol0 = int(base.mol_ids.max())

@@ -26,7 +26,7 @@ from md.build import flip_upside_down, ots_sam, place_on, silica_asperity
 from md.system.atoms import as_system
 from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
-from md.system.topology import System, with_groups
+from md.system.topology import System, minimum_image, with_groups
 
 from md.workflows.common import (Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data, intersect_ids,
                                  minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed, silica_face_of, stage_list, steps_of,
@@ -391,6 +391,8 @@ DOME_CHAIN_TILT_DEG = 0.0
 #: when a chain is added to the offset dome (:func:`_offset_sites`), the chains within this lateral distance of it
 #: may move to make room (two spacings: farther chains would only pass on a push they have room to absorb)
 LOCAL_SPREAD_A = 9.0
+#: the pull-off cell is periodic in x and y
+PBC_XY = (True, True, False)
 #: least distance (A) of an offset chain's head atoms from any heavy atom but its anchor O (the flat SAM's builder
 #: starts with none closer than 2.6 A)
 HEAD_CLEARANCE_A = 1.7
@@ -481,14 +483,12 @@ def _spread_chains(xy: np.ndarray, cell_xy, spacing: float, centre: np.ndarray, 
     pushes (each chain pushed half the overlap away from every chain too close, then projected back onto the disk)
     do not get there. Starts from the offsets ``start`` (zero if None); only the chains flagged in ``free`` (all
     if None) move. Deterministic: no random numbers."""
-    cell = np.asarray(cell_xy, float)[None, None, :]
     d = np.zeros(xy.shape, float) if start is None else np.array(start, float)
     idx = np.arange(len(xy)) if free is None else np.flatnonzero(free)
     target = spacing + 0.02                       # a little beyond, so that the last push does not stop short
 
     def gaps(p, rows):
-        v = p[rows, None, :] - p[None, :, :]
-        v -= cell * np.round(v / cell)
+        v = minimum_image(p[rows, None, :] - p[None, :, :], cell_xy, PBC_XY)
         r = np.hypot(v[..., 0], v[..., 1])
         r[np.arange(len(rows)), rows] = np.inf
         return v, r
@@ -518,8 +518,8 @@ def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: i
     from md.build.sam import chain_geometry, head_offset_disk, head_shifts
 
     L = s["chain_length"]
-    centre, radius = head_offset_disk(L, DOME_CHAIN_TILT_DEG, 0.0)
     tpos, ttypes = chain_geometry(L, DOME_CHAIN_TILT_DEG, 0.0)
+    centre, radius = head_offset_disk(L, DOME_CHAIN_TILT_DEG, 0.0)
     head = tpos[[k for k, t in enumerate(ttypes) if t in ("SIH", "OC24")] +
                 [k for k, t in enumerate(ttypes) if t == "CH2"][:2]]
     clear = _clearance_check(asp, L, DOME_CHAIN_TILT_DEG)
@@ -528,7 +528,7 @@ def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: i
     cell = np.asarray(asp.cell[:2], float)
 
     def heads(trial, d):
-        return asp.positions[sites[trial]][:, None, :] + head[None, :, :] + head_shifts(d, L, DOME_CHAIN_TILT_DEG)[:, None, :]
+        return asp.positions[sites[trial]][:, None, :] + head[None, :, :] + head_shifts(d, template=tpos)[:, None, :]
 
     def head_room(trial, d, moved) -> bool:
         h = heads(trial, d)
@@ -537,8 +537,7 @@ def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: i
             for hit in tree.query_ball_point(h[m], HEAD_CLEARANCE_A):
                 if any(int(heavy[k]) != site for k in hit):
                     return False
-        v = h[moved][:, :, None, None, :] - h[None, None, :, :, :]    # against the other chains' heads
-        v[..., :2] -= cell * np.round(v[..., :2] / cell)
+        v = minimum_image(h[moved][:, :, None, None, :] - h[None, None, :, :, :], asp.cell, PBC_XY)  # other heads
         r = np.linalg.norm(v, axis=-1)
         r[np.arange(len(moved)), :, moved, :] = np.inf
         return bool(r.min() >= HEAD_CLEARANCE_A)
@@ -548,8 +547,7 @@ def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: i
     offsets = np.zeros((0, 2))
     for k in order.tolist():
         trial = chosen + [int(k)]
-        near = xy[trial] - xy[k]
-        near -= cell * np.round(near / cell)
+        near = minimum_image(xy[trial] - xy[k], cell, PBC_XY)
         d = _spread_chains(xy[trial], cell, spacing, centre, radius, start=np.vstack([offsets, [0.0, 0.0]]),
                            free=np.hypot(near[:, 0], near[:, 1]) < LOCAL_SPREAD_A)
         if d is None:

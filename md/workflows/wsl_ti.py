@@ -254,7 +254,9 @@ class WslTI(Workflow):
                        columns=cols, n_atoms=system.n_atoms if with_water else sub.n_atoms, info=info, **common)
 
         prev, salt = film_leg, 10
+        film_starts = []                          # the leg each film charge node starts from
         for k, lam in enumerate(nodes["q"]):
+            film_starts.append(prev)
             leg = window(f"q{k}", prev, run_dir / "legs" / prev.name, float(lam), 1.0, "q", True, salt,
                          {"stage": "charges", "lambda": float(lam), "system": "film"})
             legs.append(leg)
@@ -267,7 +269,6 @@ class WslTI(Workflow):
         # version 3: each reference node starts from the state its film node starts from, the water deleted, so
         # that the solid's slow configuration (silanols, SAM heads) is the same in both and its solid-solid share
         # of dU/dlambda_q cancels in the difference
-        film_starts = [film_leg] + legs[2:2 + len(nodes["q"]) - 1]
         for k, lam in enumerate(nodes["q"]):
             start = film_starts[k]
             leg = window(f"ref_q{k}", start, run_dir / "legs" / start.name, float(lam), 1.0, "q", False, salt,
