@@ -66,9 +66,10 @@ _DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this i
             "silica droplet keeps the angle it is started at (pinned contact line: 18 deg from a 20 deg start, 39 deg "
             "from 40 deg), so it measures the start, not the surface")
 
-_DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the R0 = 2 nm droplet's angle, "
-                "which is not size-converged at quick (116.8 deg at R0 = 2 nm, 107.8 deg and still rising at 3 nm, "
-                "contact-angle version 4: docs/md.md)")
+_DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the quick R0 = 2 nm droplet's "
+                "angle after 60 ps (116.8 deg); sampled 150 ps, R0 = 2 nm reads 118.2 +- 0.8 and R0 = 3 nm "
+                "111.4 +- 3.1 deg, 2.1 sigma apart, so take +-4 deg for the droplet size (contact-angle version 4: "
+                "docs/md.md)")
 
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),

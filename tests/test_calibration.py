@@ -237,7 +237,7 @@ def test_the_ots_angle_comes_from_the_ti_and_falls_back_to_the_droplet_with_a_no
     assert table["surfaces"]["sam"]["contact_angle"] == 112.0 and e["recipe"] == "wsl_ots" and "note" not in e
     table, _ = build_parameter_set(_results(), "paper", "cal")              # no TI result: the droplet
     e = table["meta"]["calibration"]["surfaces.sam.contact_angle"]
-    assert e["recipe"] == "contact_angle_ots" and e["value"] == 108.0 and "not size-converged" in e["note"]
+    assert e["recipe"] == "contact_angle_ots" and e["value"] == 108.0 and "+-4 deg for the droplet size" in e["note"]
 
 
 def test_a_ti_that_wets_enters_as_zero_or_as_its_bound_never_as_a_film_mark():
