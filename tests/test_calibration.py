@@ -180,6 +180,9 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     # the fixture's silica angle, 31 +- 3 deg, lies 0.3 stderr above the 0-30 deg range; OTS 108 deg inside
     assert "| 31 deg | 3 | 0-30 deg | 0.3 sigma above |" in text and "| 108 deg | 4 | 105-120 deg | inside |" in text
     assert "**Against the published ranges**" in text and "4 of 8 used values inside" in text
+    # a value outside its range (the silica angle, 0.3 sigma above) is reported as measured, not tuned
+    assert "within 2 stderr of the range: `surfaces.body.contact_angle`" in text \
+        and "Values outside their range are measured with the published force fields and converged protocols, not tuned" in text
     assert "Wasserman et al., Langmuir 5 (1989) 1074" in text
     assert (tmp_path / "out" / "md_vs_literature.png").stat().st_size > 0
     saved = json.loads((tmp_path / "out" / "calibration.json").read_text())
