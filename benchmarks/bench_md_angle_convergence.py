@@ -21,14 +21,19 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from md.analysis import angle_from_work_of_adhesion_sl   # noqa: E402
+
 RESULTS = ROOT / "inputs" / "md" / "results"
 DROPLETS = ("contact_angle_ots-quick", "contact_angle_ots_long-quick", "contact_angle_ots_large-quick")
 TI = "wsl_ots-quick"
 
 
 def _tail_corrected(theta_sim_deg: np.ndarray, dw: float, gamma: float) -> np.ndarray:
-    c = np.cos(np.radians(theta_sim_deg)) + dw / gamma
-    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+    """The block angles with the tail added to W_SL = gamma (1 + cos theta), inverted by the project's Young-Dupre."""
+    w = gamma * (1.0 + np.cos(np.radians(theta_sim_deg))) + dw
+    return np.array([angle_from_work_of_adhesion_sl(x, 0.0, gamma)["theta_deg"] for x in w])
 
 
 def droplet_summary(folder: Path) -> dict:
