@@ -20,14 +20,10 @@ from pathlib import Path
 
 from nanoimpact.cli import (ArgumentParser, Command, add_verbosity, check_out_dir, logging_ready, positive_int,
                             setup_logging)
-from nanoimpact.errors import (EXIT_BACKEND, EXIT_FAILED, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, InputError,
+from nanoimpact.errors import (EXIT_FAILED, EXIT_OK, InputError,
                                RunInterrupted, UsageError, run_command)
 
 __all__ = ["COMMANDS", "main", "run", "build_parser", "format_quantities"]
-
-#: Kept for callers of the old names; the codes are nanoimpact.errors'.
-EXIT_OK, EXIT_LAMMPS, EXIT_INVALID, EXIT_UNAVAILABLE, EXIT_INTERRUPTED = (EXIT_OK, EXIT_FAILED, EXIT_INPUT,
-                                                                         EXIT_BACKEND, EXIT_INTERRUPTED)
 
 log = logging.getLogger("md.cli")      # not __name__: it is __main__ under python -m
 
@@ -104,7 +100,7 @@ def run(argv: list[str]) -> int:
     except MDRunError as exc:                 # the log tail is the point here: printed whole, not one line
         print(f"nanoimpact md: {exc}", file=sys.stderr)
         print("nanoimpact md: the run failed; no result.json was written", file=sys.stderr)
-        return EXIT_LAMMPS
+        return EXIT_FAILED
     except InputError:
         raise
     except ValueError as exc:                 # a workflow refusing its settings: an input error, as before

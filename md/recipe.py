@@ -391,9 +391,8 @@ def parse_recipe(table: Mapping[str, Any], *, name: str = "recipe", origin: str 
                   file_sha256=file_sha256, raw=MappingProxyType(dict(table)))
 
 
-#: the deepest rigid step one compression window may take from its neighbour (A). The shipped recipes step 0.5-1.0 A;
-#: one 4 A step into two OTS SAMs overlapped chains (potential energy 6.5e6 kcal/mol, LAMMPS "Bond atoms missing"
-#: at step 1), found 2026-11-25 with a cut-down quick recipe.
+#: the deepest rigid step one compression window may take from its neighbour (A): a rigid step of several A into
+#: two OTS SAMs overlaps their chains (LAMMPS stops at the first step with "Bond atoms missing").
 MAX_COMPRESS_STEP_A = 1.0
 
 

@@ -28,7 +28,7 @@ Sources (details and measured accuracies: ``docs/md-analysis.md``):
 """
 from md.analysis.adhesion import (force_integration_work, registry_average, registry_consistency, traction_peak,
                                   flat_slab_range, lj_tail_between, MAUGIS_LJ93, energy_separation_work, work_from_energy_curve)
-from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M, WATER_MOLAR_MASS
+from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
                                        block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
                                        shape_check,
@@ -42,7 +42,7 @@ from md.analysis.stats import (block_average, block_analysis, blocking_stderr, s
 from md.analysis.surface_tension import surface_tension, lj_tail_correction, density_profile, slab_density
 
 __all__ = [
-    "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M", "WATER_MOLAR_MASS",
+    "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M",
     "block_average", "block_analysis", "blocking_stderr", "statistical_inefficiency", "detect_equilibration",
     "timeseries_stats",
     "force_integration_work", "registry_average", "registry_consistency", "traction_peak", "flat_slab_range",

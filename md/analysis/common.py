@@ -13,8 +13,6 @@ KCALMOL_PER_A2_TO_J_PER_M2 = float(_units.kcal_per_mol_A2_to_J_per_m2(1.0))
 KCALMOL_PER_A_TO_N = float(_units.kcal_per_mol_A_to_N(1.0))
 #: 1 atm A in N/m (1.01325e-5)
 ATM_A_TO_N_PER_M = float(_units.atm_A_to_N_per_m(1.0))
-#: Molar mass of water in g/mol (one oxygen per molecule in density maps).
-WATER_MOLAR_MASS = _units.WATER_MOLAR_MASS
 
 
 def refined_min(x, y, i):

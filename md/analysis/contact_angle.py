@@ -10,7 +10,6 @@ import numpy as np
 
 from md import units as _units
 
-from md.analysis.common import WATER_MOLAR_MASS
 from md.analysis.stats import timeseries_stats
 
 
@@ -475,7 +474,7 @@ if _AnalysisBase is not None:
             du, dz = np.diff(self._u_edges).mean(), self.bin_size
             number_density = counts / (du * dz * la)                  # 1/A^3
             rho = _units.kg_per_m3_to_g_per_cm3(                     # g/cm^3
-                _units.amu_per_A3_to_kg_per_m3(number_density * WATER_MOLAR_MASS))
+                _units.amu_per_A3_to_kg_per_m3(number_density * _units.WATER_MOLAR_MASS))
             self._sum += rho
             self._frames_rho.append(rho.astype(np.float32))
             z = pos[:, 2].astype(float)

@@ -117,10 +117,9 @@ def detect_equilibration(x, nskip: int | None = None, min_samples: int = 10,
     about 100 candidates); at least ``min_samples`` are kept. Returns ``t0``, ``g`` (of x[t0:]) and ``n_eff``.
 
     Why the cap: a fluctuation slower than the series makes a late tail look stationary, and N_eff(t0) then
-    peaks there. In a 15 ps OTS-OTS force window held at contact (a cut-down quick run, 2026-11-25), the force
-    wanders over ~10 ps. Unbounded, the
-    detection kept the last 90 of 1500 samples and gave a stderr 10x below the blocking estimate over the whole
-    window. A mean is therefore never taken over less than the last half, the usual warm-up convention
+    peaks there: in a force window held at contact whose force wanders over most of the window, unbounded
+    detection keeps only the last few percent of the samples and gives a stderr far below the blocking estimate
+    over the whole window. A mean is therefore never taken over less than the last half, the usual warm-up convention
     (Gelman & Rubin, Statist. Sci. 7 (1992) 457). A slow drift then shows in the stderr instead of vanishing from it."""
     x = np.asarray(x, float).ravel()
     n = x.size

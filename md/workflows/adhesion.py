@@ -51,22 +51,19 @@ MIN_WINDOW_NEFF = 10
 class Adhesion(Workflow):
     """Work of adhesion of two slabs: energy route, and optionally the free energy by force integration.
 
-    Version 3 (this protocol): the force-integration windows form chains -- each window starts from its
-    neighbour's last state, the first (at contact) from the contact leg's last state -- outwards (dense near
-    contact) and inwards (``pmf_compress_windows`` pressed into the contact, so the mean force turns repulsive and
-    the bottom of the well lies inside the grid); ``lateral_registries`` chains at different lateral offsets of the
-    upper slab are averaged; every mean and stderr comes from the statistical inefficiency with automated
+    The force-integration windows form chains -- each window starts from its neighbour's last state, the first (at
+    contact) from the contact leg's last state, so every window starts from the 300 K contact -- outwards (dense
+    near contact) and inwards (``pmf_compress_windows`` pressed into the contact, so the mean force turns repulsive
+    and the bottom of the well lies inside the grid); ``lateral_registries`` chains at different lateral offsets of
+    the upper slab are averaged; every mean and stderr comes from the statistical inefficiency with automated
     equilibration detection; z0 and sigma0 come from the flat-slab curve; dispersion beyond the cutoff is added for
-    TraPPE pairs (``dispersion_tail``). Version 2 started every window from the contact (1 + 3-5 ps each) at one
-    registry and integrated from the first window; version 1 started them from the minimised build, 2.8 A wider
-    than the 300 K contact (W_F 0.006 against dE/A 0.123 J/m^2 for silica).
+    TraPPE pairs (``dispersion_tail``).
 
-    Version 4 changes bare silica pairs only (`protocol_version`; SAM pairs keep version 3, plans and hashes
-    unchanged): a registry's first window no longer shifts the upper slab laterally while in contact, which on
-    the quick (111) cells put interlocked silanols onto each other (potential energy ~1e8 kcal/mol, LAMMPS lost
-    atoms at the first step). It lifts the slab by REGISTRY_LIFT_A, shifts it, and lowers it back in
+    Bare silica pairs cannot be sheared at contact: their interlocked silanols would land on each other. There a
+    registry's first window lifts the upper slab by REGISTRY_LIFT_A, shifts it, and lowers it back in
     REGISTRY_LOWER_STEPS steps, minimising after each with the backs held: a quasi-static approach at the new
-    registry (:func:`registry_approach_lines`)."""
+    registry (:func:`registry_approach_lines`). ``version`` (4) and :meth:`protocol_version` (3 for SAM pairs,
+    whose plans this does not touch) enter the run hash."""
     name = "adhesion"
     version = 4
     yields = {"work_of_adhesion": "J/m^2", "work_of_adhesion_free_energy": "J/m^2",
@@ -501,14 +498,14 @@ def _tail_pair_table(ff: ForceField, mode: str):
 
 
 
-#: A registry's first window on bare silica (version 4): lift (A) before the lateral shift, and the number of
+#: A registry's first window on bare silica: lift (A) before the lateral shift, and the number of
 #: equal steps that lower the slab back, each followed by a minimisation (backs held)
 REGISTRY_LIFT_A = 4.0
 REGISTRY_LOWER_STEPS = 8
 
 
 def _lifts_registries(s: Mapping[str, Any]) -> bool:
-    """Bare silica on bare silica: interlocked silanols cannot be sheared at contact (version 4 lifts first)."""
+    """Bare silica on bare silica: interlocked silanols cannot be sheared at contact (lift first)."""
     return all(surface == "silica" for surface in s["surfaces"])
 
 

@@ -26,7 +26,6 @@ from md.build import SILICA_FACE, ots_sam, silica_slab
 from md.system.atoms import as_system
 from md.system.forcefield import ForceField, combine, load_forcefield
 from md.system.lammps_data import lammps_setup_commands
-from md.units import SPCE_WATER_MOLAR_MASS
 from md.engine.plan import Analysis, Plan, Stage, id_ranges
 from md.engine.store import RunContext
 from md.system.topology import System
@@ -36,7 +35,6 @@ ENERGY_NOT_FREE_ENERGY = (
     "work_of_adhesion is dE/A, the difference of mean potential energies (separated - contact) per area at "
     "the thermostat temperature: an energy, not the free energy of adhesion (the Dupre work). It neglects "
     "-T dS/A, the change of vibrational/conformational entropy on contact.")
-WATER_MASS = SPCE_WATER_MOLAR_MASS       # g/mol, SPC/E (force-field masses), from md.units
 
 
 # ================================================================================================ LAMMPS helpers
@@ -90,10 +88,8 @@ def split_thermostat_lines(groups: Sequence[str], union: str, settings: Mapping[
 
     Why: one thermostat over water and a solid keeps only their *mean* kinetic energy at T. Heat crosses a
     water-solid interface slowly (the hydrophobic one slowest), so whatever the water's relaxation releases, or a
-    start leaves unequal, stays unequal for tens of ps while the shared thermostat scales both alike: on the OTS
-    film of wsl_ti version 1 the water ran at 420 K and the SAM's CH2 at 165 K after 10 ps (NVE from there
-    conserves the energy to 1 kcal/mol in 3 ps, so the split is a start-up imbalance the single thermostat does not
-    remove, not a heat source). The remedy is the standard one for the "hot solvent / cold solute" problem:
+    start leaves unequal, stays unequal for tens of ps while the shared thermostat scales both alike (a start-up
+    imbalance the single thermostat does not remove, not a heat source). The remedy is the standard one for the "hot solvent / cold solute" problem:
     separate thermostats per component (Lingenheil, Denschlag, Reichold & Tavan, J. Chem. Theory Comput. 4 (2008)
     1293; GROMACS's separate tc-grps for solvent and solute)."""
     t = settings["temperature_K"]
@@ -350,8 +346,7 @@ def system_summary(system: System) -> dict[str, Any]:
 #: One model throughout a calibration: the angles and gamma_lv of the menisci must describe the same water.
 WATER_MODELS: dict[str, dict[str, Any]] = {
     "spce": {"name": "SPC/E", "forcefields": ["water_spce"], "gamma_lv_N_m": 0.0636, "gamma_T_K": 300.0,
-             "gamma_source": "SPC/E, 300 K, Ewald with LJ tail: Vega & de Miguel, J. Chem. Phys. 126 (2007) 154707 "
-                             "(this project's quick films: 60.7 +/- 3.0 mN/m at 25 A, 64.0 +/- 1.9 mN/m at 35 A)"},
+             "gamma_source": "SPC/E, 300 K, Ewald with LJ tail: Vega & de Miguel, J. Chem. Phys. 126 (2007) 154707"},
 }
 
 

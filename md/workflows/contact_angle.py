@@ -47,19 +47,13 @@ class ContactAngleWorkflow(Workflow):
     and H mobile, O-H constrained by SHAKE) and it is equilibrated (the SAM relaxes before any water touches it).
     *droplet*: the water cap is added to the substrate's last state (``read_data ... add append``; molecules
     overlapping the substrate deleted), minimised, equilibrated and sampled. The angle is read at the water's own
-    dividing plane (half the bulk density under the droplet).
+    dividing plane (half the bulk density under the droplet): the plane of the solid's atoms is not where the
+    liquid ends, and a circle cut there reads a different angle from the same map.
 
-    Version 4 (this protocol): the water and the substrate's mobile atoms have a thermostat each
-    (:func:`md.workflows.common.water_solid_thermostat_lines`), both temperatures sampled and reported. Version 3
-    thermostatted them together, and at the end of the quick OTS droplets the water ran at 375 K (R0 = 2 nm) and
-    366 K (3 nm) with the SAM's CH2 at 229 and 208 K (measured from their last restarts, 2026-11-26); the silica
-    droplet's water read 305 K.
-    Version 3: the substrate's FIRE minimisation runs at 1 fs; version 2 ran it at the MD
-    timestep, 2 fs on silica, where FIRE's steps (up to 20 fs) made the unconstrained silanol O-H diverge (the
-    quick silica run lost an H at FIRE step 46: "Bond atoms missing"). Version 1 froze the whole silica (silanol H
-    included) before minimising it, used the (001) face's silanol pairs, started a full cylinder on an
-    unequilibrated SAM and read the angle at the plane of the solid's atoms (OTS: 140 deg there against 129 deg at
-    the water's plane, same map)."""
+    The water and the substrate's mobile atoms have a thermostat each
+    (:func:`md.workflows.common.water_solid_thermostat_lines`: heat crosses a water-solid interface slowly), both
+    temperatures sampled and reported. The substrate's FIRE minimisation runs at :data:`FIRE_TIMESTEP_FS` (FIRE's
+    steps at a 2 fs timestep make the unconstrained silanol O-H diverge). ``version`` (4) enters the run hash."""
     name = "contact_angle"
     version = 4
     yields = {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"}
@@ -98,7 +92,7 @@ class ContactAngleWorkflow(Workflow):
             ref = system.group("sam_ch3")
         water_o = np.intersect1d(system.group("water_O"), water)
         # the SAM's TraPPE sites go into the frames too: the water-TraPPE dispersion beyond the cutoff is added
-        # in the analysis (issue 11, item 4); their C6 with the water O (4 eps sigma^6, kcal/mol A^6)
+        # in the analysis; their C6 with the water O (4 eps sigma^6, kcal/mol A^6)
         tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
         framed = np.union1d(np.union1d(water_o, ref), tail_sites)
         n_sub, n = len(substrate), system.n_atoms
@@ -350,7 +344,7 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
     is_site, c6 = framed_tail_sites(info, ids)
     if not is_site.any():
         return None
-    n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(A.WATER_MOLAR_MASS)
+    n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(U.WATER_MOLAR_MASS)
     z_ref = float(r.reference_z)
     per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, z_ref, n_w, s["cutoff_A"],
                                                  float(box[k][0] * box[k][1])) for k in range(len(pos))])

@@ -37,12 +37,12 @@ from md.workflows.common import (Workflow, common_define, equilibrate_stage, for
 class PullOff(Workflow):
     """Asperity approach-hold-retract against a flat at constant holder speed.
 
-    Version 2 (this protocol): the moving asperity is not dragged by the thermostat (``tip_thermostat``:
-    'comoving' thermostats only its thermal motion, a temp/com bias; the flat has its own thermostat), the residual
-    drag on the asperity is measured from the holder's reaction and reported; ``retract_repeats`` independent
-    retractions per speed give the pull-off force a spread; the OTS asperity carries >= 4 chains per nm^2 of
-    projected cap. Version 1 thermostatted every mobile atom in the lab frame: at 30-40 m/s a drag gamma M v of
-    10-13 nN on the asperity against pull-off forces of 0.2-0.5 nN."""
+    The moving asperity is not dragged by the thermostat (``tip_thermostat``: 'comoving' thermostats only its
+    thermal motion, a temp/com bias; the flat has its own thermostat): a lab-frame Langevin thermostat drags an
+    asperity moving at v with gamma M v, which at tens of m/s dwarfs a pull-off force of a fraction of a nN. The
+    residual drag on the asperity is measured from the holder's reaction and reported; ``retract_repeats``
+    independent retractions per speed give the pull-off force a spread; the OTS asperity carries >= 4 chains per
+    nm^2 of projected cap. ``version`` (2) enters the run hash."""
     name = "pulloff"
     version = 2
     yields = {"pull_off_force": "N", "separation_at_max_tension": "m", "interaction_range_z0": "m",
@@ -209,8 +209,8 @@ class PullOff(Workflow):
              "work_of_adhesion_eff_jkr": quantity_record(F / (1.5 * math.pi * R_m), f_err / (1.5 * math.pi * R_m) if f_err else None,
                                             "J/m^2", kind="F / (1.5 pi R)"),
              "work_of_adhesion_eff_dmt": quantity_record(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
-                                            kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit; at MD "
-                                                 "scale the contact is DMT-like, Tabor mu ~ 0.06)"),
+                                            kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit: a "
+                                                 "nanometre asperity has a small Tabor parameter)"),
              "residual_drag_force": quantity_record(float(U.kcal_per_mol_A_to_N(drag.mean())),
                                        float(U.kcal_per_mol_A_to_N(math.sqrt(np.sum(drag_err ** 2)) / len(drag))),
                                        "N", kind="mean thermostat force on the moving asperity along the pulling "
@@ -565,11 +565,9 @@ def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, d
     coverage ``sam_coverage`` per nm^2 of the cap's projected area (the chains point along the pulling axis, so
     their lateral packing is what counts): the sites are a largest set no two closer than the spacing laterally
     (:data:`GRAFT_SPACINGS_A`, tried in order until one holds the target), the ones nearest the apex kept.
-    Where chains standing on their sites fall short of the target (the production R = 3 nm dome: 92 = 3.5 per
-    nm^2, its silanols paired 2.5-3.9 A apart), the chains lean off their sites (:func:`_offset_sites`, at
-    4.4 A) if that holds more: 112 = 4.25 per nm^2 there (smoke: 8 = 4.27 instead of 7). Quick reaches its target
-    standing, so its tip is what it was.
-    Version 1 drew sites in random order at 4.4 A and reached 2.65 chains/nm^2 on the quick R = 1.2 nm dome."""
+    Where chains standing on their sites fall short of the target (dome silanols come in close pairs), the
+    chains lean off their sites (:func:`_offset_sites`, at 4.4 A) if that holds more. Sites are chosen as a
+    largest independent set, not in random order: a random sequential choice packs well below the target."""
     R = float(s["asperity_radius_A"])
     centre = np.array(asp.info["centre_A"])
     dome = np.asarray(asp.group("silanol_O_dome"), int)

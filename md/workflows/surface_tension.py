@@ -18,7 +18,8 @@ from md.system.atoms import as_system
 from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 
-from md.workflows.common import (WATER_MASS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data,
+from md.units import SPCE_WATER_MOLAR_MASS
+from md.workflows.common import (Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data,
                                  minimize_water_lines, quantity_record, restart_header_lines, derived_seed, shake_lines, stage_list, steps_of, thermostat_lines,
                                  water_forcefield_names)
 
@@ -66,8 +67,8 @@ class SurfaceTension(Workflow):
         steps, ids, pos, box = ctx.frames("film")
         area = float(info["box_A"][0] * info["box_A"][1])
         nb = min(s["n_blocks"], max(2, len(steps)))
-        dens = A.slab_density(pos[:, :, 2], WATER_MASS, area, lz_A=None, bin_A=s["bin_A"], n_blocks=nb)
-        rho_n = U.kg_per_m3_to_g_per_cm3(dens["value"]) * U.AVOGADRO / WATER_MASS * 1e-24     # O per A^3
+        dens = A.slab_density(pos[:, :, 2], SPCE_WATER_MOLAR_MASS, area, lz_A=None, bin_A=s["bin_A"], n_blocks=nb)
+        rho_n = U.kg_per_m3_to_g_per_cm3(dens["value"]) * U.AVOGADRO / SPCE_WATER_MOLAR_MASS * 1e-24     # O per A^3
         tail = A.lj_tail_correction(info["lj_epsilon_kcal"], info["lj_sigma_A"], rho_n, s["cutoff_A"],
                                     width_A=dens["width_A"])
         st = A.surface_tension(d["pxx"], d["pyy"], d["pzz"], d["lz"], tail_correction_N_per_m=tail,

@@ -7,9 +7,9 @@ wsl_ti
     through the same charge stage as the reference. On OTS the water-TraPPE dispersion beyond the cutoff is added
     statically from the film leg's framed second half, as on the OTS droplets. W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which
     derives it), then theta from Young-Dupre, or "wets" with the spreading coefficient when W_SL >= 2 gamma_lv.
-    Why: a quick droplet on silica keeps the angle it was started at (the contact line is pinned over 120 ps), so
-    a droplet cannot say whether the surface wets; issue 11 asks for W_SL measured directly. On OTS the quick
-    droplets are not size-converged (109 deg at R0 = 2 nm, 125 deg at 3 nm); W_SL has no droplet size.
+    Why: a droplet's contact line can stay pinned for the whole of a short run, so a droplet cannot say whether the
+    surface wets, and its angle depends on its size; W_SL measured directly has neither problem (Leroy &
+    Mueller-Plathe, Langmuir 31 (2015) 8335).
 """
 from __future__ import annotations
 
@@ -102,18 +102,14 @@ class WslTI(Workflow):
     nodes again, each starting from the state its film node starts from with the water deleted). Every node equilibrates ``ti_equilibrate_steps`` and samples
     ``ti_sample_steps``; dU/dlambda is sampled every ``sample_interval`` steps by two ``compute fep``.
 
-    Version 2: with the water present, the water and the solid's mobile atoms have a thermostat
-    each (:func:`md.workflows.common.split_thermostat_lines`), and both temperatures are sampled and reported.
-    Version 1 thermostatted them together: on the OTS film the water ran at 420 K and the SAM at 165 K after the
-    film leg, and at the LJ stage's small lambda, where film and solid barely interact, nothing could equalise
-    them (the silica film's water read 307 K).
+    With the water present, the water and the solid's mobile atoms have a thermostat each
+    (:func:`md.workflows.common.split_thermostat_lines`), and both temperatures are sampled and reported: at the
+    LJ stage's small lambda, where film and solid barely interact, nothing else could equalise them.
 
-    Version 3 (this protocol): each reference node starts from its film node's starting state, water deleted.
-    Version 2 ran the reference nodes in a chain from the substrate leg's last state: the two solids then sat in
-    different slow configurations (silanol orientations, SAM head groups), and their solid-solid share of
-    dU/dlambda_q, tens of thousands of kcal/mol, no longer cancelled to the few kcal/mol W_SL needs: on OTS, under
-    2 nm of uncharged chains, the electrostatic part read -5.5 +- 2.7 mJ/m^2, all of it from one node (film
-    minus reference +21 +- 7 kcal/mol at lambda_q = 0.89)."""
+    Each reference node starts from its film node's starting state, water deleted, so the solid's slow
+    configuration (silanol orientations, SAM head groups) is the same in both: the solid-solid share of
+    dU/dlambda_q is tens of thousands of kcal/mol and must cancel to the few kcal/mol W_SL needs. ``version`` (3)
+    enters the run hash."""
     name = "wsl_ti"
     version = 3
     yields = {"work_of_adhesion_sl": "J/m^2", "contact_angle": "deg", "spreading_coefficient": "J/m^2",
@@ -162,8 +158,7 @@ class WslTI(Workflow):
         nodes = self.nodes(s)
 
         def base(with_water: bool, step: int, salt: int) -> list[str]:
-            # with the water: one thermostat on the water, one on the solid's mobile atoms (version 2; version 1's
-            # single thermostat left the OTS film's water at 420 K and its SAM at 165 K), each one's temperature
+            # with the water: one thermostat on the water, one on the solid's mobile atoms, each one's temperature
             # sampled
             return (common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake +
                     ["fix hold frozen setforce 0.0 0.0 0.0"] +
@@ -266,7 +261,7 @@ class WslTI(Workflow):
                          {"stage": "dispersion", "lambda": float(lam), "system": "film"})
             legs.append(leg)
             prev, salt = leg, salt + 1
-        # version 3: each reference node starts from the state its film node starts from, the water deleted, so
+        # each reference node starts from the state its film node starts from, the water deleted, so
         # that the solid's slow configuration (silanols, SAM heads) is the same in both and its solid-solid share
         # of dU/dlambda_q cancels in the difference
         for k, lam in enumerate(nodes["q"]):
