@@ -32,6 +32,25 @@ keeps the bridge in equilibrium with the vapour). Its energy U(g) = -int_g^{D_K}
 so dU/dg = F (F pulls the surfaces together), U(D_K) = 0: rupture costs nothing and the whole
 work a bridge does on the body is -U(g_formed), booked when it forms.
 
+Solid-solid adhesion inside a bridge (``menisci.solid_adhesion``)
+-----------------------------------------------------------------
+Where a bridge stands, the two solids touch under liquid, not in vapour. The work to separate them
+across the liquid L is (Dupre in a medium; Israelachvili 2011 §17.7, Butt & Kappl 2009 §2.6)
+
+    W_wet = gamma_1L + gamma_2L - gamma_12,
+
+and with Young's gamma_iL = gamma_i - gamma_lv cos theta_i and the dry Dupre W = gamma_1 + gamma_2 - gamma_12
+(the scene's work of adhesion dgamma)
+
+    W_wet = dgamma - gamma_lv (cos theta1 + cos theta2).
+
+A negative W_wet means the liquid pushes the solids apart (it wets between them): no solid-solid
+adhesion is left. For a summit in contact the DMT solid pull is 2 pi beta W, so replacing dgamma by
+max(W_wet, 0) inside a bridge takes 2 pi beta (dgamma - max(W_wet, 0)) from each compressed bridged
+summit; where W_wet >= 0 that is exactly F0, so the sphere-flat wet pull-off is the dry one,
+2 pi beta dgamma (Israelachvili 2011 eq 17.25 for r_K << beta), not dry + F0 (the paper's additive
+eq 14). The summits' JKR hysteresis loop keeps its dry dgamma: the correction is DMT's force, stated.
+
 When bridges form (paper eq 12, corrected; Riedo et al. PRL 88 (2002) 185505)
 -----------------------------------------------------------------------------
 Condensation is thermally activated: filling a gap h costs a barrier proportional to the volume
@@ -90,29 +109,51 @@ def bridge_pull_off(radius: float, surface_tension: float, theta1: float, theta2
     return 2.0 * math.pi * radius * surface_tension * max(wetting_sum(theta1, theta2), 0.0)
 
 
-def bridge_force(gap, f0: float, d_k: float):
-    """Attractive force (N, >= 0) of one bridge at summit gap `gap` (m; < 0 = compressed)."""
+def wet_work_of_adhesion(work_of_adhesion: float, surface_tension: float, theta1: float, theta2: float) -> float:
+    """W_wet = dgamma - gamma_lv (cos theta1 + cos theta2) (J/m^2): the solids' work of adhesion under the liquid
+    (Dupre in a medium with Young's law; Israelachvili 2011 §17.7). Negative: the liquid separates them."""
+    return work_of_adhesion - surface_tension * wetting_sum(theta1, theta2)
+
+
+def solid_pull_inside_bridge(radius: float, work_of_adhesion: float, surface_tension: float, theta1: float,
+                             theta2: float, choice: str) -> float:
+    """Solid-solid pull (N, >= 0) a bridge takes from each compressed summit it wets: 2 pi beta (dgamma - max(W_wet, 0))
+    for choice 'wet', 0 for 'additive' (the paper's eq 14: the bridge adds to the dry adhesion)."""
+    if choice == "additive":
+        return 0.0
+    if choice != "wet":
+        raise ValueError(f"menisci.solid_adhesion = {choice!r}: 'wet' or 'additive'")
+    w_wet = wet_work_of_adhesion(work_of_adhesion, surface_tension, theta1, theta2)
+    return 2.0 * math.pi * radius * (work_of_adhesion - max(w_wet, 0.0))
+
+
+def bridge_force(gap, f0: float, d_k: float, solid_pull: float = 0.0):
+    """Attractive force (N) of one bridge at summit gap `gap` (m; < 0 = compressed), less the solid pull it takes
+    from a compressed summit (`solid_pull_inside_bridge`, N; 0 for the paper's additive law)."""
     g = np.asarray(gap, float)
-    out = np.where(g <= 0.0, f0 * (1.0 - g / (2.0 * d_k)), f0 * (1.0 - g / d_k))
+    out = np.where(g <= 0.0, f0 * (1.0 - g / (2.0 * d_k)) - solid_pull, f0 * (1.0 - g / d_k))
     return np.where(g < d_k, out, 0.0)
 
 
-def bridge_energy(gap, f0: float, d_k: float):
-    """Energy (J, <= 0) of one bridge, U(g) = -int_g^{D_K} F dg', zero at rupture."""
+def bridge_energy(gap, f0: float, d_k: float, solid_pull: float = 0.0):
+    """Energy (J) of one bridge, U(g) = -int_g^{D_K} F dg', zero at rupture (F with its `solid_pull`, N)."""
     g = np.asarray(gap, float)
     inside = -f0 * (d_k - g) ** 2 / (2.0 * d_k)
-    compressed = -f0 * (0.5 * d_k - g + g * g / (4.0 * d_k))
+    compressed = -f0 * (0.5 * d_k - g + g * g / (4.0 * d_k)) - solid_pull * g
     return np.where(g < d_k, np.where(g <= 0.0, compressed, inside), 0.0)
 
 
 #: U(g) and F(g) as polynomials a0 + a1 g + a2 g^2 on the two pieces, in units of F0 (force) and
 #: F0 D_K (energy), with g in units of D_K: (compressed g <= 0, stretched 0 < g < 1).
-def bridge_polynomials(kind: str) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """Coefficients (a0, a1, a2) of the normalised bridge law on (g <= 0, 0 < g < 1); kind 'force'/'energy'."""
+def bridge_polynomials(kind: str, solid: float = 0.0) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """Coefficients (a0, a1, a2) of the normalised bridge law on (g <= 0, 0 < g < 1); kind 'force'/'energy'.
+
+    `solid` = the solid pull a bridge takes from a compressed summit (`solid_pull_inside_bridge`) over F0: a
+    constant -solid F0 on g <= 0, and its energy -solid F0 (-g) there (U stays continuous at g = 0)."""
     if kind == "force":
-        return (1.0, -0.5, 0.0), (1.0, -1.0, 0.0)
+        return (1.0 - solid, -0.5, 0.0), (1.0, -1.0, 0.0)
     if kind == "energy":
-        return (-0.5, 1.0, -0.25), (-0.5, 1.0, -0.5)
+        return (-0.5, 1.0 - solid, -0.25), (-0.5, 1.0, -0.5)
     raise ValueError(f"kind = {kind!r}: 'force' or 'energy'")
 
 

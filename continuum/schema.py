@@ -138,6 +138,10 @@ FIELDS: tuple[Field, ...] = (
     Field("menisci.condensation_model", str, "", "'fixed' (t_a = condensation_time) or 'nucleation' (thermally "
           "activated: t_a = tau0 exp(dE(RH)/kT), dE = 7.8e-20 J ln(1/RH)/ln(1/0.4), tau0 = 2.6e-11 s, fitted to "
           "Szoszkiewicz & Riedo 2005: 4.2 ms at 40% RH, 299 K).", "fixed", choices=("fixed", "nucleation")),
+    Field("menisci.solid_adhesion", str, "", "Solid-solid adhesion of a summit inside a bridge: 'wet' (the work "
+          "of adhesion under the liquid, dgamma - gamma_lv (cos t1 + cos t2), Israelachvili 2011 §17.7: the bridge "
+          "replaces part of the dry pull) or 'additive' (the paper's eq 14: bridges add to the dry dgamma).", "wet",
+          choices=("wet", "additive")),
     Field("menisci.growth_length", float, "m", "h1 in h_mw(t) = h1 ln(t/t_a), the growth of the bridgeable gap "
           "(Riedo et al. 2002). Not set: 1/(n_w d_w^2 ln(1/RH)), one water molecule's cross-section d_w^2 as the "
           "condensing column.", None, low=1e-12, high=1e-6),

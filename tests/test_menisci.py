@@ -226,3 +226,76 @@ def test_condensation_time_is_computed_once_for_every_record(rh):
     if rh > 0.0 and rh < 1.0:
         from continuum.model.regime import meniscus_parameters
         assert meniscus_parameters(scene)["condensation_time"] == t_a
+
+
+# ------------------------------------------------------------------------------ solid adhesion inside a bridge
+def test_wet_work_of_adhesion_is_dupre_in_the_liquid():
+    # Israelachvili 2011 §17.7 (combining relation): W_132 = W_12 + W_33 - W_13 - W_23 with W_33 = 2 gamma_lv and
+    # the Young-Dupre W_i3 = gamma_lv (1 + cos theta_i); the formula under test writes it dgamma - gamma (c1 + c2)
+    w12, gamma, t1, t2 = 0.12, 0.072, math.radians(20.0), math.radians(60.0)
+    w132 = w12 + 2 * gamma - gamma * (1 + math.cos(t1)) - gamma * (1 + math.cos(t2))
+    assert men.wet_work_of_adhesion(w12, gamma, t1, t2) == pytest.approx(w132, rel=1e-14, abs=0)
+    # from the surface and interfacial energies directly: gamma_iL = gamma_i - gamma cos(theta_i) (Young)
+    g1, g2 = 0.25, 0.20
+    g12 = g1 + g2 - w12
+    w_direct = (g1 - gamma * math.cos(t1)) + (g2 - gamma * math.cos(t2)) - g12
+    assert men.wet_work_of_adhesion(w12, gamma, t1, t2) == pytest.approx(w_direct, rel=1e-14, abs=0)
+
+
+@pytest.mark.parametrize("w12", [0.196, 0.05])
+def test_wet_sphere_flat_pull_at_touch_is_the_dry_dmt_pull_not_dry_plus_the_bridge(w12):
+    """r_K << beta: the solid pull under the liquid 2 pi beta max(W_wet, 0) plus the bridge's F0 (Israelachvili 2011
+    eq 17.25: the wet pull-off equals the dry 2 pi beta dgamma when the liquid leaves the solids adhering)."""
+    gamma, theta = 0.064, 0.0
+    f0 = men.bridge_pull_off(BETA, gamma, theta, theta)
+    solid = men.solid_pull_inside_bridge(BETA, w12, gamma, theta, theta, "wet")
+    dry_dmt = 2 * math.pi * BETA * w12
+    total = dry_dmt + float(men.bridge_force(0.0, f0, DK, solid))
+    w_wet = w12 - 2 * gamma
+    want = dry_dmt if w_wet >= 0 else f0      # W_wet < 0: no solid adhesion left, the bridge alone pulls
+    assert total == pytest.approx(want, rel=1e-12, abs=0)
+    assert men.solid_pull_inside_bridge(BETA, w12, gamma, theta, theta, "additive") == 0.0
+    with pytest.raises(ValueError, match="solid_adhesion"):
+        men.solid_pull_inside_bridge(BETA, w12, gamma, theta, theta, "both")
+
+
+def test_bridge_force_with_solid_pull_is_the_derivative_of_its_energy():
+    solid = 0.9 * F0
+    g = np.linspace(-2 * DK, 1.2 * DK, 301)
+    h = 1e-6 * DK
+    fd = (men.bridge_energy(g + h, F0, DK, solid) - men.bridge_energy(g - h, F0, DK, solid)) / (2 * h)
+    away = (np.abs(g) > 2 * h) & (np.abs(g - DK) > 2 * h)
+    np.testing.assert_allclose(fd[away], men.bridge_force(g, F0, DK, solid)[away], rtol=1e-6, atol=1e-9 * F0)
+    # energy continuous at touch: the solid term only acts on compressed summits
+    assert float(men.bridge_energy(-1e-15 * DK, F0, DK, solid)) == pytest.approx(
+        float(men.bridge_energy(1e-15 * DK, F0, DK, solid)), rel=1e-12, abs=0)
+
+
+@pytest.mark.parametrize("gap, s", [(-2e-9, -3e-9), (-1e-9, -8e-9)])
+def test_bridge_sum_with_solid_pull_matches_a_brute_force_grid(gap, s):
+    solid = 0.8 * F0
+    b = _bridges()
+    b.set_solid_pull(solid)
+    s = max(s, gap - DK)
+    xmax = math.sqrt(2 * R * -s)
+    x = np.linspace(-xmax, xmax, 2001)
+    z = np.linspace(Z_TOP - 12e-9, Z_TOP, 12001)
+    X, Z = np.meshgrid(x, z, indexing="ij")
+    u = Z - Z_TOP - X * X / (2 * R)
+    g = gap - u
+    phi = np.exp(-0.5 * (Z / SIGMA) ** 2) / (SIGMA * math.sqrt(2 * math.pi))
+    mask = u >= s
+    for kind, fn in (("force", men.bridge_force), ("energy", men.bridge_energy)):
+        want = np.trapezoid(np.trapezoid(np.where(mask, fn(g, F0, DK, solid), 0) * phi, z, axis=1), x) * L * DENSITY
+        assert b._integral(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
+        assert b._integral_numpy(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
+
+
+def test_measured_sets_use_the_wet_solid_adhesion_and_the_paper_set_declares_additive():
+    rec = {}
+    for params in ("paper", "calibrated"):
+        scene = resolve_scene(ROOT / "inputs" / "scenes" / "wet_silica.toml", params=params).scene
+        from continuum.models import meniscus_parameters
+        rec[params] = meniscus_parameters(scene)
+    assert rec["paper"]["solid_adhesion"] == "additive" and rec["paper"]["solid_pull"] == 0.0
+    assert rec["calibrated"]["solid_adhesion"] == "wet" and rec["calibrated"]["solid_pull"] > 0.0

@@ -41,8 +41,12 @@ from .base import ContactLaw
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
-#: The bridge law's coefficients per kind, as the compiled kernel takes them.
-_COEFFS = {kind: tuple(np.array(c, dtype=float) for c in men.bridge_polynomials(kind)) for kind in ("force", "energy")}
+
+
+def _coefficients(solid: float) -> dict:
+    """The bridge law's coefficients per kind, as the compiled kernel takes them (`solid`: solid pull / F0)."""
+    return {kind: tuple(np.array(c, dtype=float) for c in men.bridge_polynomials(kind, solid))
+            for kind in ("force", "energy")}
 
 
 def _moments(a, b):
@@ -63,15 +67,23 @@ class MeniscusBridges:
 
     stats: SummitStatistics (sigma m, density 1/m^2, radius m); z_top: tallest summit (m above the
     summit mean plane); radius R and length l of the roller (m); f0 (N) and d_k (m) per bridge; t_a (s)
-    and growth length h1 (m) of h_mw(t).
+    and growth length h1 (m) of h_mw(t); solid_pull (N): the solid-solid pull a bridge takes from each
+    compressed summit it wets (``continuum.menisci.solid_pull_inside_bridge``; 0 = the paper's additive eq 14).
     """
 
     def __init__(self, stats, z_top: float, radius: float, length: float, f0: float, d_k: float,
-                 t_a: float, growth_length: float):
+                 t_a: float, growth_length: float, solid_pull: float = 0.0):
         self.sigma, self.density = stats.sigma, stats.density
         self.z_top, self.radius, self.length = z_top, radius, length
         self.f0, self.d_k, self.t_a, self.h1 = f0, d_k, t_a, growth_length
+        self.set_solid_pull(solid_pull)
         self.reset()
+
+    def set_solid_pull(self, solid_pull: float) -> None:
+        """Take `solid_pull` (N) from every compressed bridged summit (the wet solid-solid adhesion)."""
+        self.solid_pull = float(solid_pull)
+        self.solid = self.solid_pull / self.f0 if self.f0 > 0.0 else 0.0
+        self.coeffs = _coefficients(self.solid)
 
     def reset(self) -> None:
         self.s = math.inf                 # bridged summits: u >= s
@@ -95,7 +107,7 @@ class MeniscusBridges:
         Compiled (`continuum.laws.bridge_kernel`, ~30x faster); `_integral_numpy` is the same sum in NumPy,
         the reference the kernel is tested against."""
         g_hi, g_lo = formed_at if formed_at is not None else (0.0, 0.0)
-        comp, stretch = _COEFFS["energy" if kind == "count" else kind]
+        comp, stretch = self.coeffs["energy" if kind == "count" else kind]
         return bk.bridge_integral(bk.KINDS[kind], float(gap), float(s_lo), float(s_hi), formed_at is not None,
                                   float(g_hi), float(g_lo), self.z_top, self.radius, self.length, self.density,
                                   self.sigma, self.f0, self.d_k, comp, stretch, _GL_X, _GL_W)
@@ -123,7 +135,7 @@ class MeniscusBridges:
         if kind == "count":
             total = _moments(lo / sig, hi / sig)[0]
         else:
-            comp, stretch = men.bridge_polynomials(kind)
+            comp, stretch = men.bridge_polynomials(kind, self.solid)
             scale = self.f0 if kind == "force" else self.f0 * self.d_k
             alpha, beta = d / self.d_k, -sig / self.d_k      # g/D_K = alpha + beta t, t = z/sigma
             pieces = ((comp, (np.maximum(lo, d), hi)), (stretch, (lo, np.minimum(hi, d))))
@@ -197,6 +209,8 @@ class WetRoughRoller(ContactLaw):
 
     def __init__(self, dry: ContactLaw, bridges: MeniscusBridges, record: dict):
         self.dry, self.bridges, self.record = dry, bridges, record
+        if record.get("solid_pull"):
+            bridges.set_solid_pull(record["solid_pull"])
         self.name = dry.name + "+menisci"
         self.touch_gap = dry.touch_gap
         self.z_top = dry.z_top

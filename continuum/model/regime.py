@@ -124,8 +124,12 @@ def meniscus_parameters(scene: Scene) -> dict:
     beta = surf.roughness.summit_radius
     t_a, t_src = condensation_time(scene)
     h1 = m.growth_length if m.growth_length is not None else men.default_growth_length(rh)
+    w = surf.interface_work_of_adhesion
     return {"kelvin_radius": r_k, "kelvin_gap": d_k, "kelvin_gap_over_summit_radius": d_k / beta,
             "bridge_pull_off": men.bridge_pull_off(beta, m.surface_tension, t1, t2),
+            "solid_adhesion": m.solid_adhesion,
+            "work_of_adhesion_wet": men.wet_work_of_adhesion(w, m.surface_tension, t1, t2),
+            "solid_pull": men.solid_pull_inside_bridge(beta, w, m.surface_tension, t1, t2, m.solid_adhesion),
             "condensation_time": t_a, "condensation_time_source": t_src, "growth_length": h1,
             "growth_length_source": "menisci.growth_length" if m.growth_length is not None
             else "1/(n_w^(1/3) ln(1/RH)) (one molecule's cross-section)",
