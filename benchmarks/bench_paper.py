@@ -113,7 +113,7 @@ def per_impact(repeat: int, resolution: str = "standard") -> dict:
     from continuum.compiled_contact import run_compiled
     from continuum.driver import DriverSettings, simulate
     from continuum.impact import first_impact_speed
-    from continuum.models import select_law
+    from continuum.model import select_law
     from continuum.scene import resolve_scene
 
     resolved = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params="paper",

@@ -22,7 +22,9 @@ import time
 import numpy as np
 
 from continuum.reference import jkr
-from continuum.rough.gw import RESOLUTIONS, GWJKRSurface, SummitStatistics, expected_max_height
+from continuum.rough.gw import GWJKRSurface
+from continuum.rough.gw_layout import RESOLUTIONS
+from continuum.rough.summits import SummitStatistics, expected_max_height
 
 BETA, DGAMMA, ESTAR, DENSITY = 0.2e-6, 0.1, 10e9, 1e13
 DELTA_C = float(jkr.critical_approach(BETA, DGAMMA, ESTAR))

@@ -436,7 +436,7 @@ def uncertainty_sample(task: tuple) -> dict:
     scene, params, overrides, max_bounces = task
     from continuum.escape import escape_velocity, single_impact
     from continuum.impact import first_impact_speed, run_impact
-    from continuum.models import select_law
+    from continuum.model import select_law
     from continuum.scene import SceneError, resolve_scene
 
     try:

@@ -1,5 +1,5 @@
 """Before a rough impact runs: how deep it presses, how many summits it touches, how far the
-half-space under it deflects. `continuum.models` uses these numbers to decide which models a
+half-space under it deflects. `continuum.model` uses these numbers to decide which models a
 scene needs (`auto`), and records them.
 
 The estimate is the quasi-static first approach of the roller onto non-adhesive (Hertz) summits
@@ -12,7 +12,7 @@ gaps relative to the rigid geometry. Cost: ~10-50 ms.
 
 Bounded cost (`check_table_cost`): before any table is built, the memory the averaged model's
 GW tables would take is estimated from the scene (the window table grows like (delta_c/sigma)^2,
-`continuum.rough.gw.table_size`) and so is the time of the rigid-substrate footprint tables (nodes
+`continuum.rough.gw_layout.table_size`) and so is the time of the rigid-substrate footprint tables (nodes
 over the range of gaps, `continuum.laws.costs.table_shape`, times a measured cost per surface state).
 A scene beyond `MEMORY_BOUND_BYTES` or `continuum.laws.costs.MAX_BUILD_SECONDS` is refused
 with a one-line `SceneError` naming the key, the value, the estimate and the way out (discrete
@@ -104,7 +104,7 @@ def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_
     Raises `continuum.scene.SceneError` (key surfaces.roughness.sigma) with a one-line reason.
     """
     from .laws.costs import MAX_BUILD_SECONDS, SECONDS_PER_STATE, table_cost_refusal, table_shape
-    from .rough.gw import table_size
+    from .rough.gw_layout import table_size
     from .scene import SceneError
 
     sigma = stats.sigma

@@ -11,7 +11,8 @@ from continuum.reference import jkr as jkr_ref
 from continuum.reference import maugis as md_ref
 from continuum.rough.branch_laws import DUGDALE_FACTOR, make_summit_law
 from continuum.rough.datum import tallest_summit
-from continuum.rough.gw import GWJKRSurface, SummitStatistics, gw_integral
+from continuum.rough.gw import GWJKRSurface
+from continuum.rough.summits import SummitStatistics, gw_integral
 from continuum.rough.gw_branches import GWBranchSurface, quadrature_pressure
 
 BETA, W, E = 0.2e-6, 0.12, 10e9                 # the `paper` set's summits

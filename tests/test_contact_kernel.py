@@ -26,7 +26,7 @@ from continuum.compiled_contact import power_law, run_compiled
 from continuum.driver import DriverSettings, simulate
 from continuum.escape import escape_velocity, single_impact
 from continuum.impact import first_impact_speed
-from continuum.models import select_law
+from continuum.model import select_law
 from continuum.reference import hertz as ref
 from continuum.scene import resolve_scene
 

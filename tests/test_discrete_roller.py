@@ -16,10 +16,10 @@ import pytest
 
 from continuum.driver import DriverSettings, simulate
 from continuum.laws.discrete_roller import DiscreteRoughRoller
-from continuum.models import rough_law
+from continuum.model import rough_law
 from continuum.reference import jkr as ref
 from continuum.rough.datum import tallest_summit
-from continuum.rough.gw import SummitStatistics
+from continuum.rough.summits import SummitStatistics
 from continuum.scene import resolve_scene
 
 # the paper's roller and the `paper` set's summits, written out so the test does not follow edits of inputs/
@@ -249,7 +249,7 @@ def test_few_contacts_discrete_rebound_departs_from_the_average():
 def test_a_too_deep_discrete_approach_refuses_the_scene_naming_sigma():
     """Every rough roller refuses an approach beyond the rough model's range as a scene error naming
     surfaces.roughness.sigma (the CLI's input-error exit code), the discrete one included."""
-    from continuum.models import select_law
+    from continuum.model import select_law
     from continuum.scene import SceneError, resolve_scene
 
     scene = resolve_scene("rough_silica", params="paper", overrides={"surfaces.roughness.mode": "discrete"}).scene

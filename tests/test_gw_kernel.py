@@ -24,7 +24,7 @@ import pytest
 from continuum.model.factory import averaged_surface
 from continuum.reference import jkr
 from continuum.rough import gw_kernel as gk
-from continuum.rough.gw import SummitStatistics, expected_max_height
+from continuum.rough.summits import SummitStatistics, expected_max_height
 
 ROOT = Path(__file__).resolve().parents[1]
 TOL = 1e-12
@@ -55,7 +55,7 @@ def built(name):
     """The surface of CASES[name], or the rough_silica scene's own ("scene")."""
     if name == "scene":
         from continuum.impact import first_impact_speed
-        from continuum.models import select_law
+        from continuum.model import select_law
         from continuum.scene import resolve_scene
 
         resolved = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params="paper",

@@ -8,7 +8,7 @@ import pytest
 
 from continuum import regimes
 from continuum.impact import first_impact_speed, run_impact
-from continuum.models import TABOR_DMT, TABOR_JKR, decide_adhesion, select_law
+from continuum.model import TABOR_DMT, TABOR_JKR, adhesion_decision, regime_of, select_law
 from continuum.scene import resolve_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -58,7 +58,8 @@ def test_menisci_left_out_when_no_contact_lasts_t_a_is_safe():
 def test_summit_law_follows_the_tabor_parameter(z0, law):
     r = resolve_scene(SCENES / "rough_silica.toml", overrides={"physics.adhesion_law": "auto",
                                                                "surfaces.interaction_range": z0})
-    chosen, rec = decide_adhesion(r.scene)
+    decision = adhesion_decision(r.scene, regime_of(r.scene))
+    chosen, rec = decision.law, decision.record()
     mu = regimes.tabor_parameter(0.2e-6, 0.12, 10e9, z0)       # the `paper` summits, written out
     assert rec["tabor_parameter"] == pytest.approx(mu, rel=1e-12, abs=0)
     expected = "jkr" if mu > TABOR_JKR else "dmt" if mu < TABOR_DMT else "maugis_dugdale"
@@ -107,7 +108,7 @@ def test_the_dry_run_settles_a_pending_meniscus_decision_at_t_a():
 def test_discrete_summits_record_the_law_that_runs_and_what_the_map_suggests():
     """Discrete summits run JKR where Johnson & Greenwood's map says Maugis-Dugdale: models.adhesion.law is
     the law that runs (as models.contact_law says), map_suggests the map's, and a warning says so."""
-    from continuum.models import select_law
+    from continuum.model import select_law
     from continuum.scene import resolve_scene
     from continuum.warnings import model_warnings
 

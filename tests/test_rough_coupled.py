@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from continuum.reference import jkr
-from continuum.rough.gw import GWJKRSurface, SummitStatistics, expected_max_height
+from continuum.rough.gw import GWJKRSurface
+from continuum.rough.summits import SummitStatistics, expected_max_height
 
 BETA, DGAMMA, ESTAR, DENSITY = 1e-7, 0.1, 38e9, 1e14
 DELTA_C = float(jkr.critical_approach(BETA, DGAMMA, ESTAR))

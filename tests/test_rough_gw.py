@@ -22,8 +22,9 @@ import pytest
 from scipy import integrate, optimize, special
 
 from continuum.reference import jkr
-from continuum.rough.gw import (TENSILE_ONSET, GWJKRSurface, SummitStatistics, expected_max_height,
-                                quadrature_energy, quadrature_pressure)
+from continuum.rough.gw import GWJKRSurface
+from continuum.rough.gw_reference import quadrature_energy, quadrature_pressure
+from continuum.rough.summits import TENSILE_ONSET, SummitStatistics, expected_max_height
 
 BETA, DGAMMA, ESTAR, DENSITY = 1e-7, 0.1, 38e9, 1e14      # silica-like summits, n = 100 per um^2
 DELTA_C = float(jkr.critical_approach(BETA, DGAMMA, ESTAR))

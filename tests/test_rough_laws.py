@@ -14,7 +14,7 @@ from continuum.driver import DriverSettings, simulate
 from continuum.impact import run_impact
 from continuum.laws.rough_rigid import RigidRoughRoller
 from continuum.laws.rough_roller import RoughRoller
-from continuum.models import rough_law
+from continuum.model import rough_law
 from continuum.scene import resolve_scene
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -51,7 +51,7 @@ import numpy as np
 from ..physics import jkr_kernel as jk
 from ..reference import jkr as ref
 from ..rough.datum import tallest_summit
-from ..rough.gw import SummitStatistics
+from ..rough.summits import SummitStatistics
 from .roller_base import RoughRollerBase
 
 #: Up to this many attached summits the per-summit laws run in scalar arithmetic

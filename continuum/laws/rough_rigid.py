@@ -27,7 +27,7 @@ For JKR and DMT summits r_in = reach = 0.
 The driver stops a contact at the first turn while attached (stuck), so within a contact the path
 is one monotonic approach and one monotonic retreat and (h, h_min) describe it exactly. This law
 is the half-space-off counterpart of `RoughRoller` (which keeps a grid because the elastic
-deflection makes d - zeta vary across x); `tests/test_rough_rigid.py` compares the two.
+deflection makes d - zeta vary across x); `tests/test_rough_laws.py` compares the two.
 """
 from __future__ import annotations
 
@@ -37,11 +37,8 @@ import numpy as np
 from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 from ..rough.surface import SummitSurface
-from .costs import _BLOCK_STATES, MAX_BUILD_SECONDS, RESOLUTION, SECONDS_PER_STATE, table_cost_refusal, table_shape
+from .costs import _BLOCK_STATES, RESOLUTION, table_cost_refusal, table_shape
 from .roller_base import RoughRollerBase
-
-# the costs and bounds live in `continuum.laws.costs`; their old names here still work
-__all__ = ["RigidRoughRoller", "RESOLUTION", "MAX_BUILD_SECONDS", "SECONDS_PER_STATE", "table_cost_refusal"]
 
 
 class RigidRoughRoller(RoughRollerBase):

@@ -33,11 +33,8 @@ import numpy as np
 
 from ..halfspace import solve_coupled
 from ..rough.surface import SummitSurface
-from .costs import MAX_RUN_SECONDS, SECONDS_PER_STATE, beyond_range
+from .costs import MAX_RUN_SECONDS, SECONDS_PER_STATE
 from .roller_base import RoughRollerBase
-
-# the costs and bounds live in `continuum.laws.costs`; their old names here still work
-__all__ = ["RoughRoller", "MAX_RUN_SECONDS", "SECONDS_PER_STATE", "beyond_range"]
 
 
 class RoughRoller(RoughRollerBase):

@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 from .. import menisci as men
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
-from .regime import Regime, meniscus_parameters, regime_of, sam_layer, summit_e_star
+from .regime import Regime, meniscus_parameters, sam_layer, summit_e_star
 
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
 TABOR_JKR, TABOR_DMT = 5.0, 0.1
@@ -172,12 +172,6 @@ def for_discrete_summits(decision: AdhesionDecision) -> AdhesionDecision:
                                       "this law)")
 
 
-def decide_adhesion(scene: Scene, estimate=None) -> tuple[str, dict]:
-    """Summit (or sphere) adhesion law for `scene` and the record of why (`adhesion_decision`, as a pair)."""
-    d = adhesion_decision(scene, regime_of(scene, estimate=estimate))
-    return d.law, d.record()
-
-
 # ----------------------------------------------------------------------------- half-space
 @dataclass(frozen=True)
 class HalfSpaceDecision:
@@ -220,12 +214,6 @@ def half_space_decision(scene: Scene, regime: Regime) -> HalfSpaceDecision:
            + (">= " if used else "< ") + f"{NEGLIGIBLE_DEFLECTION:g} sigma: "
            + ("coupled (FFT influence coefficients)" if used else "left out, rigid substrate"))
     return HalfSpaceDecision(used, "deflection_over_sigma", why, **numbers)
-
-
-def decide_half_space(scene: Scene, estimate) -> tuple[bool, dict]:
-    """Whether the rough contact couples its summits to the elastic half-space, and why (as a pair)."""
-    d = half_space_decision(scene, regime_of(scene, estimate=estimate))
-    return d.used, d.record()
 
 
 # ----------------------------------------------------------------------------- menisci
@@ -277,12 +265,6 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
         return MenisciDecision("on", "scene", "physics.menisci = 'on' set in the scene", rh, **numbers)
     return MenisciDecision("after_dry_run", "longest_contact_time",
                            "auto: decided after a dry run (bridges cannot form before t_a)", rh, **numbers)
-
-
-def decide_menisci(scene: Scene) -> tuple[str, dict]:
-    """'off', 'on' or 'after_dry_run', with the record of why (`menisci_decision`, as a pair)."""
-    d = menisci_decision(scene)
-    return d.choice, d.record()
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ def impact_estimate(scene: Scene, speed: float) -> RoughImpactEstimate:
     """Quasi-static first approach of Hertz summits on a rigid substrate absorbing an impact at `speed` (m/s)
     (`continuum.estimates`): depth, contacts, peak force and the half-space's deflection span."""
     from ..rough.datum import tallest_summit
-    from ..rough.gw import SummitStatistics
+    from ..rough.summits import SummitStatistics
 
     body, rough = scene.body, scene.surfaces.roughness
     datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)

@@ -42,7 +42,7 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     scene beyond the bounds is refused with a `SceneError` (`continuum.estimates.check_table_cost`).
     """
     from ..rough.datum import tallest_summit
-    from ..rough.gw import SummitStatistics
+    from ..rough.summits import SummitStatistics
 
     body, surf, phys = scene.body, scene.surfaces, scene.physics
     rough = surf.roughness

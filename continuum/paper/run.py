@@ -25,7 +25,7 @@ from nanoimpact.executors import executor as make_executor
 from ..compiled_contact import warm_up
 from ..escape import escape_velocity, single_impact
 from ..impact import first_impact_speed, run_impact, write_impact
-from ..models import decide_menisci, meniscus_parameters, select_law
+from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 
@@ -104,7 +104,8 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     v0 = first_impact_speed(resolved)
     mass, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
     dry, _ = select_law(scene, v0, menisci=False)
-    wet_possible = decide_menisci(scene)[0] != "off"
+    menisci = menisci_decision(scene)
+    wet_possible = menisci.choice != "off"
     wet = select_law(scene, v0, menisci=True)[0] if wet_possible else None
     grid = [v0 * f for f in FIG8_SPEED_FACTORS]
     # each dry impact runs once: the grid's outcomes are reused by the near-escape sweep below
@@ -132,7 +133,7 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     return {"kind": "wet", "case": case.name, "set": Path(params).stem, "points": points, "escape_dry": esc_dry,
             "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": m.get("condensation_time"),
             "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length")} if m else None,
-            "why_no_menisci": None if wet_possible else decide_menisci(scene)[1]["why"],
+            "why_no_menisci": None if wet_possible else menisci.why,
             "gravity": g, "v_drop": v0, "sigma": scene.surfaces.roughness.sigma}
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from .gw import expected_max_height
+from .summits import expected_max_height
 
 #: Depth of the summit band below the mean plane that defines the nominal footprint (units of sigma).
 FOOTPRINT_BAND = 3.0

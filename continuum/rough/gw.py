@@ -57,26 +57,13 @@ import numpy as np
 
 from ..physics import jkr_kernel as jk
 from ..reference import jkr as _jkr
-from .gw_layout import _H_DEEP, _H_ZERO, _HERTZ_NU, _T_CUT, RESOLUTIONS, table_size
-from .gw_reference import quadrature_contact_fraction, quadrature_energy, quadrature_pressure, table_error
 from ..physics.jkr_kernel import reduced_curve_minus_hertz as _g_of_s
-from .summits import (_GH_W, _GH_X, TENSILE_ONSET, SummitStatistics, _gauss_mass, _out, _s_of_x,
-                      expected_max_height, gw_integral)
 from . import gw_kernel
+from .gw_layout import _H_DEEP, _H_ZERO, _HERTZ_NU, _T_CUT, RESOLUTIONS
+from .gw_reference import table_error
 from .gw_tables import GWTables
+from .summits import _GH_W, _GH_X, TENSILE_ONSET, SummitStatistics, _gauss_mass, _out, _s_of_x, gw_integral
 
-__all__ = [
-    "SummitStatistics",
-    "GWJKRSurface",
-    "expected_max_height",
-    "gw_integral",
-    "quadrature_pressure",
-    "quadrature_energy",
-    "quadrature_contact_fraction",
-    "RESOLUTIONS",
-    "TENSILE_ONSET",
-    "table_size",
-]
 _NO_BRANCH = np.zeros(0, np.int8)      # `gw_kernel.integral` records no branches
 # ==============================================================================================
 # The surface

@@ -21,7 +21,7 @@ at most sigma/4), split per state at the threshold and cut at z_max. States are 
 separation and integrated in chunks of 512 over the panels their deepest member needs: 15-20 us per
 state and quantity on a busy 2-core machine for a footprint table's spread of states (65 us unsorted).
 No tables: the rigid-substrate law tabulates the footprint integral of this surface once per set.
-Accuracy against adaptive quadrature is measured in tests/test_gw_branches.py.
+Accuracy against adaptive quadrature is measured in tests/test_branch_laws.py.
 """
 from __future__ import annotations
 
