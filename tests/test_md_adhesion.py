@@ -129,15 +129,20 @@ def test_dispersion_tail_applies_to_trappe_pairs_only():
     assert _tail_pair_table(ff, "all")[3][i["OC24"], i["OW"]]
 
 
+def _dome(fidelity):
+    """The pulloff_ots asperity at ``fidelity`` with its chains grafted as the workflow grafts them."""
+    from md.build import graft_dome, silica_asperity
+    s = load_recipe("pulloff_ots").typed_settings(fidelity)
+    asp = silica_asperity.system(radius=s.asperity_radius_A, holder_thickness=s.holder_thickness_A,
+                                 margin=s.asperity_margin_A, silanol_density=4.5, face="111", seed=s.seed)
+    return graft_dome(asp, radius_A=s.asperity_radius_A, max_polar_deg=s.graft_max_polar_deg,
+                      coverage_nm2=s.sam_coverage, chain_length=s.chain_length, seed=s.seed + 30)
+
+
 def test_ots_asperity_is_grafted_at_sam_density():
-    """Version 1 drew dome sites in random order at 4.4 A and stopped at 9 chains (2.65 per nm^2 of projected cap)
-    on the quick R = 1.2 nm dome; now a largest set of sites at >= 4.3 A lateral spacing, >= 4 chains/nm^2."""
-    from md.build import silica_asperity
-    from md.workflows.pulloff import _graft_dome
-    s = _settings("pulloff_ots", "quick")
-    asp = silica_asperity.system(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
-                          margin=s["asperity_margin_A"], silanol_density=4.5, face="111", seed=int(s["seed"]))
-    sam, g = _graft_dome(asp, s, int(s["seed"]) + 30)
+    """The quick dome carries the SAM's coverage (>= 4 chains per nm^2 of projected cap: a largest set of sites at
+    >= 4.3 A lateral spacing; a random sequential choice of sites stops well short of it)."""
+    sam, g = _dome("quick")
     assert g["chains_per_projected_nm2"] >= 4.0 and g["chains"] == g["requested_chains"]
     assert g["min_spacing_A"] >= 4.3
     anchors = sam.positions[sam.group("sam_anchor_O"), :2]
@@ -162,7 +167,7 @@ def test_offset_heads_keep_their_anchor_bond_and_refuse_to_lean_too_far():
 
 
 def test_spread_chains_parts_a_close_pair_within_the_disk_or_says_it_cannot():
-    from md.workflows.pulloff import _spread_chains
+    from md.build.dome import _spread_chains
     cell = (40.0, 40.0)
     pair = np.array([[10.0, 10.0], [12.9, 10.0]])
     d = _spread_chains(pair, cell, 4.4, np.zeros(2), 1.0)
@@ -173,18 +178,14 @@ def test_spread_chains_parts_a_close_pair_within_the_disk_or_says_it_cannot():
 
 
 def test_production_ots_asperity_reaches_sam_density_with_leaning_chains():
-    """The production dome (R = 3 nm) has its silanols in pairs 2.5-3.9 A apart in projection: chains standing on
-    their sites stopped at 92 = 3.5 per nm^2 of cap (and that tip's minimisation lost atoms: 1.5 A head contacts).
-    Leaning heads (anchor bond up to 60 deg off the vertical) reach >= 4 per nm^2 with the chains 4.4 A apart and
+    """The production dome (R = 3 nm) has its silanols in close pairs in projection, so chains standing on their
+    sites cannot reach the SAM's coverage (the chains must lean: ``chain_offset_max_A`` > 0). Leaning heads (anchor bond up to 60 deg off the vertical) reach >= 4 per nm^2 with the chains 4.4 A apart and
     no head atom within 1.7 A of a heavy atom but its anchor O."""
     from scipy.spatial import cKDTree
     from md.build import silica_asperity
     from md.build.sam import MAX_ANCHOR_TILT_DEG
-    from md.workflows.pulloff import HEAD_CLEARANCE_A, _graft_dome
-    s = _settings("pulloff_ots", "production")
-    asp = silica_asperity.system(radius=s["asperity_radius_A"], holder_thickness=s["holder_thickness_A"],
-                                 margin=s["asperity_margin_A"], silanol_density=4.5, face="111", seed=int(s["seed"]))
-    sam, g = _graft_dome(asp, s, int(s["seed"]) + 30)
+    from md.build.dome import HEAD_CLEARANCE_A
+    sam, g = _dome("production")
     assert g["chains_per_projected_nm2"] >= 4.0 and g["chain_offset_max_A"] > 0.0
     si = np.asarray(sam.group("sam_head_si"), int)
     anchor = np.asarray(sam.group("sam_anchor_O"), int)
@@ -235,7 +236,7 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
     assert s["sam"]["interaction_range"] == 0.94e-9
     sam = table["meta"]["calibration"]["surfaces.sam.interaction_range"]
     assert sam["recipe"] == "pulloff_ots" and "compliance" in sam["note"]
-    assert "pull-off" in table["meta"]["sources"]["surfaces.sam.interaction_range"]
+    assert "pull-off" in table["meta"]["origin"]["surfaces.sam.interaction_range"]["note"]
     val = table["meta"]["validation"]["pulloff_silica"]
     assert val["ratio"] == pytest.approx(0.054 / 0.075) and val["adhesion_recipe"] == "adhesion_silica"
     assert "pulloff_silica" in recipes_needed() and recipes_needed()[0] == "adhesion_silica"
@@ -257,10 +258,10 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     from md.system.lammps_data import read_atoms
     from md.workflows.adhesion import _tail_pair_table
     from md.workflows.common import forcefield_of, surface_slab
-    s = _settings("adhesion_ots")
+    s = load_recipe("adhesion_ots").typed_settings("smoke")
     ff = forcefield_of(["silica_interface", "ots_trappe_ua"])
-    lower = surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, "111")
-    upper = surface_slab("ots", s["nx"], s["ny"], s["slab_thickness_A"], s, 11, "111")
+    lower = surface_slab("ots", s.nx, s.ny, s.slab_thickness_A, s, 1, "111")
+    upper = surface_slab("ots", s.nx, s.ny, s.slab_thickness_A, s, 11, "111")
     system = place_on.system(lower, flip_upside_down(upper), gap=3.0, vacuum=40.0)
     data = write_data(system, ff, tmp_path / "ots.data")
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")

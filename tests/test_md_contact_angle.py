@@ -380,7 +380,7 @@ def test_the_substrate_equilibrates_alone_before_the_water_is_added(name, tmp_pa
 
 
 def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
-    """Review item 1: contact angle, adhesion and pull-off share one IFF surface, cristobalite (111) with isolated
+    """Contact angle, adhesion and pull-off share one IFF surface, cristobalite (111) with isolated
     Q3 silanols: no two top silanol O closer than 4 A (minimum image; the (001) face has pairs at 2.53 A)."""
     from md.system.topology import minimum_image
     from md.workflows import get_workflow
@@ -395,9 +395,10 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
         return d.min()
 
     for name in ("contact_angle_silica", "adhesion_silica"):
-        s = load_recipe(name).settings("smoke")
-        assert silica_face_of(s) == "111"
-        slab = surface_slab("silica", s["nx"], s["ny"], s["slab_thickness_A"], s, 1, silica_face_of(s))
+        s = load_recipe(name).typed_settings("smoke")
+        face = silica_face_of(getattr(s, "surfaces", None) or (s.surface,), s.silica_face)
+        assert face == "111"
+        slab = surface_slab("silica", s.nx, s.ny, s.slab_thickness_A, s, 1, face)
         assert slab.info["face"] == "111" and slab.info["q_distribution"]["Q2"] == 0
         assert min_oo(slab, slab.group("silanol_O_top")) > 4.0
     _, plan, _ = _plan("contact_angle_silica", tmp_path)

@@ -85,10 +85,10 @@ def test_no_recipe_minimises_with_fire_above_1_fs(fidelity):
     cg for rigid water): FIRE never above 1 fs, the recipe's timestep restored after it."""
     from md.workflows.common import minimize_lines
     for name in RECIPES:
-        s = load_recipe(name).settings(fidelity)
-        at_fire, dt = _fire_timesteps(minimize_lines(s), dt=s["timestep_fs"])
+        s = load_recipe(name).typed_settings(fidelity)
+        at_fire, dt = _fire_timesteps(minimize_lines(s), dt=s.timestep_fs)
         assert all(x <= FIRE_DT_MAX_FS for x in at_fire), (name, at_fire)
-        assert dt == s["timestep_fs"], name
+        assert dt == s.timestep_fs, name
 
 
 @pytest.mark.md
@@ -135,15 +135,14 @@ def _substrates(name: str, fidelity: str):
     """The periodic silica (with its SAM) the recipe's workflow builds, and the cell counts it asked for."""
     from md.workflows.common import silica_face_of, surface_slab
     from md.workflows.pulloff import PullOff
-    s = load_recipe(name).settings(fidelity)
-    seed = int(s["seed"])
+    s = load_recipe(name).typed_settings(fidelity)
     if name.startswith("pulloff"):
         system, _ = PullOff().build(s)
         return [system], None
-    kinds = s["surfaces"] if name.startswith("adhesion") else [s["surface"]]
-    slabs = [surface_slab(k, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10 * i, silica_face_of(s))
+    kinds = s.surfaces if name.startswith("adhesion") else [s.surface]
+    slabs = [surface_slab(k, s.nx, s.ny, s.slab_thickness_A, s, s.seed + 10 * i, silica_face_of(kinds, s.silica_face))
              for i, k in enumerate(kinds)]
-    return slabs, (s["nx"], s["ny"])
+    return slabs, (s.nx, s.ny)
 
 
 def _forcefield_r0(system) -> np.ndarray:

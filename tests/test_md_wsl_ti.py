@@ -286,7 +286,7 @@ def _smoke_film(tmp_path):
     from md.system.lammps_data import write_data
     from md.workflows.common import forcefield_of
     from md.workflows.wsl_ti import WslTI
-    s = load_recipe("wsl_silica").settings("smoke")
+    s = load_recipe("wsl_silica").typed_settings("smoke")
     wf = WslTI()
     _, _, system = wf.build(s)
     ff = forcefield_of(wf.forcefield_files(s))
@@ -334,6 +334,7 @@ def _dudl_q(lmp, lam, delta=0.002):
     return d, pe
 
 
+@pytest.mark.md
 def test_compute_fep_is_the_energy_derivative_and_the_solid_solid_share_cancels(tmp_path):
     film, solid = _lammps_pair(tmp_path, fixed_pppm=True)
     # the derivative: U(lambda) is quadratic in the solid's charges, so a wide central difference of energies
@@ -349,6 +350,7 @@ def test_compute_fep_is_the_energy_derivative_and_the_solid_solid_share_cancels(
     assert np.ptp(diffs) < 1e-6 * big + 1e-3, diffs
 
 
+@pytest.mark.md
 def test_without_one_pppm_mesh_the_solid_solid_share_does_not_cancel(tmp_path):
     """The reason pppm_lines exists: LAMMPS's own G and mesh depend on the charges present (film vs solid alone),
     and the difference then drifts with lambda by more than it does with the fixed mesh."""
@@ -358,6 +360,7 @@ def test_without_one_pppm_mesh_the_solid_solid_share_does_not_cancel(tmp_path):
     assert abs(diffs[1] - diffs[0]) > 1e-6 * big + 1e-3, diffs
 
 
+@pytest.mark.md
 def test_soft_core_at_lambda_one_is_the_plain_pair_style(tmp_path):
     from md.lammps_loader import new_lammps
     from md.system.lammps_data import lammps_setup_commands
@@ -389,7 +392,9 @@ def test_the_ots_result_adds_the_dispersion_tail_into_w_sl(md_smoke):
     parts = d["parts_J_m2"]
     total = parts["electrostatic"] + parts["dispersion"] + parts["tether_correction"]["value"] + tail
     # the same four floats summed in another grouping: a few roundings of terms within 10x of the sum, so 1e-12
-    # relative holds on any IEEE-754 CPU (a missing or doubled part would miss by > 1e-2)
-    assert q["work_of_adhesion_sl"]["value"] == pytest.approx(total, rel=1e-12, abs=1e-15)
+    # relative holds on any IEEE-754 CPU; the negative control: without the tail the sum misses W_SL by far more
+    w = q["work_of_adhesion_sl"]["value"]
+    assert w == pytest.approx(total, rel=1e-12, abs=1e-15)
+    assert w != pytest.approx(total - tail, rel=1e-6)
     assert any("beyond the 12 A cutoff" in n for n in r["notes"])
     assert "dispersion_tail_work_sl" not in md_smoke("wsl_silica").outcome.result["quantities"]

@@ -70,30 +70,34 @@ class Adhesion(Workflow):
               "entropic_term_TdS": "J/m^2", "interface_area": "m^2"}
 
     def forcefield_files(self, s):
-        return ["silica_interface"] + (["ots_trappe_ua"] if "ots" in s["surfaces"] else [])
+        s = self.typed(s)
+        return ["silica_interface"] + (["ots_trappe_ua"] if "ots" in s.surfaces else [])
 
     def protocol_version(self, s) -> int:
+        s = self.typed(s)
         return self.version if _lifts_registries(s) else 3
 
     def windows(self, s) -> np.ndarray:
         """Nominal separations from contact (A): the compressed chain (negative, innermost first) and the outward
         chain (0 first, quadratically spaced to separation_A)."""
-        n = int(s["pmf_windows"])
-        out = s["separation_A"] * (np.arange(n) / (n - 1)) ** 2
-        m = int(s["pmf_compress_windows"])
-        inward = -s["pmf_compress_A"] * np.arange(m, 0, -1) / m if m else np.zeros(0)
+        s = self.typed(s)
+        n = int(s.pmf_windows)
+        out = s.separation_A * (np.arange(n) / (n - 1)) ** 2
+        m = int(s.pmf_compress_windows)
+        inward = -s.pmf_compress_A * np.arange(m, 0, -1) / m if m else np.zeros(0)
         return np.concatenate([inward, out])
 
-    @staticmethod
-    def chains(s) -> list[tuple[str, float, str | None]]:
+    @classmethod
+    def chains(cls, s) -> list[tuple[str, float, str | None]]:
         """(leg-name suffix, nominal separation, suffix of the leg it continues from) in run order: the contact
         window, the inward chain, the outward chain."""
-        n, m = int(s["pmf_windows"]), int(s["pmf_compress_windows"])
-        out = s["separation_A"] * (np.arange(n) / (n - 1)) ** 2
+        s = cls.typed(s)
+        n, m = int(s.pmf_windows), int(s.pmf_compress_windows)
+        out = s.separation_A * (np.arange(n) / (n - 1)) ** 2
         rows = [("o00", 0.0, None)]
         prev = "o00"
         for k in range(1, m + 1):
-            rows.append((f"i{k:02d}", -s["pmf_compress_A"] * k / m, prev))
+            rows.append((f"i{k:02d}", -s.pmf_compress_A * k / m, prev))
             prev = f"i{k:02d}"
         prev = "o00"
         for k in range(1, n):
@@ -102,21 +106,22 @@ class Adhesion(Workflow):
         return rows
 
     def plan(self, s, run_dir):
+        s = self.typed(s)
         ff = forcefield_of(self.forcefield_files(s))
-        lower_kind, upper_kind = s["surfaces"]
-        face = silica_face_of(s)
-        seed = int(s["seed"])
-        lower = surface_slab(lower_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed, face)
-        upper = surface_slab(upper_kind, s["nx"], s["ny"], s["slab_thickness_A"], s, seed + 10, face)
-        system = as_system(place_on(lower, flip_upside_down(upper), gap=s["contact_gap_A"],
-                                    vacuum=s["separation_A"] + 15.0))
+        lower_kind, upper_kind = s.surfaces
+        face = silica_face_of(s.surfaces, s.silica_face)
+        seed = int(s.seed)
+        lower = surface_slab(lower_kind, s.nx, s.ny, s.slab_thickness_A, s, seed, face)
+        upper = surface_slab(upper_kind, s.nx, s.ny, s.slab_thickness_A, s, seed + 10, face)
+        system = as_system(place_on(lower, flip_upside_down(upper), gap=s.contact_gap_A,
+                                    vacuum=s.separation_A + 15.0))
         data = run_dir / "system.data"
         write_data(system, ff, data)
         groups = {"lower": system.group("substrate"), "upper": system.group("adsorbate"),
                   "lower_fixed": intersect_ids(system, "frozen", "substrate"),
                   "upper_back": intersect_ids(system, "frozen", "adsorbate")}
         tail = _tail_applies(s, system)
-        study = s["dispersion_tail"] == "trappe"   # contact frames for the cutoff study, even without TraPPE atoms
+        study = s.dispersion_tail == "trappe"   # contact frames for the cutoff study, even without TraPPE atoms
         if study:
             groups["tailset"] = np.arange(system.n_atoms)
         n = system.n_atoms
@@ -125,7 +130,7 @@ class Adhesion(Workflow):
         minimized = contact_dir / "minimized.data"
         setup_groups = lambda: ["group held union lower_fixed upper_back", "group mobile subtract all held"]
         columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_back": "v_zback"}
-        si = s["sample_interval"]
+        si = s.sample_interval
 
         def define(upper_free: bool, salt: int):
             def d(step: int) -> list[str]:
@@ -151,39 +156,39 @@ class Adhesion(Workflow):
                     ([f"displace_atoms upper move 0.0 0.0 {shift:.6f} units box"] if shift else [])
             return f
 
-        def frames(sample_key: str, per_leg: int, on: bool = True) -> Frames | None:
-            return Frames("tailset", round_up(steps_of(s, sample_key) / per_leg, si)) if on else None
+        def frames(sample_steps: int, per_leg: int, on: bool = True) -> Frames | None:
+            return Frames("tailset", round_up(steps_of(sample_steps, si) / per_leg, si)) if on else None
 
         base = dict(define=None, restart_head=restart_header_lines(s), columns=columns,
-                    sample_interval=si, chunk_steps=s["chunk_steps"], n_atoms=n)
-        sample = Stage("sample", steps_of(s, "sample_steps"))
+                    sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n)
+        sample = Stage("sample", steps_of(s.sample_steps, s.sample_interval))
         contact = Leg(name="contact", fresh=fresh_contact,
                       prepare=lambda d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"]
                       + minimize_lines(s, d / "minimized.data") + ["unfix back_min", _BACK_RIGID],
                       stages=stage_list(equilibrate_stage(s, "mobile", 1), sample),
-                      frames=frames("sample_steps", TAIL_FRAMES_CONTACT, study),
+                      frames=frames(s.sample_steps, TAIL_FRAMES_CONTACT, study),
                       **{**base, "define": define(True, 1)})
         legs = [
             contact,
-            Leg(name="separated", fresh=fresh_from_minimized(s["separation_A"]), prepare=lambda d: ["reset_timestep 0"],
+            Leg(name="separated", fresh=fresh_from_minimized(s.separation_A), prepare=lambda d: ["reset_timestep 0"],
                 stages=stage_list(equilibrate_stage(s, "mobile", 2), sample), **{**base, "define": define(False, 2)}),
         ]
         registries = []
-        if s["free_energy"] == "pmf":
+        if s.free_energy == "pmf":
             # a chain: each window continues (positions and velocities) from its neighbour's last restart, moved
             # rigidly by the difference of the nominal separations; the first from the contact leg's last state,
             # moved laterally to the registry's offset
-            pmf_equil = Stage("equilibrate", steps_of(s, "pmf_equilibrate_steps"), (), sampled=False)
-            pmf_sample = Stage("sample", steps_of(s, "pmf_sample_steps"))
+            pmf_equil = Stage("equilibrate", steps_of(s.pmf_equilibrate_steps, s.sample_interval), (), sampled=False)
+            pmf_sample = Stage("sample", steps_of(s.pmf_sample_steps, s.sample_interval))
             stages = stage_list(pmf_equil, pmf_sample)
             total = sum(st.steps for st in stages)
-            cell = (float(system.cell[0]) / s["nx"], float(system.cell[1]) / s["ny"])
-            registries = _registry_offsets(int(s["lateral_registries"]), cell)
+            cell = (float(system.cell[0]) / s.nx, float(system.cell[1]) / s.ny)
+            registries = _registry_offsets(int(s.lateral_registries), cell)
             nominal = {}
 
             def from_leg(prev_dir: Path, prev_total: int, move: tuple[float, float, float]):
                 def f(leg_dir: Path) -> list[str]:
-                    cmds = restart_header_lines(s)(prev_dir / f"restart.{prev_total}") + [f"timestep {s['timestep_fs']:g}"]
+                    cmds = restart_header_lines(s)(prev_dir / f"restart.{prev_total}") + [f"timestep {s.timestep_fs:g}"]
                     if any(abs(x) > 0 for x in move):
                         cmds.append(f"displace_atoms upper move {move[0]:.6f} {move[1]:.6f} {move[2]:.6f} units box")
                     return cmds
@@ -203,17 +208,17 @@ class Adhesion(Workflow):
                         fresh = from_leg(run_dir / "legs" / f"pmf_r{r}_{prev}", total, (0.0, 0.0, d_nom - nominal[prev]))
                     nominal[suffix] = d_nom
                     legs.append(Leg(name=name, fresh=fresh, prepare=prepare, stages=stages,
-                                    frames=frames("pmf_sample_steps", TAIL_FRAMES_WINDOW, tail and r == 0),
+                                    frames=frames(s.pmf_sample_steps, TAIL_FRAMES_WINDOW, tail and r == 0),
                                     info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
                                           "continues": f"pmf_r{r}_{prev}" if prev else "contact"},
                                     **{**base, "define": define(False, salt)}))
                     salt += 1
-        info = {"area_A2": area, "box_A": system.cell.tolist(), "surfaces": list(s["surfaces"]), "face": face,
+        info = {"area_A2": area, "box_A": system.cell.tolist(), "surfaces": list(s.surfaces), "face": face,
                 "n_lower": int(len(groups["lower"])), "n_upper": int(len(groups["upper"])),
-                "lower": system_summary(lower), "upper": system_summary(upper), "dispersion_tail": s["dispersion_tail"],
+                "lower": system_summary(lower), "upper": system_summary(upper), "dispersion_tail": s.dispersion_tail,
                 "tail_applies": bool(tail), "tail_study": bool(study),
                 "registry_offsets_A": [list(o) for o in registries]}
-        return Plan(legs=legs, timestep_fs=s["timestep_fs"], n_atoms=n,
+        return Plan(legs=legs, timestep_fs=s.timestep_fs, n_atoms=n,
                     seeds={"structure_lower": seed, "structure_upper": seed + 10, "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed},
                     forcefield_files=self.forcefield_files(s), system_info=info)
@@ -237,14 +242,14 @@ class Adhesion(Workflow):
         es, fs, pairs = [], [], 0
         for k in range(len(steps)):
             r = A.lj_tail_between(pos[k][low], t[low], pos[k][~low], t[~low], eps, sig, inc, box[k][:2],
-                                  ctx.settings["cutoff_A"], r_max)
+                                  self.typed(ctx.settings).cutoff_A, r_max)
             es.append(r["energy"])
             fs.append(r["force_z"])
             pairs = r["pairs"]
         return {"energy": np.array(es), "force_z": np.array(fs), "pairs": pairs}
 
     def analyse(self, ctx):
-        s = ctx.settings
+        s = self.typed(ctx.settings)
         info = ctx.plan.system_info
         area = info["area_A2"]
         conv = U.kcal_per_mol_A2_to_J_per_m2(1.0) / area           # kcal/mol -> J/m^2 over this interface
@@ -259,11 +264,11 @@ class Adhesion(Workflow):
         details["contact_back_z_A"] = {"mean": zc, "stderr": zs["stderr"], "g": zs["g"]}
         # ---- dispersion beyond the cutoff (static, on the contact leg's frames)
         tail_on = bool(info.get("tail_applies"))
-        w_tail_static, tail_det = 0.0, {"mode": s["dispersion_tail"], "applied": tail_on}
+        w_tail_static, tail_det = 0.0, {"mode": s.dispersion_tail, "applied": tail_on}
         if tail_on:
             tc = self._tail(ctx, "trappe", "contact")
             u = tc["energy"]
-            kt = U.kT_kcal_per_mol(s["temperature_K"])
+            kt = U.kT_kcal_per_mol(s.temperature_K)
             w_tail_static = -float(np.mean(u)) * conv
             # second-order check: the free-energy perturbation -kT ln <exp(-U/kT)> against the mean
             fep = -kt * (np.log(np.mean(np.exp(-(u - u.min()) / kt))) - u.min() / kt) if len(u) else float("nan")
@@ -304,7 +309,7 @@ class Adhesion(Workflow):
             ax.set_title(f"W = {w['value']:.3f} ± {w['stderr']:.3f} J/m² (energy)")
             ax.legend()
         figures["energy_timeseries"] = figure_writer(draw_energy)
-        if s["free_energy"] != "pmf":
+        if s.free_energy != "pmf":
             notes.append("free energy not estimated at this fidelity (free_energy = 'none'); the quick and "
                          "production recipes integrate the mean force over separation to measure T dS.")
             details["dispersion_tail"] = tail_det
@@ -418,7 +423,7 @@ class Adhesion(Workflow):
             "tail_force_kcal_mol_A": f_tail.tolist(), "window": suffixes,
             "per_registry_mean_force_kcal_mol_A": f_m.tolist(), "per_registry_stderr_kcal_mol_A": f_e.tolist(),
             "statistical_inefficiency": g_w.tolist(), "n_eff": neff_w.tolist(),
-            "decorrelation_time_ps": ((g_w - 1) / 2 * s["sample_interval"] * dt * 1e-3).tolist(),
+            "decorrelation_time_ps": ((g_w - 1) / 2 * s.sample_interval * dt * 1e-3).tolist(),
             "registry_work_J_m2": w_reg.tolist(), "registry_offsets_A": info["registry_offsets_A"],
             "zero_force_separation_A": ti["zero_force_separation_A"], "repulsive_end": repulsive,
             "windows_with_few_samples": short, "cutoff_only_work_J_m2": ti_cut["value"],
@@ -458,7 +463,7 @@ class Adhesion(Workflow):
                         "MORE THAN 2 STDERR: the windows are too short for the mean force to settle; lengthen "
                         "pmf_sample_steps") + ").")
         if tail_on:
-            notes.append(f"dispersion beyond the {s['cutoff_A']:g} A cutoff for TraPPE pairs (any pair with a CH2/CH3 "
+            notes.append(f"dispersion beyond the {s.cutoff_A:g} A cutoff for TraPPE pairs (any pair with a CH2/CH3 "
                          f"united atom) added as a static correction measured on this run's frames: "
                          f"{wf - ti_cut['value']:+.4f} J/m^2 in W_F (tail force per window + tail energy left at the "
                          f"last window), {w_tail_static:+.4f} J/m^2 in dE/A (contact frames). IFF pairs keep the plain "
@@ -480,7 +485,7 @@ class Adhesion(Workflow):
 
 
 def _tail_applies(s: Mapping[str, Any], system: System) -> bool:
-    return s["dispersion_tail"] == "trappe" and bool(np.isin(system.types, TRAPPE_UA).any())
+    return s.dispersion_tail == "trappe" and bool(np.isin(system.types, TRAPPE_UA).any())
 
 
 def _tail_pair_table(ff: ForceField, mode: str):
@@ -506,7 +511,7 @@ REGISTRY_LOWER_STEPS = 8
 
 def _lifts_registries(s: Mapping[str, Any]) -> bool:
     """Bare silica on bare silica: interlocked silanols cannot be sheared at contact (lift first)."""
-    return all(surface == "silica" for surface in s["surfaces"])
+    return all(surface == "silica" for surface in s.surfaces)
 
 
 def registry_approach_lines(s: Mapping[str, Any]) -> list[str]:

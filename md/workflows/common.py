@@ -22,14 +22,19 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from md.build import SILICA_FACE, ots_sam, silica_slab
+from md.build import ots_sam, silica_slab
 from md.system.atoms import as_system
 from md.system.forcefield import ForceField, combine, load_forcefield
 from md.system.lammps_data import lammps_setup_commands
 from md.engine.plan import Analysis, Plan, Stage, id_ranges
 from md.engine.store import RunContext
+from md.recipe import settings_class
 from md.system.topology import System
 
+
+#: A workflow's frozen settings dataclass (:func:`md.recipe.settings_class`, :meth:`Workflow.typed`): the recipe's
+#: resolved settings at one fidelity, one attribute per key.
+Settings = Any
 
 ENERGY_NOT_FREE_ENERGY = (
     "work_of_adhesion is dE/A, the difference of mean potential energies (separated - contact) per area at "
@@ -47,10 +52,10 @@ def derived_seed(base: int, *salt: int) -> int:
     return x + 1
 
 
-def restart_header_lines(settings: Mapping[str, Any]) -> Callable[[Path], list[str]]:
+def restart_header_lines(settings: Settings) -> Callable[[Path], list[str]]:
     def head(path: Path) -> list[str]:
         return [f"read_restart {Path(path).as_posix()}",
-                f"kspace_style pppm {settings['kspace_accuracy']:g}", "kspace_modify slab 3.0"] + neighbor_lines()
+                f"kspace_style pppm {settings.kspace_accuracy:g}", "kspace_modify slab 3.0"] + neighbor_lines()
     return head
 
 
@@ -58,12 +63,12 @@ def neighbor_lines() -> list[str]:
     return ["neighbor 2.0 bin", "neigh_modify delay 0 every 1 check yes"]
 
 
-def fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], groups: Mapping[str, Any],
+def fresh_from_data(ff: ForceField, data: Path, settings: Settings, groups: Mapping[str, Any],
                     pair: str = "long") -> list[str]:
-    cmds = lammps_setup_commands(ff, data, boundary="p p f", pair=pair, cutoff=settings["cutoff_A"],
-                                 kspace_accuracy=settings["kspace_accuracy"])
+    cmds = lammps_setup_commands(ff, data, boundary="p p f", pair=pair, cutoff=settings.cutoff_A,
+                                 kspace_accuracy=settings.kspace_accuracy)
     cmds += neighbor_lines()
-    cmds += [f"timestep {settings['timestep_fs']:g}"]
+    cmds += [f"timestep {settings.timestep_fs:g}"]
     for name, idx in groups.items():
         if len(idx):
             cmds.append(f"group {name} id {id_ranges(idx)}")
@@ -72,16 +77,16 @@ def fresh_from_data(ff: ForceField, data: Path, settings: Mapping[str, Any], gro
     return cmds
 
 
-def thermostat_lines(group: str, settings: Mapping[str, Any], step: int, salt: int = 0) -> list[str]:
-    t = settings["temperature_K"]
-    damp = settings["thermostat_damping_fs"]
-    if settings["thermostat"] == "nose-hoover":
+def thermostat_lines(group: str, settings: Settings, step: int, salt: int = 0) -> list[str]:
+    t = settings.temperature_K
+    damp = settings.thermostat_damping_fs
+    if settings.thermostat == "nose-hoover":
         return [f"fix thermostat {group} nvt temp {t:g} {t:g} {damp:g}"]
-    return [f"fix thermostat {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings['seed'], 17, salt, step)} "
+    return [f"fix thermostat {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings.seed, 17, salt, step)} "
             f"zero yes", f"fix integrate {group} nve"]
 
 
-def split_thermostat_lines(groups: Sequence[str], union: str, settings: Mapping[str, Any], step: int,
+def split_thermostat_lines(groups: Sequence[str], union: str, settings: Settings, step: int,
                            salt: int = 0) -> list[str]:
     """One thermostat per group (``groups`` partition ``union``, the atoms integrated): a Nose-Hoover ``fix nvt``
     each, or a Langevin each (own seeds) with one ``fix nve`` on ``union``.
@@ -92,12 +97,12 @@ def split_thermostat_lines(groups: Sequence[str], union: str, settings: Mapping[
     imbalance the single thermostat does not remove, not a heat source). The remedy is the standard one for the "hot solvent / cold solute" problem:
     separate thermostats per component (Lingenheil, Denschlag, Reichold & Tavan, J. Chem. Theory Comput. 4 (2008)
     1293; GROMACS's separate tc-grps for solvent and solute)."""
-    t = settings["temperature_K"]
-    damp = settings["thermostat_damping_fs"]
-    if settings["thermostat"] == "nose-hoover":
+    t = settings.temperature_K
+    damp = settings.thermostat_damping_fs
+    if settings.thermostat == "nose-hoover":
         return [f"fix thermostat{'' if k == 0 else k} {g} nvt temp {t:g} {t:g} {damp:g}" for k, g in enumerate(groups)]
     return [f"fix thermostat{'' if k == 0 else k} {g} langevin {t:g} {t:g} {damp:g} "
-            f"{derived_seed(settings['seed'], 17, salt, step, k)} zero yes" for k, g in enumerate(groups)] + \
+            f"{derived_seed(settings.seed, 17, salt, step, k)} zero yes" for k, g in enumerate(groups)] + \
         [f"fix integrate {union} nve"]
 
 
@@ -125,7 +130,7 @@ def framed_tail_sites(info: Mapping[str, Any], ids) -> tuple[np.ndarray, np.ndar
 WATER_SOLID_COLUMNS = {"temp_water": "v_tw", "temp_solid": "v_ts"}
 
 
-def water_solid_thermostat_lines(settings: Mapping[str, Any], step: int, salt: int = 0) -> list[str]:
+def water_solid_thermostat_lines(settings: Settings, step: int, salt: int = 0) -> list[str]:
     """Groups ``water`` and ``mobile`` given: the solid's mobile atoms as group ``solidmobile``, their and the
     water's temperatures (variables ``tw``, ``ts``: :data:`WATER_SOLID_COLUMNS`) and a thermostat each
     (:func:`split_thermostat_lines`)."""
@@ -165,12 +170,12 @@ def leg_temperatures(ctx, legs, target: float, second_half: tuple[str, ...] = ()
             "tolerance_K": TEMPERATURE_TOLERANCE_K, "note": note}
 
 
-def common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
+def common_define(settings: Settings, mobile: str) -> list[str]:
     return ["fix zwalls all wall/reflect zlo EDGE zhi EDGE",
             f"compute tmob {mobile} temp",
             "variable pe equal pe", "variable temp equal c_tmob",
             "thermo_style custom step temp c_tmob pe ke press",
-            f"thermo {max(settings['sample_interval'], settings['chunk_steps'] // 4)}",
+            f"thermo {max(settings.sample_interval, settings.chunk_steps // 4)}",
             "thermo_modify norm no flush yes lost error"]
 
 
@@ -183,13 +188,13 @@ def common_define(settings: Mapping[str, Any], mobile: str) -> list[str]:
 FIRE_TIMESTEP_FS = 1.0
 
 
-def minimize_lines(settings: Mapping[str, Any], write: Path | None = None, style: str = "fire") -> list[str]:
+def minimize_lines(settings: Settings, write: Path | None = None, style: str = "fire") -> list[str]:
     """FIRE (or ``style``) minimisation of ``minimize_steps`` iterations; FIRE at :data:`FIRE_TIMESTEP_FS` when the
     MD timestep is longer, the MD timestep restored afterwards."""
-    n = int(settings["minimize_steps"])
+    n = int(settings.minimize_steps)
     cmds = []
     if n > 0:
-        dt = float(settings["timestep_fs"])
+        dt = float(settings.timestep_fs)
         slow = style == "fire" and dt > FIRE_TIMESTEP_FS
         cmds += ([f"timestep {FIRE_TIMESTEP_FS:g}"] if slow else []) + \
             [f"min_style {style}", f"minimize 0.0 1.0e-3 {n} {10 * n}"] + ([f"timestep {dt:g}"] if slow else [])
@@ -198,7 +203,7 @@ def minimize_lines(settings: Mapping[str, Any], write: Path | None = None, style
     return cmds + ["reset_timestep 0"]
 
 
-def minimize_water_lines(settings: Mapping[str, Any], write: Path | None = None) -> list[str]:
+def minimize_water_lines(settings: Settings, write: Path | None = None) -> list[str]:
     """Minimisation of a system with rigid water: conjugate gradients (FIRE moves SHAKE clusters apart: LAMMPS
     turns SHAKE into restraints while minimising, and FIRE's steps break them; cg does not)."""
     return minimize_lines(settings, write, style="cg")
@@ -238,15 +243,16 @@ def round_up(n: float, k: int) -> int:
     return int(max(k, k * math.ceil(float(n) / k - 1e-9)))
 
 
-def steps_of(settings: Mapping[str, Any], key: str) -> int:
-    n = int(settings[key])
-    return 0 if n == 0 else round_up(n, settings["sample_interval"])
+def steps_of(n: int, interval: int) -> int:
+    """``n`` MD steps rounded up to a whole number of sample intervals (0 stays 0)."""
+    n = int(n)
+    return 0 if n == 0 else round_up(n, interval)
 
 
-def equilibrate_stage(settings: Mapping[str, Any], group: str, salt: int = 0, extra: tuple[str, ...] = ()) -> Stage:
-    t = settings["temperature_K"]
-    return Stage("equilibrate", steps_of(settings, "equilibrate_steps"),
-                 (f"velocity {group} create {t:g} {derived_seed(settings['seed'], 3, salt)} mom yes rot no dist gaussian",)
+def equilibrate_stage(settings: Settings, group: str, salt: int = 0, extra: tuple[str, ...] = ()) -> Stage:
+    t = settings.temperature_K
+    return Stage("equilibrate", steps_of(settings.equilibrate_steps, settings.sample_interval),
+                 (f"velocity {group} create {t:g} {derived_seed(settings.seed, 3, salt)} mom yes rot no dist gaussian",)
                  + extra, sampled=False)
 
 
@@ -280,14 +286,11 @@ def figure_writer(draw: Callable) -> Callable[[Path], None]:
     return save
 
 
-def silica_face_of(settings: Mapping[str, Any]) -> str:
+def silica_face_of(surfaces: Sequence[str], silica_face: str) -> str:
     """The cristobalite face of a recipe's silica: the recipe's ``silica_face`` (default
     :data:`md.build.SILICA_FACE` = '111', isolated Q3 silanols) for bare silica; always (111) when an OTS SAM
-    is involved (it is grafted on (111), and the two slabs of a pair must share the lateral cell)."""
-    kinds = settings.get("surfaces") or [settings.get("surface")]
-    if "ots" in kinds:
-        return "111"
-    return settings.get("silica_face", SILICA_FACE)
+    is among ``surfaces`` (it is grafted on (111), and the two slabs of a pair must share the lateral cell)."""
+    return "111" if "ots" in surfaces else silica_face
 
 
 def held_deep(system: System, group: str = "frozen") -> np.ndarray:
@@ -297,13 +300,13 @@ def held_deep(system: System, group: str = "frozen") -> np.ndarray:
     return idx[np.isin(system.types[idx], ["SC4", "OC23"])]
 
 
-def surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Mapping[str, Any], seed: int,
+def surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Settings, seed: int,
                   face: str) -> System:
     if kind == "silica":
-        dens = settings["silanol_density"] if face == "001" else 4.5
+        dens = settings.silanol_density if face == "001" else 4.5
         return as_system(silica_slab(nx, ny, thickness=thickness, silanol_density=dens, face=face, seed=seed))
     slab = as_system(silica_slab(nx, ny, thickness=thickness, face="111", silanol_density=4.5, seed=seed))
-    return as_system(ots_sam(slab, coverage=settings["sam_coverage"], chain_length=settings["chain_length"],
+    return as_system(ots_sam(slab, coverage=settings.sam_coverage, chain_length=settings.chain_length,
                              seed=seed + 1))
 
 
@@ -318,13 +321,21 @@ class Workflow:
     version = 1
     yields: dict[str, str] = {}
 
-    def protocol_version(self, settings: Mapping[str, Any]) -> int:
+    @classmethod
+    def typed(cls, settings: Mapping[str, Any] | Settings) -> Settings:
+        """``settings`` (a recipe's resolved settings, the mapping the engine hands a workflow) as this workflow's
+        frozen settings dataclass (:func:`md.recipe.settings_class`: every key an attribute, typed and
+        documented); a settings dataclass is returned as it is."""
+        kind = settings_class(cls.name)
+        return settings if isinstance(settings, kind) else kind(**settings)
+
+    def protocol_version(self, settings: Settings) -> int:
         return self.version
 
-    def forcefield_files(self, settings: Mapping[str, Any]) -> list[str]:
+    def forcefield_files(self, settings: Settings) -> list[str]:
         raise NotImplementedError
 
-    def plan(self, settings: Mapping[str, Any], run_dir: Path) -> Plan:
+    def plan(self, settings: Settings, run_dir: Path) -> Plan:
         raise NotImplementedError
 
     def analyse(self, ctx: RunContext) -> Analysis:

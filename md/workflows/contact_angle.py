@@ -59,24 +59,27 @@ class ContactAngleWorkflow(Workflow):
     yields = {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"}
 
     def forcefield_files(self, s):
-        return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else []) + \
-            water_forcefield_names(s["water_model"])
+        s = self.typed(s)
+        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else []) + \
+            water_forcefield_names(s.water_model)
 
     def build(self, s) -> tuple[System, System, System]:
         """(substrate, droplet, both placed in one box) -- the substrate's coordinates are those of the combined
         system, so atom ids 1..n_substrate are the same in both legs."""
-        seed = int(s["seed"])
-        sub = surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, silica_face_of(s))
-        R0 = float(s["droplet_radius_A"])
-        wff = forcefield_of(water_forcefield_names(s["water_model"]))
-        drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s["droplet_initial_angle_deg"],
+        s = self.typed(s)
+        seed = int(s.seed)
+        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed, silica_face_of((s.surface,), s.silica_face))
+        R0 = float(s.droplet_radius_A)
+        wff = forcefield_of(water_forcefield_names(s.water_model))
+        drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s.droplet_initial_angle_deg,
                                    seed=seed + 1, forcefield=wff))
         system = as_system(place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0)))
         return sub, drop, system
 
     def plan(self, s, run_dir):
+        s = self.typed(s)
         ff = forcefield_of(self.forcefield_files(s))
-        seed = int(s["seed"])
+        seed = int(s.seed)
         sub, drop, system = self.build(s)
         substrate = system.group("substrate")
         water = system.group("adsorbate")
@@ -86,7 +89,7 @@ class ContactAngleWorkflow(Workflow):
                    "two parts)")
         write_data(remove_atoms(system, water), ff, sub_data, title="contact_angle substrate")
         write_data(remove_atoms(system, substrate), ff, water_data, title="contact_angle droplet")
-        if s["surface"] == "silica":
+        if s.surface == "silica":
             ref = intersect_ids(system, "silanol_O_top", "substrate")
         else:
             ref = system.group("sam_ch3")
@@ -96,7 +99,7 @@ class ContactAngleWorkflow(Workflow):
         tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
         framed = np.union1d(np.union1d(water_o, ref), tail_sites)
         n_sub, n = len(substrate), system.n_atoms
-        dt = s["timestep_fs"]
+        dt = s.timestep_fs
         shake = shake_lines(ff, also=SILANOL_OH)
         sub_groups = {"substrate": substrate, "frozen": held}
 
@@ -114,14 +117,14 @@ class ContactAngleWorkflow(Workflow):
                      if with_water else thermostat_lines("mobile", s, step, salt))
             return d
 
-        t = s["temperature_K"]
+        t = s.temperature_K
         sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=define(0, False), prepare=lambda d: [],
                       restart_head=restart_header_lines(s),
-                      stages=[Stage("equilibrate", steps_of(s, "substrate_equilibrate_steps"),
+                      stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
                                     (f"velocity mobile create {t:g} {derived_seed(seed, 3, 0)} mom yes rot no "
                                      f"dist gaussian",), sampled=False)],
-                      columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s["sample_interval"],
-                      chunk_steps=s["chunk_steps"], n_atoms=n_sub)
+                      columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s.sample_interval,
+                      chunk_steps=s.chunk_steps, n_atoms=n_sub)
         sub_dir = run_dir / "legs" / "substrate"
 
         def fresh_droplet(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
@@ -135,18 +138,18 @@ class ContactAngleWorkflow(Workflow):
 
         drop_leg = Leg(name="droplet", fresh=fresh_droplet, define=define(1, True),
                        prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
-                       stages=stage_list(equilibrate_stage(s, "mobile", 1), Stage("sample", steps_of(s, "sample_steps"))),
+                       stages=stage_list(equilibrate_stage(s, "mobile", 1), Stage("sample", steps_of(s.sample_steps, s.sample_interval))),
                        columns={"pe": "v_pe", "temp": "v_temp", "n_water": "v_nw"} | WATER_SOLID_COLUMNS,
-                       sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"], n_atoms=n,
-                       frames=Frames("framed", s["frame_interval"] or s["sample_interval"]))
+                       sample_interval=s.sample_interval, chunk_steps=s.chunk_steps, n_atoms=n,
+                       frames=Frames("framed", s.frame_interval or s.sample_interval))
         ids = lammps_type_ids(ff)
         info = {"substrate": system_summary(sub), "droplet": dict(drop.info), "box_A": system.cell.tolist(),
                 "n_substrate": int(n_sub), "n_water_molecules_built": int(len(water_o)),
                 "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
-                "silica_face": silica_face_of(s),
+                "silica_face": silica_face_of((s.surface,), s.silica_face),
                 "water_O_ids": (water_o + 1).tolist(), "surface_ref_ids": (ref + 1).tolist(),
-                "surface_ref": "top silanol O" if s["surface"] == "silica" else "OTS CH3 groups",
-                "water_model": s["water_model"], "type_ids": ids,
+                "surface_ref": "top silanol O" if s.surface == "silica" else "OTS CH3 groups",
+                "water_model": s.water_model, "type_ids": ids,
                 "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6}
         return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
                     seeds=substrate_water_seeds(seed), forcefield_files=self.forcefield_files(s), system_info=info)
@@ -155,7 +158,7 @@ class ContactAngleWorkflow(Workflow):
         import MDAnalysis as mda
         from MDAnalysis.coordinates.memory import MemoryReader
 
-        s = ctx.settings
+        s = self.typed(ctx.settings)
         info = ctx.plan.system_info
         steps, ids, pos, box = ctx.frames("droplet")
         if not len(steps):
@@ -171,19 +174,19 @@ class ContactAngleWorkflow(Workflow):
         u.load_new(opos, format=MemoryReader, dimensions=dims)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            ca = A.ContactAngle(u.select_atoms("type OW"), surface_z=floor, axis="y", bin_size=s["bin_A"],
-                                n_blocks=min(s["n_blocks"], len(steps)), reference="dividing_surface")
+            ca = A.ContactAngle(u.select_atoms("type OW"), surface_z=floor, axis="y", bin_size=s.bin_A,
+                                n_blocks=min(s.n_blocks, len(steps)), reference="dividing_surface")
             ca.run()
         r = ca.results
         xc, zc, rad = r.circle
         z_ref = float(r.reference_z)
         wet = r.wetting
-        model = WATER_MODELS[s["water_model"]]
+        model = WATER_MODELS[s.water_model]
         gamma = model["gamma_lv_N_m"]
         notes: list[str] = []
-        if abs(s["temperature_K"] - model["gamma_T_K"]) > 1.0:
+        if abs(s.temperature_K - model["gamma_T_K"]) > 1.0:
             notes.append(f"gamma_lv = {gamma * 1e3:.1f} mN/m is the model's value at {model['gamma_T_K']:g} K, not at "
-                         f"the run's {s['temperature_K']:g} K: W_SL and gamma_lv cos theta carry that mismatch.")
+                         f"the run's {s.temperature_K:g} K: W_SL and gamma_lv cos theta carry that mismatch.")
         # what the map shows: a measured angle, no contact yet, or a film / a cap too flat to fit ("wets")
         if np.isfinite(r.angle_deg) and not wet["spans_box"]:
             status, angle, angle_err = "measured", float(r.angle_deg), r.stderr_deg
@@ -271,13 +274,13 @@ class ContactAngleWorkflow(Workflow):
                   f"(md.analysis.ContactAngle, {r.n_frames} frames).",
                   "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
                   "mobile (O-H by SHAKE)" + ("; the OTS SAM equilibrated alone before the droplet was placed"
-                                              if s["surface"] == "ots" else "") +
+                                              if s.surface == "ots" else "") +
                   f"; water rigid {model['name']} (SHAKE); the droplet started as a "
-                  f"{s['droplet_initial_angle_deg']:g} deg cylindrical cap.",
+                  f"{s.droplet_initial_angle_deg:g} deg cylindrical cap.",
                   "a cylindrical droplet has a straight contact line: no line-tension correction.",
                   f"W_SL and gamma_lv cos theta use gamma_lv = {gamma * 1e3:.1f} mN/m of the same water model "
-                  f"({s['water_model']}); combine the angle only with a gamma_lv of that model."]
-        temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "droplet"], s["temperature_K"])
+                  f"({s.water_model}); combine the angle only with a gamma_lv of that model."]
+        temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "droplet"], s.temperature_K)
         if temps:
             notes.append(temps["note"])
         ue, ze = r.edges
@@ -306,7 +309,7 @@ class ContactAngleWorkflow(Workflow):
             ax.set_ylabel("z (Å)")
             title = {"measured": f"θ = {angle:.1f} ± {(angle_err or float('nan')):.1f}°",
                      "no_contact": "no contact", "wets": "wets"}[status]
-            ax.set_title(f"{title} ({s['surface']})")
+            ax.set_title(f"{title} ({s.surface})")
             ax.legend(fontsize=7)
         block_w = [A.work_of_adhesion_sl(gamma, a)["value"] if np.isfinite(a) else None for a in r.block_angles_deg]
         details = {"status": status, "reference_z_A": z_ref, "surface_z_A": solid_z,
@@ -315,8 +318,8 @@ class ContactAngleWorkflow(Workflow):
                    "block_times_ns": t_blocks.tolist(), "block_work_of_adhesion_sl_J_m2": block_w,
                    "drift": drift, "wetting": wet, "fit_error": r.fit_error, "cap_height_A": r.cap_height_A,
                    "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames), "n_water_molecules": n_water,
-                   "water_model": s["water_model"], "gamma_lv_N_m": gamma,
-                   "blocks": {"n_blocks_used": int(r.n_blocks_used), "n_blocks_most": int(s["n_blocks"]),
+                   "water_model": s.water_model, "gamma_lv_N_m": gamma,
+                   "blocks": {"n_blocks_used": int(r.n_blocks_used), "n_blocks_most": int(s.n_blocks),
                               "shape_statistical_inefficiency_frames": float(r.shape_statistical_inefficiency),
                               "independent": bool(r.blocks_independent),
                               "what": "blocks of frames sized to span 2 g of the water's mean height (g its "
@@ -346,7 +349,7 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
         return None
     n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(U.WATER_MOLAR_MASS)
     z_ref = float(r.reference_z)
-    per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, z_ref, n_w, s["cutoff_A"],
+    per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, z_ref, n_w, s.cutoff_A,
                                                  float(box[k][0] * box[k][1])) for k in range(len(pos))])
     st = A.timeseries_stats(per_frame, equilibrate=False)
     dw = U.kcal_per_mol_A2_to_J_per_m2(st["mean"])
@@ -359,12 +362,12 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
     if not wets and angle_err is not None:
         var = (np.sin(th) * np.radians(angle_err)) ** 2 + ((dw_err or 0.0) / gamma) ** 2
         new_err = float(np.degrees(np.sqrt(var) / max(np.sin(np.radians(new)), 1e-12)))
-    note = (f"water-TraPPE dispersion beyond the {s['cutoff_A']:g} A cutoff added statically: dW_SL = "
+    note = (f"water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff added statically: dW_SL = "
             f"{dw * 1e3:.2f} mJ/m^2 ({int(is_site.sum())} CH2/CH3 sites under the water's dividing plane, water at its "
             f"bulk density above it), so theta = {angle:.1f} deg as simulated -> {new:.1f} deg "
             "(cos theta + dW/gamma_lv); the water-water and IFF pairs keep the plain cutoff.")
     return {"angle": new, "angle_stderr": new_err, "wets": wets, "work": dw, "work_stderr": dw_err, "note": note,
             "kind": "water-TraPPE dispersion beyond the cutoff, per area of wetted SAM (static half-space sum)",
             "details": {"per_frame_J_m2": U.kcal_per_mol_A2_to_J_per_m2(per_frame).tolist(),
-                        "g": st["g"], "cutoff_A": s["cutoff_A"], "water_number_density_A3": n_w,
+                        "g": st["g"], "cutoff_A": s.cutoff_A, "water_number_density_A3": n_w,
                         "plane_z_A": z_ref, "sites": int(is_site.sum()), "angle_as_simulated_deg": angle}}

@@ -22,11 +22,11 @@ import numpy as np
 
 from md import analysis as A
 from md import units as U
-from md.build import flip_upside_down, ots_sam, place_on, silica_asperity
+from md.build import flip_upside_down, graft_dome, place_on, silica_asperity
 from md.system.atoms import as_system
 from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
-from md.system.topology import System, minimum_image, with_groups
+from md.system.topology import System
 
 from md.workflows.common import (Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data, intersect_ids,
                                  minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed, silica_face_of, stage_list, steps_of,
@@ -49,31 +49,35 @@ class PullOff(Workflow):
               "work_of_adhesion_eff_jkr": "J/m^2", "work_of_adhesion_eff_dmt": "J/m^2"}
 
     def forcefield_files(self, s):
-        return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else [])
+        s = self.typed(s)
+        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else [])
 
     def build(self, s) -> tuple[System, dict[str, Any]]:
-        seed = int(s["seed"])
-        R = float(s["asperity_radius_A"])
-        face = silica_face_of(s)
-        dens = s["silanol_density"] if face == "001" else 4.5
-        asp = as_system(silica_asperity(radius=R, holder_thickness=s["holder_thickness_A"],
-                                        margin=s["asperity_margin_A"], silanol_density=dens, face=face, seed=seed))
+        s = self.typed(s)
+        seed = int(s.seed)
+        R = float(s.asperity_radius_A)
+        face = silica_face_of((s.surface,), s.silica_face)
+        dens = s.silanol_density if face == "001" else 4.5
+        asp = as_system(silica_asperity(radius=R, holder_thickness=s.holder_thickness_A,
+                                        margin=s.asperity_margin_A, silanol_density=dens, face=face, seed=seed))
         nx, ny = asp.info["surface_cells"]
-        fnx, fny = (s["flat_nx"] or nx), (s["flat_ny"] or ny)
+        fnx, fny = (s.flat_nx or nx), (s.flat_ny or ny)
         if (fnx, fny) != (nx, ny):
             raise ValueError(f"flat_nx/flat_ny ({fnx}, {fny}) must match the asperity's holder cells ({nx}, {ny}) "
                              f"(both are periodic in x and y); set them to 0")
-        flat = surface_slab(s["surface"], nx, ny, s["flat_thickness_A"], s, seed + 20, face)
+        flat = surface_slab(s.surface, nx, ny, s.flat_thickness_A, s, seed + 20, face)
         info: dict[str, Any] = {"radius_A": R, "face": face}
-        if s["surface"] == "ots":
-            asp, ginfo = _graft_dome(asp, s, seed + 30)
+        if s.surface == "ots":
+            asp, ginfo = graft_dome(asp, radius_A=R, max_polar_deg=s.graft_max_polar_deg,
+                                    coverage_nm2=s.sam_coverage, chain_length=s.chain_length, seed=seed + 30)
             info["asperity_sam"] = ginfo
-        system = as_system(place_on(flat, flip_upside_down(asp), gap=s["initial_gap_A"],
-                                    vacuum=s["retract_distance_A"] + 15.0))
+        system = as_system(place_on(flat, flip_upside_down(asp), gap=s.initial_gap_A,
+                                    vacuum=s.retract_distance_A + 15.0))
         info.update(asperity=system_summary(asp), flat=system_summary(flat), box_A=system.cell.tolist())
         return system, info
 
     def plan(self, s, run_dir):
+        s = self.typed(s)
         ff = forcefield_of(self.forcefield_files(s))
         system, info = self.build(s)
         data = run_dir / "system.data"
@@ -83,11 +87,11 @@ class PullOff(Workflow):
                   "holder_rigid": intersect_ids(system, "frozen", "adsorbate")}
         tip_mobile = np.setdiff1d(groups["tip"], groups["holder_rigid"])
         n = system.n_atoms
-        dt = s["timestep_fs"]
-        si = s["sample_interval"]
-        seed = int(s["seed"])
-        v_app = U.m_per_s_to_angstrom_per_fs(s["approach_speed_m_s"])
-        n_app = round_up(s["approach_distance_A"] / (v_app * dt), si)
+        dt = s.timestep_fs
+        si = s.sample_interval
+        seed = int(s.seed)
+        v_app = U.m_per_s_to_angstrom_per_fs(s.approach_speed_m_s)
+        n_app = round_up(s.approach_distance_A / (v_app * dt), si)
         columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_holder": "v_zh", "tip_zmin": "v_tipmin",
                    "flat_zmax": "v_flatmax", "f_holder": "f_hold_holder[3]", "p_tip": "v_ptip"}
 
@@ -116,40 +120,40 @@ class PullOff(Workflow):
             name="approach", fresh=fresh, define=define(0), prepare=lambda d: minimize_lines(s, d / "minimized.data"),
             restart_head=restart_header_lines(s),
             stages=stage_list(equilibrate_stage(s, "mobile", 1, (vz(0.0),)), Stage("approach", n_app, (vz(-v_app),)),
-                           Stage("hold", steps_of(s, "hold_steps"), (vz(0.0),))),
-            columns=columns, sample_interval=si, chunk_steps=s["chunk_steps"], n_atoms=n,
+                           Stage("hold", steps_of(s.hold_steps, s.sample_interval), (vz(0.0),))),
+            columns=columns, sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
             info={"v_approach_A_fs": v_app})
         legs = [approach]
         approach_dir = run_dir / "legs" / "approach"
-        repeats = int(s["retract_repeats"])
-        t = s["temperature_K"]
-        for k, v in enumerate(s["retract_speeds_m_s"]):
+        repeats = int(s.retract_repeats)
+        t = s.temperature_K
+        for k, v in enumerate(s.retract_speeds_m_s):
             v_ret = U.m_per_s_to_angstrom_per_fs(v)
-            n_ret = round_up(s["retract_distance_A"] / (v_ret * dt), si)
+            n_ret = round_up(s.retract_distance_A / (v_ret * dt), si)
             for j in range(repeats):
                 def fresh_retract(leg_dir: Path, _total=approach.total_steps) -> list[str]:
                     return restart_header_lines(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
                 stages = [Stage("retract", n_ret, (vz(v_ret),))]
                 if repeats > 1:     # independent pulls: fresh velocities, then hold_steps more in contact
-                    stages = stage_list(Stage("rehold", steps_of(s, "hold_steps"), (
+                    stages = stage_list(Stage("rehold", steps_of(s.hold_steps, s.sample_interval), (
                         f"velocity mobile create {t:g} {derived_seed(seed, 7, k, j)} mom yes rot no dist gaussian",
                         vz(0.0)), sampled=False)) + stages
                 legs.append(Leg(name=f"retract_{k}" + (f"_{j}" if j else ""), fresh=fresh_retract,
                                 define=define(100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
                                 restart_head=restart_header_lines(s), stages=stages, columns=columns, sample_interval=si,
-                                chunk_steps=s["chunk_steps"], n_atoms=n,
+                                chunk_steps=s.chunk_steps, n_atoms=n,
                                 info={"speed_m_s": v, "v_A_fs": v_ret, "repeat": j}))
         info.update(n_flat=int(len(groups["flat"])), n_tip=int(len(groups["tip"])),
-                    tip_mobile_mass_g_mol=float(system.masses[tip_mobile].sum()), tip_thermostat=s["tip_thermostat"])
+                    tip_mobile_mass_g_mol=float(system.masses[tip_mobile].sum()), tip_thermostat=s.tip_thermostat)
         return Plan(legs=legs, timestep_fs=dt, n_atoms=n,
                     seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": derived_seed(seed, 3, 1),
-                           "thermostat_base": seed, **({"sam_asperity": seed + 30} if s["surface"] == "ots" else {})},
+                           "thermostat_base": seed, **({"sam_asperity": seed + 30} if s.surface == "ots" else {})},
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        s = ctx.settings
+        s = self.typed(ctx.settings)
         info = ctx.plan.system_info
-        R_m = U.angstrom_to_m(s["asperity_radius_A"])
+        R_m = U.angstrom_to_m(s.asperity_radius_A)
         ids, _, pos = read_atoms(ctx.leg_dir("approach") / "minimized.data")
         n_flat = info["n_flat"]
         # ids 1..n_flat are the flat (place_on puts the substrate first)
@@ -199,7 +203,7 @@ class PullOff(Workflow):
         drag_err = np.array([r["drag"]["stderr"] for r in slow["results"]])
         v_slow = U.m_per_s_to_angstrom_per_fs(slow["speed_m_s"])
         gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(info["tip_mobile_mass_g_mol"] * v_slow /
-                                                           s["thermostat_damping_fs"])
+                                                           s.thermostat_damping_fs)
         err = lambda x: x / (2 * math.pi * R_m) if x else None
         q = {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"], repeats=len(slow["results"]),
                                   kind=f"maximum tensile force on retraction (mean of {len(slow['results'])}; "
@@ -222,20 +226,20 @@ class PullOff(Workflow):
                  f"positive = repulsive.",
                  f"pull-off force: mean of {len(slow['results'])} retraction(s) at {slow['speed_m_s']:g} m/s; "
                  f"stderr: {slow['how']}.",
-                 f"thermostat on the asperity: '{s['tip_thermostat']}'"
+                 f"thermostat on the asperity: '{s.tip_thermostat}'"
                  + {"comoving": " (its thermal motion only: compute temp/com bias, so no drag on its motion; the flat "
                                 "has its own thermostat)",
                     "none": " (the asperity runs NVE; only the flat is thermostatted)",
-                    "lab": " (lab frame, every mobile atom: the old protocol; it drags the moving asperity)"}[
-                     s["tip_thermostat"]]
+                    "lab": " (lab frame, every mobile atom together with the flat: it drags the moving asperity)"}[
+                     s.tip_thermostat]
                  + f"; residual drag measured {q['residual_drag_force']['value'] * 1e9:+.3f} nN against "
                    f"{-gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
                    f"(gamma M v) would apply.",
-                 f"validation, not calibration: at MD scale (R = {s['asperity_radius_A']:g} A) the contact is "
+                 f"validation, not calibration: at MD scale (R = {s.asperity_radius_A:g} A) the contact is "
                  f"DMT-like (Tabor mu ~ 0.06), so F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the number "
                  f"to compare with the flat-slab work of adhesion W_F (the calibration report does).",
-                 f"R = {s['asperity_radius_A']:g} A (the requested radius of the carved, faceted dome)."]
-        if s["surface"] == "ots":
+                 f"R = {s.asperity_radius_A:g} A (the requested radius of the carved, faceted dome)."]
+        if s.surface == "ots":
             g = info.get("asperity_sam", {})
             notes.append(f"OTS chains on the asperity: {g.get('chains')} on dome silanols within "
                          f"graft_max_polar_deg of the apex ({g.get('chains_per_projected_nm2', float('nan')):.2f} per "
@@ -261,7 +265,7 @@ class PullOff(Workflow):
                    "tip_mobile_mass_g_mol": info["tip_mobile_mass_g_mol"]}
         if len(speeds) >= 2:
             ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in per_speed]),
-                                       target_rate=float(min(speeds)) / 10.0, temperature_K=s["temperature_K"])
+                                       target_rate=float(min(speeds)) / 10.0, temperature_K=s.temperature_K)
             q["pull_off_force_extrapolated"] = quantity_record(ext["F0"], ext["stderr"], "N",
                                                   kind=f"F = a + b ln(v) fitted to {len(speeds)} speeds, "
                                                        f"evaluated at {ext['target_rate']:g} m/s")
@@ -279,7 +283,7 @@ class PullOff(Workflow):
             ax.axhline(0, color="k", lw=0.5)
             ax.set_xlabel("separation (nm)")
             ax.set_ylabel("force on asperity (nN)")
-            ax.set_title(f"pull-off {F * 1e9:.3f} nN, R = {s['asperity_radius_A']:g} Å")
+            ax.set_title(f"pull-off {F * 1e9:.3f} nN, R = {s.asperity_radius_A:g} Å")
             ax.legend(fontsize=7)
         figures["pulloff_curve"] = figure_writer(draw)
         return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
@@ -287,20 +291,20 @@ class PullOff(Workflow):
 
 def _thermostat_fix(name: str, group: str, settings: Mapping[str, Any], step: int, salt: int) -> list[str]:
     """A named thermostat fix on ``group`` (Langevin + nve, or Nose-Hoover nvt)."""
-    t = settings["temperature_K"]
-    damp = settings["thermostat_damping_fs"]
-    if settings["thermostat"] == "nose-hoover":
+    t = settings.temperature_K
+    damp = settings.thermostat_damping_fs
+    if settings.thermostat == "nose-hoover":
         return [f"fix {name} {group} nvt temp {t:g} {t:g} {damp:g}"]
-    return [f"fix {name} {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings['seed'], 17, salt, step)} zero yes",
+    return [f"fix {name} {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings.seed, 17, salt, step)} zero yes",
             f"fix {name}_nve {group} nve"]
 
 
 def _pulloff_thermostat(s: Mapping[str, Any], step: int, salt: int) -> list[str]:
     """The pull-off thermostats (recipe ``tip_thermostat``): the flat's mobile atoms always; the asperity's mobile
     atoms in its own frame ('comoving': a temp/com bias, so drag and noise act on the thermal velocities only and
-    sum to zero over the asperity), not at all ('none': NVE), or -- the version-1 protocol -- together with the
+    sum to zero over the asperity), not at all ('none': NVE), or together with the
     flat in the lab frame ('lab')."""
-    mode = s["tip_thermostat"]
+    mode = s.tip_thermostat
     if mode == "lab":
         return thermostat_lines("mobile", s, step, salt)
     cmds = _thermostat_fix("thermo_flat", "flat_mobile", s, step, 2 * salt)
@@ -380,243 +384,3 @@ def _z0_mean(rs: list[Mapping[str, Any]]) -> dict[str, Any]:
     avg = A.registry_average(z, e) if z.size >= 2 else {"mean": float(z[0]), "stderr": float(e[0]) or None}
     return quantity_record(avg["mean"], avg["stderr"], "m", kind=f"mean z0 of the LJ 9-3 law fitted to {z.size} retraction "
                                                     f"curves (includes the asperity's compliance)")
-
-
-#: lateral spacing of grafted chains on the asperity: tried in this order until the cap holds the target coverage
-#: (a crystalline dome's silanols pair up at 4.3-4.4 A in projection; polyethylene's nearest chains are 4.46 A
-#: apart, TraPPE CH2 sigma 3.95 A); the builder's default for flat SAMs is 4.4 A
-GRAFT_SPACINGS_A = (4.4, 4.35, 4.3)
-#: the dome's chains stand along the pulling axis (the flat SAM's builder default is 15 deg off it)
-DOME_CHAIN_TILT_DEG = 0.0
-#: when a chain is added to the offset dome (:func:`_offset_sites`), the chains within this lateral distance of it
-#: may move to make room (two spacings: farther chains would only pass on a push they have room to absorb)
-LOCAL_SPREAD_A = 9.0
-#: the pull-off cell is periodic in x and y
-PBC_XY = (True, True, False)
-#: least distance (A) of an offset chain's head atoms from any heavy atom but its anchor O (the flat SAM's builder
-#: starts with none closer than 2.6 A)
-HEAD_CLEARANCE_A = 1.7
-
-
-def _independent_sites(xy: np.ndarray, cell_xy, spacing: float, order: np.ndarray, exact_max: int = 60,
-                       restarts: int = 200, seed: int = 0) -> list[int]:
-    """A largest set of sites (indices into ``xy``) no two closer than ``spacing`` laterally (periodic): exact
-    branch and bound up to ``exact_max`` sites, else the best of ``restarts`` randomised min-degree greedy passes.
-    Ties prefer sites early in ``order`` (nearest the apex)."""
-    n = len(xy)
-    d = xy[:, None, :] - xy[None, :, :]
-    d -= np.asarray(cell_xy)[None, None, :] * np.round(d / np.asarray(cell_xy)[None, None, :])
-    close = (np.hypot(d[..., 0], d[..., 1]) < spacing) & ~np.eye(n, dtype=bool)
-    adj = [set(np.flatnonzero(close[i]).tolist()) for i in range(n)]
-    rank = {int(i): r for r, i in enumerate(order)}
-    if n <= exact_max:
-        best: list[list[int]] = [[]]
-
-        def rec(cand: set, chosen: list):
-            if len(chosen) + len(cand) <= len(best[0]):
-                return
-            if not cand:
-                best[0] = list(chosen)
-                return
-            v = max(cand, key=lambda u: (len(adj[u] & cand), -rank[u]))
-            if not adj[v] & cand:
-                rec(cand - {v}, chosen + [v])
-                return
-            rec(cand - adj[v] - {v}, chosen + [v])
-            rec(cand - {v}, chosen)
-        rec(set(range(n)), [])
-        return sorted(best[0], key=lambda i: rank[i])
-    rng = np.random.default_rng(seed)
-    best_set: list[int] = []
-    for it in range(restarts):
-        cand = set(range(n))
-        chosen = []
-        noise = rng.random(n) if it else np.zeros(n)
-        while cand:
-            v = min(cand, key=lambda u: (len(adj[u] & cand) + noise[u], rank[u]))
-            chosen.append(v)
-            cand -= adj[v] | {v}
-        if len(chosen) > len(best_set):
-            best_set = chosen
-    return sorted(best_set, key=lambda i: rank[i])
-
-
-def _clearance_check(asp: System, chain_length: int, tilt_deg: float = 0.0, clearance_A: float = 2.6):
-    """A function ``(sites, offsets=None) -> bool array``: True for the sites whose chain -- straight, ``tilt_deg``
-    from +z towards +x, as :func:`md.build.ots_sam` grafts it, moved laterally by ``offsets`` (n x 2, A; see
-    ``ots_sam(head_offsets=...)``) -- keeps ``clearance_A`` from every heavy atom of the asperity from 4 A above
-    the anchor O to the chain's end. Near the rim of a stepped dome a chain along the pulling axis can run into the
-    dome above its site (an 80 deg cap at smoke without this check: an overlap the minimiser cannot undo). The
-    asperity's neighbour tree is built once per call of this factory."""
-    from scipy.spatial import cKDTree
-
-    t = math.radians(tilt_deg)
-    axis = np.array([math.sin(t), 0.0, math.cos(t)])
-    heavy = np.flatnonzero(~np.isin(asp.types, ["HOY"]))
-    tree = cKDTree(asp.positions[heavy])
-    length = 1.54 * math.cos(math.radians(33.0)) * (chain_length + 1)     # all-trans axial length, A
-    line = np.arange(4.0, length + 0.5, 0.7)[:, None] * axis[None, :]
-
-    def check(sites: np.ndarray, offsets: np.ndarray | None = None) -> np.ndarray:
-        ok = np.ones(len(sites), bool)
-        for k, site in enumerate(np.asarray(sites, int)):
-            base = asp.positions[site].copy()
-            if offsets is not None:
-                base[:2] += offsets[k]
-            hits = tree.query_ball_point(base + line, clearance_A)
-            ok[k] = not any(heavy[h] != site for hs in hits for h in hs)
-        return ok
-    return check
-
-
-def _chain_clearance(asp: System, sites: np.ndarray, chain_length: int, tilt_deg: float = 0.0,
-                     clearance_A: float = 2.6) -> np.ndarray:
-    """:func:`_clearance_check` for the chains standing on their sites."""
-    return _clearance_check(asp, chain_length, tilt_deg, clearance_A)(sites)
-
-
-def _spread_chains(xy: np.ndarray, cell_xy, spacing: float, centre: np.ndarray, radius: float,
-                   start: np.ndarray | None = None, free: np.ndarray | None = None,
-                   iterations: int = 200) -> np.ndarray | None:
-    """Lateral offsets (n x 2, A) inside the disk (``centre``, ``radius``) that put the chains standing on the
-    sites ``xy`` at least ``spacing`` apart laterally (periodic), or None if ``iterations`` rounds of pairwise
-    pushes (each chain pushed half the overlap away from every chain too close, then projected back onto the disk)
-    do not get there. Starts from the offsets ``start`` (zero if None); only the chains flagged in ``free`` (all
-    if None) move. Deterministic: no random numbers."""
-    d = np.zeros(xy.shape, float) if start is None else np.array(start, float)
-    idx = np.arange(len(xy)) if free is None else np.flatnonzero(free)
-    target = spacing + 0.02                       # a little beyond, so that the last push does not stop short
-
-    def gaps(p, rows):
-        v = minimum_image(p[rows, None, :] - p[None, :, :], cell_xy, PBC_XY)
-        r = np.hypot(v[..., 0], v[..., 1])
-        r[np.arange(len(rows)), rows] = np.inf
-        return v, r
-
-    for _ in range(iterations):
-        v, r = gaps(xy + d, idx)
-        if r.min() >= spacing:
-            break
-        over = np.where(r < target, 0.5 * (target - r), 0.0)
-        push = (over[..., None] * v / np.maximum(r, 1e-9)[..., None]).sum(axis=1)
-        rel = d[idx] + push - centre
-        n = np.hypot(rel[:, 0], rel[:, 1])
-        d[idx] = centre + rel * np.minimum(1.0, radius / np.maximum(n, 1e-12))[:, None]
-    _, r = gaps(xy + d, np.arange(len(xy)))
-    return d if r.min() >= spacing else None
-
-
-def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: int, s: Mapping[str, Any],
-                  spacing: float) -> tuple[list[int], np.ndarray]:
-    """Sites (indices into ``sites``, apex first) and lateral chain offsets for a dome whose silanols sit closer
-    than chains pack: sites are taken apex first and kept when the chains so far, the ones within
-    :data:`LOCAL_SPREAD_A` of the new one moved within :func:`md.build.sam.head_offset_disk`
-    (:func:`_spread_chains`), still stand ``spacing`` apart, clear of the dome (:func:`_clearance_check`), with
-    every head atom (head Si, its two O, the first two CH2) :data:`HEAD_CLEARANCE_A` from every heavy atom but its
-    anchor O -- until ``n_target`` chains stand."""
-    from scipy.spatial import cKDTree
-    from md.build.sam import chain_geometry, head_offset_disk, head_shifts
-
-    L = s["chain_length"]
-    tpos, ttypes = chain_geometry(L, DOME_CHAIN_TILT_DEG, 0.0)
-    centre, radius = head_offset_disk(L, DOME_CHAIN_TILT_DEG, 0.0)
-    head = tpos[[k for k, t in enumerate(ttypes) if t in ("SIH", "OC24")] +
-                [k for k, t in enumerate(ttypes) if t == "CH2"][:2]]
-    clear = _clearance_check(asp, L, DOME_CHAIN_TILT_DEG)
-    heavy = np.flatnonzero(asp.types != "HOY")
-    tree = cKDTree(asp.positions[heavy])
-    cell = np.asarray(asp.cell[:2], float)
-
-    def heads(trial, d):
-        return asp.positions[sites[trial]][:, None, :] + head[None, :, :] + head_shifts(d, template=tpos)[:, None, :]
-
-    def head_room(trial, d, moved) -> bool:
-        h = heads(trial, d)
-        for m in moved:                                   # against the dome
-            site = int(sites[trial[m]])
-            for hit in tree.query_ball_point(h[m], HEAD_CLEARANCE_A):
-                if any(int(heavy[k]) != site for k in hit):
-                    return False
-        v = minimum_image(h[moved][:, :, None, None, :] - h[None, None, :, :, :], asp.cell, PBC_XY)  # other heads
-        r = np.linalg.norm(v, axis=-1)
-        r[np.arange(len(moved)), :, moved, :] = np.inf
-        return bool(r.min() >= HEAD_CLEARANCE_A)
-
-    xy = asp.positions[sites, :2]
-    chosen: list[int] = []
-    offsets = np.zeros((0, 2))
-    for k in order.tolist():
-        trial = chosen + [int(k)]
-        near = minimum_image(xy[trial] - xy[k], cell, PBC_XY)
-        d = _spread_chains(xy[trial], cell, spacing, centre, radius, start=np.vstack([offsets, [0.0, 0.0]]),
-                           free=np.hypot(near[:, 0], near[:, 1]) < LOCAL_SPREAD_A)
-        if d is None:
-            continue
-        moved = np.flatnonzero(np.hypot(*(d - np.vstack([offsets, [np.inf, np.inf]])).T) > 1e-9)
-        if not clear(sites[np.array(trial)[moved]], d[moved]).all() or not head_room(trial, d, moved):
-            continue
-        chosen, offsets = trial, d
-        if len(chosen) == n_target:
-            break
-    return chosen, offsets
-
-def _graft_dome(asp: System, s: Mapping[str, Any], seed: int) -> tuple[System, dict[str, Any]]:
-    """OTS chains on the dome silanols within ``graft_max_polar_deg`` of the apex (asperity tip up), at the SAM's
-    coverage ``sam_coverage`` per nm^2 of the cap's projected area (the chains point along the pulling axis, so
-    their lateral packing is what counts): the sites are a largest set no two closer than the spacing laterally
-    (:data:`GRAFT_SPACINGS_A`, tried in order until one holds the target), the ones nearest the apex kept.
-    Where chains standing on their sites fall short of the target (dome silanols come in close pairs), the
-    chains lean off their sites (:func:`_offset_sites`, at 4.4 A) if that holds more. Sites are chosen as a
-    largest independent set, not in random order: a random sequential choice packs well below the target."""
-    R = float(s["asperity_radius_A"])
-    centre = np.array(asp.info["centre_A"])
-    dome = np.asarray(asp.group("silanol_O_dome"), int)
-    p = asp.positions[dome] - centre
-    cosang = p[:, 2] / np.maximum(np.linalg.norm(p, axis=1), 1e-9)
-    keep = cosang >= math.cos(math.radians(s["graft_max_polar_deg"]))
-    sites, cos_k = dome[keep], cosang[keep]
-    all_sites, all_cos = sites, cos_k
-    clear = _chain_clearance(asp, sites, s["chain_length"], DOME_CHAIN_TILT_DEG)
-    n_blocked = int((~clear).sum())
-    sites, cos_k = sites[clear], cos_k[clear]
-    if not len(sites):
-        raise ValueError("no dome silanols within graft_max_polar_deg of the apex: nothing to graft on")
-    cap = math.pi * (R * math.sin(math.radians(s["graft_max_polar_deg"]))) ** 2      # projected area, A^2
-    cell_area = float(asp.cell[0] * asp.cell[1])
-    n_target = max(1, int(round(s["sam_coverage"] * cap / 100.0)))
-    order = np.argsort(-cos_k, kind="stable")               # apex first
-    xy = asp.positions[sites, :2]
-    chosen, spacing = [], GRAFT_SPACINGS_A[0]
-    for spacing in GRAFT_SPACINGS_A:
-        chosen = _independent_sites(xy, asp.cell[:2], spacing, order, seed=seed)
-        if len(chosen) >= n_target:
-            break
-    chosen = chosen[:n_target]
-    grafts = [sites[np.array(chosen[:n], int)] for n in range(len(chosen), 0, -1)]
-    offsets: dict[int, np.ndarray] = {}
-    if len(chosen) < n_target:
-        # the dome's silanols pair up closer than chains pack: let the chains lean off their sites
-        picked, d = _offset_sites(asp, all_sites, np.argsort(-all_cos, kind="stable"), n_target, s,
-                                  GRAFT_SPACINGS_A[0])
-        if len(picked) > len(chosen):
-            grp = all_sites[np.array(picked, int)]
-            grafts, spacing = [grp], GRAFT_SPACINGS_A[0]
-            offsets = {int(i): d[k] for k, i in enumerate(grp)}
-    last = None
-    for grp in grafts:
-        n = len(grp)
-        try:
-            sam = as_system(ots_sam(with_groups(asp, graft_sites=grp), coverage=(n + 0.49) / (cell_area / 100.0),
-                                    chain_length=s["chain_length"], seed=seed, site_group="graft_sites",
-                                    min_spacing=spacing - 1e-6, tilt_deg=DOME_CHAIN_TILT_DEG,
-                                    head_offsets=offsets or None))
-            break
-        except ValueError as exc:
-            last = exc
-    else:
-        raise ValueError(f"no OTS chain fits on the dome: {last}")
-    chains = int(sam.info["chains"])
-    return sam, {"chains": chains, "requested_chains": n_target, "cap_projected_area_nm2": cap / 100.0,
-                 "chains_per_projected_nm2": chains / (cap / 100.0), "sites": int(len(sites)),
-                 "sites_blocked_by_the_dome": n_blocked, "min_spacing_A": float(spacing),
-                 "chain_offset_max_A": float(sam.info.get("head_offset_max_A", 0.0))}

@@ -29,16 +29,18 @@ class SurfaceTension(Workflow):
     yields = {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"}
 
     def forcefield_files(self, s):
-        return water_forcefield_names(s["water_model"])
+        s = self.typed(s)
+        return water_forcefield_names(s.water_model)
 
     def plan(self, s, run_dir):
+        s = self.typed(s)
         ff = forcefield_of(self.forcefield_files(s))
-        seed = int(s["seed"])
-        film = as_system(water_slab(s["lx_A"], s["ly_A"], s["film_thickness_A"], vacuum=s["vacuum_A"], seed=seed))
+        seed = int(s.seed)
+        film = as_system(water_slab(s.lx_A, s.ly_A, s.film_thickness_A, vacuum=s.vacuum_A, seed=seed))
         data = run_dir / "system.data"
         write_data(film, ff, data)
         n = film.n_atoms
-        fi = s["frame_interval"] or s["sample_interval"]
+        fi = s.frame_interval or s.sample_interval
         groups = {"water_O": film.group("water_O")}
 
         def define(step: int) -> list[str]:
@@ -48,31 +50,31 @@ class SurfaceTension(Workflow):
 
         leg = Leg(name="film", fresh=lambda d: fresh_from_data(ff, data, s, groups), define=define,
                   prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
-                  stages=stage_list(equilibrate_stage(s, "all", 1), Stage("sample", steps_of(s, "sample_steps"))),
+                  stages=stage_list(equilibrate_stage(s, "all", 1), Stage("sample", steps_of(s.sample_steps, s.sample_interval))),
                   columns={"pe": "v_pe", "temp": "v_temp", "pxx": "v_pxx", "pyy": "v_pyy", "pzz": "v_pzz",
                            "lz": "v_lz"},
-                  sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"], n_atoms=n,
+                  sample_interval=s.sample_interval, chunk_steps=s.chunk_steps, n_atoms=n,
                   frames=Frames("water_O", fi))
         ow = ff.atom_type("OW")
         info = {"film": dict(film.info), "box_A": film.cell.tolist(), "n_molecules": int(film.info["n_molecules"]),
                 "lj_epsilon_kcal": ow.epsilon, "lj_sigma_A": ow.sigma}
-        return Plan(legs=[leg], timestep_fs=s["timestep_fs"], n_atoms=n,
+        return Plan(legs=[leg], timestep_fs=s.timestep_fs, n_atoms=n,
                     seeds={"structure": seed, "velocities": derived_seed(seed, 3, 1), "thermostat_base": seed},
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        s = ctx.settings
+        s = self.typed(ctx.settings)
         info = ctx.plan.system_info
         d = ctx.samples("film")
         steps, ids, pos, box = ctx.frames("film")
         area = float(info["box_A"][0] * info["box_A"][1])
-        nb = min(s["n_blocks"], max(2, len(steps)))
-        dens = A.slab_density(pos[:, :, 2], SPCE_WATER_MOLAR_MASS, area, lz_A=None, bin_A=s["bin_A"], n_blocks=nb)
+        nb = min(s.n_blocks, max(2, len(steps)))
+        dens = A.slab_density(pos[:, :, 2], SPCE_WATER_MOLAR_MASS, area, lz_A=None, bin_A=s.bin_A, n_blocks=nb)
         rho_n = U.kg_per_m3_to_g_per_cm3(dens["value"]) * U.AVOGADRO / SPCE_WATER_MOLAR_MASS * 1e-24     # O per A^3
-        tail = A.lj_tail_correction(info["lj_epsilon_kcal"], info["lj_sigma_A"], rho_n, s["cutoff_A"],
+        tail = A.lj_tail_correction(info["lj_epsilon_kcal"], info["lj_sigma_A"], rho_n, s.cutoff_A,
                                     width_A=dens["width_A"])
         st = A.surface_tension(d["pxx"], d["pyy"], d["pzz"], d["lz"], tail_correction_N_per_m=tail,
-                               n_blocks=s["n_blocks"])
+                               n_blocks=s.n_blocks)
         q = {"surface_tension": quantity_record(st["value"], st["stderr"], "N/m",
                                    kind="Kirkwood-Buff from the pressure tensor, LJ tail correction included"),
              "surface_tension_uncorrected": quantity_record(st["value_uncorrected"], st["stderr"], "N/m",
@@ -84,7 +86,7 @@ class SurfaceTension(Workflow):
                                       np.column_stack([d["step"], U.atm_to_Pa(d["pxx"]), U.atm_to_Pa(d["pyy"]),
                                                        U.atm_to_Pa(d["pzz"]), U.angstrom_to_m(d["lz"])]))}
         notes = [f"Coulomb: PPPM with kspace_modify slab 3.0 (long-ranged); Lennard-Jones: truncated at "
-                 f"{s['cutoff_A']:g} A in the dynamics, its long-range part added analytically "
+                 f"{s.cutoff_A:g} A in the dynamics, its long-range part added analytically "
                  f"(Blokhuis et al. 1995, tanh profile of width {dens['width_A']:.2f} A): "
                  f"{tail * 1e3:.2f} mN/m.",
                  "reference: SPC/E 63.6 mN/m at 300 K (Vega & de Miguel, J. Chem. Phys. 126 (2007) 154707); "

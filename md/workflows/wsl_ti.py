@@ -84,7 +84,7 @@ def _fft_size(n: int) -> int:
 
 def pppm_lines(settings, box_A) -> list[str]:
     """``kspace_modify`` fixing the Ewald parameter and the mesh (:data:`PPPM_G_RC`, :data:`PPPM_MESH_A`)."""
-    g = PPPM_G_RC / float(settings["cutoff_A"])
+    g = PPPM_G_RC / float(settings.cutoff_A)
     lx, ly, lz = (float(x) for x in box_A)
     mesh = [_fft_size(math.ceil(lx / PPPM_MESH_A)), _fft_size(math.ceil(ly / PPPM_MESH_A)),
             _fft_size(math.ceil(3.0 * lz / PPPM_MESH_A))]
@@ -116,24 +116,28 @@ class WslTI(Workflow):
               "surface_tension_lv": "N/m"}
 
     def forcefield_files(self, s):
-        return ["silica_interface"] + (["ots_trappe_ua"] if s["surface"] == "ots" else []) + \
-            water_forcefield_names(s["water_model"])
+        s = self.typed(s)
+        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else []) + \
+            water_forcefield_names(s.water_model)
 
     def build(self, s):
-        seed = int(s["seed"])
-        sub = surface_slab(s["surface"], s["nx"], s["ny"], s["slab_thickness_A"], s, seed, silica_face_of(s))
-        wff = forcefield_of(water_forcefield_names(s["water_model"]))
-        film = as_system(water_slab(float(sub.cell[0]), float(sub.cell[1]), float(s["film_thickness_A"]),
+        s = self.typed(s)
+        seed = int(s.seed)
+        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed, silica_face_of((s.surface,), s.silica_face))
+        wff = forcefield_of(water_forcefield_names(s.water_model))
+        film = as_system(water_slab(float(sub.cell[0]), float(sub.cell[1]), float(s.film_thickness_A),
                                     vacuum=2.0, seed=seed + 1, forcefield=wff))
         return sub, film, as_system(place_on(sub, film, gap=FILM_GAP_A, vacuum=FILM_VACUUM_A))
 
-    @staticmethod
-    def nodes(s) -> dict[str, np.ndarray]:
-        return {"q": A.gauss_legendre_unit(s["ti_charge_nodes"])[0], "lj": A.gauss_legendre_unit(s["ti_lj_nodes"])[0]}
+    @classmethod
+    def nodes(cls, s) -> dict[str, np.ndarray]:
+        s = cls.typed(s)
+        return {"q": A.gauss_legendre_unit(s.ti_charge_nodes)[0], "lj": A.gauss_legendre_unit(s.ti_lj_nodes)[0]}
 
     def plan(self, s, run_dir):
+        s = self.typed(s)
         ff = forcefield_of(self.forcefield_files(s))
-        seed = int(s["seed"])
+        seed = int(s.seed)
         sub, film, system = self.build(s)
         substrate, water = system.group("substrate"), system.group("adsorbate")
         held = np.intersect1d(held_deep(system), substrate)
@@ -144,7 +148,7 @@ class WslTI(Workflow):
         ids = lammps_type_ids(ff)
         all_types, charged_types = solid_types(system, ff)
         solid_t, charged_t = [ids[t] for t in all_types], [ids[t] for t in charged_types]
-        water_t = sorted(ids[a.name] for a in forcefield_of(water_forcefield_names(s["water_model"])).atom_types)
+        water_t = sorted(ids[a.name] for a in forcefield_of(water_forcefield_names(s.water_model)).atom_types)
         charge = {ids[t]: ff.atom_type(t).charge for t in charged_types}
         # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
         # dispersion beyond the cutoff (analysis: md.analysis.film_lower_dividing_plane + dispersion_tail_work)
@@ -153,7 +157,7 @@ class WslTI(Workflow):
         ow = str(np.asarray(system.types)[water_o[0]])
         z_film = float(system.positions[water, 2].mean())
         area = float(system.cell[0] * system.cell[1])
-        dt, t = s["timestep_fs"], s["temperature_K"]
+        dt, t = s.timestep_fs, s.temperature_K
         shake = shake_lines(ff, also=SILANOL_OH)
         nodes = self.nodes(s)
 
@@ -200,10 +204,10 @@ class WslTI(Workflow):
 
         def head(path: Path) -> list[str]:
             return restart_header_lines(s)(path) + kspace
-        common = dict(restart_head=head, sample_interval=s["sample_interval"], chunk_steps=s["chunk_steps"])
+        common = dict(restart_head=head, sample_interval=s.sample_interval, chunk_steps=s.chunk_steps)
         sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=lambda step: base(False, step, 0),
                       prepare=lambda d: [],
-                      stages=[Stage("equilibrate", steps_of(s, "substrate_equilibrate_steps"),
+                      stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
                                     (f"velocity mobile create {t:g} {derived_seed(seed, 3, 0)} mom yes rot no "
                                      f"dist gaussian",), sampled=False)],
                       columns={"pe": "v_pe", "temp": "v_temp"}, n_atoms=sub.n_atoms, **common)
@@ -221,13 +225,13 @@ class WslTI(Workflow):
         if len(tail_sites):
             # the equilibration's second half is framed (a sampled stage; its samples are the same series as
             # before); silica, with no tail to add, keeps a single unsampled stage
-            n_eq = steps_of(s, "equilibrate_steps")
-            half = (n_eq // 2) // s["chunk_steps"] * s["chunk_steps"] or n_eq // 2
+            n_eq = steps_of(s.equilibrate_steps, s.sample_interval)
+            half = (n_eq // 2) // s.chunk_steps * s.chunk_steps or n_eq // 2
             film_stages = stage_list(Stage("equilibrate", n_eq - half, begin, sampled=False),
                                      Stage("sample", half))
-            film_frames = Frames("framed", s["sample_interval"] * FRAME_EVERY_SAMPLES)
+            film_frames = Frames("framed", s.sample_interval * FRAME_EVERY_SAMPLES)
         else:
-            film_stages = [Stage("equilibrate", steps_of(s, "equilibrate_steps"), begin, sampled=False)]
+            film_stages = [Stage("equilibrate", steps_of(s.equilibrate_steps, s.sample_interval), begin, sampled=False)]
             film_frames = None
         film_leg = Leg(name="film", fresh=fresh_film, define=lambda step: base(True, step, 1),
                        prepare=lambda d: minimize_water_lines(s), stages=film_stages,
@@ -244,8 +248,8 @@ class WslTI(Workflow):
             return Leg(name=name, fresh=fresh,
                        define=lambda step: base(with_water, step, salt) + coupling(lam_q, lam_lj, stage, with_water),
                        prepare=lambda d: ["reset_timestep 0"],
-                       stages=stage_list(Stage("equilibrate", steps_of(s, "ti_equilibrate_steps"), sampled=False),
-                                         Stage("sample", steps_of(s, "ti_sample_steps"))),
+                       stages=stage_list(Stage("equilibrate", steps_of(s.ti_equilibrate_steps, s.sample_interval), sampled=False),
+                                         Stage("sample", steps_of(s.ti_sample_steps, s.sample_interval))),
                        columns=cols, n_atoms=system.n_atoms if with_water else sub.n_atoms, info=info, **common)
 
         prev, salt = film_leg, 10
@@ -275,9 +279,9 @@ class WslTI(Workflow):
         info = {"substrate": system_summary(sub), "film": dict(film.info), "box_A": system.cell.tolist(),
                 "area_A2": area, "n_substrate": int(len(substrate)), "n_water_molecules_built": int(len(water) // 3),
                 "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
-                "silica_face": silica_face_of(s), "water_model": s["water_model"], "type_ids": ids,
+                "silica_face": silica_face_of((s.surface,), s.silica_face), "water_model": s.water_model, "type_ids": ids,
                 "solid_types": all_types, "solid_charges_e": {x: ff.atom_type(x).charge for x in charged_types},
-                "surface": s["surface"], "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6,
+                "surface": s.surface, "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6,
                 "tether": {"k_kcal_mol_A2": TETHER_K, "z_A": z_film}, "fep_delta": FEP_DELTA,
                 "soft_core": "lj/cut/coul/long/soft n = 1, alpha_LJ = 0.5 (Beutler et al. 1994)",
                 "nodes": {k: v.tolist() for k, v in nodes.items()}, "pppm": kspace[0]}
@@ -286,9 +290,9 @@ class WslTI(Workflow):
 
     # ------------------------------------------------------------------------------------------ analysis
     def analyse(self, ctx):
-        s = ctx.settings
+        s = self.typed(ctx.settings)
         info = ctx.plan.system_info
-        model = WATER_MODELS[s["water_model"]]
+        model = WATER_MODELS[s.water_model]
         gamma = model["gamma_lv_N_m"]
         nodes = {k: np.asarray(v, float) for k, v in info["nodes"].items()}
         stages, per_node, halves = {}, {}, {0: {}, 1: {}}
@@ -311,7 +315,7 @@ class WslTI(Workflow):
             for h in (0, 1):
                 halves[h][key] = A.ti_integral(lam, half_means[h], [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
         temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "film" or
-                                       leg.name.startswith(("q", "lj"))], s["temperature_K"], second_half=("film",))
+                                       leg.name.startswith(("q", "lj"))], s.temperature_K, second_half=("film",))
         w = A.ti_work_of_adhesion_sl(stages["charge_film"], stages["lj_film"], stages["charge_reference"],
                                      info["area_A2"])
         # the tether's energy at full coupling (the film leg's second half), added back
@@ -378,7 +382,7 @@ class WslTI(Workflow):
                  f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
                  f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
                  f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f}"
-                 + (f", water-TraPPE dispersion beyond the {s['cutoff_A']:g} A cutoff {dw_tail * 1e3:+.1f} +/- "
+                 + (f", water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff {dw_tail * 1e3:+.1f} +/- "
                     f"{tail['stderr'] * 1e3:.1f}" if tail is not None else "") + " mJ/m^2.",
                  {"measured": f"theta = {ang['theta_deg']:.1f} deg from Young-Dupre with gamma_lv = "
                               f"{gamma * 1e3:.1f} mN/m ({model['name']}).",
@@ -392,8 +396,8 @@ class WslTI(Workflow):
                  f"placed; bound at full coupling it sits {tc['offset_A']:+.2f} A from there, and the spring's "
                  f"energy there ({tc['energy_kcal_mol']:.2f} kcal/mol = {tc['value'] * 1e3:.1f} mJ/m^2) is added "
                  f"to W_SL (md.analysis.tether_correction); the O(kT) translational term it leaves, "
-                 f"{U.kT_kcal_per_mol(s['temperature_K']):.2f} kcal/mol = "
-                 f"{U.kT_kcal_per_mol(s['temperature_K']) * conv * 1e3:.1f} mJ/m^2 here, is not.",
+                 f"{U.kT_kcal_per_mol(s.temperature_K):.2f} kcal/mol = "
+                 f"{U.kT_kcal_per_mol(s.temperature_K) * conv * 1e3:.1f} mJ/m^2 here, is not.",
                  "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
                  f"mobile (O-H by SHAKE); water rigid {model['name']} (SHAKE); PPPM throughout (the charge stage "
                  "scales the solid's charges, the reference subtracts their solid-solid part)."]
@@ -401,7 +405,7 @@ class WslTI(Workflow):
             notes.append(temps["note"])
         if tail is not None:
             notes.append(
-                f"the water-TraPPE dispersion beyond the {s['cutoff_A']:g} A cutoff (which TraPPE was fitted with) is "
+                f"the water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff (which TraPPE was fitted with) is "
                 f"added statically: {tail['sites']} CH2/CH3 sites under the film's lower dividing plane "
                 f"(z = {tail['plane_z_A']:.2f} A, bulk {tail['number_density_A3']:.4f} molecules/A^3), "
                 f"{tail['frames']} frames of the film leg's second half; the IFF pairs and water-water keep the "
@@ -431,7 +435,7 @@ class WslTI(Workflow):
         details = {"stages": stages, "nodes": per_node, "parts_J_m2": w, "angle": ang, "gamma_lv_N_m": gamma,
                    "window_halves_J_m2": {"first": w_half[0], "second": w_half[1], "consistent": half_ok,
                                           "difference_sigma": 2.0 * half_sigma},
-                   "water_model": s["water_model"]}
+                   "water_model": s.water_model}
         if tail is not None:
             details["dispersion_tail"] = tail
         if temps:
@@ -453,11 +457,11 @@ def _dispersion_tail(ctx, info, s) -> dict | None:
     area = float(info["area_A2"])
     plane = A.film_lower_dividing_plane(pos[:, ~is_site, 2], area, len(steps))
     per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, plane["z_A"], plane["number_density_A3"],
-                                                 s["cutoff_A"], area) for k in range(len(steps))])
+                                                 s.cutoff_A, area) for k in range(len(steps))])
     st = A.timeseries_stats(per_frame, equilibrate=False)
     err = st["stderr"] if np.isfinite(st["stderr"]) else float(np.std(per_frame, ddof=1) if len(per_frame) > 1 else 0.0)
     return {"value": U.kcal_per_mol_A2_to_J_per_m2(st["mean"]), "stderr": U.kcal_per_mol_A2_to_J_per_m2(err),
             "per_frame_J_m2": U.kcal_per_mol_A2_to_J_per_m2(per_frame).tolist(), "g": st["g"],
             "plane_z_A": plane["z_A"], "number_density_A3": plane["number_density_A3"],
             "film_thickness_A": plane["film_thickness_A"], "sites": int(is_site.sum()), "frames": int(len(steps)),
-            "cutoff_A": s["cutoff_A"]}
+            "cutoff_A": s.cutoff_A}
