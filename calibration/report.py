@@ -16,7 +16,7 @@ from typing import Any, Mapping
 from nanoimpact import __version__
 from nanoimpact.fileio import atomic_write_text
 
-from .targets import target_figure, target_of, verdict
+from .targets import comparison_lines, range_cell, target_figure, target_of, verdict
 
 __all__ = ["ValueRow", "CalibrationReport", "versions"]
 
@@ -114,7 +114,7 @@ class CalibrationReport:
         out.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out / "calibration.json", json.dumps(self.to_dict(), indent=1, default=str) + "\n")
         target_figure(self.rows, out / "md_vs_literature.png",
-                      title=f"calibration `{self.name}`: MD values (+- stderr) against published ranges")
+                      title=f"calibration `{self.name}`: MD values (+- stderr) against the literature")
         atomic_write_text(out / "report.md", report_markdown(self))
         return out / "report.md"
 
@@ -138,36 +138,6 @@ def _work_sentence(rows: tuple[ValueRow, ...]) -> str:
         parts.append(f"{', '.join(f'`{k}`' for k in de)}: the energy difference dE/A, not a free energy (the run "
                      "has no force integration)")
     return ("Work of adhesion: " + "; ".join(parts) + " (docs/calibration.md).") if parts else ""
-
-
-def _target_sentences(rows: tuple[ValueRow, ...]) -> list[str]:
-    """Which used values lie inside their published range (calibration.targets), which miss it, and the sources."""
-    used = [r for r in rows if r.status == "used" and r.value is not None]
-    inside, near, miss, none = [], [], [], []
-    for r in used:
-        tgt = target_of(r.key)
-        if tgt is None:
-            none.append(r)
-            continue
-        v = verdict(r.value, r.stderr, tgt)
-        (inside if v.inside else near if v.inside_2sigma else miss).append((r, v))
-    out = ["", f"**Against the published ranges** (`calibration/targets.py`, figure `md_vs_literature.png`): "
-               f"{len(inside)} of {len(used)} used values inside"
-           + (f"; within 2 stderr of the range: {', '.join(f'`{r.key}` ({v.text})' for r, v in near)}" if near else "")
-           + (f"; **outside** by more than 2 stderr: {', '.join(f'`{r.key}` ({v.text})' for r, v in miss)}"
-              if miss else "")
-           + (f"; no published range quoted for {', '.join(f'`{r.key}`' for r in none)}" if none else "") + "."
-           + (" Values outside their range are measured with the published force fields and converged protocols, "
-              "not tuned: where the model does not reach the published value, docs/md.md (Quick results) shows "
-              "the runs that say why." if near or miss else "")]
-    sources = {}
-    for r in used:
-        tgt = target_of(r.key)
-        if tgt is not None:
-            sources.setdefault(tgt.source, []).append(r.key)
-    out += ["", "Ranges: " + "; ".join(f"{', '.join(f'`{k}`' for k in keys)}: {src}" for src, keys in sources.items())
-            + "."] if sources else []
-    return out
 
 
 def _validation_lines(validation: Mapping[str, Any]) -> list[str]:
@@ -204,16 +174,15 @@ def report_markdown(rec: CalibrationReport) -> str:
              "(cached or committed runs cost nothing), paper cases "
              f"{t['paper_s']:.1f} s, uncertainty {t['uncertainty_s']:.1f} s, total "
              f"{t['total_s']:.1f} s. Set written to `{rec.set_path}`.", "",
-             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | published range | against it "
+             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | literature range (accepted) | against the literature range "
              "| status | why / run |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rec.rows:
         tgt = target_of(r.key)
-        rng = f"{_fmt(tgt.low)}-{_fmt(tgt.high)} {tgt.unit}" if tgt else "none quoted"
         against = verdict(r.value, r.stderr, tgt).text if tgt and r.value is not None else "-"
         lines.append(f"| `{r.key}` | {r.recipe} | {r.quantity or '-'} | {_fmt(r.value)} "
-                     f"{r.units} | {_fmt(r.stderr)} | {rng} | {against} | {r.status} | "
+                     f"{r.units} | {_fmt(r.stderr)} | {range_cell(tgt)} | {against} | {r.status} | "
                      f"{r.why or str(r.run_hash or '')[:16]} |")
-    lines += _target_sentences(rec.rows)
+    lines += comparison_lines(rec.rows)
     sets = sorted({c["set"] for c in rec.paper_checks})
     lines += _validation_lines(rec.validation)
     lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec.md_sources.items()), "",

@@ -177,12 +177,13 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     assert '`claim_b`: needs t2; got {"v": 1}. **Why:** holds again when only W is put back.' in text
     assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 | 0.03 | " \
            "none quoted | - |" in text
-    # the fixture's silica angle, 31 +- 3 deg, lies 0.3 stderr above the 0-30 deg range; OTS 108 deg inside
-    assert "| 31 deg | 3 | 0-30 deg | 0.3 sigma above |" in text and "| 108 deg | 4 | 105-120 deg | inside |" in text
-    assert "**Against the published ranges**" in text and "4 of 8 used values inside" in text
-    # a value outside its range (the silica angle, 0.3 sigma above) is reported as measured, not tuned
-    assert "within 2 stderr of the range: `surfaces.body.contact_angle`" in text \
-        and "Values outside their range are measured with the published force fields and converged protocols, not tuned" in text
+    # the fixture's silica angle, 31 +- 3 deg: (31 - 20) / 3 = 3.7 stderr above the literature's 0-20 deg and beyond
+    # the 0-30 deg acceptance window; OTS 108 deg inside Wasserman's 105-112 deg; z0 = 0.35 nm only inside the window
+    assert "| 31 deg | 3 | 0-20 deg (accepted 0-30) | 3.7 sigma above |" in text
+    assert "| 108 deg | 4 | 105-112 deg (accepted 105-120) | inside |" in text
+    assert "**Against the literature**" in text and "2 of 8 used values inside the literature range;" in text
+    assert "outside it but inside the acceptance window: `surfaces.interaction_range` (1.0 sigma above" in text
+    assert "**outside the acceptance window**: `surfaces.body.contact_angle` (3.7 sigma above" in text
     assert "Wasserman et al., Langmuir 5 (1989) 1074" in text
     assert (tmp_path / "out" / "md_vs_literature.png").stat().st_size > 0
     saved = json.loads((tmp_path / "out" / "calibration.json").read_text())
@@ -433,7 +434,12 @@ def test_a_value_is_placed_against_its_published_range_in_its_own_stderr():
     from continuum.schema import FIELD_BY_PATH
     for tgt in TARGETS:
         f = FIELD_BY_PATH[tgt.key]
-        assert tgt.unit == f.unit and tgt.low < tgt.high and f.low <= tgt.low and tgt.high <= f.high and tgt.source
+        lo, hi = tgt.window
+        assert tgt.unit == f.unit and tgt.low <= tgt.high and f.low <= lo <= tgt.low and tgt.high <= hi <= f.high
+        assert tgt.source and (tgt.accept_reason or (lo, hi) == (tgt.low, tgt.high))
+    # a value inside the acceptance window but outside the literature range is accepted, never "inside"
+    w = Target("k", 1.0, 2.0, "m", "src", 0.5, 3.0, "a choice")
+    assert verdict(2.5, 0.1, w).accepted and not verdict(2.5, 0.1, w).inside and not verdict(3.5, 0.1, w).accepted
     assert target_of("surfaces.work_of_adhesion") is None        # no published Dupre work for this IFF surface
 
 
