@@ -45,6 +45,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     result = {
         "schema_version": SCHEMA_VERSION,
         "scene": resolved.to_json(),
+        "surface": resolved.surface,
         "models": models,
         "bounces": run.bounce_dicts(),
         "n_bounces": len(run.bounces),

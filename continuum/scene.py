@@ -21,6 +21,8 @@ from nanoimpact.errors import InputError
 from nanoimpact.fields import Resolved, frozen_dataclass, resolved, section_members
 
 from .reference.hertz import effective_modulus
+from .rough.surface_map import map_statistics, statistics_block
+from .rough.topography import KEY_FILE, KEY_SYNTH, TopographyError
 from .schema import FIDELITY, FIELD_BY_PATH, FIELDS, REQUIRED, Field, is_section, to_internal
 
 #: The shipped parameter sets (inputs/params, installed as package data); names are looked up in
@@ -56,6 +58,8 @@ FOLDED_KEYS = {
     "params": "ResolvedScene.params_file (the parameter set read)",
     "body.density": "Body.mass (mass from the density and the shape's volume)",
     "surfaces.sam.coverage": "Surfaces.sam (None when 'none')",
+    **{f.path: "Roughness.sigma, summit_density and summit_radius (the synthetic map's statistics; "
+               "ResolvedScene.surface)" for f in FIELDS if f.path.startswith(f"{KEY_SYNTH}.")},
 }
 
 Body = _dataclass("Body", _replace_member(_members("body", skip=("density",)), "mass",
@@ -160,6 +164,9 @@ class ResolvedScene:
     scene_file: str | None
     params_file: str | None
     params_meta: dict | None = None
+    surface: dict | None = None
+    """result.json's `surface` block: a height map's statistics and source, or the plain statistics of a rough
+    scene (source kind 'statistics'); None for smooth contact."""
 
     def to_json(self) -> dict:
         """JSON-ready record: nested values in file units (as written), sources, files, SI dataclass."""
@@ -310,9 +317,26 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
     if values.get("name") is None:
         values["name"] = Path(scene_file).stem if scene_file is not None else "scene"
         sources["name"] = "file name"
+    surface = _surface(values, sources, scene_file, origin)
     scene = _build(values, origin)
     return ResolvedScene(scene, values, sources, str(scene_file) if scene_file else None,
-                         str(params_file) if params_file else None, params_meta)
+                         str(params_file) if params_file else None, params_meta, surface=surface)
+
+
+def _surface(values: dict, sources: dict, scene_file, origin: str) -> dict | None:
+    """result.json's `surface` block. A height map's statistics replace sigma, summit_density and summit_radius
+    in `values` (source 'topography' or 'synthetic'); continuum.rough.surface_map states the precedence."""
+    try:
+        stats = map_statistics(values, sources, Path(scene_file).parent if scene_file is not None else None)
+    except TopographyError as exc:
+        raise SceneError(exc.key, exc.value, exc.allowed, origin) from None
+    if stats is None:
+        return statistics_block(values, sources) if values.get("contact") == "rough" else None
+    label = "topography" if values.get(KEY_FILE) is not None else "synthetic"
+    for key, value in stats.values.items():
+        values[key] = check_value(FIELD_BY_PATH[key], float(value), f"{origin} ({label} map)")
+        sources[key] = label
+    return stats.block
 
 
 def _require(values: dict, path: str, origin: str, why: str):
@@ -322,18 +346,31 @@ def _require(values: dict, path: str, origin: str, why: str):
 
 
 def _build(v: dict, origin: str) -> Scene:
-    """Cross-field checks, then the dataclasses (SI; degrees -> radians)."""
+    """Cross-field checks, then the dataclasses (SI; degrees -> radians): one step per part of the scene."""
     for f in FIELDS:
         if f.default is REQUIRED and f.path not in v:
             raise SceneError(f.path, None, f"is required: {f.allowed()}", origin)
     si = {path: to_internal(FIELD_BY_PATH[path], val) for path, val in v.items()}
+    _check_start(si, origin)
+    mass, length = _body_mass(si, v, origin)
+    roughness = _roughness(si, origin)
+    sam = _sam(si, v, origin)
+    _check_law(si, sam, origin)
+    _check_menisci(si, sam, origin)
+    return _assemble(si, mass, length, roughness, sam)
 
+
+def _check_start(si: dict, origin: str) -> None:
+    """How the body starts: exactly one of release height and impact velocity; gravity to fall from a height."""
     if (si["release_height"] is None) == (si["impact_velocity"] is None):
         raise SceneError("release_height", si["release_height"],
                          "give exactly one of release_height and impact_velocity", origin)
     if si["release_height"] is not None and si["environment.gravity"] == 0.0:
         raise SceneError("environment.gravity", 0.0, "must be > 0 when the body is released from a height", origin)
 
+
+def _body_mass(si: dict, v: dict, origin: str) -> tuple[float, float | None]:
+    """(mass in kg, cylinder length in m or None): the mass given, or the density times the shape's volume."""
     shape = si["body.shape"]
     if shape == "cylinder":
         length = _require(si, "body.length", origin, "for a cylinder")
@@ -349,16 +386,24 @@ def _build(v: dict, origin: str) -> Scene:
         mass = 4.0 / 3.0 * math.pi * si["body.radius"] ** 3 * si["body.density"]
     else:
         mass = math.pi * si["body.radius"] ** 2 * length * si["body.density"]
+    return mass, length
 
-    roughness = None
-    if si["contact"] == "rough":
-        if shape != "cylinder":
-            raise SceneError("contact", "rough", "rough contact is modelled for a roller (body.shape = 'cylinder', "
-                             "plane-strain line contact) only", origin)
-        for key in ("sigma", "summit_density", "summit_radius"):
-            _require(si, f"surfaces.roughness.{key}", origin, "for contact = 'rough'")
-        roughness = Roughness(**_section(Roughness, si, "surfaces.roughness"))
 
+def _roughness(si: dict, origin: str):
+    """The summit statistics of rough contact (a roller only); None for smooth contact."""
+    if si["contact"] != "rough":
+        return None
+    if si["body.shape"] != "cylinder":
+        raise SceneError("contact", "rough", "rough contact is modelled for a roller (body.shape = 'cylinder', "
+                         "plane-strain line contact) only", origin)
+    for key in ("sigma", "summit_density", "summit_radius"):
+        _require(si, f"surfaces.roughness.{key}", origin, "for contact = 'rough' (or a height map: "
+                 f"{KEY_FILE} or [{KEY_SYNTH}])")
+    return Roughness(**_section(Roughness, si, "surfaces.roughness"))
+
+
+def _sam(si: dict, v: dict, origin: str):
+    """The monolayer on both surfaces; None without one (a layer modulus then has nothing to describe)."""
     sam = None
     if si["surfaces.sam.coverage"] == "both":
         _require(si, "surfaces.sam.work_of_adhesion", origin, "when surfaces.sam.coverage = 'both'")
@@ -369,8 +414,13 @@ def _build(v: dict, origin: str) -> Scene:
     elif si["surfaces.sam.layer_modulus"] is not None:
         raise SceneError("surfaces.sam.layer_modulus", v["surfaces.sam.layer_modulus"],
                          "is for a SAM; set surfaces.sam.coverage = 'both' or remove it", origin)
-    adhesion = sam.work_of_adhesion if sam is not None else si["surfaces.work_of_adhesion"]
+    return sam
 
+
+def _check_law(si: dict, sam, origin: str) -> None:
+    """The adhesion law fits the contact: no 2-D JKR, summit laws for rough contact, adhesion > 0 where used."""
+    shape = si["body.shape"]
+    adhesion = sam.work_of_adhesion if sam is not None else si["surfaces.work_of_adhesion"]
     law = si["physics.adhesion_law"]
     if law in ("jkr", "dmt", "maugis_dugdale"):
         if shape == "cylinder" and si["contact"] == "smooth":
@@ -387,6 +437,9 @@ def _build(v: dict, origin: str) -> Scene:
         raise SceneError("physics.adhesion_law", law, "discrete summits use JKR or Hertz; DMT and Maugis-Dugdale "
                          "summits run in surfaces.roughness.mode = 'averaged'", origin)
 
+
+def _check_menisci(si: dict, sam, origin: str) -> None:
+    """Menisci need averaged rough contact, 0 < RH < 1 and both faces' water contact angles."""
     menisci = si["physics.menisci"]
     rh = si["environment.relative_humidity"]
     if menisci == "on":
@@ -406,6 +459,9 @@ def _build(v: dict, origin: str) -> Scene:
                      f"'{menisci}' (the bridge force needs both faces' water contact angles; or set "
                      "physics.menisci = 'off')")
 
+
+def _assemble(si: dict, mass: float, length: float | None, roughness, sam) -> Scene:
+    """The Scene dataclass from the checked SI values; tolerance and grid from the fidelity preset unless given."""
     preset = FIDELITY[si["numerics.fidelity"]]
     default_rtol = preset["rtol_rough"] if si["contact"] == "rough" else preset["rtol"]
     rtol = si["numerics.rtol"] if si["numerics.rtol"] is not None else default_rtol

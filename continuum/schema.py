@@ -91,7 +91,8 @@ FIELDS: tuple[Field, ...] = (
           "of the Lennard-Jones surface law): sets the summits' Tabor parameter and the Maugis-Dugdale stress "
           "1.03 dgamma/z0. Default 0.3 nm (Tabor 1977; Johnson & Greenwood 1997).", 0.3e-9, low=5e-11, high=1e-8),
     Field("surfaces.roughness.sigma", float, "m", "Standard deviation of summit heights (composite of both "
-          "surfaces; the paper's 'average asperity height'). Required for contact = 'rough'.", None,
+          "surfaces; the paper's 'average asperity height'). Required for contact = 'rough' unless a height map "
+          "(topography or synthetic) gives it.", None,
           low=1e-11, high=1e-5),
     Field("surfaces.roughness.summit_density", float, "1/m^2", "Summits per unit nominal area (n).", None,
           low=1e6, high=1e20),
@@ -106,6 +107,44 @@ FIELDS: tuple[Field, ...] = (
           "random realisation of individual summits along the footprint, same laws).", "averaged",
           choices=("averaged", "discrete")),
     Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation.", 0,
+          low=0, high=2**63 - 1),
+    Field("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography reads: "
+          "NanoScope .di, Gwyddion .gwy, Nanosurf .nid, Asylum .ibw, matrix text, .npy); a relative path is looked "
+          "up beside the scene file, then in the data folders. Its summit statistics fill sigma, summit_density and "
+          "summit_radius (replacing the parameter set's; giving them in the scene too is an error).", None),
+    Field("surfaces.roughness.topography_channel", int, "1", "Channel of the topography file (index; default 0).",
+          None, low=0, high=1000),
+    Field("surfaces.roughness.topography_size", list, "m", "Physical size [L] or [Lx, Ly] of a topography file "
+          "that has none (refused where the file has its own).", None, item=float, length=(1, 2), low=1e-9,
+          high=1.0),
+    Field("surfaces.roughness.topography_unit", str, "", "Height unit of a topography file that has none "
+          "(refused where the file has its own).", None, choices=("m", "mm", "um", "nm", "pm")),
+    Field("surfaces.roughness.summit_route", str, "", "How a height map gives summit statistics: 'direct' "
+          "(summits found on the filtered grid: 8-neighbour maxima, curvature of a 3x3 quadratic fit; measures the "
+          "map as it is) or 'spectral' (Nayak/McCool from the spectral moments m0, m2, m4; assumes an isotropic "
+          "Gaussian surface, which scan artefacts and non-Gaussian heights break). Both are recorded in result.json "
+          "(surface.routes).", "direct", choices=("direct", "spectral")),
+    Field("surfaces.roughness.summit_cutoff", float, "m", "Shortest wavelength kept for summit statistics (the map "
+          "is low-pass filtered there; >= 4 pixels): summit radius and density depend on it. Required with a "
+          "measured map unless tip_radius is given; a synthetic map defaults to its short_cutoff.", None,
+          low=1e-10, high=1e-3),
+    Field("surfaces.roughness.tip_radius", float, "m", "AFM tip radius: the cutoff becomes the shortest wavelength "
+          "the tip resolves (SurfaceTopography's scanning_probe_reliability_cutoff; Sanner et al. 2022). Instead "
+          "of summit_cutoff.", None, low=1e-10, high=1e-4),
+    Field("surfaces.roughness.synthetic.hurst", float, "1", "Synthetic self-affine surface (Fourier synthesis, "
+          "SurfaceTopography): Hurst exponent H, C(q) ~ q^(-2-2H).", None, low=0.0, high=1.0, low_open=True),
+    Field("surfaces.roughness.synthetic.rms_height", float, "m", "Synthetic surface: rms height.", None,
+          low=1e-11, high=1e-5),
+    Field("surfaces.roughness.synthetic.short_cutoff", float, "m", "Synthetic surface: shortest wavelength "
+          "(>= 4 pixels); also the summit cutoff unless summit_cutoff is given.", None, low=1e-10, high=1e-3),
+    Field("surfaces.roughness.synthetic.long_cutoff", float, "m", "Synthetic surface: roll-off wavelength (flat "
+          "spectrum above it); not set: self-affine up to the map size.", None, low=1e-10, high=1e-2),
+    Field("surfaces.roughness.synthetic.size", float, "m", "Synthetic surface: side of the square periodic map.",
+          None, low=1e-9, high=1e-2),
+    Field("surfaces.roughness.synthetic.grid_points", int, "1", "Synthetic surface: grid points along each side.",
+          256, low=16, high=4096),
+    Field("surfaces.roughness.synthetic.seed", int, "1", "Synthetic surface: seed of its random phases and "
+          "amplitudes (NumPy default_rng); independent of surfaces.roughness.seed (discrete summits).", 0,
           low=0, high=2**63 - 1),
     # --- environment ---------------------------------------------------------------------
     Field("environment.gravity", float, "m/s^2", "Gravitational acceleration (0 switches gravity off).",

@@ -1,0 +1,140 @@
+"""A scene's height map: which map (a file or a synthesis), which cutoff, and the summit statistics it gives.
+
+`map_statistics(values, sources, scene_dir)` reads the `surfaces.roughness` keys of a merged scene (file units,
+which are SI for these keys) and returns the statistics the run uses together with the `surface` block of
+result.json, or None when the scene names no map. Precedence, one rule: a map's sigma, summit_density and
+summit_radius replace those of the parameter set (the block lists what they replaced); the same key given in the
+scene file itself or as an override next to a map is an error, since two sources for one number would leave the
+reader guessing which one ran. `surfaces.roughness.sigma` holds the summits' height standard deviation (the GW
+sigma), so a map fills it with sigma_s, not with the surface's rms height.
+
+The map supplies statistics for the mean-field (Greenwood-Williamson) model only: the roller's footprint may be
+far larger than the map, and nothing here tiles the map under it.
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+from nanoimpact import data
+
+from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_FILE, KEY_SIZE, KEY_SYNTH, KEY_TIP, KEY_UNIT, HeightMap,
+                         SurfaceStatistics, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map,
+                         summit_statistics)
+
+__all__ = ["MapStatistics", "map_statistics", "statistics_block", "find_topography", "MAP_KEYS"]
+
+KEY_ROUTE = "surfaces.roughness.summit_route"
+#: The scene keys a map fills, and the statistic each takes.
+MAP_KEYS = {"surfaces.roughness.sigma": "summit_height_std", "surfaces.roughness.summit_density": "summit_density",
+            "surfaces.roughness.summit_radius": "summit_radius"}
+_SYNTH_KEYS = ("hurst", "rms_height", "short_cutoff", "long_cutoff", "size", "grid_points", "seed")
+_SYNTH_REQUIRED = ("hurst", "rms_height", "short_cutoff", "size")
+
+
+@dataclass(frozen=True)
+class MapStatistics:
+    """What a scene's map gives: the values of MAP_KEYS (SI) and result.json's `surface` block."""
+
+    values: dict
+    block: dict
+
+
+def find_topography(spec: str, scene_dir: Path | None) -> Path:
+    """A height-map path: absolute as given; a relative one against the scene file's folder (the working folder
+    for a scene given as a table), then each data root (`nanoimpact.data.roots`) and its `topographies/`."""
+    path = Path(spec).expanduser()
+    if path.is_absolute():
+        candidates = [path]
+    else:
+        candidates = [(scene_dir or Path.cwd()) / path]
+        for root in data.roots():
+            candidates += [root / path, root / "topographies" / path]
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    raise TopographyError(KEY_FILE, spec, "file not found (looked in: " + ", ".join(str(c.parent) for c in candidates)
+                          + ")")
+
+
+def _synthesis(values: dict) -> Synthesis | None:
+    given = {k: values.get(f"{KEY_SYNTH}.{k}") for k in _SYNTH_KEYS}
+    if all(given[k] is None for k in ("hurst", "rms_height", "short_cutoff", "long_cutoff", "size")):
+        return None
+    for k in _SYNTH_REQUIRED:
+        if given[k] is None:
+            raise TopographyError(f"{KEY_SYNTH}.{k}", None, "is required for a synthetic surface (hurst, rms_height, "
+                                                            "short_cutoff, size)")
+    return Synthesis(**{k: v for k, v in given.items() if v is not None})
+
+
+@functools.lru_cache(maxsize=8)
+def _statistics(spec, channel, size, unit, cutoff, tip_radius, route, stamp) -> tuple[HeightMap, SurfaceStatistics,
+                                                                                          str]:
+    """(map, statistics, what set the cutoff); cached on the inputs and the file's size and mtime (`stamp`), as
+    sweeps resolve one scene many times."""
+    if isinstance(spec, Synthesis):
+        hmap = load_height_map(synthesis=spec)
+    else:
+        hmap = load_height_map(spec, channel=channel, size=None if size is None else list(size), unit=unit)
+    if cutoff is not None:
+        wavelength, origin = cutoff, "summit_cutoff"
+    elif tip_radius is not None:
+        wavelength = cutoff_from_tip_radius(hmap, tip_radius)
+        origin = f"tip_radius {tip_radius:g} m (SurfaceTopography scanning_probe_reliability_cutoff)"
+    else:
+        wavelength, origin = spec.short_cutoff, "synthetic.short_cutoff (the spectrum holds no shorter wavelength)"
+    return hmap, summit_statistics(hmap, wavelength, route), origin
+
+
+def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapStatistics | None:
+    """The statistics of the scene's height map, or None when it names none (see the module docstring for the
+    precedence). Raises TopographyError naming the key."""
+    file_spec, synthesis = values.get(KEY_FILE), _synthesis(values)
+    if file_spec is None and synthesis is None:
+        for key in (KEY_CHANNEL, KEY_SIZE, KEY_UNIT, KEY_CUTOFF, KEY_TIP):
+            if values.get(key) is not None:
+                raise TopographyError(key, values[key], f"is for a height map: set {KEY_FILE} or [{KEY_SYNTH}]")
+        return None
+    if file_spec is not None and synthesis is not None:
+        raise TopographyError(KEY_FILE, file_spec, f"give a measured map or a synthetic one ([{KEY_SYNTH}]), not both")
+    if values.get("contact") != "rough":
+        raise TopographyError(KEY_FILE if file_spec else f"{KEY_SYNTH}.hurst", file_spec or synthesis.hurst,
+                              "a height map is for contact = 'rough'")
+    cutoff, tip = values.get(KEY_CUTOFF), values.get(KEY_TIP)
+    if cutoff is not None and tip is not None:
+        raise TopographyError(KEY_TIP, tip, "give summit_cutoff or tip_radius, not both")
+    if synthesis is None and cutoff is None and tip is None:
+        raise TopographyError(KEY_CUTOFF, None, "is required with a measured map (or give tip_radius): summit "
+                                                "radius and density depend on the shortest wavelength kept")
+    replaced = {}
+    for key in MAP_KEYS:
+        source = sources.get(key)
+        if values.get(key) is not None and source != "default":
+            if not str(source).startswith("params:"):
+                raise TopographyError(key, values[key], f"is derived from the height map; remove it from the "
+                                                        f"{source}, or remove the map")
+            replaced[key] = {"value": values[key], "source": source}
+    if synthesis is not None:
+        spec, stamp = synthesis, None
+    else:
+        spec = find_topography(file_spec, scene_dir)
+        stat = spec.stat()
+        spec, stamp = spec.resolve(), (stat.st_size, stat.st_mtime_ns)
+    size = values.get(KEY_SIZE)
+    hmap, stats, origin = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
+                                      values.get(KEY_UNIT), cutoff, tip, values.get(KEY_ROUTE, "direct"), stamp)
+    block = {**stats.to_json(), "cutoff_from": origin, "source": dict(hmap.source), "replaced": replaced,
+             "fills": {key: attr for key, attr in MAP_KEYS.items()},
+             "note": "the map supplies summit statistics to the mean-field (GW) law; the roller's footprint is not "
+                     "tiled with the map"}
+    return MapStatistics(values={key: getattr(stats, attr) for key, attr in MAP_KEYS.items()}, block=block)
+
+
+def statistics_block(values: dict, sources: dict) -> dict:
+    """result.json's `surface` block of a rough scene given by its statistics (no map)."""
+    return {"rms_height": None, "summit_height_std": values.get("surfaces.roughness.sigma"),
+            "summit_density": values.get("surfaces.roughness.summit_density"),
+            "summit_radius": values.get("surfaces.roughness.summit_radius"), "route": None, "cutoff": None,
+            "source": {"kind": "statistics", "keys": {key: sources.get(key) for key in MAP_KEYS}}}
