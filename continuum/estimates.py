@@ -29,7 +29,7 @@ import numpy as np
 
 from .halfspace import LineHalfSpace
 
-#: Most memory (bytes) the averaged rough model's tables may take while they are built (issue 12).
+#: Most memory (bytes) the averaged rough model's tables may take while they are built.
 MEMORY_BOUND_BYTES = 2 * 2**30
 #: Build time of the GW window table per node (s), measured on a busy 2-core machine (load ~10):
 #: 20-23 us at 9e4-6e5 nodes, the band table's build included (docs/rough-gw.md).

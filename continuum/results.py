@@ -8,8 +8,8 @@ Schema 2.0 keeps the spatial profiles' arrays (`x`, `pressure`, ... : 257 number
 bounce) out of result.json, in `profiles.npz` beside it (NumPy's zip of .npy arrays, exact float64); each
 profile in result.json keeps its scalars and names the file, its array and their rows (`arrays_file`, `arrays_key`,
 `array_fields`, `array_lengths`).
-A 100-bounce run's result.json was 7 MB of decimal floats whose encoding took ~0.6 s (a quarter of a paper
-impact task); it is now ~0.1 MB. `load_result` puts the arrays back, so readers see the record the run
+Kept inline, the profiles of a 100-bounce run would make result.json megabytes of decimal floats, slow to
+encode. `load_result` puts the arrays back, so readers see the record the run
 returned; it also reads schema 1.x folders, whose profiles are inline.
 """
 from __future__ import annotations

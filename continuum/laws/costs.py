@@ -13,7 +13,7 @@ import math
 #: Hertz summits (GWJKRSurface) 2.0 us, generic summit laws (GWBranchSurface: DMT, Maugis-Dugdale, layered)
 #: 19 us with its states sorted by depth (shared with the rigid law's table bound).
 SECONDS_PER_STATE = {"tabulated": 2.5e-6, "generic": 2.5e-5}
-#: Most estimated seconds of surface evaluations one run of the grid law may spend (issue 12); beyond it
+#: Most estimated seconds of surface evaluations one run of the grid law may spend; beyond it
 #: the run stops with a one-line SceneError naming the way out. rough_silica as shipped (`standard`, up to
 #: 57 bounces over sigma = 3-30 nm) uses 2-93 s of it; Maugis-Dugdale summits on the grid (quadrature,
 #: ~10x the cost per state) reach it after ~60 contacts at `standard`.
@@ -41,7 +41,7 @@ def beyond_range(depth_search, sigma: float) -> float:
 RESOLUTION = {"fast": (8, 40, 9, 16), "standard": (16, 80, 17, 24), "reference": (32, 160, 33, 40)}
 #: Most surface states evaluated at once while the tables are built (bounds the build's temporaries).
 _BLOCK_STATES = 200_000
-#: Most estimated seconds one build of the tables may take; beyond it the scene is refused (issue 12).
+#: Most estimated seconds one build of the tables may take; beyond it the scene is refused.
 MAX_BUILD_SECONDS = 30.0
 
 

@@ -1,8 +1,8 @@
 """The paper's cases: a scene file plus overrides (file units), and the sweeps behind Figs 7 and 8.
 
-Dry cases (issue 3): the Hertz roller, rough silica and OTS-covered silica (sigma = 6 nm), the
-roughness sweep (Fig 7) and the velocity sweep with escape velocities (Fig 8a). Wet cases (issue
-4): the 100 nm drop onto wet silica and wet OTS, and their velocity sweeps near the escape
+Dry cases: the Hertz roller, rough silica and OTS-covered silica (sigma = 6 nm), the
+roughness sweep (Fig 7) and the velocity sweep with escape velocities (Fig 8a). Wet cases:
+the 100 nm drop onto wet silica and wet OTS, and their velocity sweeps near the escape
 velocity (Fig 8a's t_a limit, Fig 8b).
 """
 from __future__ import annotations

@@ -25,8 +25,8 @@ Dimensional equations (Johnson & Greenwood 1997, Johnson's E*):
     dgamma = (sigma0 a^2/(pi beta)) [sqrt(m^2-1) + (m^2-2) arctan sqrt(m^2-1)]
              + (4 sigma0^2 a/(pi E*)) [sqrt(m^2-1) arctan sqrt(m^2-1) - m + 1]
 
-(the last is "gap at r = c equals h0"). Normalisation (Maugis 1992) making these the parametric
-equations in the brief::
+(the last is "gap at r = c equals h0"). Normalisation (Maugis 1992) gives the parametric
+equations::
 
     A      = a     / (pi dgamma beta^2 / K)^{1/3} = a (4 E*/(3 pi dgamma beta^2))^{1/3}
     Pbar   = P     / (pi dgamma beta)

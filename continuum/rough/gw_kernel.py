@@ -3,7 +3,7 @@
 The rigid rough roller's footprint tables (`continuum.laws.rough_rigid.RigidRoughRoller._integrate`) evaluate the
 surface's pressure and energy at ~1e5-1e6 states (d, zeta) per build. In NumPy (`GWJKRSurface._integral_numpy`)
 that is a few dozen passes over arrays of the states, with gathers, masks and index sets per branch: memory-bound,
-~1/3 of `nanoimpact paper`'s CPU (issue 14). `integral` does the same arithmetic one state at a time, reading the
+~1/3 of `nanoimpact paper`'s CPU. `integral` does the same arithmetic one state at a time, reading the
 surface's own tables (passed as arrays: no Python object enters the kernel), every branch included:
 
 * the 1-D table in h = d/sigma (log of the Hertz integral, and for adhesive surfaces the columns G, Wr, A0), or in
