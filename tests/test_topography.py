@@ -139,6 +139,24 @@ def test_a_text_map_is_read_in_si_units_and_detrended(tmp_path):
     assert abs(np.mean(hmap.heights)) < 1e-6 * hmap.rms_height
 
 
+def test_a_tip_radius_sets_the_cutoff_surfacetopography_finds(tmp_path):
+    """tip_radius instead of summit_cutoff: the cutoff is SurfaceTopography's scanning-probe reliability cutoff
+    of the map for that tip, and the record says where it came from; a map pickles (process executors)."""
+    import pickle
+
+    from SurfaceTopography import open_topography
+    heights = np.asarray(_synthetic(256, 8, seed=6).heights()) * 1e9
+    path = _write_text_map(tmp_path / "tip.txt", heights, size_um=1.0)
+    tip = 3e-7                                             # blunt enough for a cutoff on this map (0.1 um is not)
+    expected = open_topography(str(path)).topography().to_unit("m").detrend("height") \
+        .scanning_probe_reliability_cutoff(tip)
+    r = resolve_scene(table={**SCENE, "surfaces": {"roughness": {"topography": str(path), "tip_radius": tip}}})
+    assert r.surface["cutoff"] == pytest.approx(expected, rel=1e-6)
+    assert r.surface["cutoff_from"].startswith("tip_radius")
+    hmap = load_height_map(path)
+    assert np.array_equal(pickle.loads(pickle.dumps(hmap)).heights, hmap.heights)
+
+
 def test_shipped_topography_scene_takes_its_statistics_from_the_map():
     """rough_topography: sigma, summit_density and summit_radius come from the map (sigma is the summit heights'
     standard deviation), replacing the parameter set's, which the surface block lists."""

@@ -31,8 +31,6 @@ import logging
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from types import MappingProxyType
-from typing import Mapping
 
 import numpy as np
 
@@ -87,7 +85,7 @@ class HeightMap:
     """True for a periodic map (a synthesis); a measured map is not."""
     rms_height: float
     """RMS height of the detrended map at full resolution (m; SurfaceTopography's rms_height_from_area)."""
-    source: Mapping = field(default_factory=dict)
+    source: dict = field(default_factory=dict)
     """Where the map came from, JSON-ready: a file (path, sha256, channel, units, size, detrending) or the
     synthesis parameters."""
 
@@ -237,7 +235,7 @@ def _finish(topo, source: dict, key: str, value) -> HeightMap:
               "grid_points": [int(nx), int(ny)], "physical_size_m": list(size)}
     return HeightMap(heights=heights, pixel_size=(size[0] / nx, size[1] / ny), physical_size=size,
                      periodic=bool(topo.is_periodic), rms_height=float(detrended.rms_height_from_area()),
-                     source=MappingProxyType(source))
+                     source=source)
 
 
 def cutoff_from_tip_radius(hmap: HeightMap, tip_radius: float) -> float:
