@@ -147,6 +147,26 @@ def _constants(datasets):
     return lines + [""]
 
 
+def _summary(results):
+    """One line per data set, every number read from the results."""
+    cap, res, cpl = results["capture"], results["restitution"], results["capillary"]
+    pts = cap["points"]
+    cap_txt = "; ".join(f"{p['diameter'] * 1e9:g} nm: elastic {_vs_band(p['measured'], p['elastic_band'])}, "
+                        f"Thornton–Ning {_vs_band(p['measured'], p['tn_band'])}" for p in pts)
+    ex = cap["exponents"]
+    floor = res["points"][0]["measured_floor"]
+    losses = ", ".join(f"{label} {_g(v)}" for label, v in _largest_losses(res))
+    return ["## Summary", "",
+            "- Capture velocity of silver spheres, where the measurement lies against each predicted band: "
+            f"{cap_txt}. Size "
+            f"exponent measured {ex['measured_end_points']:.3g}, elastic {ex['elastic']:.4g}, Thornton–Ning "
+            f"{_band(ex['tn_range'])}.",
+            f"- Share of the impact energy lost by 4.9 um ammonium fluorescein spheres at 20–100 m/s: measured "
+            f"up to {_g(1.0 - floor ** 2)}; largest predicted: {losses}.",
+            f"- Capillary adhesion limit of wet rough polysilicon: measured {cpl['measured']:g} J/m^2, predicted "
+            f"{_band(cpl['predicted_band'], 4)} J/m^2 ({_vs_band(cpl['measured'], cpl['predicted_band'])}).", ""]
+
+
 def write(path, results, datasets, simulate):
     """Write the page (atomically)."""
     lines = ["# Validation against published measurements", "",
@@ -158,6 +178,7 @@ def write(path, results, datasets, simulate):
              "(`continuum.reference.thornton_ning`) and, where an impact run applies, by the smooth-sphere "
              "simulator. An input that was not measured is swept over a stated range and shown as a band; "
              "nothing is fitted.", ""]
+    lines += _summary(results)
     lines += _capture(results["capture"], datasets["arffman2015"], simulate)
     lines += _restitution(results["restitution"], datasets["wall1990"], simulate)
     lines += _capillary(results["capillary"], datasets["delrio2007"])

@@ -42,27 +42,25 @@ e^2 = W_out / (m v^2 / 2); the sphere is captured when W_out <= 0.
 
 Why this model (and not the others)
 -----------------------------------
-* Mesarovic & Johnson (J. Mech. Phys. Solids 48 (2000) 2009) analyse the adhesive unloading of an
-  elastic-plastically flattened sphere with a cohesive-zone (Maugis-Dugdale) interface and find
-  the JKR-like unloading about the flattened profile that Thornton & Ning assume, with a
-  Tabor-parameter dependence that matters only for small, stiff contacts. Their result is a
-  map of unloading regimes, not a loading law, so it cannot by itself give e(v).
+* Mesarovic & Johnson (J. Mech. Phys. Solids 48 (2000) 2009) analyse the elastic unloading, with
+  Maugis-Dugdale adhesion, of a sphere flattened by plastic loading: the pull-off force rises with
+  the flattening, as in Thornton & Ning's R_p construction, and how it rises depends on an
+  adhesion (Tabor-type) parameter. They give unloading and pull-off, not a closed-form e(v).
 * Kogut & Etsion (J. Colloid Interface Sci. 261 (2003) 372) fit finite-element results for an
-  adhesive elastic-plastic microcontact (loading only, DMT-type adhesion, valid up to
-  delta/delta_c ~ 110), with no unloading branch, hence no restitution or capture velocity.
+  adhesive elastic-plastic microcontact under loading (DMT-type adhesion outside the contact, on
+  their finite-element loading fits for 1 <= delta/delta_c <= 110), with no unloading branch,
+  hence no restitution or capture velocity.
 * Thornton & Ning give loading, unloading and detachment, reduce exactly to the two closed forms
   the project already trusts (JKR hysteresis; Thornton 1997 without adhesion), have a single
-  plastic parameter p_y, and were built for exactly this problem (the stick/bounce of micro-spheres;
-  their paper compares with Wall et al. 1990's ammonium fluorescein spheres). Their limits:
-  perfect plasticity (no hardening), a^2 = R delta kept during plastic loading, and the centre
-  pressure yield criterion; Wu, Li & Thornton (Int. J. Impact Eng. 28 (2003) 929) find the
-  truncated-pressure loading underestimates the force of finite-element spheres, so e is a
-  lower bound at high speed.
+  plastic parameter p_y, and were built for this problem (the stick/bounce of micro-spheres).
+  Their idealisations: perfect plasticity (no hardening), a^2 = R delta kept during plastic
+  loading, a centre-pressure yield criterion, and a truncated Hertzian pressure whose prefactor
+  finite-element analyses of plastic sphere impact are the check on.
 
-Sources: C. Thornton & Z. Ning, Powder Technol. 99 (1998) 154-162, doi:10.1016/S0032-5910(98)00099-0;
-C. Thornton, J. Appl. Mech. 64 (1997) 383-386, doi:10.1115/1.2787319; K. L. Johnson, *Contact
-Mechanics* (1985) §5.5, §6.2, §11.5; D. Tabor, *The Hardness of Metals* (1951) (constraint factor
-H ~ 2.8 Y); K. L. Johnson, K. Kendall & A. D. Roberts, Proc. R. Soc. Lond. A 324 (1971) 301.
+Sources: C. Thornton & Z. Ning, Powder Technol. 99 (1998) 154-162; C. Thornton, J. Appl. Mech.
+64 (1997) 383-386; K. L. Johnson, *Contact Mechanics* (1985) §5.5, §6.2, §11.5; D. Tabor, *The
+Hardness of Metals* (1951) (constraint factor H ~ 2.8 Y); K. L. Johnson, K. Kendall & A. D. Roberts,
+Proc. R. Soc. Lond. A 324 (1971) 301; D. Maugis & H. M. Pollock, Acta Metall. 32 (1984) 1323.
 """
 from __future__ import annotations
 
