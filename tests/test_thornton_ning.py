@@ -165,3 +165,21 @@ def test_bad_inputs_are_one_line_errors_naming_the_key():
         tn.impact(1.0, R, W, E_STAR, RHO, PY, detachment="sideways")
     assert tn.limiting_contact_pressure(hardness=1e9, youngs_modulus=7e10) == 1e9
     assert tn.limiting_contact_pressure(yield_strength=1e8, youngs_modulus=7e10) == pytest.approx(2.8e8)
+
+
+def test_load_controlled_detachment_uses_the_load_loop():
+    v_s = float(tn.capture_velocity(R, W, E_STAR, RHO, np.inf, detachment="load"))
+    loop = jkr.LOOP_AREA_LOAD * float(jkr.pull_off_force(R, W)) * float(jkr.critical_approach(R, W, E_STAR))
+    assert 0.5 * float(tn.sphere_mass(R, RHO)) * v_s**2 == pytest.approx(loop, rel=1e-12)
+    # detaching earlier (at P = -P_c) loses less than at the fold, with or without plasticity
+    for py in (np.inf, PY):
+        e_load = tn.restitution(5.0, R, W, E_STAR, RHO, py, detachment="load")
+        assert e_load > tn.restitution(5.0, R, W, E_STAR, RHO, py)
+
+
+def test_vectorised_impact_equals_scalar_calls():
+    v = np.array([0.3, 0.8, 1.5, 4.0, 30.0])
+    r = tn.impact(v, R, W, E_STAR, RHO, PY)
+    for i, vi in enumerate(v):
+        one = tn.impact(vi, R, W, E_STAR, RHO, PY)
+        assert one.restitution[0] == r.restitution[i] and one.plastic_radius[0] == r.plastic_radius[i]
