@@ -44,7 +44,7 @@ from .report import CalibrationReport, ValueRow
 
 from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
-from nanoimpact.errors import InputError
+from nanoimpact.errors import DataNotFound, InputError
 from nanoimpact.fields import REQUIRED, Field, Resolved, frozen_dataclass, section_members
 from nanoimpact.fields import json_schema as json_schema_of
 
@@ -177,7 +177,7 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
 
     try:
         path = data.find("calibration", spec, key="recipe")
-    except data.DataNotFound as exc:
+    except DataNotFound as exc:
         raise CalibrationError("recipe", str(spec), exc.allowed) from None
     origin = str(path)
     try:

@@ -9,7 +9,7 @@ import sys
 import numpy
 import scipy
 
-from nanoimpact.provenance import git_commit  # noqa: F401  (re-exported: the one implementation)
+from nanoimpact.provenance import git_commit
 
 
 def package_version() -> str:

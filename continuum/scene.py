@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from nanoimpact import data
-from nanoimpact.errors import InputError
+from nanoimpact.errors import DataNotFound, InputError
 from nanoimpact.fields import Resolved, frozen_dataclass, resolved, section_members
 
 from .reference.hertz import effective_modulus
@@ -234,7 +234,7 @@ def find_params(spec: str, params_dir: Path | None = None) -> Path:
     if params_dir is None:
         try:
             return data.find("params", spec)
-        except data.DataNotFound:
+        except DataNotFound:
             raise SceneError("params", spec, "no parameter set of that name; available: "
                                              f"{', '.join(data.names('params')) or 'none'}") from None
     folder = Path(params_dir)
@@ -249,7 +249,7 @@ def find_scene(spec: str | Path) -> Path:
     """A scene file: a path, or the name of a shipped (or user-folder) scene (`hertz_roller`)."""
     try:
         return data.find("scenes", spec, key="scene")
-    except data.DataNotFound as exc:
+    except DataNotFound as exc:
         raise SceneError("scene", str(spec), exc.allowed) from None
 
 

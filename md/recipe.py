@@ -29,7 +29,7 @@ from typing import Any, Mapping
 from nanoimpact import data as shipped_data
 from nanoimpact import fields
 from nanoimpact.fields import REQUIRED
-from nanoimpact.errors import InputError
+from nanoimpact.errors import DataNotFound, InputError
 
 __all__ = ["RecipeError", "Recipe", "Field", "RecipeField", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES", "load_recipe",
            "parse_recipe", "schema_markdown", "RECIPE_DIR"]
@@ -433,7 +433,7 @@ def load_recipe(spec: str | Path) -> Recipe:
     """A recipe from a path, or a name in ``inputs/md`` (``adhesion_silica`` -> inputs/md/adhesion_silica.toml)."""
     try:
         p = shipped_data.find("md", spec, key="recipe")
-    except shipped_data.DataNotFound as exc:
+    except DataNotFound as exc:
         raise RecipeError("recipe", str(spec), exc.allowed) from None
     data = p.read_bytes()
     try:

@@ -20,7 +20,7 @@ from pathlib import Path
 from .errors import DataNotFound
 from .provenance import source_checkout
 
-__all__ = ["DataNotFound", "KINDS", "ENV_VAR", "find", "names", "roots", "shipped_root", "user_root",
+__all__ = ["KINDS", "ENV_VAR", "find", "names", "roots", "shipped_root", "user_root",
            "set_user_root", "writable_root", "md_results_dirs", "is_path_spec"]
 
 #: The kinds of shipped data, each a folder of TOML files under `inputs/`.

@@ -7,7 +7,7 @@ double and any double-precision inverse loses half its digits); booked dissipati
 summits x loop to 1e-12; the single-impact energy audit at rtol 1e-10 below 1e-6 of the impact
 energy (each summit that attaches or lets go is a jump in force that the integrator crosses at
 its tolerance). The averaged-vs-discrete comparison uses measured seed-to-seed spreads, stated at
-the test (docs/_fragments/discrete.md has the full table).
+the test (docs/discrete.md has the full table).
 """
 import math
 
@@ -216,7 +216,7 @@ def _rebounds(seeds, rtol_discrete, w=W, **rough):
 def test_many_contacts_discrete_rebound_agrees_with_the_average():
     """Dense compliant summits (sigma 1 nm, n 1e14 /m^2, E* 1 GPa, dgamma 2 mJ/m^2): ~600 summits touch.
 
-    Measured over seeds 1-8 (docs/_fragments/discrete.md): discrete/averaged rebound height
+    Measured over seeds 1-8 (docs/discrete.md): discrete/averaged rebound height
     1.012 +- 0.039 (mean +- std); seeds 1-4 give 1.014, 0.971, 1.017, 1.016. Tolerances: each seed
     within 6 %, their mean within 3 %. The discrete runs use rtol 1e-6 (their rebound moves by
     < 1e-3 relative against rtol 1e-8; each summit event costs the integrator a few rejected steps).

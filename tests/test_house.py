@@ -1,0 +1,158 @@
+"""House rules a reader relies on, checked over the whole library (no imports, text and syntax trees only).
+
+* Functions stay readable: none in `continuum/`, `md/`, `calibration/` or `nanoimpact/` is over 100 lines.
+* History lives in git, not in the code: no "issue N" or "session N" narrative in library code.
+* Every cited repository path exists: the docs, the README, the inputs' READMEs and the code name files as
+  ``docs/model.md``, ``tests/test_paper.py`` or ``md/system/forcefield.py`` (prefixed by a top-level folder, or
+  relative to `inputs/`, the shipped data root), and markdown links point at files next to the page. Paths
+  outside the repository (``shared/...``) are not something a reader of the repository can open, so citing one
+  fails too. ``NAME``-style placeholders are templates, not citations.
+* One import path per name: no module lists in ``__all__`` a name it only imports, marks an import as kept for
+  re-export (``noqa: F401``), or is nothing but imports, and no comment or docstring keeps an "old name" alive.
+  A package's front doors, its ``__init__`` and its ``api`` module (docs/api.md), gather its public names.
+
+Each rule has a negative control on a synthetic source, so a scanner that found nothing would fail.
+"""
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+LIBRARY = ("continuum", "md", "calibration", "nanoimpact")
+MAX_FUNCTION_LINES = 100
+TOP = ("docs", "tests", "md", "continuum", "calibration", "nanoimpact", "inputs", "benchmarks", ".ci", "shared")
+EXTENSIONS = ("md", "py", "toml", "json", "txt", "csv", "yaml", "yml", "cfg", "sh")
+CITED = re.compile(r"(?<![\w./-])((?:\.\./)*(?:" + "|".join(re.escape(t) for t in TOP) + r")/[\w./-]*\w\.(?:"
+                   + "|".join(EXTENSIONS) + r"))(?![\w/])")
+LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
+PLACEHOLDER = re.compile(r"(?:^|/)[A-Z][A-Z_]{2,}\.")
+HISTORY = re.compile(r"\b(?:issues?|sessions?)\s+#?\d+", re.IGNORECASE)
+COMPAT = re.compile(r"old names?\b.*\b(?:still work|kept|alive)|for (?:backward[s]? )?compatibility|"
+                    r"backward[s]?[- ]compatib|noqa: ?F401", re.IGNORECASE)
+FRONT_DOORS = ("__init__.py", "api.py")
+
+
+def library_files():
+    for package in LIBRARY:
+        yield from sorted((ROOT / package).rglob("*.py"))
+
+
+def doc_sources():
+    for pattern in ("*.md", "docs/**/*.md", "inputs/**/*.md", "benchmarks/**/*.py", "tests/**/*.py", ".ci/*"):
+        yield from sorted(p for p in ROOT.glob(pattern) if p.is_file())
+    yield from library_files()
+
+
+# ----------------------------------------------------------------------------- the scanners
+def long_functions(source: str, name: str, limit: int = MAX_FUNCTION_LINES) -> list[str]:
+    """`name:line function (n lines)` for every function or method of `source` longer than `limit` lines."""
+    return [f"{name}:{node.lineno} {node.name} ({node.end_lineno - node.lineno + 1} lines)"
+            for node in ast.walk(ast.parse(source))
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+            and node.end_lineno - node.lineno + 1 > limit]
+
+
+def history_lines(source: str, name: str) -> list[str]:
+    return [f"{name}:{n}: {line.strip()}" for n, line in enumerate(source.splitlines(), 1) if HISTORY.search(line)]
+
+
+def _exists(ref: str, page: Path) -> bool:
+    if ref.startswith("../"):
+        return (page.parent / ref).resolve().is_relative_to(ROOT) and (page.parent / ref).exists()
+    if ref.startswith("shared/"):
+        return False
+    return (ROOT / ref).exists() or (ROOT / "inputs" / ref).exists()
+
+
+def missing_citations(text: str, page: Path) -> list[str]:
+    """Cited paths in `text` (the contents of `page`) that do not exist in the repository."""
+    bad = []
+    for n, line in enumerate(text.splitlines(), 1):
+        refs = [m.group(1) for m in CITED.finditer(line)]
+        bad += [f"{n}: {r}" for r in refs if not PLACEHOLDER.search(r) and not _exists(r, page)]
+        if page.suffix == ".md":
+            for m in LINK.finditer(line):
+                target = m.group(1)
+                if re.match(r"[a-z]+:", target) or target.startswith(("/", "<")):
+                    continue
+                if not (page.parent / target).exists():
+                    bad.append(f"{n}: link {target}")
+    return bad
+
+
+def compatibility_reexports(source: str, name: str) -> list[str]:
+    """Names a non-package module lists in __all__ without defining them; a module of imports only; comments or
+    docstrings that keep old names alive."""
+    bad = [f"{name}:{n}: {line.strip()}" for n, line in enumerate(source.splitlines(), 1) if COMPAT.search(line)]
+    if name.endswith(FRONT_DOORS):
+        return bad
+    tree = ast.parse(source)
+    defined, imported, exported = set(), set(), []
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            defined.add(node.name)
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for t in targets:
+                for leaf in ast.walk(t):
+                    if isinstance(leaf, ast.Name):
+                        defined.add(leaf.id)
+                        if leaf.id == "__all__" and isinstance(node.value, (ast.List, ast.Tuple)):
+                            exported = [e.value for e in node.value.elts if isinstance(e, ast.Constant)]
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            imported |= {(a.asname or a.name).split(".")[0] for a in node.names}
+    bad += [f"{name}: __all__ re-exports {e}" for e in exported if e in imported and e not in defined]
+    body = [n for n in tree.body if not (isinstance(n, ast.Expr) and isinstance(n.value, ast.Constant))]
+    if body and all(isinstance(n, (ast.Import, ast.ImportFrom)) or
+                    (isinstance(n, ast.Assign) and [getattr(t, "id", "") for t in n.targets] == ["__all__"])
+                    for n in body) and any(isinstance(n, ast.ImportFrom) and n.module != "__future__" for n in body):
+        bad.append(f"{name}: a module of imports only")
+    return bad
+
+
+# ----------------------------------------------------------------------------- the rules
+def test_no_library_function_is_over_100_lines():
+    bad = [hit for path in library_files()
+           for hit in long_functions(path.read_text(), str(path.relative_to(ROOT)))]
+    assert not bad, "\n".join(bad)
+
+
+def test_no_issue_or_session_narrative_in_library_code():
+    bad = [hit for path in library_files() for hit in history_lines(path.read_text(), str(path.relative_to(ROOT)))]
+    assert not bad, "\n".join(bad)
+
+
+def test_every_cited_repository_path_exists():
+    bad = [f"{page.relative_to(ROOT)}:{hit}" for page in doc_sources()
+           for hit in missing_citations(page.read_text(errors="replace"), page)]
+    assert not bad, "\n".join(bad)
+
+
+def test_no_module_re_exports_a_name_for_compatibility():
+    bad = [hit for path in library_files()
+           for hit in compatibility_reexports(path.read_text(), str(path.relative_to(ROOT)))]
+    assert not bad, "\n".join(bad)
+
+
+# ----------------------------------------------------------------------------- negative controls
+def test_the_scanners_find_what_they_look_for():
+    long_source = "def f():\n" + "    x = 1\n" * MAX_FUNCTION_LINES + "def g():\n    return 1\n"
+    assert long_functions(long_source, "m.py") == [f"m.py:1 f ({MAX_FUNCTION_LINES + 1} lines)"]
+    assert history_lines('"""Bounded cost (issue 12)."""\nx = 1  # per Issue #3\ny = 2\n', "m.py") == [
+        'm.py:1: """Bounded cost (issue 12)."""', "m.py:2: x = 1  # per Issue #3"]
+    page = ROOT / "docs" / "page.md"
+    nowhere, outside = "tests" + "/test_nowhere.py", "shared" + "/docs/notes.md"     # not citations of this file
+    text = (f"See `docs/model.md` and {nowhere}, `inputs/params/NAME.toml`, `md/adhesion_silica.toml`,\n"
+            f"[model](model.md), [gone](gone.md), [site](https://example.org) and `{outside}`.\n")
+    assert missing_citations(text, page) == [f"1: {nowhere}", f"2: {outside}", "2: link gone.md"]
+    shim = ('"""The old name of `pkg.model`: its names, re-exported; the old names here still work."""\n'
+            "from .model import select_law\n__all__ = ['select_law']\n")
+    assert compatibility_reexports(shim, "pkg/models.py") == [
+        'pkg/models.py:1: """The old name of `pkg.model`: its names, re-exported; the old names here still work."""',
+        "pkg/models.py: __all__ re-exports select_law", "pkg/models.py: a module of imports only"]
+    marked = "from .impl import helper  # noqa" + ": F401  (re-exported)\n\n\ndef f():\n    return 1\n"
+    assert compatibility_reexports(marked, "pkg/m.py") == ["pkg/m.py:1: " + marked.splitlines()[0]]
+    clean = "from .costs import LIMIT\n\n\ndef law():\n    return LIMIT\n\n\n__all__ = ['law']\n"
+    assert compatibility_reexports(clean, "pkg/law.py") == []
