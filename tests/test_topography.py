@@ -81,8 +81,8 @@ def test_profile_moments_are_the_direction_averaged_ones():
 @pytest.mark.parametrize("wavelength_px", [16, 32])
 def test_direct_route_on_an_egg_box(wavelength_px):
     """h = A cos(kx) cos(ky) has maxima at (0, 0) and (lambda/2, lambda/2) of every lambda^2 cell: density
-    2/lambda^2, mean curvature A k^2 (radius 1/(A k^2)), height A. The 3x3 quadratic fit's curvature is low by
-    about (5/12)(k dx)^2 (second difference plus averaging over the stencil's rows): the tolerance."""
+    2/lambda^2, mean curvature A k^2 (radius 1/(A k^2)), height A. The central-difference quadratic's curvature
+    is low by the factor sinc^2(k dx/2) ~ 1 - (k dx)^2/12: the tolerance."""
     n, dx, amp = 256, 1e-9, 2e-9
     lam = wavelength_px * dx
     x = np.arange(n) * dx
@@ -91,7 +91,7 @@ def test_direct_route_on_an_egg_box(wavelength_px):
     s = identify_summits(h, dx, cutoff=lam / 2, periodic=True)
     assert s.count == 2 * (n // wavelength_px) ** 2
     assert s.density == pytest.approx(2 / lam**2, rel=1e-12)
-    bias = 5 / 12 * (k * dx) ** 2
+    bias = (k * dx) ** 2 / 12
     assert np.allclose(s.curvature, amp * k**2, rtol=1.2 * bias)
     assert np.allclose(s.height, amp, rtol=1e-9)
     assert np.allclose(s.x / (lam / 2), np.round(s.x / (lam / 2)), rtol=0, atol=1e-6)
