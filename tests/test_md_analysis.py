@@ -360,8 +360,8 @@ def _lattice_slab(n_side, nz, a, z0):
 def test_dispersion_tail_between_two_slabs_has_the_sign_size_and_force_expected():
     """Two simple-cubic LJ slabs (CH2-like: eps 0.0914 kcal/mol, sigma 3.95 A, 0.034 sites/A^3) 3.5 A apart, cut
     at 12 A: the interaction beyond the cutoff is attractive, converges with the explicit radius (the smeared
-    images take over beyond it), is within 10 % of two laterally smeared stacks of planes (about 7 mJ/m^2 here:
-    the size of the review's 12-vs-40 A estimate for OTS-OTS), and its force is minus the energy's derivative."""
+    images take over beyond it), is within 10 % of two laterally smeared stacks of planes (about 7 mJ/m^2 here),
+    and its force is minus the energy's derivative."""
     from md.analysis import lj_tail_between
     a, n_side, nz, gap = 3.1, 8, 10, 3.5
     L = n_side * a

@@ -203,7 +203,7 @@ def test_cristobalite_111_gives_q3_silanols_at_4_50_per_nm2(slab111):
 
 
 def test_default_silica_face_has_isolated_q3_silanols_no_pair_closer_than_4_A():
-    """The surface every recipe shares (review item 1): the default cristobalite face is (111), one Q3 silanol per
+    """The surface every recipe shares: the default cristobalite face is (111), one Q3 silanol per
     surface Si on a 5.06 A hexagonal lattice; no two silanol O of a face are closer than 4 A (minimum image).
     The (001) face has geminal/vicinal pairs 2.53 A apart, which H-bond to each other instead of to water."""
     assert SILICA_FACE == "111"

@@ -1,10 +1,10 @@
-"""One writer per run directory (issue 12, point 9).
+"""One writer per run directory.
 
-Reported: two ``nanoimpact md surface_tension_spce --fidelity smoke`` started together on one cache both exited 0
-with gamma_lv = 0.086 and 0.036 N/m, while one run alone gives 0.0709 every time: both wrote into the same run
-directory. Now the engine (:func:`md.engine.runner.run_job`, under :func:`md.workflows.run_recipe`) holds
-:func:`nanoimpact.lock.run_lock` on it; the second waits and
-reuses the first's result, or stops with RunBusy (exit 75) under ``--no-wait``.
+Two runs of one recipe at one fidelity started together on one cache would write into the same run directory and
+report numbers neither run alone gives. The engine (:func:`md.engine.runner.run_job`, under
+:func:`md.workflows.run_recipe`) holds :func:`nanoimpact.lock.run_lock` on it; the second waits and reuses the
+first's result, or stops with RunBusy (exit 75) under ``--no-wait``. No test here times anything: what shows that a
+process waited or got in is what it logged and whether it raised.
 
 The lock tests need no LAMMPS (a child process holds the lock); the two ``md`` tests run smoke MD.
 """
@@ -61,11 +61,9 @@ def test_a_second_process_is_refused_with_one_line_naming_the_holder(tmp_path):
         assert "\n" not in msg
         assert str(run_dir) in msg and f"PID {child.pid} on {HOST} (since " in msg and "wait for it" in msg
         assert info.value.exit_code == EXIT_BUSY == 75
-        t0 = time.monotonic()
         with pytest.raises(RunBusy, match=rf"still in use by PID {child.pid} .* after waiting 0.5 s"):
             with run_lock(run_dir, timeout=0.5):
                 pytest.fail("got a lock another process holds")
-        assert 0.5 <= time.monotonic() - t0 < 5
     finally:
         child.kill()
         child.wait()
@@ -75,12 +73,9 @@ def test_a_waiting_process_gets_the_lock_when_the_holder_is_done(tmp_path, caplo
     run_dir = tmp_path / "recipe-smoke-0123456789abcdef"
     caplog.set_level(logging.INFO, logger="nanoimpact.lock")
     child = _hold(run_dir, 1.5)
-    t0 = time.monotonic()
     with run_lock(run_dir, wait=True):
-        waited = time.monotonic() - t0
         assert read_holder(run_dir).pid == os.getpid()
-    assert child.wait(timeout=30) == 0          # it finished its block before we got in
-    assert waited > 0.5
+    assert child.wait(timeout=30) == 0          # it finished its block (it held the lock when we asked: logged)
     assert f"waiting for PID {child.pid} on {HOST} to finish {run_dir}" in caplog.text
     assert caplog.text.count("waiting for PID") == 1
     assert not lock_path(run_dir).exists()      # a holder deletes its lock file when it lets go
@@ -95,10 +90,8 @@ def test_a_holder_killed_with_sigkill_releases_the_lock_at_once(tmp_path):
     os.kill(child.pid, signal.SIGKILL)
     assert child.wait(timeout=30) == -signal.SIGKILL
     assert read_holder(run_dir).pid == child.pid        # the file outlives its holder ...
-    t0 = time.monotonic()
-    with run_lock(run_dir, wait=False):                 # ... the lock does not
+    with run_lock(run_dir, wait=False):                 # ... the lock does not: got at once, without waiting
         assert read_holder(run_dir).pid == os.getpid()
-    assert time.monotonic() - t0 < 1.0
 
 
 def test_lockers_exclude_each_other_and_release_lets_no_two_in(tmp_path):
@@ -169,15 +162,14 @@ def _md(cache: Path, out: Path, *extra: str) -> subprocess.Popen:
 
 @pytest.mark.md
 def test_two_simultaneous_runs_on_one_cache_report_the_single_runs_numbers(md_smoke, md_smoke_cache, tmp_path):
-    """The issue's reproduction: two runs started together on one fresh cache. One runs, the other waits for it
-    (and says so) and then reuses its finished result: both exit 0 with byte-identical result.json files.
+    """Two runs started together on one fresh cache. One runs, the other waits for it (and says so) and then reuses
+    its finished result: both exit 0 with byte-identical result.json files.
 
     The reference is a run alone in its own cache: the session's smoke run of the recipe (md_smoke, in process,
     shared with test_md_workflows; it shares no file with the other two). Same recipe, seeds and binary on one
     rank: LAMMPS is deterministic across processes here, so the numbers are compared for equality, not within a
-    tolerance -- the samples and frames of the two run directories are bit-identical too (measured: gamma_lv
-    equal to the last digit in all three; 0.0709267 N/m with the analysis of the issue's time). Without the lock
-    (the runner before this test) both runs exited 0 and reported 0.0625448 N/m, neither the single run's value."""
+    tolerance -- the samples and frames of the two run directories are bit-identical too. Without the lock both
+    runs would write into one run directory and report a value the single run does not give."""
     alone_run = md_smoke(RECIPE)
     t0 = time.monotonic()
     procs = {k: _md(tmp_path / "shared", tmp_path / f"out_{k}") for k in ("a", "b")}

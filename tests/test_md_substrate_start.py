@@ -1,15 +1,12 @@
 """How the silica substrates start: the periodic build every silica recipe shares, and the FIRE minimisation.
 
-The quick contact_angle_silica run (version 2) died at FIRE step 48 with "Bond atoms 3501 3502 missing", E_mol =
-81 147 kcal/mol at step 0. Not a periodic-bond error: every bond of that data file is 1.550 A (Si-O) or 0.945 A
-(O-H) under minimum image, the box is exactly 48 x 3 (111) cells, and E_mol is the builder's ideal-cristobalite
-strain (Si-O 1.55 A against IFF's 1.68 A, straight Si-O-Si against 149 deg; 4.8 kcal/mol per Si-O bond and
-~6 per angle), the same per bond at every size. The cause was the minimiser: FIRE grows its step to 10 x the
-timestep, and the recipe's 2 fs (chosen for SHAKE, which is not on while minimising) let it reach 20 fs, two
-periods of the free silanol O-H; in 4320 atoms FIRE's global power test did not see one H diverging, and the H
-collapsed onto its O (0.03 A at step 47) and was shot away. In the 780-atom smoke slab the same 2 fs FIRE only
-shows force spikes it recovers from, so smoke passed. FIRE now runs at 1 fs (``md.workflows.common.FIRE_TIMESTEP_FS``):
-the quick minimisation then runs its 500 iterations to -301 018 kcal/mol (final step changes it by 1e-4).
+The builds start strained (the builder's ideal cristobalite: Si-O 1.55 A against IFF's 1.68 A, straight Si-O-Si
+against 149 deg), so every workflow minimises first. FIRE grows its step to 10 x the timestep, and nothing is
+constrained while it runs: at a SHAKE recipe's 2 fs it reaches 20 fs, two periods of the free silanol O-H, and in
+a large slab FIRE's global power test does not see one H diverging until it collapses onto its O and is shot away
+("Bond atoms missing"); a small slab recovers from the same force spikes. FIRE therefore runs at 1 fs
+(``md.workflows.common.FIRE_TIMESTEP_FS``), and the quick silica substrate is minimised here by the plan's own
+commands.
 
 The build-level checks below (every silica recipe, every fidelity) guard the other suspects: each bond's
 minimum-image length is at its force-field r0 (within the builder's documented strain), and the lateral box is
@@ -66,8 +63,8 @@ def _fire_timesteps(cmds: list[str], dt: float | None = None) -> tuple[list[floa
 
 @pytest.mark.parametrize("name", ["contact_angle_silica", "contact_angle_ots"])
 def test_the_substrate_is_minimised_by_fire_at_1_fs_and_run_at_the_recipes_timestep(name, tmp_path):
-    """The plan's own commands: FIRE at <= 1 fs (silica's recipe timestep is 2 fs: fails on version 2), then the
-    recipe's timestep again before any dynamics."""
+    """The plan's own commands: FIRE at <= 1 fs (silica's recipe timestep is 2 fs), then the recipe's timestep
+    again before any dynamics."""
     from md.workflows import get_workflow
     s = load_recipe(name).settings("smoke")
     plan = get_workflow("contact_angle").plan(s, tmp_path)
@@ -95,8 +92,8 @@ def test_no_recipe_minimises_with_fire_above_1_fs(fidelity):
 @pytest.mark.slow
 def test_quick_silica_substrate_survives_fire(needs_lammps, tmp_path):
     """The failing case itself: the quick contact_angle_silica substrate, minimised by the plan's own commands.
-    Version 2 (FIRE at 2 fs) raised "Bond atoms 3501 3502 missing" at step 48; now 60 steps leave every silanol
-    O-H at its length and the energy lower."""
+    This is the substrate on which FIRE at the recipe's 2 fs loses a silanol H ("Bond atoms missing"); at 1 fs 60
+    steps leave every silanol O-H at its length and the energy lower."""
     from md.lammps_loader import new_lammps
     from md.workflows import get_workflow
     from md.workflows.common import forcefield_of

@@ -188,7 +188,7 @@ def test_plan_legs_scale_the_right_things(tmp_path, recipe):
         else:
             assert pairs == {(i, j) for i in every for j in water}        # every solid-water pair, no other
         thermostats = [c.split()[2] for c in cmds if c.startswith("fix thermostat")]
-        # version 2: the water and the solid's mobile atoms each have their own thermostat; the solid alone one
+        # the water and the solid's mobile atoms each have their own thermostat; the solid alone one
         assert thermostats == (["mobile"] if leg.name.startswith("ref") else ["water", "solidmobile"]), leg.name
         if leg.name.startswith("lj"):
             assert lam["lq"] == 0.0 and 0 < lam["ll"] < 1 and all(" pair " in c for c in fep)
@@ -198,9 +198,8 @@ def test_plan_legs_scale_the_right_things(tmp_path, recipe):
 
 @pytest.mark.parametrize("recipe", sorted(_SOLIDS))
 def test_each_reference_node_starts_from_its_film_nodes_start_without_the_water(tmp_path, recipe):
-    """Version 3: the solid-alone node k reads the restart film node k reads and deletes the water, so both start
-    from one solid configuration (version 2 chained the reference from the substrate leg: the OTS solid-solid
-    share did not cancel, -5.5 +- 2.7 mJ/m^2 of electrostatics under 2 nm of uncharged chains)."""
+    """The solid-alone node k reads the restart film node k reads and deletes the water, so both start from one
+    solid configuration and the solid-solid share of dU/dlambda_q cancels in their difference."""
     s, plan = _plan(tmp_path, recipe)
     legs = {leg.name: leg for leg in plan.legs}
     reads = set()
@@ -260,7 +259,7 @@ def test_leg_temperatures_are_reported_and_an_off_target_leg_is_flagged():
                                    "temp_solid": np.full(40, 300.0)}})
     r = leg_temperatures(ctx, ctx.legs, 300.0, second_half=("film",))
     assert not r["off_target_legs"] and "within" in r["note"]
-    assert leg_temperatures(_Ctx({"film": {"pe": np.ones(3)}}), _Ctx({"film": {}}).legs, 300.0) == {}   # version 1
+    assert leg_temperatures(_Ctx({"film": {"pe": np.ones(3)}}), _Ctx({"film": {}}).legs, 300.0) == {}   # not sampled: nothing
 
 
 def test_film_dividing_plane_of_a_uniform_slab():
