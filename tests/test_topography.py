@@ -237,6 +237,8 @@ def _bad_cases(tmp_path: Path):
          "summit_cutoff", "must be >= 4 pixels"),
         ({"synthetic": {"hurst": 0.8, "rms_height": 1e-9, "short_cutoff": 1e-8, "size": 1e-6, "grid_points": 64}},
          "synthetic.short_cutoff", "must be >= 4 pixels"),
+        ({"synthetic": {"hurst": 0.8, "rms_height": 1e-9, "short_cutoff": 1e-7, "size": 1e-6, "grid_points": 63}},
+         "synthetic.grid_points", "must be even"),
     ]
 
 

@@ -206,6 +206,9 @@ def synthesise_height_map(s: Synthesis) -> HeightMap:
     from SurfaceTopography.Generation import fourier_synthesis
 
     pixel = s.size / s.grid_points
+    if s.grid_points % 2:
+        raise TopographyError(f"{KEY_SYNTH}.grid_points", s.grid_points, "must be even (the Fourier filter of a "
+                                                                       "periodic map drops a column of an odd one)")
     if s.short_cutoff < MIN_CUTOFF_PIXELS * pixel:
         raise TopographyError(f"{KEY_SYNTH}.short_cutoff", s.short_cutoff, f"must be >= {MIN_CUTOFF_PIXELS:g} "
                               f"pixels ({MIN_CUTOFF_PIXELS * pixel:.3g} m for size {s.size:g} m on "
