@@ -136,222 +136,128 @@ class WslTI(Workflow):
 
     def plan(self, s, run_dir):
         s = self.typed(s)
-        ff = forcefield_of(self.forcefield_files(s))
-        seed = int(s.seed)
-        sub, film, system = self.build(s)
-        substrate, water = system.group("substrate"), system.group("adsorbate")
-        held = np.intersect1d(held_deep(system), substrate)
-        sub_data, water_data = run_dir / "substrate.data", run_dir / "water.data"
-        write_data(system, ff, run_dir / "system.data", title="wsl_ti system (reference; the legs read the two parts)")
-        write_data(remove_atoms(system, water), ff, sub_data, title="wsl_ti substrate")
-        write_data(remove_atoms(system, substrate), ff, water_data, title="wsl_ti water film")
-        ids = lammps_type_ids(ff)
-        all_types, charged_types = solid_types(system, ff)
-        solid_t, charged_t = [ids[t] for t in all_types], [ids[t] for t in charged_types]
-        water_t = sorted(ids[a.name] for a in forcefield_of(water_forcefield_names(s.water_model)).atom_types)
-        charge = {ids[t]: ff.atom_type(t).charge for t in charged_types}
-        # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
-        # dispersion beyond the cutoff (analysis: md.analysis.film_lower_dividing_plane + dispersion_tail_work)
-        water_o = np.intersect1d(system.group("water_O"), water)
-        tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
-        ow = str(np.asarray(system.types)[water_o[0]])
-        z_film = float(system.positions[water, 2].mean())
-        area = float(system.cell[0] * system.cell[1])
-        dt, t = s.timestep_fs, s.temperature_K
-        shake = shake_lines(ff, also=SILANOL_OH)
-        nodes = self.nodes(s)
-
-        def base(with_water: bool, step: int, salt: int) -> list[str]:
-            # with the water: one thermostat on the water, one on the solid's mobile atoms, each one's temperature
-            # sampled
-            return (common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake +
-                    ["fix hold frozen setforce 0.0 0.0 0.0"] +
-                    ([f"fix tether water spring tether {TETHER_K:g} NULL NULL {z_film:.4f} 0.0",
-                      "variable zw equal xcm(water,z)"] + water_solid_thermostat_lines(s, step, salt)
-                     if with_water else thermostat_lines("mobile", s, step, salt)))
-
-        def coupling(lam_q: float, lam_lj: float, stage: str, with_water: bool) -> list[str]:
-            """the solid's charges at lam_q x their force-field values, solid-water LJ at lam_lj; dU/dlambda of
-            ``stage`` ('q' or 'lj') by central differences of two compute fep"""
-            cmds = [f"variable lq equal {lam_q:.12g}", f"variable ll equal {lam_lj:.12g}"]
-            args = []
-            for k in charged_t:
-                cmds += [f"variable q{k} equal {charge[k]:.8g}*v_lq",
-                         f"variable dqp{k} equal {charge[k] * FEP_DELTA:.8g}",
-                         f"variable dqm{k} equal {-charge[k] * FEP_DELTA:.8g}"]
-                args.append(f"atom charge {k} v_q{k}")
-            pairs = [(i, j) for i in solid_t for j in water_t] if with_water else []
-            args += [f"pair lj/cut/coul/long/soft lambda {i} {j} v_ll" for i, j in pairs]
-            cmds.append(f"fix couple all adapt/fep 0 {' '.join(args)} reset no")
-            cmds += [f"variable dlp equal {FEP_DELTA:g}", f"variable dlm equal {-FEP_DELTA:g}"]
-            if stage == "q":
-                plus = " ".join(f"atom charge {k} v_dqp{k}" for k in charged_t)
-                minus = " ".join(f"atom charge {k} v_dqm{k}" for k in charged_t)
-            else:
-                plus = " ".join(f"pair lj/cut/coul/long/soft lambda {i} {j} v_dlp" for i, j in pairs)
-                minus = " ".join(f"pair lj/cut/coul/long/soft lambda {i} {j} v_dlm" for i, j in pairs)
-            cmds += [f"compute fepp all fep {t:g} {plus}", f"compute fepm all fep {t:g} {minus}",
-                     f"variable dudl equal (c_fepp[1]-c_fepm[1])/{2 * FEP_DELTA:g}"]
-            return cmds
-
-        sub_groups = {"substrate": substrate, "frozen": held}
-
-        def fresh_substrate(leg_dir: Path) -> list[str]:
-            return fresh_from_data(ff, sub_data, s, sub_groups, pair="long/soft") + kspace + \
-                ["group mobile subtract all frozen"] + minimize_lines(s, leg_dir / "minimized.data")
-
-        kspace = pppm_lines(s, system.cell)
-
-        def head(path: Path) -> list[str]:
-            return restart_header_lines(s)(path) + kspace
-        common = dict(restart_head=head, sample_interval=s.sample_interval, chunk_steps=s.chunk_steps)
-        sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=lambda step: base(False, step, 0),
-                      prepare=lambda d: [],
-                      stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
-                                    (f"velocity mobile create {t:g} {derived_seed(seed, 3, 0)} mom yes rot no "
-                                     f"dist gaussian",), sampled=False)],
-                      columns={"pe": "v_pe", "temp": "v_temp"}, n_atoms=sub.n_atoms, **common)
-        sub_dir = run_dir / "legs" / "substrate"
-
-        def fresh_film(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
-            return head(sub_dir / f"restart.{_total}") + [
-                f"timestep {dt:g}", f"read_data {water_data.as_posix()} add append group water",
-                "group mobile subtract all frozen"] + \
-                ([f"group framed type {ids[ow]} " + " ".join(str(ids[x]) for x in TRAPPE_UA if x in all_types)]
-                 if len(tail_sites) else []) + \
-                [f"delete_atoms overlap {FILM_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
-
-        begin = (f"velocity mobile create {t:g} {derived_seed(seed, 3, 1)} mom yes rot no dist gaussian",)
-        if len(tail_sites):
-            # the equilibration's second half is framed (a sampled stage; its samples are the same series as
-            # before); silica, with no tail to add, keeps a single unsampled stage
-            n_eq = steps_of(s.equilibrate_steps, s.sample_interval)
-            half = (n_eq // 2) // s.chunk_steps * s.chunk_steps or n_eq // 2
-            film_stages = stage_list(Stage("equilibrate", n_eq - half, begin, sampled=False),
-                                     Stage("sample", half))
-            film_frames = Frames("framed", s.sample_interval * FRAME_EVERY_SAMPLES)
-        else:
-            film_stages = [Stage("equilibrate", steps_of(s.equilibrate_steps, s.sample_interval), begin, sampled=False)]
-            film_frames = None
-        film_leg = Leg(name="film", fresh=fresh_film, define=lambda step: base(True, step, 1),
-                       prepare=lambda d: minimize_water_lines(s), stages=film_stages,
-                       columns={"pe": "v_pe", "temp": "v_temp", "z_film": "v_zw"} | WATER_SOLID_COLUMNS,
-                       n_atoms=system.n_atoms, frames=film_frames, **common)
-        legs = [sub_leg, film_leg]
-
-        def window(name: str, prev: Leg, prev_dir: Path, lam_q: float, lam_lj: float, stage: str,
-                   with_water: bool, salt: int, info: dict, extra: tuple[str, ...] = ()) -> Leg:
-            def fresh(leg_dir: Path, _total=prev.total_steps) -> list[str]:
-                return head(prev_dir / f"restart.{_total}") + [f"timestep {dt:g}", *extra]
-            cols = {"dudl": "v_dudl", "pe": "v_pe", "temp": "v_temp"} | (
-                {"z_film": "v_zw"} | WATER_SOLID_COLUMNS if with_water else {})
-            return Leg(name=name, fresh=fresh,
-                       define=lambda step: base(with_water, step, salt) + coupling(lam_q, lam_lj, stage, with_water),
-                       prepare=lambda d: ["reset_timestep 0"],
-                       stages=stage_list(Stage("equilibrate", steps_of(s.ti_equilibrate_steps, s.sample_interval), sampled=False),
-                                         Stage("sample", steps_of(s.ti_sample_steps, s.sample_interval))),
-                       columns=cols, n_atoms=system.n_atoms if with_water else sub.n_atoms, info=info, **common)
-
-        prev, salt = film_leg, 10
-        film_starts = []                          # the leg each film charge node starts from
-        for k, lam in enumerate(nodes["q"]):
-            film_starts.append(prev)
-            leg = window(f"q{k}", prev, run_dir / "legs" / prev.name, float(lam), 1.0, "q", True, salt,
-                         {"stage": "charges", "lambda": float(lam), "system": "film"})
-            legs.append(leg)
-            prev, salt = leg, salt + 1
-        for k, lam in enumerate(nodes["lj"]):
-            leg = window(f"lj{k}", prev, run_dir / "legs" / prev.name, 0.0, float(lam), "lj", True, salt,
-                         {"stage": "dispersion", "lambda": float(lam), "system": "film"})
-            legs.append(leg)
-            prev, salt = leg, salt + 1
-        # each reference node starts from the state its film node starts from, the water deleted, so
-        # that the solid's slow configuration (silanols, SAM heads) is the same in both and its solid-solid share
-        # of dU/dlambda_q cancels in the difference
-        for k, lam in enumerate(nodes["q"]):
-            start = film_starts[k]
-            leg = window(f"ref_q{k}", start, run_dir / "legs" / start.name, float(lam), 1.0, "q", False, salt,
-                         {"stage": "charges", "lambda": float(lam), "system": "solid alone",
-                          "start": f"{start.name}'s last state, water deleted"},
-                         extra=("delete_atoms group water mol yes bond yes compress no",))
-            legs.append(leg)
-            salt += 1
-        info = {"substrate": system_summary(sub), "film": dict(film.info), "box_A": system.cell.tolist(),
-                "area_A2": area, "n_substrate": int(len(substrate)), "n_water_molecules_built": int(len(water) // 3),
-                "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
-                "silica_face": silica_face_of((s.surface,), s.silica_face), "water_model": s.water_model, "type_ids": ids,
-                "solid_types": all_types, "solid_charges_e": {x: ff.atom_type(x).charge for x in charged_types},
-                "surface": s.surface, "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6,
-                "tether": {"k_kcal_mol_A2": TETHER_K, "z_A": z_film}, "fep_delta": FEP_DELTA,
-                "soft_core": "lj/cut/coul/long/soft n = 1, alpha_LJ = 0.5 (Beutler et al. 1994)",
-                "nodes": {k: v.tolist() for k, v in nodes.items()}, "pppm": kspace[0]}
-        return Plan(legs=legs, timestep_fs=dt, n_atoms=system.n_atoms,
-                    seeds=substrate_water_seeds(seed), forcefield_files=self.forcefield_files(s), system_info=info)
+        legs = _WslLegs(self, s, run_dir)
+        return Plan(legs=legs.all(), timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
+                    seeds=substrate_water_seeds(int(s.seed)), forcefield_files=self.forcefield_files(s),
+                    system_info=legs.info())
 
     # ------------------------------------------------------------------------------------------ analysis
     def analyse(self, ctx):
-        s = self.typed(ctx.settings)
-        info = ctx.plan.system_info
-        model = WATER_MODELS[s.water_model]
-        gamma = model["gamma_lv_N_m"]
-        nodes = {k: np.asarray(v, float) for k, v in info["nodes"].items()}
-        stages, per_node, halves = {}, {}, {0: {}, 1: {}}
-        for key, prefix, lam in (("charge_film", "q", nodes["q"]), ("lj_film", "lj", nodes["lj"]),
-                                 ("charge_reference", "ref_q", nodes["q"])):
-            rows, half_means = [], ([], [])
-            for k, x in enumerate(lam):
-                d = ctx.samples(f"{prefix}{k}")
-                st = A.timeseries_stats(d["dudl"])
-                row = {"lambda": float(x), "mean_kcal_mol": st["mean"], "stderr_kcal_mol": st["stderr"],
-                       "g": st["g"], "n_eff": st["n_eff"], "n": int(len(d["dudl"])), "t0": int(st["t0"])}
-                if "z_film" in d and len(d["z_film"]):
-                    row["z_film_A"] = float(np.mean(d["z_film"]))
-                rows.append(row)
-                used = np.asarray(d["dudl"], float)[int(st["t0"]):]          # the samples the mean uses
-                for h, part in enumerate((used[:used.size // 2], used[used.size // 2:])):
-                    half_means[h].append(float(np.mean(part)) if part.size else float("nan"))
-            per_node[key] = rows
-            stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
-            for h in (0, 1):
-                halves[h][key] = A.ti_integral(lam, half_means[h], [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
+        return _WslAnalysis(ctx, self.typed(ctx.settings)).run()
+
+
+class _WslAnalysis:
+    """W_SL from the stored dU/dlambda, in the MDAnalysis manner: :meth:`_prepare`, :meth:`_single_node` for every
+    lambda node of every stage (film charges, film LJ, solid-alone charges), :meth:`_conclude` (the integrals, the
+    tether and dispersion-tail corrections, Young-Dupre, the window-length check, notes, curves and the figure)."""
+
+    #: (stage key, leg-name prefix, node set) in the order the stages are read
+    STAGES = (("charge_film", "q", "q"), ("lj_film", "lj", "lj"), ("charge_reference", "ref_q", "q"))
+
+    def __init__(self, ctx, s):
+        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+
+    def run(self) -> Analysis:
+        self._prepare()
+        for key, prefix, node_set in self.STAGES:
+            for k, x in enumerate(self.nodes[node_set]):
+                self._single_node(key, f"{prefix}{k}", x)
+            self._conclude_stage(key, self.nodes[node_set])
+        return self._conclude()
+
+    def _prepare(self) -> None:
+        self.model = WATER_MODELS[self.s.water_model]
+        self.gamma = self.model["gamma_lv_N_m"]
+        self.nodes = {k: np.asarray(v, float) for k, v in self.info["nodes"].items()}
+        self.stages, self.per_node, self.halves = {}, {}, {0: {}, 1: {}}
+        self.rows = {key: [] for key, _, _ in self.STAGES}
+        self.half_means = {key: ([], []) for key, _, _ in self.STAGES}
+
+    def _single_node(self, key: str, leg: str, x: float) -> None:
+        """One node: the mean of dU/dlambda with its stderr (statistical inefficiency, equilibration detected), the
+        film's height, and the means of the two halves of the samples the mean uses."""
+        d = self.ctx.samples(leg)
+        st = A.timeseries_stats(d["dudl"])
+        row = {"lambda": float(x), "mean_kcal_mol": st["mean"], "stderr_kcal_mol": st["stderr"],
+               "g": st["g"], "n_eff": st["n_eff"], "n": int(len(d["dudl"])), "t0": int(st["t0"])}
+        if "z_film" in d and len(d["z_film"]):
+            row["z_film_A"] = float(np.mean(d["z_film"]))
+        self.rows[key].append(row)
+        used = np.asarray(d["dudl"], float)[int(st["t0"]):]          # the samples the mean uses
+        for h, part in enumerate((used[:used.size // 2], used[used.size // 2:])):
+            self.half_means[key][h].append(float(np.mean(part)) if part.size else float("nan"))
+
+    def _conclude_stage(self, key: str, lam: np.ndarray) -> None:
+        rows = self.rows[key]
+        self.per_node[key] = rows
+        self.stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
+        for h in (0, 1):
+            self.halves[h][key] = A.ti_integral(lam, self.half_means[key][h],
+                                                [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
+
+    def _conclude(self) -> Analysis:
+        s, ctx = self.s, self.ctx
         temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "film" or
                                        leg.name.startswith(("q", "lj"))], s.temperature_K, second_half=("film",))
-        w = A.ti_work_of_adhesion_sl(stages["charge_film"], stages["lj_film"], stages["charge_reference"],
-                                     info["area_A2"])
+        self._work()
+        q = self._quantities()
+        notes = self._notes() + ([temps["note"]] if temps else []) + self._tail_notes()
+        details = {"stages": self.stages, "nodes": self.per_node, "parts_J_m2": self.w, "angle": self.ang,
+                   "gamma_lv_N_m": self.gamma,
+                   "window_halves_J_m2": {"first": self.w_half[0], "second": self.w_half[1],
+                                          "consistent": self.half_ok, "difference_sigma": 2.0 * self.half_sigma},
+                   "water_model": s.water_model}
+        if self.tail is not None:
+            details["dispersion_tail"] = self.tail
+        if temps:
+            details["temperatures_K"] = temps
+        return Analysis(quantities=q, curves=self._curves(), figures={"dudl": figure_writer(self._draw)},
+                        notes=notes, details=details)
+
+    def _work(self) -> None:
+        """W_SL (J/m^2) with the tether and the dispersion-tail corrections, the halves' W_SL, and the angle."""
+        info, gamma = self.info, self.gamma
+        w = A.ti_work_of_adhesion_sl(self.stages["charge_film"], self.stages["lj_film"],
+                                     self.stages["charge_reference"], info["area_A2"])
         # the tether's energy at full coupling (the film leg's second half), added back
-        zf = np.asarray(ctx.samples("film", False).get("z_film", []), float)
+        zf = np.asarray(self.ctx.samples("film", False).get("z_film", []), float)
         tc = A.tether_correction(zf[zf.size // 2:], info["tether"]["z_A"], info["tether"]["k_kcal_mol_A2"],
                                  info["area_A2"])
         w["value"] += tc["value"]
         w["tether_correction"] = tc
         # OTS: the water-TraPPE dispersion beyond the cutoff, static, at full coupling (the film leg's framed half)
-        tail = _dispersion_tail(ctx, info, s) if info.get("tail_site_ids") else None
+        tail = _dispersion_tail(self.ctx, info, self.s) if info.get("tail_site_ids") else None
         if tail is not None:
             w["value"] += tail["value"]
             w["stderr"] = math.hypot(w["stderr"], tail["stderr"])
             w["dispersion_tail"] = tail
-        dw_tail = tail["value"] if tail is not None else 0.0
+        self.dw_tail = tail["value"] if tail is not None else 0.0
         # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
-        w_half = [A.ti_work_of_adhesion_sl(halves[h]["charge_film"], halves[h]["lj_film"],
-                                           halves[h]["charge_reference"], info["area_A2"])["value"] + tc["value"]
-                  + dw_tail for h in (0, 1)]
-        half_sigma = w["stderr"] * 2.0                  # each half has sqrt(2) x the stderr; their difference 2 x
-        w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
-        ang = A.angle_from_work_of_adhesion_sl(w["value"], w_err, gamma)
+        self.w_half = [A.ti_work_of_adhesion_sl(self.halves[h]["charge_film"], self.halves[h]["lj_film"],
+                                                self.halves[h]["charge_reference"], info["area_A2"])["value"]
+                       + tc["value"] + self.dw_tail for h in (0, 1)]
+        self.half_sigma = w["stderr"] * 2.0             # each half has sqrt(2) x the stderr; their difference 2 x
+        self.half_ok = bool(abs(self.w_half[1] - self.w_half[0]) <= 2.0 * self.half_sigma)
+        self.w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
+        ang = A.angle_from_work_of_adhesion_sl(w["value"], self.w_err, gamma)
         # the quadrature's share of the angle's error, first order (reported apart from the statistical one)
-        th_disc = th_stat = None
+        self.th_disc = self.th_stat = None
         if ang["status"] == "measured":
-            th_disc = math.degrees(w["discretisation_error"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
-            th_stat = math.degrees(w["stderr"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
+            self.th_disc = math.degrees(w["discretisation_error"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
+            self.th_stat = math.degrees(w["stderr"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
+        self.w, self.tc, self.tail, self.ang = w, tc, tail, ang
+
+    def _quantities(self) -> dict:
+        w, ang, tail, gamma, model = self.w, self.ang, self.tail, self.gamma, self.model
         kinds = {"measured": "Young-Dupre from the TI W_SL: theta = arccos(W_SL / gamma_lv - 1)",
                  "wets": "0 = wets (W_SL >= 2 gamma_lv; mark, not a measurement): see spreading_coefficient",
                  "dewets": "180 = W_SL <= 0 (mark, not a measurement)"}
         q = {"work_of_adhesion_sl": quantity_record(
                 w["value"], w["stderr"], "J/m^2", kind="thermodynamic integration: film decoupled from the solid "
                 "(charges, then soft-core LJ) minus the solid-alone charge stage", discretisation_error=w["discretisation_error"]),
-             "contact_angle": quantity_record(ang["theta_deg"], th_stat, "deg",
+             "contact_angle": quantity_record(ang["theta_deg"], self.th_stat, "deg",
                                               status=ang["status"], kind=kinds[ang["status"]],
-                                              discretisation_error=th_disc,
+                                              discretisation_error=self.th_disc,
                                               upper_one_stderr_deg=ang["theta_upper_deg"]),
              "spreading_coefficient": quantity_record(ang["spreading_coefficient"], w["stderr"], "J/m^2",
                                                       kind="S = W_SL - 2 gamma_lv (>= 0: wets)"),
@@ -364,84 +270,268 @@ class WslTI(Workflow):
                                                    kind=f"the water model's published gamma_lv ({model['gamma_source']})")}
         if ang["status"] == "wets":
             # W_SL - 2 sigma (statistical and quadrature together): the largest angle the run does not exclude
-            bound = A.angle_from_work_of_adhesion_sl(w["value"] - 2.0 * w_err, 0.0, gamma)["theta_deg"]
+            bound = A.angle_from_work_of_adhesion_sl(w["value"] - 2.0 * self.w_err, 0.0, gamma)["theta_deg"]
             q["contact_angle_upper_bound"] = quantity_record(bound, None, "deg", kind="wets: theta below this "
                                                              "bound (Young-Dupre at W_SL - 2 stderr, quadrature included)")
         if ang["status"] == "measured":
             wl = A.work_of_adhesion_sl(gamma, ang["theta_deg"], None, ang["stderr_deg"])
             q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
                                                       kind="gamma_lv cos theta = W_SL - gamma_lv")
-        conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / info["area_A2"]
-        half_ok = bool(abs(w_half[1] - w_half[0]) <= 2.0 * half_sigma)
-        notes = [f"window length: W_SL from the first halves of the nodes' samples {w_half[0] * 1e3:.1f}, from the "
-                 f"second halves {w_half[1] * 1e3:.1f} mJ/m^2 (difference {(w_half[1] - w_half[0]) * 1e3:+.1f}, 2 sigma "
-                 f"= {2 * half_sigma * 1e3:.1f}): " + ("consistent, the nodes are long enough for their decorrelation."
-                                                      if half_ok else "NOT consistent: the nodes still relax; longer "
-                                                      "nodes are needed."),
-                 ] + [f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
-                 f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
-                 f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
-                 f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f}"
-                 + (f", water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff {dw_tail * 1e3:+.1f} +/- "
-                    f"{tail['stderr'] * 1e3:.1f}" if tail is not None else "") + " mJ/m^2.",
-                 {"measured": f"theta = {ang['theta_deg']:.1f} deg from Young-Dupre with gamma_lv = "
-                              f"{gamma * 1e3:.1f} mN/m ({model['name']}).",
-                  "wets": f"WETS: W_SL exceeds 2 gamma_lv = {2 * gamma * 1e3:.1f} mJ/m^2 by "
-                          f"{ang['spreading_coefficient'] * 1e3:.1f} mJ/m^2 (spreading coefficient); theta = 0.",
-                  "dewets": "W_SL <= 0: the film does not bind."}[ang["status"]],
-                 "no droplet and no contact line: the film covers the periodic solid; the decoupled film is "
-                 "free-standing, so F(decoupled) - F(coupled) = A W_SL with nothing estimated at the end state "
-                 "(md.analysis.free_energy).",
-                 f"the film's centre of mass is tethered along z (k = {TETHER_K:g} kcal/mol/A^2) to where it was "
-                 f"placed; bound at full coupling it sits {tc['offset_A']:+.2f} A from there, and the spring's "
-                 f"energy there ({tc['energy_kcal_mol']:.2f} kcal/mol = {tc['value'] * 1e3:.1f} mJ/m^2) is added "
-                 f"to W_SL (md.analysis.tether_correction); the O(kT) translational term it leaves, "
-                 f"{U.kT_kcal_per_mol(s.temperature_K):.2f} kcal/mol = "
-                 f"{U.kT_kcal_per_mol(s.temperature_K) * conv * 1e3:.1f} mJ/m^2 here, is not.",
-                 "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
-                 f"mobile (O-H by SHAKE); water rigid {model['name']} (SHAKE); PPPM throughout (the charge stage "
-                 "scales the solid's charges, the reference subtracts their solid-solid part)."]
-        if temps:
-            notes.append(temps["note"])
-        if tail is not None:
-            notes.append(
-                f"the water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff (which TraPPE was fitted with) is "
-                f"added statically: {tail['sites']} CH2/CH3 sites under the film's lower dividing plane "
+        return q
+
+    def _notes(self) -> list[str]:
+        s, w, ang, tail, tc, gamma, model = self.s, self.w, self.ang, self.tail, self.tc, self.gamma, self.model
+        w_half, half_sigma = self.w_half, self.half_sigma
+        conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / self.info["area_A2"]
+        return [f"window length: W_SL from the first halves of the nodes' samples {w_half[0] * 1e3:.1f}, from the "
+                f"second halves {w_half[1] * 1e3:.1f} mJ/m^2 (difference {(w_half[1] - w_half[0]) * 1e3:+.1f}, 2 sigma "
+                f"= {2 * half_sigma * 1e3:.1f}): " + ("consistent, the nodes are long enough for their decorrelation."
+                                                     if self.half_ok else "NOT consistent: the nodes still relax; longer "
+                                                     "nodes are needed."),
+                f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
+                f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
+                f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
+                f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f}"
+                + (f", water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff {self.dw_tail * 1e3:+.1f} +/- "
+                   f"{tail['stderr'] * 1e3:.1f}" if tail is not None else "") + " mJ/m^2.",
+                {"measured": f"theta = {ang['theta_deg']:.1f} deg from Young-Dupre with gamma_lv = "
+                             f"{gamma * 1e3:.1f} mN/m ({model['name']}).",
+                 "wets": f"WETS: W_SL exceeds 2 gamma_lv = {2 * gamma * 1e3:.1f} mJ/m^2 by "
+                         f"{ang['spreading_coefficient'] * 1e3:.1f} mJ/m^2 (spreading coefficient); theta = 0.",
+                 "dewets": "W_SL <= 0: the film does not bind."}[ang["status"]],
+                "no droplet and no contact line: the film covers the periodic solid; the decoupled film is "
+                "free-standing, so F(decoupled) - F(coupled) = A W_SL with nothing estimated at the end state "
+                "(md.analysis.free_energy).",
+                f"the film's centre of mass is tethered along z (k = {TETHER_K:g} kcal/mol/A^2) to where it was "
+                f"placed; bound at full coupling it sits {tc['offset_A']:+.2f} A from there, and the spring's "
+                f"energy there ({tc['energy_kcal_mol']:.2f} kcal/mol = {tc['value'] * 1e3:.1f} mJ/m^2) is added "
+                f"to W_SL (md.analysis.tether_correction); the O(kT) translational term it leaves, "
+                f"{U.kT_kcal_per_mol(s.temperature_K):.2f} kcal/mol = "
+                f"{U.kT_kcal_per_mol(s.temperature_K) * conv * 1e3:.1f} mJ/m^2 here, is not.",
+                "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
+                f"mobile (O-H by SHAKE); water rigid {model['name']} (SHAKE); PPPM throughout (the charge stage "
+                "scales the solid's charges, the reference subtracts their solid-solid part)."]
+
+    def _tail_notes(self) -> list[str]:
+        tail = self.tail
+        if tail is None:
+            return []
+        return [f"the water-TraPPE dispersion beyond the {self.s.cutoff_A:g} A cutoff (which TraPPE was fitted with) "
+                f"is added statically: {tail['sites']} CH2/CH3 sites under the film's lower dividing plane "
                 f"(z = {tail['plane_z_A']:.2f} A, bulk {tail['number_density_A3']:.4f} molecules/A^3), "
                 f"{tail['frames']} frames of the film leg's second half; the IFF pairs and water-water keep the "
-                "plain cutoff, as in every recipe.")
-        curves, rows = {}, []
+                "plain cutoff, as in every recipe."]
+
+    def _curves(self) -> dict:
+        rows = []
         for key, code in (("charge_film", 0), ("lj_film", 1), ("charge_reference", 2)):
-            for r in per_node[key]:
+            for r in self.per_node[key]:
                 rows.append([code, r["lambda"], U.kcal_per_mol_to_J(r["mean_kcal_mol"]),
                              U.kcal_per_mol_to_J(r["stderr_kcal_mol"]), r["g"], r["n_eff"]])
-        curves["dudl_nodes"] = (["stage_code", "lambda", "dudl_mean_J", "dudl_stderr_J", "g", "n_eff"],
-                                np.array(rows, float))
+        return {"dudl_nodes": (["stage_code", "lambda", "dudl_mean_J", "dudl_stderr_J", "g", "n_eff"],
+                               np.array(rows, float))}
 
-        def draw(ax):
-            qf, qr, lj = per_node["charge_film"], per_node["charge_reference"], per_node["lj_film"]
-            ax.errorbar([r["lambda"] for r in qf], [a["mean_kcal_mol"] - b["mean_kcal_mol"] for a, b in zip(qf, qr)],
-                        yerr=[np.hypot(a["stderr_kcal_mol"], b["stderr_kcal_mol"]) for a, b in zip(qf, qr)],
-                        marker="o", lw=1, capsize=2, label="charges: film minus solid alone")
-            ax.errorbar([r["lambda"] for r in lj], [r["mean_kcal_mol"] for r in lj],
-                        yerr=[r["stderr_kcal_mol"] for r in lj], marker="^", lw=1, capsize=2,
-                        label="solid-water LJ (soft core)")
-            ax.axhline(0.0, color="k", lw=0.6)
-            ax.set_xlabel("λ")
-            ax.set_ylabel("⟨∂U/∂λ⟩ (kcal/mol)")
-            title = {"measured": f"θ = {ang['theta_deg']:.1f}°", "wets": "wets", "dewets": "no binding"}[ang["status"]]
-            ax.set_title(f"W_SL = {w['value'] * 1e3:.0f} ± {w['stderr'] * 1e3:.0f} mJ/m², {title}")
-            ax.legend(fontsize=7)
-        details = {"stages": stages, "nodes": per_node, "parts_J_m2": w, "angle": ang, "gamma_lv_N_m": gamma,
-                   "window_halves_J_m2": {"first": w_half[0], "second": w_half[1], "consistent": half_ok,
-                                          "difference_sigma": 2.0 * half_sigma},
-                   "water_model": s.water_model}
-        if tail is not None:
-            details["dispersion_tail"] = tail
-        if temps:
-            details["temperatures_K"] = temps
-        return Analysis(quantities=q, curves=curves, figures={"dudl": figure_writer(draw)}, notes=notes,
-                        details=details)
+    def _draw(self, ax) -> None:
+        w, ang = self.w, self.ang
+        qf, qr, lj = self.per_node["charge_film"], self.per_node["charge_reference"], self.per_node["lj_film"]
+        ax.errorbar([r["lambda"] for r in qf], [a["mean_kcal_mol"] - b["mean_kcal_mol"] for a, b in zip(qf, qr)],
+                    yerr=[np.hypot(a["stderr_kcal_mol"], b["stderr_kcal_mol"]) for a, b in zip(qf, qr)],
+                    marker="o", lw=1, capsize=2, label="charges: film minus solid alone")
+        ax.errorbar([r["lambda"] for r in lj], [r["mean_kcal_mol"] for r in lj],
+                    yerr=[r["stderr_kcal_mol"] for r in lj], marker="^", lw=1, capsize=2,
+                    label="solid-water LJ (soft core)")
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_xlabel("λ")
+        ax.set_ylabel("⟨∂U/∂λ⟩ (kcal/mol)")
+        title = {"measured": f"θ = {ang['theta_deg']:.1f}°", "wets": "wets", "dewets": "no binding"}[ang["status"]]
+        ax.set_title(f"W_SL = {w['value'] * 1e3:.0f} ± {w['stderr'] * 1e3:.0f} mJ/m², {title}")
+        ax.legend(fontsize=7)
+
+
+class _WslLegs:
+    """The legs of a W_SL run (:meth:`WslTI.plan`): the system is built and its two parts written on construction;
+    :meth:`all` gives the substrate and film legs, then the film's charge nodes, its LJ nodes and the solid-alone
+    charge nodes, each node continuing from the leg before it (the reference nodes from their film node's start)."""
+
+    def __init__(self, wf: "WslTI", s, run_dir: Path):
+        self.wf, self.s, self.run_dir = wf, s, run_dir
+        self.ff = ff = forcefield_of(wf.forcefield_files(s))
+        self.sub, self.film, system = wf.build(s)
+        self.system = system
+        self.substrate, self.water = substrate, water = system.group("substrate"), system.group("adsorbate")
+        self.held = np.intersect1d(held_deep(system), substrate)
+        self.sub_data, self.water_data = run_dir / "substrate.data", run_dir / "water.data"
+        write_data(system, ff, run_dir / "system.data", title="wsl_ti system (reference; the legs read the two parts)")
+        write_data(remove_atoms(system, water), ff, self.sub_data, title="wsl_ti substrate")
+        write_data(remove_atoms(system, substrate), ff, self.water_data, title="wsl_ti water film")
+        self.ids = ids = lammps_type_ids(ff)
+        self.all_types, self.charged_types = solid_types(system, ff)
+        self.solid_t, self.charged_t = [ids[t] for t in self.all_types], [ids[t] for t in self.charged_types]
+        self.water_t = sorted(ids[a.name] for a in forcefield_of(water_forcefield_names(s.water_model)).atom_types)
+        self.charge = {ids[t]: ff.atom_type(t).charge for t in self.charged_types}
+        # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
+        # dispersion beyond the cutoff (analysis: md.analysis.film_lower_dividing_plane + dispersion_tail_work)
+        water_o = np.intersect1d(system.group("water_O"), water)
+        self.tail_sites, self.c6 = trappe_tail_sites(system, ff, water_o)
+        self.ow = str(np.asarray(system.types)[water_o[0]])
+        self.z_film = float(system.positions[water, 2].mean())
+        self.shake = shake_lines(ff, also=SILANOL_OH)
+        self.nodes = wf.nodes(s)
+        self.kspace = pppm_lines(s, system.cell)
+        self.common = dict(restart_head=self.head, sample_interval=s.sample_interval, chunk_steps=s.chunk_steps)
+
+    def head(self, path: Path) -> list[str]:
+        return restart_header_lines(self.s)(path) + self.kspace
+
+    def base(self, with_water: bool, step: int, salt: int) -> list[str]:
+        """Every leg's set-up; with the water: one thermostat on the water, one on the solid's mobile atoms, each
+        one's temperature sampled, and the film's tether."""
+        s = self.s
+        return (common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + self.shake +
+                ["fix hold frozen setforce 0.0 0.0 0.0"] +
+                ([f"fix tether water spring tether {TETHER_K:g} NULL NULL {self.z_film:.4f} 0.0",
+                  "variable zw equal xcm(water,z)"] + water_solid_thermostat_lines(s, step, salt)
+                 if with_water else thermostat_lines("mobile", s, step, salt)))
+
+    def coupling(self, lam_q: float, lam_lj: float, stage: str, with_water: bool) -> list[str]:
+        """the solid's charges at lam_q x their force-field values, solid-water LJ at lam_lj; dU/dlambda of
+        ``stage`` ('q' or 'lj') by central differences of two compute fep"""
+        charged_t, charge = self.charged_t, self.charge
+        cmds = [f"variable lq equal {lam_q:.12g}", f"variable ll equal {lam_lj:.12g}"]
+        args = []
+        for k in charged_t:
+            cmds += [f"variable q{k} equal {charge[k]:.8g}*v_lq",
+                     f"variable dqp{k} equal {charge[k] * FEP_DELTA:.8g}",
+                     f"variable dqm{k} equal {-charge[k] * FEP_DELTA:.8g}"]
+            args.append(f"atom charge {k} v_q{k}")
+        pairs = [(i, j) for i in self.solid_t for j in self.water_t] if with_water else []
+        args += [f"pair lj/cut/coul/long/soft lambda {i} {j} v_ll" for i, j in pairs]
+        cmds.append(f"fix couple all adapt/fep 0 {' '.join(args)} reset no")
+        cmds += [f"variable dlp equal {FEP_DELTA:g}", f"variable dlm equal {-FEP_DELTA:g}"]
+        if stage == "q":
+            plus = " ".join(f"atom charge {k} v_dqp{k}" for k in charged_t)
+            minus = " ".join(f"atom charge {k} v_dqm{k}" for k in charged_t)
+        else:
+            plus = " ".join(f"pair lj/cut/coul/long/soft lambda {i} {j} v_dlp" for i, j in pairs)
+            minus = " ".join(f"pair lj/cut/coul/long/soft lambda {i} {j} v_dlm" for i, j in pairs)
+        t = self.s.temperature_K
+        cmds += [f"compute fepp all fep {t:g} {plus}", f"compute fepm all fep {t:g} {minus}",
+                 f"variable dudl equal (c_fepp[1]-c_fepm[1])/{2 * FEP_DELTA:g}"]
+        return cmds
+
+    def substrate_leg(self) -> Leg:
+        """The slab minimised with nothing held, then deep Si and bridging O held, equilibrated."""
+        s = self.s
+        sub_groups = {"substrate": self.substrate, "frozen": self.held}
+
+        def fresh_substrate(leg_dir: Path) -> list[str]:
+            return fresh_from_data(self.ff, self.sub_data, s, sub_groups, pair="long/soft") + self.kspace + \
+                ["group mobile subtract all frozen"] + minimize_lines(s, leg_dir / "minimized.data")
+
+        t = s.temperature_K
+        return Leg(name="substrate", fresh=fresh_substrate, define=lambda step: self.base(False, step, 0),
+                   prepare=lambda d: [],
+                   stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
+                                 (f"velocity mobile create {t:g} {derived_seed(int(s.seed), 3, 0)} mom yes rot no "
+                                  f"dist gaussian",), sampled=False)],
+                   columns={"pe": "v_pe", "temp": "v_temp"}, n_atoms=self.sub.n_atoms, **self.common)
+
+    def film_leg(self, sub_leg: Leg) -> Leg:
+        """The water film added on the substrate's last state, minimised, equilibrated at full coupling; on OTS the
+        second half is a sampled stage framing the water O and the CH2/CH3 sites, for the dispersion tail."""
+        s, ids = self.s, self.ids
+        sub_dir = self.run_dir / "legs" / "substrate"
+
+        def fresh_film(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
+            return self.head(sub_dir / f"restart.{_total}") + [
+                f"timestep {s.timestep_fs:g}", f"read_data {self.water_data.as_posix()} add append group water",
+                "group mobile subtract all frozen"] + \
+                ([f"group framed type {ids[self.ow]} " + " ".join(str(ids[x]) for x in TRAPPE_UA
+                                                                   if x in self.all_types)]
+                 if len(self.tail_sites) else []) + \
+                [f"delete_atoms overlap {FILM_OVERLAP_A:g} water substrate mol yes bond yes compress no"]
+
+        begin = (f"velocity mobile create {s.temperature_K:g} {derived_seed(int(s.seed), 3, 1)} mom yes rot no "
+                 f"dist gaussian",)
+        if len(self.tail_sites):
+            # the equilibration's second half is framed (a sampled stage; its samples are the same series as
+            # before); silica, with no tail to add, keeps a single unsampled stage
+            n_eq = steps_of(s.equilibrate_steps, s.sample_interval)
+            half = (n_eq // 2) // s.chunk_steps * s.chunk_steps or n_eq // 2
+            film_stages = stage_list(Stage("equilibrate", n_eq - half, begin, sampled=False),
+                                     Stage("sample", half))
+            film_frames = Frames("framed", s.sample_interval * FRAME_EVERY_SAMPLES)
+        else:
+            film_stages = [Stage("equilibrate", steps_of(s.equilibrate_steps, s.sample_interval), begin,
+                                 sampled=False)]
+            film_frames = None
+        return Leg(name="film", fresh=fresh_film, define=lambda step: self.base(True, step, 1),
+                   prepare=lambda d: minimize_water_lines(s), stages=film_stages,
+                   columns={"pe": "v_pe", "temp": "v_temp", "z_film": "v_zw"} | WATER_SOLID_COLUMNS,
+                   n_atoms=self.system.n_atoms, frames=film_frames, **self.common)
+
+    def window(self, name: str, prev: Leg, lam_q: float, lam_lj: float, stage: str, with_water: bool, salt: int,
+               info: dict, extra: tuple[str, ...] = ()) -> Leg:
+        """One lambda node, continuing from the last restart of ``prev``."""
+        s = self.s
+        prev_dir = self.run_dir / "legs" / prev.name
+
+        def fresh(leg_dir: Path, _total=prev.total_steps) -> list[str]:
+            return self.head(prev_dir / f"restart.{_total}") + [f"timestep {s.timestep_fs:g}", *extra]
+        cols = {"dudl": "v_dudl", "pe": "v_pe", "temp": "v_temp"} | (
+            {"z_film": "v_zw"} | WATER_SOLID_COLUMNS if with_water else {})
+        return Leg(name=name, fresh=fresh,
+                   define=lambda step: self.base(with_water, step, salt) + self.coupling(lam_q, lam_lj, stage,
+                                                                                         with_water),
+                   prepare=lambda d: ["reset_timestep 0"],
+                   stages=stage_list(Stage("equilibrate", steps_of(s.ti_equilibrate_steps, s.sample_interval),
+                                           sampled=False),
+                                     Stage("sample", steps_of(s.ti_sample_steps, s.sample_interval))),
+                   columns=cols, n_atoms=self.system.n_atoms if with_water else self.sub.n_atoms, info=info,
+                   **self.common)
+
+    def all(self) -> list[Leg]:
+        sub_leg = self.substrate_leg()
+        film_leg = self.film_leg(sub_leg)
+        legs = [sub_leg, film_leg]
+        prev, salt = film_leg, 10
+        film_starts = []                          # the leg each film charge node starts from
+        for k, lam in enumerate(self.nodes["q"]):
+            film_starts.append(prev)
+            leg = self.window(f"q{k}", prev, float(lam), 1.0, "q", True, salt,
+                              {"stage": "charges", "lambda": float(lam), "system": "film"})
+            legs.append(leg)
+            prev, salt = leg, salt + 1
+        for k, lam in enumerate(self.nodes["lj"]):
+            leg = self.window(f"lj{k}", prev, 0.0, float(lam), "lj", True, salt,
+                              {"stage": "dispersion", "lambda": float(lam), "system": "film"})
+            legs.append(leg)
+            prev, salt = leg, salt + 1
+        # each reference node starts from the state its film node starts from, the water deleted, so that the
+        # solid's slow configuration (silanols, SAM heads) is the same in both and its solid-solid share of
+        # dU/dlambda_q cancels in the difference
+        for k, lam in enumerate(self.nodes["q"]):
+            start = film_starts[k]
+            legs.append(self.window(f"ref_q{k}", start, float(lam), 1.0, "q", False, salt,
+                                    {"stage": "charges", "lambda": float(lam), "system": "solid alone",
+                                     "start": f"{start.name}'s last state, water deleted"},
+                                    extra=("delete_atoms group water mol yes bond yes compress no",)))
+            salt += 1
+        return legs
+
+    def info(self) -> dict:
+        s, ff, system = self.s, self.ff, self.system
+        return {"substrate": system_summary(self.sub), "film": dict(self.film.info), "box_A": system.cell.tolist(),
+                "area_A2": float(system.cell[0] * system.cell[1]), "n_substrate": int(len(self.substrate)),
+                "n_water_molecules_built": int(len(self.water) // 3),
+                "held_atoms": int(len(self.held)), "held": "deep Si and bridging O of the builder's bottom layer",
+                "silica_face": silica_face_of((s.surface,), s.silica_face), "water_model": s.water_model,
+                "type_ids": self.ids, "solid_types": self.all_types,
+                "solid_charges_e": {x: ff.atom_type(x).charge for x in self.charged_types},
+                "surface": s.surface, "tail_site_ids": (self.tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": self.c6,
+                "tether": {"k_kcal_mol_A2": TETHER_K, "z_A": self.z_film}, "fep_delta": FEP_DELTA,
+                "soft_core": "lj/cut/coul/long/soft n = 1, alpha_LJ = 0.5 (Beutler et al. 1994)",
+                "nodes": {k: v.tolist() for k, v in self.nodes.items()}, "pppm": self.kspace[0]}
 
 
 def _dispersion_tail(ctx, info, s) -> dict | None:
