@@ -107,121 +107,14 @@ class Adhesion(Workflow):
 
     def plan(self, s, run_dir):
         s = self.typed(s)
-        ff = forcefield_of(self.forcefield_files(s))
-        lower_kind, upper_kind = s.surfaces
-        face = silica_face_of(s.surfaces, s.silica_face)
+        legs = _AdhesionLegs(self, s, run_dir)
+        contact = legs.contact()
+        windows = legs.windows(contact) if s.free_energy == "pmf" else []
         seed = int(s.seed)
-        lower = surface_slab(lower_kind, s.nx, s.ny, s.slab_thickness_A, s, seed, face)
-        upper = surface_slab(upper_kind, s.nx, s.ny, s.slab_thickness_A, s, seed + 10, face)
-        system = as_system(place_on(lower, flip_upside_down(upper), gap=s.contact_gap_A,
-                                    vacuum=s.separation_A + 15.0))
-        data = run_dir / "system.data"
-        write_data(system, ff, data)
-        groups = {"lower": system.group("substrate"), "upper": system.group("adsorbate"),
-                  "lower_fixed": intersect_ids(system, "frozen", "substrate"),
-                  "upper_back": intersect_ids(system, "frozen", "adsorbate")}
-        tail = _tail_applies(s, system)
-        study = s.dispersion_tail == "trappe"   # contact frames for the cutoff study, even without TraPPE atoms
-        if study:
-            groups["tailset"] = np.arange(system.n_atoms)
-        n = system.n_atoms
-        area = float(system.cell[0] * system.cell[1])
-        contact_dir = run_dir / "legs" / "contact"
-        minimized = contact_dir / "minimized.data"
-        setup_groups = lambda: ["group held union lower_fixed upper_back", "group mobile subtract all held"]
-        columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_back": "v_zback"}
-        si = s.sample_interval
-
-        def define(upper_free: bool, salt: int):
-            def d(step: int) -> list[str]:
-                cmds = common_define(s, "mobile") + [
-                    "neigh_modify exclude group lower_fixed lower_fixed",
-                    "neigh_modify exclude group upper_back upper_back",
-                    "fix hold_lower lower_fixed setforce 0.0 0.0 0.0",
-                    "compute gg upper group/group lower kspace yes",
-                    "variable zback equal xcm(upper_back,z)"]
-                if upper_free:      # one rigid body moving along z only, zero load: the contact finds its gap
-                    cmds += [_BACK_RIGID]
-                else:
-                    cmds += ["fix hold_upper upper_back setforce 0.0 0.0 0.0"]
-                return cmds + thermostat_lines("mobile", s, step, salt)
-            return d
-
-        def fresh_contact(leg_dir: Path) -> list[str]:
-            return fresh_from_data(ff, data, s, groups) + setup_groups()
-
-        def fresh_from_minimized(shift: float):
-            def f(leg_dir: Path) -> list[str]:
-                return fresh_from_data(ff, minimized, s, groups) + setup_groups() + \
-                    ([f"displace_atoms upper move 0.0 0.0 {shift:.6f} units box"] if shift else [])
-            return f
-
-        def frames(sample_steps: int, per_leg: int, on: bool = True) -> Frames | None:
-            return Frames("tailset", round_up(steps_of(sample_steps, si) / per_leg, si)) if on else None
-
-        base = dict(define=None, restart_head=restart_header_lines(s), columns=columns,
-                    sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n)
-        sample = Stage("sample", steps_of(s.sample_steps, s.sample_interval))
-        contact = Leg(name="contact", fresh=fresh_contact,
-                      prepare=lambda d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"]
-                      + minimize_lines(s, d / "minimized.data") + ["unfix back_min", _BACK_RIGID],
-                      stages=stage_list(equilibrate_stage(s, "mobile", 1), sample),
-                      frames=frames(s.sample_steps, TAIL_FRAMES_CONTACT, study),
-                      **{**base, "define": define(True, 1)})
-        legs = [
-            contact,
-            Leg(name="separated", fresh=fresh_from_minimized(s.separation_A), prepare=lambda d: ["reset_timestep 0"],
-                stages=stage_list(equilibrate_stage(s, "mobile", 2), sample), **{**base, "define": define(False, 2)}),
-        ]
-        registries = []
-        if s.free_energy == "pmf":
-            # a chain: each window continues (positions and velocities) from its neighbour's last restart, moved
-            # rigidly by the difference of the nominal separations; the first from the contact leg's last state,
-            # moved laterally to the registry's offset
-            pmf_equil = Stage("equilibrate", steps_of(s.pmf_equilibrate_steps, s.sample_interval), (), sampled=False)
-            pmf_sample = Stage("sample", steps_of(s.pmf_sample_steps, s.sample_interval))
-            stages = stage_list(pmf_equil, pmf_sample)
-            total = sum(st.steps for st in stages)
-            cell = (float(system.cell[0]) / s.nx, float(system.cell[1]) / s.ny)
-            registries = _registry_offsets(int(s.lateral_registries), cell)
-            nominal = {}
-
-            def from_leg(prev_dir: Path, prev_total: int, move: tuple[float, float, float]):
-                def f(leg_dir: Path) -> list[str]:
-                    cmds = restart_header_lines(s)(prev_dir / f"restart.{prev_total}") + [f"timestep {s.timestep_fs:g}"]
-                    if any(abs(x) > 0 for x in move):
-                        cmds.append(f"displace_atoms upper move {move[0]:.6f} {move[1]:.6f} {move[2]:.6f} units box")
-                    return cmds
-                return f
-
-            salt = 10
-            for r, (dx, dy) in enumerate(registries):
-                for suffix, d_nom, prev in self.chains(s):
-                    name = f"pmf_r{r}_{suffix}"
-                    prepare = lambda _d: ["reset_timestep 0"]
-                    if prev is None and r > 0 and _lifts_registries(s):
-                        fresh = from_leg(contact_dir, contact.total_steps, (dx, dy, d_nom + REGISTRY_LIFT_A))
-                        prepare = lambda _d: registry_approach_lines(s)
-                    elif prev is None:
-                        fresh = from_leg(contact_dir, contact.total_steps, (dx, dy, d_nom))
-                    else:
-                        fresh = from_leg(run_dir / "legs" / f"pmf_r{r}_{prev}", total, (0.0, 0.0, d_nom - nominal[prev]))
-                    nominal[suffix] = d_nom
-                    legs.append(Leg(name=name, fresh=fresh, prepare=prepare, stages=stages,
-                                    frames=frames(s.pmf_sample_steps, TAIL_FRAMES_WINDOW, tail and r == 0),
-                                    info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
-                                          "continues": f"pmf_r{r}_{prev}" if prev else "contact"},
-                                    **{**base, "define": define(False, salt)}))
-                    salt += 1
-        info = {"area_A2": area, "box_A": system.cell.tolist(), "surfaces": list(s.surfaces), "face": face,
-                "n_lower": int(len(groups["lower"])), "n_upper": int(len(groups["upper"])),
-                "lower": system_summary(lower), "upper": system_summary(upper), "dispersion_tail": s.dispersion_tail,
-                "tail_applies": bool(tail), "tail_study": bool(study),
-                "registry_offsets_A": [list(o) for o in registries]}
-        return Plan(legs=legs, timestep_fs=s.timestep_fs, n_atoms=n,
+        return Plan(legs=[contact, legs.separated()] + windows, timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
                     seeds={"structure_lower": seed, "structure_upper": seed + 10, "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed},
-                    forcefield_files=self.forcefield_files(s), system_info=info)
+                    forcefield_files=self.forcefield_files(s), system_info=legs.info())
 
     # ------------------------------------------------------------------------------------------ analysis
     def _tail(self, ctx, mode: str, leg: str, r_max: float = TAIL_R_MAX_A, frames=None) -> dict:
@@ -249,144 +142,209 @@ class Adhesion(Workflow):
         return {"energy": np.array(es), "force_z": np.array(fs), "pairs": pairs}
 
     def analyse(self, ctx):
-        s = self.typed(ctx.settings)
-        info = ctx.plan.system_info
-        area = info["area_A2"]
-        conv = U.kcal_per_mol_A2_to_J_per_m2(1.0) / area           # kcal/mol -> J/m^2 over this interface
+        return _AdhesionAnalysis(self, ctx).run()
+
+
+class _AdhesionAnalysis:
+    """dE/A from the contact and separated legs and, with ``free_energy = "pmf"``, the free energy from the force
+    windows, in the MDAnalysis manner: :meth:`_prepare` (the energy route, the static dispersion tail, the cutoff
+    study), :meth:`_single_window` for every window of every registry, :meth:`_conclude` (registry average, force
+    integration, z0 and sigma0, the window checks, notes, curves and figures)."""
+
+    def __init__(self, wf: Adhesion, ctx):
+        self.wf, self.ctx, self.s, self.info = wf, ctx, wf.typed(ctx.settings), ctx.plan.system_info
+
+    def run(self) -> Analysis:
+        self._prepare()
+        if self.s.free_energy != "pmf":
+            self.notes.append("free energy not estimated at this fidelity (free_energy = 'none'); the quick and "
+                              "production recipes integrate the mean force over separation to measure T dS.")
+            self.details["dispersion_tail"] = self.tail_det
+            return self._analysis()
+        self.suffixes = [c[0] for c in self.wf.chains(self.s)]
+        self.n_reg = len(self.info["registry_offsets_A"])
+        shape = (self.n_reg, len(self.suffixes))
+        self.d_A, self.f_m, self.f_e, self.g_w, self.neff_w = (np.full(shape, np.nan) for _ in range(5))
+        # mean force of the first and the second half of each window's equilibrated samples (those after the
+        # detected start t0, as the mean itself)
+        self.halves = np.full((2,) + shape, np.nan)
+        for r in range(self.n_reg):
+            for k, suf in enumerate(self.suffixes):
+                self._single_window(r, k, suf)
+        return self._conclude()
+
+    def _analysis(self) -> Analysis:
+        return Analysis(quantities=self.q, curves=self.curves, figures=self.figures, notes=self.notes,
+                        details=self.details)
+
+    # ---- prepare: the energy route and the static tail
+    def _prepare(self) -> None:
+        ctx, s, info = self.ctx, self.s, self.info
+        self.area = area = info["area_A2"]
+        self.conv = U.kcal_per_mol_A2_to_J_per_m2(1.0) / area           # kcal/mol -> J/m^2 over this interface
         con, sep = ctx.samples("contact"), ctx.samples("separated")
-        w = A.energy_separation_work(con["pe"], sep["pe"], area)
-        notes = [ENERGY_NOT_FREE_ENERGY,
-                 "every mean and stderr comes from the statistical inefficiency with automated equilibration "
-                 "detection (Chodera, J. Chem. Theory Comput. 12 (2016) 1799; md.analysis.timeseries_stats)."]
-        details: dict[str, Any] = {"energy": {k: v for k, v in w.items() if k not in ("value", "stderr", "units")}}
+        self.w = w = A.energy_separation_work(con["pe"], sep["pe"], area)
+        self.notes = [ENERGY_NOT_FREE_ENERGY,
+                      "every mean and stderr comes from the statistical inefficiency with automated equilibration "
+                      "detection (Chodera, J. Chem. Theory Comput. 12 (2016) 1799; md.analysis.timeseries_stats)."]
+        self.details: dict[str, Any] = {"energy": {k: v for k, v in w.items() if k not in ("value", "stderr", "units")}}
         zs = A.timeseries_stats(con["z_back"])
-        zc = zs["mean"]
-        details["contact_back_z_A"] = {"mean": zc, "stderr": zs["stderr"], "g": zs["g"]}
-        # ---- dispersion beyond the cutoff (static, on the contact leg's frames)
-        tail_on = bool(info.get("tail_applies"))
-        w_tail_static, tail_det = 0.0, {"mode": s.dispersion_tail, "applied": tail_on}
+        self.zc = zs["mean"]
+        self.details["contact_back_z_A"] = {"mean": self.zc, "stderr": zs["stderr"], "g": zs["g"]}
+        self._static_tail()
+        tail_on = self.tail_on
+        self.q = {"work_of_adhesion": quantity_record(w["value"] + self.w_tail_static, w["stderr"], "J/m^2",
+                                         kind="energy per area (not a free energy)" + (
+                                             "; dispersion beyond the cutoff for TraPPE pairs included (static)"
+                                             if tail_on else "")),
+                  "interface_area": quantity_record(U.angstrom_to_m(U.angstrom_to_m(area)), 0.0, "m^2")}
+        self.details["energy"]["cutoff_only_J_m2"] = w["value"]
+        self._energy_curves()
+
+    def _static_tail(self) -> None:
+        """Dispersion beyond the cutoff, static, on the contact leg's frames; and the cutoff study on its last frame
+        (explicit sum to 20/30/40 A + smeared beyond; the TraPPE pairs, applied, and every pair, IFF included:
+        reported, not applied)."""
+        ctx, s, info, conv = self.ctx, self.s, self.info, self.conv
+        self.tail_on = tail_on = bool(info.get("tail_applies"))
+        self.w_tail_static, self.tail_det = 0.0, {"mode": s.dispersion_tail, "applied": tail_on}
         if tail_on:
-            tc = self._tail(ctx, "trappe", "contact")
+            tc = self.wf._tail(ctx, "trappe", "contact")
             u = tc["energy"]
             kt = U.kT_kcal_per_mol(s.temperature_K)
-            w_tail_static = -float(np.mean(u)) * conv
+            self.w_tail_static = -float(np.mean(u)) * conv
             # second-order check: the free-energy perturbation -kT ln <exp(-U/kT)> against the mean
             fep = -kt * (np.log(np.mean(np.exp(-(u - u.min()) / kt))) - u.min() / kt) if len(u) else float("nan")
-            tail_det.update(contact_energy_kcal=u.tolist(), static_work_J_m2=w_tail_static,
-                            fep_minus_mean_J_m2=float(-(fep - np.mean(u)) * conv) if len(u) else None,
-                            r_max_A=TAIL_R_MAX_A, pairs_per_frame=tc["pairs"])
+            self.tail_det.update(contact_energy_kcal=u.tolist(), static_work_J_m2=self.w_tail_static,
+                                 fep_minus_mean_J_m2=float(-(fep - np.mean(u)) * conv) if len(u) else None,
+                                 r_max_A=TAIL_R_MAX_A, pairs_per_frame=tc["pairs"])
         if info.get("tail_study") and len(ctx.frames("contact")[0]):
-            # cutoff study on the last contact frame: explicit sum to 20/30/40 A (+ smeared beyond), the TraPPE pairs
-            # (applied) and every pair (IFF included: reported, not applied)
             st, ids, pos, box = ctx.frames("contact")
             last = (st[-1:], ids, pos[-1:], box[-1:])
             study = {}
             for mode in ("trappe", "all"):
                 for rm in (20.0, 30.0, 40.0):
-                    e = self._tail(ctx, mode, "contact", rm, frames=last)["energy"]
+                    e = self.wf._tail(ctx, mode, "contact", rm, frames=last)["energy"]
                     study[f"{mode}_{rm:g}A_J_m2"] = -float(e[0]) * conv
-            tail_det["cutoff_study_last_contact_frame"] = study
-        q = {"work_of_adhesion": quantity_record(w["value"] + w_tail_static, w["stderr"], "J/m^2",
-                                    kind="energy per area (not a free energy)" + (
-                                        "; dispersion beyond the cutoff for TraPPE pairs included (static)"
-                                        if tail_on else "")),
-             "interface_area": quantity_record(U.angstrom_to_m(U.angstrom_to_m(area)), 0.0, "m^2")}
-        details["energy"]["cutoff_only_J_m2"] = w["value"]
-        curves: dict[str, tuple[list[str], np.ndarray]] = {}
-        figures = {}
-        dt = ctx.plan.timestep_fs
-        all_con, all_sep = ctx.samples("contact", False), ctx.samples("separated", False)
-        for name, d in (("energy_contact", all_con), ("energy_separated", all_sep)):
-            curves[name] = (["step", "time_s", "stage", "potential_energy_J", "temperature_K"],
-                            np.column_stack([d["step"], U.fs_to_s(d["step"] * dt), d["stage"],
-                                             U.kcal_per_mol_to_J(d["pe"]), d["temp"]]))
+            self.tail_det["cutoff_study_last_contact_frame"] = study
 
-        def draw_energy(ax):
-            for d, lab in ((all_con, "contact"), (all_sep, "separated")):
-                ax.plot(d["step"] * dt * 1e-3, d["pe"], lw=0.8, label=lab)
-            ax.set_xlabel("time (ps)")
-            ax.set_ylabel("potential energy (kcal/mol)")
-            ax.set_title(f"W = {w['value']:.3f} ± {w['stderr']:.3f} J/m² (energy)")
-            ax.legend()
-        figures["energy_timeseries"] = figure_writer(draw_energy)
-        if s.free_energy != "pmf":
-            notes.append("free energy not estimated at this fidelity (free_energy = 'none'); the quick and "
-                         "production recipes integrate the mean force over separation to measure T dS.")
-            details["dispersion_tail"] = tail_det
-            return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
-        # ---- the windows: per registry, per window: measured separation, mean force and its stderr
-        suffixes = [c[0] for c in self.chains(s)]
-        n_reg = len(info["registry_offsets_A"])
-        d_A = np.full((n_reg, len(suffixes)), np.nan)
-        f_m, f_e = np.full_like(d_A, np.nan), np.full_like(d_A, np.nan)
-        g_w, neff_w = np.full_like(d_A, np.nan), np.full_like(d_A, np.nan)
-        # mean force of the first and the second half of each window's equilibrated samples (those after the
-        # detected start t0, as the mean itself)
-        halves = np.full((2,) + d_A.shape, np.nan)
-        for r in range(n_reg):
-            for k, suf in enumerate(suffixes):
-                win = ctx.samples(f"pmf_r{r}_{suf}")           # one read of the window's samples
-                st = A.timeseries_stats(win["fz"])
-                d_A[r, k] = float(np.mean(win["z_back"])) - zc
-                f_m[r, k], f_e[r, k], g_w[r, k], neff_w[r, k] = st["mean"], st["stderr"], st["g"], st["n_eff"]
-                fz = np.asarray(win["fz"], float)[int(st["t0"]):]     # the samples the mean uses (after t0)
-                if fz.size >= 2:
-                    halves[0, r, k], halves[1, r, k] = np.mean(fz[:fz.size // 2]), np.mean(fz[fz.size // 2:])
-        order = np.argsort(d_A[0])
-        d_A, f_m, f_e, g_w, neff_w = (a[:, order] for a in (d_A, f_m, f_e, g_w, neff_w))
-        halves = halves[:, :, order]
-        suffixes = [suffixes[i] for i in order]
-        dsep = d_A.mean(axis=0)
-        avg = A.registry_average(f_m, f_e)
-        fbar, ebar = np.asarray(avg["mean"]), np.asarray(avg["stderr"])
-        # tail force per window (registry 0's frames; the tail hardly depends on the registry) and the tail energy
-        # left at the last window (the integral of the tail force from there to infinity)
-        f_tail = np.zeros_like(fbar)
-        u_tail_last = 0.0
-        if tail_on:
-            for k, suf in enumerate(suffixes):
-                tw = self._tail(ctx, "trappe", f"pmf_r0_{suf}")
+    def _energy_curves(self) -> None:
+        self.curves: dict[str, tuple[list[str], np.ndarray]] = {}
+        self.figures = {}
+        self.dt = dt = self.ctx.plan.timestep_fs
+        self.all_con, self.all_sep = self.ctx.samples("contact", False), self.ctx.samples("separated", False)
+        for name, d in (("energy_contact", self.all_con), ("energy_separated", self.all_sep)):
+            self.curves[name] = (["step", "time_s", "stage", "potential_energy_J", "temperature_K"],
+                                 np.column_stack([d["step"], U.fs_to_s(d["step"] * dt), d["stage"],
+                                                  U.kcal_per_mol_to_J(d["pe"]), d["temp"]]))
+        self.figures["energy_timeseries"] = figure_writer(self._draw_energy)
+
+    def _draw_energy(self, ax) -> None:
+        w, dt = self.w, self.dt
+        for d, lab in ((self.all_con, "contact"), (self.all_sep, "separated")):
+            ax.plot(d["step"] * dt * 1e-3, d["pe"], lw=0.8, label=lab)
+        ax.set_xlabel("time (ps)")
+        ax.set_ylabel("potential energy (kcal/mol)")
+        ax.set_title(f"W = {w['value']:.3f} ± {w['stderr']:.3f} J/m² (energy)")
+        ax.legend()
+
+    # ---- per window
+    def _single_window(self, r: int, k: int, suf: str) -> None:
+        """Window ``suf`` of registry ``r``: measured separation, mean force with its stderr, statistical
+        inefficiency, and the mean forces of the two halves of the samples the mean uses."""
+        win = self.ctx.samples(f"pmf_r{r}_{suf}")           # one read of the window's samples
+        st = A.timeseries_stats(win["fz"])
+        self.d_A[r, k] = float(np.mean(win["z_back"])) - self.zc
+        self.f_m[r, k], self.f_e[r, k], self.g_w[r, k], self.neff_w[r, k] = st["mean"], st["stderr"], st["g"], st["n_eff"]
+        fz = np.asarray(win["fz"], float)[int(st["t0"]):]     # the samples the mean uses (after t0)
+        if fz.size >= 2:
+            self.halves[0, r, k], self.halves[1, r, k] = np.mean(fz[:fz.size // 2]), np.mean(fz[fz.size // 2:])
+
+    # ---- conclude
+    def _conclude(self) -> Analysis:
+        order = np.argsort(self.d_A[0])
+        self.d_A, self.f_m, self.f_e, self.g_w, self.neff_w = (a[:, order] for a in (self.d_A, self.f_m, self.f_e,
+                                                                                     self.g_w, self.neff_w))
+        self.halves = self.halves[:, :, order]
+        self.suffixes = [self.suffixes[i] for i in order]
+        self.dsep = self.d_A.mean(axis=0)
+        avg = A.registry_average(self.f_m, self.f_e)
+        self.fbar, self.ebar = np.asarray(avg["mean"]), np.asarray(avg["stderr"])
+        self._tail_forces()
+        self._free_energy()
+        self._flat_slab_law()
+        self._window_checks()
+        self.tail_det.update(tail_energy_last_window_kcal=self.u_tail_last)
+        self.details["dispersion_tail"] = self.tail_det
+        pmf = self.ti["pmf_J_per_m2"]
+        self.curves["pmf"] = (["separation_m", "mean_force_N", "mean_force_stderr_N", "tail_force_N", "pmf_J_per_m2"],
+                              np.column_stack([U.angstrom_to_m(self.dsep), U.kcal_per_mol_A_to_N(self.f_tot),
+                                               U.kcal_per_mol_A_to_N(self.ebar), U.kcal_per_mol_A_to_N(self.f_tail),
+                                               pmf]))
+        self.notes += self._pmf_notes()
+        self.figures["pmf"] = figure_writer(self._draw_pmf)
+        return self._analysis()
+
+    def _tail_forces(self) -> None:
+        """Tail force per window (registry 0's frames; the tail hardly depends on the registry) and the tail energy
+        left at the last window (the integral of the tail force from there to infinity)."""
+        self.f_tail = np.zeros_like(self.fbar)
+        self.u_tail_last = 0.0
+        if self.tail_on:
+            for k, suf in enumerate(self.suffixes):
+                tw = self.wf._tail(self.ctx, "trappe", f"pmf_r0_{suf}")
                 if len(tw["force_z"]):
-                    f_tail[k] = float(np.mean(tw["force_z"]))
-                    if k == len(suffixes) - 1:
-                        u_tail_last = float(np.mean(tw["energy"]))
-        f_tot = fbar + f_tail
-        ti_cut = A.force_integration_work(dsep, fbar, ebar, area)
-        ti = A.force_integration_work(dsep, f_tot, ebar, area)
-        wf = ti["value"] - u_tail_last * conv
-        wf_pchip = ti["value_pchip"] - u_tail_last * conv
-        wf_err, wf_disc = ti["stderr"], ti["discretisation_error"]
+                    self.f_tail[k] = float(np.mean(tw["force_z"]))
+                    if k == len(self.suffixes) - 1:
+                        self.u_tail_last = float(np.mean(tw["energy"]))
+
+    def _free_energy(self) -> None:
+        """W_F by force integration from the zero-force point (trapezoid; PCHIP and the grid error beside it), per
+        registry and from each half of the windows' samples; T dS = dE - dF."""
+        dsep, ebar, area, conv, w = self.dsep, self.ebar, self.area, self.conv, self.w
+        self.f_tot = f_tot = self.fbar + self.f_tail
+        self.ti_cut = A.force_integration_work(dsep, self.fbar, ebar, area)
+        self.ti = ti = A.force_integration_work(dsep, f_tot, ebar, area)
+        self.wf_val = wf = ti["value"] - self.u_tail_last * conv
+        self.wf_pchip = ti["value_pchip"] - self.u_tail_last * conv
+        wf_err, self.wf_disc = ti["stderr"], ti["discretisation_error"]
         # window length: W_F from each window's first half against its second half (the same grid, tail and
         # registries); windows long enough for their decorrelation give the same W within the errors
-        w_half = [A.force_integration_work(dsep, np.nanmean(h, axis=0) + f_tail, ebar * math.sqrt(2.0),
-                                           area)["value"] - u_tail_last * conv for h in halves]
-        per_reg = [A.force_integration_work(d_A[r], f_m[r], f_e[r], area) for r in range(n_reg)]
-        w_reg = np.array([p["value"] for p in per_reg])
-        if n_reg >= 2:
-            reg_avg = A.registry_average(w_reg, [p["stderr"] for p in per_reg])
+        self.w_half = [A.force_integration_work(dsep, np.nanmean(h, axis=0) + self.f_tail, ebar * math.sqrt(2.0),
+                                                area)["value"] - self.u_tail_last * conv for h in self.halves]
+        per_reg = [A.force_integration_work(self.d_A[r], self.f_m[r], self.f_e[r], area) for r in range(self.n_reg)]
+        self.w_reg = np.array([p["value"] for p in per_reg])
+        if self.n_reg >= 2:
+            reg_avg = A.registry_average(self.w_reg, [p["stderr"] for p in per_reg])
             wf_err = max(wf_err, reg_avg["stderr"])
-        w_e = w["value"] + w_tail_static
-        tds = w_e - wf
-        repulsive = bool(ti["repulsive_end"])
+        self.wf_err = wf_err
+        w_e = w["value"] + self.w_tail_static
+        self.tds = w_e - wf
+        self.repulsive = bool(ti["repulsive_end"])
+        q, tail_on, n_reg = self.q, self.tail_on, self.n_reg
         q["work_of_adhesion_free_energy"] = quantity_record(
             wf, wf_err, "J/m^2", kind="free energy per area (force integration from the zero-force point of the "
             "registry-averaged mean-force curve, trapezoid rule" + ("; dispersion beyond the cutoff for TraPPE pairs "
                                                                    "included" if tail_on else "") + ")",
-            discretisation_error=wf_disc, value_pchip=wf_pchip, repulsive_end=repulsive,
-            registry_spread=float(np.std(w_reg, ddof=1)) if n_reg >= 2 else 0.0, registries=n_reg)
-        q["entropic_term_TdS"] = quantity_record(tds, math.hypot(w["stderr"], wf_err), "J/m^2",
-                                    kind="T dS / A = (dE - dF) / A", discretisation_error=wf_disc)
+            discretisation_error=self.wf_disc, value_pchip=self.wf_pchip, repulsive_end=self.repulsive,
+            registry_spread=float(np.std(self.w_reg, ddof=1)) if n_reg >= 2 else 0.0, registries=n_reg)
+        q["entropic_term_TdS"] = quantity_record(self.tds, math.hypot(w["stderr"], wf_err), "J/m^2",
+                                    kind="T dS / A = (dE - dF) / A", discretisation_error=self.wf_disc)
         if tail_on:
-            q["dispersion_tail_work"] = quantity_record(wf - ti_cut["value"], None, "J/m^2",
+            q["dispersion_tail_work"] = quantity_record(wf - self.ti_cut["value"], None, "J/m^2",
                                            kind="static dispersion beyond the cutoff for TraPPE pairs, in W_F: "
                                                 "tail force integrated over the windows + tail energy left at "
                                                 "the last window")
-        # ---- z0 and sigma0 from the flat-slab curve
+
+    def _flat_slab_law(self) -> None:
+        """z0 and sigma0 from the flat-slab curve (peak traction, Maugis range) and an LJ 9-3 fit beside them."""
+        dsep, f_tot, ebar, area, conv, q = self.dsep, self.f_tot, self.ebar, self.area, self.conv, self.q
         zsig: dict[str, Any] = {}
         try:
             pk = A.traction_peak(dsep, f_tot, ebar, area)
             pk_disc = pk["discretisation_error"] if np.isfinite(pk["discretisation_error"]) else 0.0
-            rng = A.flat_slab_range(wf, math.hypot(wf_err, wf_disc), pk["sigma0"], math.hypot(pk["stderr"], pk_disc))
+            rng = A.flat_slab_range(self.wf_val, math.hypot(self.wf_err, self.wf_disc), pk["sigma0"],
+                                    math.hypot(pk["stderr"], pk_disc))
             q["peak_traction_sigma0"] = quantity_record(pk["sigma0"], pk["stderr"], "Pa",
                                            kind=f"maximum tensile traction of the flat-slab mean-force curve "
                                                 f"({pk['method']}: the vertex of the quadratic through the three "
@@ -399,7 +357,7 @@ class Adhesion(Workflow):
             zsig.update(peak=pk, z0=rng)
         except ValueError as exc:
             zsig["error"] = str(exc)
-            notes.append(f"z0 and sigma0 not measured: {exc}")
+            self.notes.append(f"z0 and sigma0 not measured: {exc}")
         try:
             fit = A.fit_traction_law(dsep, f_tot, offset=True, force_stderr=ebar)
             zsig["lj93_fit"] = {"z0_A": fit["z0"], "z0_stderr_A": fit["stderr"]["z0"],
@@ -408,80 +366,212 @@ class Adhesion(Workflow):
                                 "offset_A": fit["offset"], "rms_kcal_mol_A": fit["rms"]}
         except (ValueError, RuntimeError) as exc:
             zsig["lj93_fit"] = {"error": str(exc)}
-        details["flat_slab_law"] = zsig
-        short = [suffixes[k] for k in range(len(suffixes)) if np.nanmin(neff_w[:, k]) < MIN_WINDOW_NEFF]
-        cons = A.registry_consistency(f_m, f_e)
+        self.details["flat_slab_law"] = zsig
+
+    def _window_checks(self) -> None:
+        """Windows with few independent samples, registries that disagree beyond their stderrs, the window-length
+        check (W_F from the halves), and the per-window record."""
+        suffixes, s = self.suffixes, self.s
+        self.short = [suffixes[k] for k in range(len(suffixes)) if np.nanmin(self.neff_w[:, k]) < MIN_WINDOW_NEFF]
+        cons = A.registry_consistency(self.f_m, self.f_e)
         disagree = [suffixes[k] for k in np.flatnonzero(cons["inconsistent"])]
         if disagree:
-            notes.append(
+            self.notes.append(
                 f"registries disagree beyond their own stderrs (chi^2 p < 0.01) at {len(disagree)} of {len(suffixes)} "
                 f"windows ({', '.join(disagree)}; chi^2/dof up to {np.nanmax(cons['chi2_per_dof']):.3g}): there the "
                 "force depends on the registry or a window is too short for its mean, and the registries' spread, "
                 "not a window's own stderr, is its error (W_F's stderr takes the larger per window)")
-        details["pmf_windows"] = {
-            "separation_A": dsep.tolist(), "mean_force_kcal_mol_A": fbar.tolist(), "stderr_kcal_mol_A": ebar.tolist(),
-            "tail_force_kcal_mol_A": f_tail.tolist(), "window": suffixes,
-            "per_registry_mean_force_kcal_mol_A": f_m.tolist(), "per_registry_stderr_kcal_mol_A": f_e.tolist(),
-            "statistical_inefficiency": g_w.tolist(), "n_eff": neff_w.tolist(),
-            "decorrelation_time_ps": ((g_w - 1) / 2 * s.sample_interval * dt * 1e-3).tolist(),
-            "registry_work_J_m2": w_reg.tolist(), "registry_offsets_A": info["registry_offsets_A"],
-            "zero_force_separation_A": ti["zero_force_separation_A"], "repulsive_end": repulsive,
-            "windows_with_few_samples": short, "cutoff_only_work_J_m2": ti_cut["value"],
+        self.details["pmf_windows"] = {
+            "separation_A": self.dsep.tolist(), "mean_force_kcal_mol_A": self.fbar.tolist(),
+            "stderr_kcal_mol_A": self.ebar.tolist(), "tail_force_kcal_mol_A": self.f_tail.tolist(), "window": suffixes,
+            "per_registry_mean_force_kcal_mol_A": self.f_m.tolist(), "per_registry_stderr_kcal_mol_A": self.f_e.tolist(),
+            "statistical_inefficiency": self.g_w.tolist(), "n_eff": self.neff_w.tolist(),
+            "decorrelation_time_ps": ((self.g_w - 1) / 2 * s.sample_interval * self.dt * 1e-3).tolist(),
+            "registry_work_J_m2": self.w_reg.tolist(), "registry_offsets_A": self.info["registry_offsets_A"],
+            "zero_force_separation_A": self.ti["zero_force_separation_A"], "repulsive_end": self.repulsive,
+            "windows_with_few_samples": self.short, "cutoff_only_work_J_m2": self.ti_cut["value"],
             "registry_chi2_per_dof": cons["chi2_per_dof"].tolist(), "registries_disagree": disagree}
         # the halves' errors are sqrt(2) of the whole's, so their difference has stderr 2 x the whole's
-        half_diff, half_err = w_half[1] - w_half[0], 2.0 * wf_err
-        details["window_length_check"] = {
-            "first_half_J_m2": w_half[0], "second_half_J_m2": w_half[1], "whole_J_m2": wf,
-            "difference_J_m2": half_diff, "difference_stderr_J_m2": half_err,
-            "converged": bool(abs(half_diff) <= 2.0 * half_err),
+        self.half_diff, self.half_err = self.w_half[1] - self.w_half[0], 2.0 * self.wf_err
+        self.details["window_length_check"] = {
+            "first_half_J_m2": self.w_half[0], "second_half_J_m2": self.w_half[1], "whole_J_m2": self.wf_val,
+            "difference_J_m2": self.half_diff, "difference_stderr_J_m2": self.half_err,
+            "converged": bool(abs(self.half_diff) <= 2.0 * self.half_err),
             "what": "W_F from the first and the second half of every window's equilibrated samples (after the detected "
                     "start, as W_F itself; same grid, tail, registries): a drift between them means the windows are "
                     "too short for the force to settle"}
-        tail_det.update(tail_energy_last_window_kcal=u_tail_last)
-        details["dispersion_tail"] = tail_det
-        pmf = ti["pmf_J_per_m2"]
-        curves["pmf"] = (["separation_m", "mean_force_N", "mean_force_stderr_N", "tail_force_N", "pmf_J_per_m2"],
-                         np.column_stack([U.angstrom_to_m(dsep), U.kcal_per_mol_A_to_N(f_tot),
-                                          U.kcal_per_mol_A_to_N(ebar), U.kcal_per_mol_A_to_N(f_tail), pmf]))
-        notes.append(
-            f"free energy of separation from {len(suffixes)} windows x {n_reg} lateral registr"
+
+    def _pmf_notes(self) -> list[str]:
+        dsep, wf, wf_err, n_reg, s = self.dsep, self.wf_val, self.wf_err, self.n_reg, self.s
+        half_diff, half_err, w_half = self.half_diff, self.half_err, self.w_half
+        notes = [
+            f"free energy of separation from {len(self.suffixes)} windows x {n_reg} lateral registr"
             f"{'y' if n_reg == 1 else 'ies'} ({dsep[0]:+.2f} to {dsep[-1]:.2f} A from the contact leg's mean back "
-            f"height {zc:.2f} A; chains: each window continues from its neighbour): dF/A = {wf:.4f} +/- {wf_err:.4f} "
-            f"J/m^2 (trapezoid from the zero-force point {ti['zero_force_separation_A']:+.2f} A; PCHIP gives "
-            f"{wf_pchip:.4f}, grid error about {wf_disc:.4f}); T dS/A = {tds:.4f} J/m^2. The stderr is statistical "
-            f"(and the registries' spread); the discretisation error is given beside it.")
-        if not repulsive:
+            f"height {self.zc:.2f} A; chains: each window continues from its neighbour): dF/A = {wf:.4f} +/- "
+            f"{wf_err:.4f} J/m^2 (trapezoid from the zero-force point {self.ti['zero_force_separation_A']:+.2f} A; "
+            f"PCHIP gives {self.wf_pchip:.4f}, grid error about {self.wf_disc:.4f}); T dS/A = {self.tds:.4f} J/m^2. "
+            f"The stderr is statistical (and the registries' spread); the discretisation error is given beside it."]
+        if not self.repulsive:
             notes.append("NO REPULSIVE END: no window before the most attractive one has a repulsive mean force, so "
                          "the bottom of the adhesive well lies inside the innermost window and W_F is a lower bound: "
                          "raise pmf_compress_A.")
-        if short:
-            notes.append(f"windows with fewer than {MIN_WINDOW_NEFF} effectively independent samples: {short} "
+        if self.short:
+            notes.append(f"windows with fewer than {MIN_WINDOW_NEFF} effectively independent samples: {self.short} "
                          f"(lengthen pmf_sample_steps).")
         notes.append(f"window length: W_F from the first half of every window {w_half[0]:.4f}, from the second half "
                      f"{w_half[1]:.4f} J/m^2 (difference {half_diff:+.4f} +/- {half_err:.4f}: "
                      + ("within 2 stderr" if abs(half_diff) <= 2.0 * half_err else
                         "MORE THAN 2 STDERR: the windows are too short for the mean force to settle; lengthen "
                         "pmf_sample_steps") + ").")
-        if tail_on:
+        if self.tail_on:
             notes.append(f"dispersion beyond the {s.cutoff_A:g} A cutoff for TraPPE pairs (any pair with a CH2/CH3 "
                          f"united atom) added as a static correction measured on this run's frames: "
-                         f"{wf - ti_cut['value']:+.4f} J/m^2 in W_F (tail force per window + tail energy left at the "
-                         f"last window), {w_tail_static:+.4f} J/m^2 in dE/A (contact frames). IFF pairs keep the plain "
-                         f"cutoff IFF was parametrised with.")
+                         f"{wf - self.ti_cut['value']:+.4f} J/m^2 in W_F (tail force per window + tail energy left at "
+                         f"the last window), {self.w_tail_static:+.4f} J/m^2 in dE/A (contact frames). IFF pairs keep "
+                         f"the plain cutoff IFF was parametrised with.")
+        return notes
 
-        def draw_pmf(ax):
-            for r in range(n_reg):
-                ax.plot(d_A[r], f_m[r], ".", ms=3, alpha=0.6, label=f"registry {r}")
-            ax.errorbar(dsep, f_tot, yerr=ebar, marker="o", ms=3, lw=1, color="k", label="mean (+ tail)")
-            ax.axhline(0, color="k", lw=0.5)
-            ax.set_xlabel("separation from contact (Å)")
-            ax.set_ylabel("mean force on upper slab (kcal/mol/Å)")
-            ax.set_title(f"dF/A = {wf:.3f} ± {wf_err:.3f} (stat.) ± {wf_disc:.3f} (grid) J/m²")
-            ax.legend(fontsize=7)
-        figures["pmf"] = figure_writer(draw_pmf)
-        return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
+    def _draw_pmf(self, ax) -> None:
+        for r in range(self.n_reg):
+            ax.plot(self.d_A[r], self.f_m[r], ".", ms=3, alpha=0.6, label=f"registry {r}")
+        ax.errorbar(self.dsep, self.f_tot, yerr=self.ebar, marker="o", ms=3, lw=1, color="k", label="mean (+ tail)")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_xlabel("separation from contact (Å)")
+        ax.set_ylabel("mean force on upper slab (kcal/mol/Å)")
+        ax.set_title(f"dF/A = {self.wf_val:.3f} ± {self.wf_err:.3f} (stat.) ± {self.wf_disc:.3f} (grid) J/m²")
+        ax.legend(fontsize=7)
 
 
+class _AdhesionLegs:
+    """The legs of an adhesion run (:meth:`Adhesion.plan`): the two slabs are built and written on construction;
+    :meth:`contact` (upper back one rigid body, free along z at zero load), :meth:`separated` (both backs held,
+    ``separation_A`` apart) and, for the free energy, :meth:`windows` (chains of force windows per registry)."""
+
+    def __init__(self, wf: Adhesion, s, run_dir: Path):
+        self.wf, self.s, self.run_dir = wf, s, run_dir
+        self.ff = forcefield_of(wf.forcefield_files(s))
+        lower_kind, upper_kind = s.surfaces
+        self.face = face = silica_face_of(s.surfaces, s.silica_face)
+        seed = int(s.seed)
+        self.lower = surface_slab(lower_kind, s.nx, s.ny, s.slab_thickness_A, s, seed, face)
+        self.upper = surface_slab(upper_kind, s.nx, s.ny, s.slab_thickness_A, s, seed + 10, face)
+        self.system = system = as_system(place_on(self.lower, flip_upside_down(self.upper), gap=s.contact_gap_A,
+                                                  vacuum=s.separation_A + 15.0))
+        self.data = run_dir / "system.data"
+        write_data(system, self.ff, self.data)
+        self.groups = {"lower": system.group("substrate"), "upper": system.group("adsorbate"),
+                       "lower_fixed": intersect_ids(system, "frozen", "substrate"),
+                       "upper_back": intersect_ids(system, "frozen", "adsorbate")}
+        self.tail = _tail_applies(s, system)
+        self.study = s.dispersion_tail == "trappe"   # contact frames for the cutoff study, even without TraPPE atoms
+        if self.study:
+            self.groups["tailset"] = np.arange(system.n_atoms)
+        self.contact_dir = run_dir / "legs" / "contact"
+        self.registries: list[tuple[float, float]] = []
+        si = s.sample_interval
+        self.base = dict(define=None, restart_head=restart_header_lines(s),
+                         columns={"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_back": "v_zback"},
+                         sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=system.n_atoms)
+        self.sample = Stage("sample", steps_of(s.sample_steps, si))
+
+    @staticmethod
+    def setup_groups() -> list[str]:
+        return ["group held union lower_fixed upper_back", "group mobile subtract all held"]
+
+    def define(self, upper_free: bool, salt: int):
+        s = self.s
+
+        def d(step: int) -> list[str]:
+            cmds = common_define(s, "mobile") + [
+                "neigh_modify exclude group lower_fixed lower_fixed",
+                "neigh_modify exclude group upper_back upper_back",
+                "fix hold_lower lower_fixed setforce 0.0 0.0 0.0",
+                "compute gg upper group/group lower kspace yes",
+                "variable zback equal xcm(upper_back,z)"]
+            if upper_free:      # one rigid body moving along z only, zero load: the contact finds its gap
+                cmds += [_BACK_RIGID]
+            else:
+                cmds += ["fix hold_upper upper_back setforce 0.0 0.0 0.0"]
+            return cmds + thermostat_lines("mobile", s, step, salt)
+        return d
+
+    def frames(self, sample_steps: int, per_leg: int, on: bool = True) -> Frames | None:
+        si = self.s.sample_interval
+        return Frames("tailset", round_up(steps_of(sample_steps, si) / per_leg, si)) if on else None
+
+    def contact(self) -> Leg:
+        s = self.s
+
+        def fresh_contact(leg_dir: Path) -> list[str]:
+            return fresh_from_data(self.ff, self.data, s, self.groups) + self.setup_groups()
+        return Leg(name="contact", fresh=fresh_contact,
+                   prepare=lambda d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"]
+                   + minimize_lines(s, d / "minimized.data") + ["unfix back_min", _BACK_RIGID],
+                   stages=stage_list(equilibrate_stage(s, "mobile", 1), self.sample),
+                   frames=self.frames(s.sample_steps, TAIL_FRAMES_CONTACT, self.study),
+                   **{**self.base, "define": self.define(True, 1)})
+
+    def separated(self) -> Leg:
+        s = self.s
+        minimized, shift = self.contact_dir / "minimized.data", s.separation_A
+
+        def fresh(leg_dir: Path) -> list[str]:
+            return fresh_from_data(self.ff, minimized, s, self.groups) + self.setup_groups() + \
+                ([f"displace_atoms upper move 0.0 0.0 {shift:.6f} units box"] if shift else [])
+        return Leg(name="separated", fresh=fresh, prepare=lambda d: ["reset_timestep 0"],
+                   stages=stage_list(equilibrate_stage(s, "mobile", 2), self.sample),
+                   **{**self.base, "define": self.define(False, 2)})
+
+    def from_leg(self, prev_dir: Path, prev_total: int, move: tuple[float, float, float]):
+        s = self.s
+
+        def f(leg_dir: Path) -> list[str]:
+            cmds = restart_header_lines(s)(prev_dir / f"restart.{prev_total}") + [f"timestep {s.timestep_fs:g}"]
+            if any(abs(x) > 0 for x in move):
+                cmds.append(f"displace_atoms upper move {move[0]:.6f} {move[1]:.6f} {move[2]:.6f} units box")
+            return cmds
+        return f
+
+    def windows(self, contact: Leg) -> list[Leg]:
+        """A chain per registry: each window continues (positions and velocities) from its neighbour's last restart,
+        moved rigidly by the difference of the nominal separations; the first from the contact leg's last state,
+        moved laterally to the registry's offset (bare silica: lifted first, lowered back in :meth:`prepare`)."""
+        s, system = self.s, self.system
+        stages = stage_list(Stage("equilibrate", steps_of(s.pmf_equilibrate_steps, s.sample_interval), (),
+                                  sampled=False),
+                            Stage("sample", steps_of(s.pmf_sample_steps, s.sample_interval)))
+        total = sum(st.steps for st in stages)
+        cell = (float(system.cell[0]) / s.nx, float(system.cell[1]) / s.ny)
+        self.registries = _registry_offsets(int(s.lateral_registries), cell)
+        legs, nominal, salt = [], {}, 10
+        for r, (dx, dy) in enumerate(self.registries):
+            for suffix, d_nom, prev in self.wf.chains(s):
+                prepare = lambda _d: ["reset_timestep 0"]
+                if prev is None and r > 0 and _lifts_registries(s):
+                    fresh = self.from_leg(self.contact_dir, contact.total_steps, (dx, dy, d_nom + REGISTRY_LIFT_A))
+                    prepare = lambda _d: registry_approach_lines(s)
+                elif prev is None:
+                    fresh = self.from_leg(self.contact_dir, contact.total_steps, (dx, dy, d_nom))
+                else:
+                    fresh = self.from_leg(self.run_dir / "legs" / f"pmf_r{r}_{prev}", total,
+                                          (0.0, 0.0, d_nom - nominal[prev]))
+                nominal[suffix] = d_nom
+                legs.append(Leg(name=f"pmf_r{r}_{suffix}", fresh=fresh, prepare=prepare, stages=stages,
+                                frames=self.frames(s.pmf_sample_steps, TAIL_FRAMES_WINDOW, self.tail and r == 0),
+                                info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
+                                      "continues": f"pmf_r{r}_{prev}" if prev else "contact"},
+                                **{**self.base, "define": self.define(False, salt)}))
+                salt += 1
+        return legs
+
+    def info(self) -> dict:
+        s, system, groups = self.s, self.system, self.groups
+        return {"area_A2": float(system.cell[0] * system.cell[1]), "box_A": system.cell.tolist(),
+                "surfaces": list(s.surfaces), "face": self.face,
+                "n_lower": int(len(groups["lower"])), "n_upper": int(len(groups["upper"])),
+                "lower": system_summary(self.lower), "upper": system_summary(self.upper),
+                "dispersion_tail": s.dispersion_tail, "tail_applies": bool(self.tail), "tail_study": bool(self.study),
+                "registry_offsets_A": [list(o) for o in self.registries]}
 
 
 def _tail_applies(s: Mapping[str, Any], system: System) -> bool:
