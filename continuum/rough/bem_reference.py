@@ -101,6 +101,10 @@ class BEMContact:
     heights (m, shape (nx, ny); its mean is removed), physical_size (m, one number or (Lx, Ly)), e_star (Pa),
     work_of_adhesion (J/m^2; 0 leaves the adhesion functional out: Hertzian, frictionless contact), z0 (m)."""
 
+    #: Further solver calls (each up to max_iter iterations, from the current fields) for a state in contact
+    #: that has not converged: snap-outs of single contacts need more than Tamaas' default 1000 iterations.
+    continuations = 8
+
     def __init__(self, heights, physical_size, e_star: float, work_of_adhesion: float, z0: float, *,
                  tolerance: float = 1e-8, length_unit: float = 1e-9):
         h, size = _check(heights, physical_size, e_star, work_of_adhesion, z0)
@@ -110,7 +114,7 @@ class BEMContact:
         self.sigma0, self.rho = dugdale_range(work_of_adhesion, z0) if work_of_adhesion > 0 else (0.0, 0.0)
         self._h = np.ascontiguousarray((h - h.mean()) / length_unit)
         self._top = float(self._h.max())
-        self.restarts = 0
+        self.restarts = self.continued = 0
         self._build()
 
     def _build(self):
@@ -139,11 +143,18 @@ class BEMContact:
         """Equilibrium at rigid separation `separation` (m) from the previous state: force (N), contact area
         (m^2), solver error, whether it is free and an equilibrium, traction (Pa) and gap (m) fields.
 
+        A state in contact that has not converged is solved on from where it stopped, up to `continuations`
+        times (`continued` counts them).
         A state without contact that is no equilibrium (after a snap-out the warm start can stall: the solver's
         error is undefined without contact) is solved once more from a cold start, the unloaded flat, which
         is where a released surface goes; `restarts` counts these. A state that ends free of the cohesive range
         while the undeformed map is out of reach is the exact free state (zero traction)."""
         state = self._state(float(self._solver.solve(separation / self.unit)))
+        for _ in range(self.continuations):
+            if state["converged"] or state["area"] == 0.0:
+                break
+            self.continued += 1                         # more iterations from where the last call stopped
+            state = self._state(float(self._solver.solve(separation / self.unit)))
         if not state["converged"] and state["area"] == 0.0:
             self.restarts += 1
             self._build()
@@ -199,6 +210,6 @@ def bem_cycle(heights, physical_size, e_star: float, work_of_adhesion: float, z0
         force[k], area[k] = state["force"], state["area"]
     stats = BEMStats(solves, free, bad, max_err, time.perf_counter() - start, contact.shape,
                      contact.size[0] / contact.shape[0], contact.rho, contact.sigma0,
-                     notes={"cold_restarts": contact.restarts})
+                     notes={"cold_restarts": contact.restarts, "continued_solves": contact.continued})
     log.info("BEM cycle: %d solves, %d free, %d unconverged, %.1f s", solves, free, bad, stats.seconds)
     return ForceCycle(path, force, area, turn), stats

@@ -1,0 +1,349 @@
+"""Modelling error of the rough-contact levels against an independent boundary-element reference.
+
+    .venv/bin/python benchmarks/bench_accuracy.py --quick [--json FILE] [--png FILE]
+    .venv/bin/python benchmarks/bench_accuracy.py [--map FILE --cutoff M [--size M]] [--grid N] [--json FILE]
+
+One rough patch, one cohesive law, one quasi-static approach-retraction cycle (the rigid separation s of the flat
+above the heights' mean plane stepped down and back, each state in equilibrium). Compared at every s: the force
+and the real contact area; per cycle: the pull-off force (largest tension on retraction) and the hysteresis
+energy (the loop's area). Levels:
+
+* `bem` (the reference): Tamaas boundary elements on the whole map, Dugdale law with sigma0 = 1.03 dgamma/z0 and
+  range rho = z0/1.03, so the project's Maugis-Dugdale summit law and the reference share the cohesive law
+  (continuum/rough/bem_reference.py); repeated on the half grid for its discretisation error, and the
+  first-order Richardson value 2 F(n) - F(n/2) (the order measured on a sphere in tests/test_bem_reference.py);
+* `gw_direct_md`: the GW mean field with the summits' statistics counted on the map (direct route), all
+  summits of the mean tip radius, Maugis-Dugdale summits, truncated at the tallest expected of N;
+* `gw_spectral_md`: the same with Nayak's spectral-moment statistics (continuum/rough/summit_stats.py);
+* `gw_direct_jkr`: `gw_direct_md` with JKR summits (what the rough scenes used before the regime picked the law);
+* `discrete_md`: the map's own summits, each at its own height, all of the mean tip radius, Maugis-Dugdale;
+* `discrete_md_own_radii`: the same, each summit with its own tip radius.
+The summit levels see the same band-limited surface as the reference: the map low-pass filtered at the summit
+cutoff, summits identified on the reference grid (continuum/rough/topography.py).
+
+The patch: `--quick` and the default use a periodic self-affine synthesis (continuum/rough/topography.py's
+`Synthesis`), synthesised on a 64^2 grid and Fourier-interpolated (exact for a band-limited map) onto the BEM
+grids: 128^2 (quick) or 256^2. `--map FILE` takes a height map (the shipped synthetic map, an AFM file), filtered
+at `--cutoff` and Fourier-resampled to `--grid`; such maps are treated as periodic (a measured map's edges are
+not: its wrap-around step is part of that reference). Materials: the `calibrated` set's work of adhesion and z0,
+the contact modulus of its body and substrate. Writes JSON (the numbers and curves) and a PNG.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import sys
+import time
+import tomllib
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from continuum.reference.hertz import effective_modulus   # noqa: E402
+from continuum.reference.maugis import md_parameter   # noqa: E402
+from continuum.rough.bem_reference import bem_cycle, dugdale_range   # noqa: E402
+from continuum.rough.branch_laws import make_summit_law   # noqa: E402
+from continuum.rough.gw_branches import GWBranchSurface   # noqa: E402
+from continuum.rough.quasistatic import discrete_cycle, gw_cycle, separation_path   # noqa: E402
+from continuum.rough.summit_stats import direct_summary, spectral_summits   # noqa: E402
+from continuum.rough.summits import SummitStatistics, expected_max_height   # noqa: E402
+from continuum.rough.topography import Synthesis, identify_summits, load_height_map, synthesise_height_map   # noqa: E402
+from nanoimpact import data   # noqa: E402
+from nanoimpact.fileio import atomic_save_figure, atomic_write_json   # noqa: E402
+
+#: The default patch: the shipped map's spectrum shape (Hurst 0.8, long cutoff 4x and summit cutoff 8 pixels of
+#: the 64^2 base grid), 0.25 um wide and 1.2 nm rms: the Dugdale zone of a summit at touch, sqrt(2 beta rho),
+#: spans ~3.5 pixels of the 128^2 grid and ~7 of 256^2 (the reference needs several: tests/test_bem_reference.py)
+#: while the patch holds ~20 summits. The shipped 5 um map (rms 6 nm, summit radii ~2 um) would need ~1000^2.
+PATCH = Synthesis(hurst=0.8, rms_height=1.2e-9, short_cutoff=0.25e-6 / 8, size=0.25e-6, grid_points=64,
+                  long_cutoff=0.25e-6 / 2, seed=1)
+
+
+def materials(params: str) -> dict:
+    """Work of adhesion, z0 and the pair's contact modulus from a parameter set (SI)."""
+    raw = tomllib.loads(data.find("params", params).read_text())
+    s = raw["surfaces"]
+    e_star = float(effective_modulus(s["body"]["youngs_modulus"], s["body"]["poisson_ratio"],
+                                     s["substrate"]["youngs_modulus"], s["substrate"]["poisson_ratio"]))
+    sigma0, rho = dugdale_range(s["work_of_adhesion"], s["interaction_range"])
+    return {"params": params, "work_of_adhesion": s["work_of_adhesion"], "z0": s["interaction_range"],
+            "e_star": e_star, "dugdale_stress": sigma0, "dugdale_range": rho,
+            "source": f"inputs/params/{params}.toml: surfaces.work_of_adhesion, surfaces.interaction_range; E* of "
+                      "surfaces.body and surfaces.substrate (continuum.reference.hertz.effective_modulus)"}
+
+
+def patch(args) -> tuple[dict, dict]:
+    """(grids: n -> heights (m) on n^2 points, description) of the band-limited periodic patch."""
+    n_ref = args.grid or (128 if args.quick else 256)
+    if args.map:
+        hmap = load_height_map(args.map, size=args.size)
+        topo = hmap.topography().shortcut(cutoff_wavelength=args.cutoff)
+        cutoff, source = args.cutoff, dict(hmap.source)
+        base = np.asarray(topo.heights())
+    else:
+        synthesis = replace(PATCH, rms_height=args.rms or PATCH.rms_height)
+        hmap = synthesise_height_map(synthesis)
+        topo, cutoff, source = hmap.topography(), synthesis.short_cutoff, dict(hmap.source)
+        base = np.asarray(topo.heights())
+    from SurfaceTopography import Topography
+
+    periodic = Topography(base - base.mean(), topo.physical_sizes, periodic=True)
+    grids = {}
+    for n in (n_ref // 2, n_ref):
+        if cutoff < 4 * float(topo.physical_sizes[0]) / n:
+            raise SystemExit(f"--grid {n_ref}: the cutoff {cutoff:.3g} m spans fewer than 4 pixels of the {n}^2 grid")
+        if n >= base.shape[0]:
+            grids[n] = np.asarray(periodic.interpolate_fourier((n, n)).heights()) if n > base.shape[0] else base
+        else:
+            grids[n] = _truncate(base, n)
+    return grids, {"source": source, "size_m": float(topo.physical_sizes[0]), "cutoff_m": float(cutoff),
+                   "base_grid": list(base.shape), "rms_height_m": float(np.std(grids[n_ref])),
+                   "reference_grid": n_ref, "periodic_topography": periodic}
+
+
+def _truncate(heights: np.ndarray, n: int) -> np.ndarray:
+    """A periodic map band-limited below the new grid's Nyquist wavelength, sampled on n x n points (Fourier
+    truncation: exact for such a map)."""
+    m = heights.shape[0]
+    spec = np.fft.fft2(heights)
+    k = np.fft.fftfreq(m, 1.0 / m)
+    keep = np.abs(k) < n / 2
+    kk = k[keep].astype(int) % n
+    out = np.zeros((n, n), complex)
+    out[np.ix_(kk, kk)] = spec[np.ix_(keep, keep)]
+    return np.real(np.fft.ifft2(out)) * (n * n) / (m * m)
+
+
+def summit_sets(h: np.ndarray, desc: dict) -> dict:
+    """The map's summits (direct) and both routes' GW statistics."""
+    size, cutoff = desc["size_m"], desc["cutoff_m"]
+    summits = identify_summits(h, size / h.shape[0], cutoff, periodic=True)
+    direct = direct_summary(summits)
+    spectral = spectral_summits(desc.pop("periodic_topography"), cutoff)
+    keep = np.isfinite(summits.radius)
+    return {"summits": summits, "own_radii": summits.radius[keep], "own_heights": summits.height[keep],
+            "direct": direct, "spectral": spectral, "area": size * size,
+            "record": {"count": summits.count, "direct": vars(direct), "spectral": vars(spectral),
+                       "not_convex": int((~keep).sum())}}
+
+
+def path_for(h: np.ndarray, sets: dict, mat: dict, quick: bool, depth: float | None = None) -> np.ndarray:
+    """Separations: from 2 rho above the tallest point down to the mean summit height + half a summit std (or
+    `depth` below the tallest point), in
+    steps of rho/8 (quick) or rho/16: a summit's loop spans about delta_c ~ rho, and each force jump inside a step
+    costs the trapezoid loop area at most |jump| step / 2."""
+    z = sets["summits"].height
+    top = float(np.max(h))
+    deepest = top - depth if depth else float(np.mean(z) + 0.5 * np.std(z))
+    rho = mat["dugdale_range"]
+    return separation_path(top + 2 * rho, deepest, rho / (8 if quick else 16))
+
+
+def _gw_level(route: str, law_name: str, sets: dict, mat: dict, path: np.ndarray):
+    """GW mean field of one route's statistics with one summit law; its cycle."""
+    st = sets[route]
+    stats = SummitStatistics(st.summit_height_std, st.summit_density, st.summit_radius)
+    n_summits = st.summit_density * sets["area"]
+    z_max = float(expected_max_height(max(n_summits, 2.0)))
+    delta_max = 1.5 * (st.mean_summit_height + z_max * stats.sigma - path.min()) + 10 * mat["z0"]
+    law = make_summit_law(law_name, stats.radius, mat["work_of_adhesion"], mat["e_star"], z0=mat["z0"],
+                          delta_max=delta_max)
+    surface = GWBranchSurface(stats, law, z_max=z_max)
+    return gw_cycle(surface, sets["area"], path, st.mean_summit_height)
+
+
+def _discrete_level(own_radii: bool, sets: dict, mat: dict, path: np.ndarray):
+    """The map's summits at their own heights, Maugis-Dugdale, of the mean radius or each of its own."""
+    z = sets["own_heights"]
+    delta_max = 1.5 * float(z.max() - path.min()) + 10 * mat["z0"]
+    make = lambda beta: make_summit_law("maugis_dugdale", beta, mat["work_of_adhesion"], mat["e_star"],   # noqa: E731
+                                        z0=mat["z0"], delta_max=delta_max)
+    if not own_radii:
+        return discrete_cycle(make(sets["direct"].summit_radius), z, path)
+    cycles = [discrete_cycle(make(float(b)), [zi], path) for b, zi in zip(sets["own_radii"], z)]
+    first = cycles[0]
+    return type(first)(path, np.sum([c.force for c in cycles], axis=0),
+                       np.sum([c.contact_area for c in cycles], axis=0), first.turn)
+
+
+LEVELS = {
+    "gw_direct_md": ("GW mean field, direct-route statistics, Maugis-Dugdale summits",
+                     lambda s, m, p: _gw_level("direct", "maugis_dugdale", s, m, p)),
+    "gw_spectral_md": ("GW mean field, spectral-moment statistics (Nayak), Maugis-Dugdale summits",
+                       lambda s, m, p: _gw_level("spectral", "maugis_dugdale", s, m, p)),
+    "gw_direct_jkr": ("GW mean field, direct-route statistics, JKR summits",
+                      lambda s, m, p: _gw_level("direct", "jkr", s, m, p)),
+    "discrete_md": ("the map's summits at their own heights, mean tip radius, Maugis-Dugdale",
+                    lambda s, m, p: _discrete_level(False, s, m, p)),
+    "discrete_md_own_radii": ("the map's summits at their own heights and tip radii, Maugis-Dugdale",
+                              lambda s, m, p: _discrete_level(True, s, m, p)),
+}
+
+
+def _rel(value: float, ref: float) -> float:
+    return (value - ref) / ref if ref else math.nan
+
+
+def _area_error(cycle, ref) -> float:
+    """RMS over the approach states where the reference touches of (A - A_ref), over the reference's largest
+    approach area."""
+    k = ref.turn + 1
+    touch = ref.contact_area[:k] > 0
+    if not touch.any():
+        return math.nan
+    diff = cycle.contact_area[:k][touch] - ref.contact_area[:k][touch]
+    return float(np.sqrt(np.mean(diff**2)) / np.max(ref.contact_area[:k]))
+
+
+def _row(name: str, description: str, seconds: float, cycle, ref, rich: dict) -> dict:
+    return {"name": name, "description": description, "seconds": seconds,
+            "pull_off_force_N": cycle.pull_off_force, "hysteresis_energy_J": cycle.hysteresis_energy,
+            "pull_off_rel_error": _rel(cycle.pull_off_force, ref.pull_off_force),
+            "hysteresis_rel_error": _rel(cycle.hysteresis_energy, ref.hysteresis_energy),
+            "area_rel_error": _area_error(cycle, ref),
+            "pull_off_rel_error_vs_richardson": _rel(cycle.pull_off_force, rich["pull_off_force_N"]),
+            "hysteresis_rel_error_vs_richardson": _rel(cycle.hysteresis_energy, rich["hysteresis_energy_J"])}
+
+
+def reference(grids: dict, desc: dict, mat: dict, path: np.ndarray) -> tuple[dict, dict]:
+    """BEM on the reference grid and the half grid; (record, cycles by grid)."""
+    cycles, runs = {}, {}
+    for n in sorted(grids):
+        cyc, stats = bem_cycle(grids[n], desc["size_m"], mat["e_star"], mat["work_of_adhesion"], mat["z0"], path)
+        cycles[n], runs[n] = cyc, stats.to_json()
+    fine, coarse = max(grids), min(grids)
+    f, c = cycles[fine], cycles[coarse]
+    rich = {"pull_off_force_N": 2 * f.pull_off_force - c.pull_off_force,
+            "hysteresis_energy_J": 2 * f.hysteresis_energy - c.hysteresis_energy}
+    record = {"name": "bem", "grid": fine, "seconds": runs[fine]["seconds"], "pull_off_force_N": f.pull_off_force,
+              "hysteresis_energy_J": f.hysteresis_energy, "solver": runs[fine], "half_grid": {
+                  "grid": coarse, "pull_off_force_N": c.pull_off_force, "hysteresis_energy_J": c.hysteresis_energy,
+                  "solver": runs[coarse]},
+              "richardson": rich,
+              "discretisation_rel": {"pull_off": _rel(rich["pull_off_force_N"], f.pull_off_force),
+                                     "hysteresis": _rel(rich["hysteresis_energy_J"], f.hysteresis_energy)},
+              "note": "errors of the levels are relative to the reference grid's values; discretisation_rel is "
+                      "the first-order Richardson estimate's distance from them (the reference's own error)"}
+    return record, cycles
+
+
+def figure(result: dict, path_png: Path) -> None:
+    """Force against separation (whole cycle and the tensile part), contact area on approach, relative errors;
+    drawn from the result's curves."""
+    from matplotlib.figure import Figure
+
+    curves = result["curves"]
+    s_nm = np.asarray(curves["separation_m"]) * 1e9
+    k = int(np.argmin(s_nm)) + 1
+    pull = result["reference"]["pull_off_force_N"] * 1e6
+    fig = Figure(figsize=(14, 3.8))
+    ax_f, ax_t, ax_a, ax_e = fig.subplots(1, 4)
+    for name, c in curves.items():
+        if name == "separation_m":
+            continue
+        style = {"color": "k", "lw": 2} if name == "bem" else {"lw": 1}
+        force, area = np.asarray(c["force_N"]) * 1e6, np.asarray(c["contact_area_m2"]) * 1e18
+        for ax in (ax_f, ax_t):
+            line, = ax.plot(s_nm[:k], force[:k], label=name, **style)
+            ax.plot(s_nm[k - 1:], force[k - 1:], ls="--", color=line.get_color(), lw=style["lw"])
+        ax_a.plot(s_nm[:k], area[:k], color=line.get_color(), lw=style["lw"])
+    ax_f.set(xlabel="separation s (nm)", ylabel="force (uN; + compressive)",
+             title="approach (solid), retraction (dashed)")
+    ax_t.set(xlabel="separation s (nm)", ylim=(-2.0 * pull, 1.0 * pull), title="the tensile part")
+    for ax in (ax_f, ax_t):
+        ax.axhline(0, color="0.7", lw=0.5)
+    ax_f.legend(fontsize=7)
+    ax_a.set(xlabel="separation s (nm)", ylabel="real contact area on approach (nm^2)", yscale="log")
+    names = [r["name"] for r in result["levels"]]
+    x = np.arange(len(names))
+    ax_e.bar(x - 0.2, [100 * r["pull_off_rel_error"] for r in result["levels"]], 0.4, label="pull-off")
+    ax_e.bar(x + 0.2, [100 * r["hysteresis_rel_error"] for r in result["levels"]], 0.4, label="hysteresis")
+    ax_e.axhline(0, color="k", lw=0.5)
+    ax_e.set_xticks(x, names, rotation=60, ha="right", fontsize=7)
+    ax_e.set(ylabel=f"error against BEM {result['reference']['grid']}^2 (%)")
+    ax_e.legend(fontsize=7)
+    fig.tight_layout()
+    atomic_save_figure(fig, path_png, dpi=110)
+
+
+def run(args) -> dict:
+    start = time.perf_counter()
+    mat = materials(args.params)
+    grids, desc = patch(args)
+    n_ref = desc["reference_grid"]
+    sets = summit_sets(grids[n_ref], desc)
+    path = path_for(grids[n_ref], sets, mat, args.quick, args.depth)
+    ref_record, bem = reference(grids, desc, mat, path)
+    ref = bem[n_ref]
+    cycles, levels = {"bem": ref, f"bem_{min(grids)}": bem[min(grids)]}, []
+    levels.append(_row(f"bem_half_grid_{min(grids)}", "the reference on the half grid (numerical error only)",
+                       ref_record["half_grid"]["solver"]["seconds"], bem[min(grids)], ref, ref_record["richardson"]))
+    for name, (description, build) in LEVELS.items():
+        t0 = time.perf_counter()
+        cycles[name] = build(sets, mat, path)
+        levels.append(_row(name, description, time.perf_counter() - t0, cycles[name], ref, ref_record["richardson"]))
+    beta = sets["direct"].summit_radius
+    pixel = desc["size_m"] / n_ref
+    surface = {k: v for k, v in desc.items()}
+    surface.update(summits=sets["record"], pixel_m=pixel,
+                   maugis_lambda_mean_summit=float(md_parameter(beta, mat["work_of_adhesion"], mat["e_star"],
+                                                                mat["dugdale_stress"])),
+                   touch_zone_radius_pixels=math.sqrt(2 * beta * mat["dugdale_range"]) / pixel)
+    result = {"benchmark": "benchmarks/bench_accuracy.py", "mode": "quick" if args.quick else "full",
+              "machine": {"cores": __import__("os").cpu_count(), "platform": platform.platform(),
+                          "python": platform.python_version()},
+              "materials": mat, "surface": surface,
+              "path": {"start_m": float(path[0]), "deepest_m": float(path.min()), "states": int(path.size)},
+              "reference": ref_record, "levels": levels,
+              "curves": {"separation_m": path.tolist(), **{n: {"force_N": c.force.tolist(),
+                                                                "contact_area_m2": c.contact_area.tolist()}
+                                                            for n, c in cycles.items()}},
+              "wall_s": time.perf_counter() - start}
+    return result
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--quick", action="store_true", help="128^2 reference (else 256^2), coarser separation steps")
+    p.add_argument("--map", type=Path, help="a height map SurfaceTopography reads (default: the synthetic patch)")
+    p.add_argument("--cutoff", type=float, help="summit cutoff wavelength (m); required with --map")
+    p.add_argument("--size", type=float, help="physical size (m) of a map whose file has none")
+    p.add_argument("--grid", type=int, help="reference grid points per side (the half grid is also run)")
+    p.add_argument("--depth", type=float, help="deepest state this far (m) below the tallest point (default: down "
+                                               "to the mean summit height + half a summit std)")
+    p.add_argument("--rms", type=float, help="rms height (m) of the synthetic patch (default 0.6 nm)")
+    p.add_argument("--params", default="calibrated", help="parameter set giving dgamma, z0 and the moduli")
+    p.add_argument("--json", type=Path, help="write the numbers and curves here")
+    p.add_argument("--png", type=Path, help="write the figure here")
+    p.add_argument("--replot", type=Path, help="only draw --png from this result JSON")
+    args = p.parse_args(argv)
+    if args.replot:
+        figure(json.loads(args.replot.read_text()), args.png)
+        return
+    if args.map and not args.cutoff:
+        p.error("--map needs --cutoff (the summit cutoff wavelength, m)")
+    result = run(args)
+    ref = result["reference"]
+    print(f"reference: BEM {ref['grid']}^2, {ref['seconds']:.1f} s, pull-off {ref['pull_off_force_N']:.4g} N, "
+          f"hysteresis {ref['hysteresis_energy_J']:.4g} J; Richardson shift {ref['discretisation_rel']}")
+    print(f"{'level':24s} {'seconds':>8s} {'pull-off err':>13s} {'hysteresis err':>15s} {'area err':>9s} "
+          f"{'pull-off vs R':>14s} {'hyst. vs R':>11s}")
+    for r in result["levels"]:
+        print(f"{r['name']:24s} {r['seconds']:8.2f} {r['pull_off_rel_error']:+13.3f} "
+              f"{r['hysteresis_rel_error']:+15.3f} {r['area_rel_error']:9.3f} "
+              f"{r['pull_off_rel_error_vs_richardson']:+14.3f} {r['hysteresis_rel_error_vs_richardson']:+11.3f}")
+    print(f"total {result['wall_s']:.1f} s")
+    if args.json:
+        atomic_write_json(args.json, result)
+    if args.png:
+        figure(result, args.png)
+
+
+if __name__ == "__main__":
+    main()
