@@ -151,77 +151,128 @@ class PullOff(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        s = self.typed(ctx.settings)
-        info = ctx.plan.system_info
-        R_m = U.angstrom_to_m(s.asperity_radius_A)
+        return _PullOffAnalysis(ctx, self.typed(ctx.settings)).run()
+
+
+class _PullOffAnalysis:
+    """Pull-off force, z0 and the residual drag from the retraction legs, in the MDAnalysis manner:
+    :meth:`_prepare` (the separation's origin), :meth:`_single_retraction` for every retraction leg,
+    :meth:`_conclude` (per-speed means, quantities, notes, a rate extrapolation over several speeds, curves and the
+    figure)."""
+
+    def __init__(self, ctx, s):
+        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+
+    def run(self) -> Analysis:
+        self._prepare()
+        for leg in self.ctx.plan.legs:
+            if leg.name.startswith("retract_"):
+                self._single_retraction(leg)
+        return self._conclude()
+
+    def _prepare(self) -> None:
+        ctx = self.ctx
+        self.R_m = U.angstrom_to_m(self.s.asperity_radius_A)
         ids, _, pos = read_atoms(ctx.leg_dir("approach") / "minimized.data")
-        n_flat = info["n_flat"]
+        n_flat = self.info["n_flat"]
         # ids 1..n_flat are the flat (place_on puts the substrate first)
         flat_top = pos[:n_flat, 2].max()
         tip_bottom = pos[n_flat:, 2].min()
-        s0 = tip_bottom - flat_top
+        self.s0 = tip_bottom - flat_top
         app = ctx.samples("approach", False)
         # the holder's height at the minimised start: it does not move before the approach stage, so the first
         # sample of the equilibration has it exactly
-        zh0 = float(app["z_holder"][0])
-        sep = lambda d: s0 + (d["z_holder"] - zh0)
-        dt = ctx.plan.timestep_fs
-        curves, figures, pulls = {}, {}, []
-        retracts = [l for l in ctx.plan.legs if l.name.startswith("retract_")]
-        smooth = None
-        for l in retracts:
-            d = ctx.samples(l)
-            n = len(d["step"])
-            smooth = max(5, (n // 25) | 1) if n >= 15 else None
-            r = A.pull_off_analysis(sep(d), d["fz"], smooth=smooth, radius_m=R_m)
-            r["local_noise"] = _local_noise(r, smooth)
-            r["drag"] = _residual_drag(d, dt)
-            pulls.append((l.info["speed_m_s"], l.info.get("repeat", 0), l.name, r))
-            curves[f"pulloff_curve_{l.name}"] = (
-                ["separation_m", "force_N", "force_smoothed_N"],
-                np.column_stack([r["curve"]["separation"], r["curve"]["force"], r["curve"]["force_smoothed"]]))
-        d_app = ctx.samples("approach", False)
-        curves["approach_curve"] = (["step", "stage", "separation_m", "force_N"],
-                                    np.column_stack([d_app["step"], d_app["stage"], U.angstrom_to_m(sep(d_app)),
-                                                     U.kcal_per_mol_A_to_N(d_app["fz"])]))
-        speeds = sorted({v for v, *_ in pulls})
-        per_speed = []
+        self.zh0 = float(app["z_holder"][0])
+        self.dt = ctx.plan.timestep_fs
+        self.curves, self.figures, self.pulls = {}, {}, []
+        self.smooth = None
+
+    def sep(self, d) -> np.ndarray:
+        """The rigid-holder separation (A) of the samples ``d``."""
+        return self.s0 + (d["z_holder"] - self.zh0)
+
+    def _single_retraction(self, leg) -> None:
+        d = self.ctx.samples(leg)
+        n = len(d["step"])
+        self.smooth = smooth = max(5, (n // 25) | 1) if n >= 15 else None
+        r = A.pull_off_analysis(self.sep(d), d["fz"], smooth=smooth, radius_m=self.R_m)
+        r["local_noise"] = _local_noise(r, smooth)
+        r["drag"] = _residual_drag(d, self.dt)
+        self.pulls.append((leg.info["speed_m_s"], leg.info.get("repeat", 0), leg.name, r))
+        self.curves[f"pulloff_curve_{leg.name}"] = (
+            ["separation_m", "force_N", "force_smoothed_N"],
+            np.column_stack([r["curve"]["separation"], r["curve"]["force"], r["curve"]["force_smoothed"]]))
+
+    def _conclude(self) -> Analysis:
+        self.d_app = d_app = self.ctx.samples("approach", False)
+        self.curves["approach_curve"] = (["step", "stage", "separation_m", "force_N"],
+                                         np.column_stack([d_app["step"], d_app["stage"],
+                                                          U.angstrom_to_m(self.sep(d_app)),
+                                                          U.kcal_per_mol_A_to_N(d_app["fz"])]))
+        self.speeds = speeds = sorted({v for v, *_ in self.pulls})
+        self.per_speed = []
         for v in speeds:
-            rs = [r for vv, _, _, r in pulls if vv == v]
+            rs = [r for vv, _, _, r in self.pulls if vv == v]
             fs = np.array([r["max_tensile_force"] for r in rs])
             if len(rs) >= 2:
                 f_err, how = float(fs.std(ddof=1) / math.sqrt(len(rs))), f"spread of {len(rs)} pulls"
             else:
                 f_err, how = rs[0]["local_noise"], "force noise of one curve near its maximum"
-            per_speed.append({"speed_m_s": float(v), "force": float(fs.mean()), "stderr": f_err, "how": how,
-                              "forces": fs.tolist(), "results": rs})
-        slow = per_speed[0]
+            self.per_speed.append({"speed_m_s": float(v), "force": float(fs.mean()), "stderr": f_err, "how": how,
+                                   "forces": fs.tolist(), "results": rs})
+        q = self._quantities()
+        notes = self._notes(q)
+        details = self._details()
+        if len(speeds) >= 2:
+            ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in self.per_speed]),
+                                       target_rate=float(min(speeds)) / 10.0, temperature_K=self.s.temperature_K)
+            q["pull_off_force_extrapolated"] = quantity_record(ext["F0"], ext["stderr"], "N",
+                                                  kind=f"F = a + b ln(v) fitted to {len(speeds)} speeds, "
+                                                       f"evaluated at {ext['target_rate']:g} m/s")
+            details["rate_extrapolation"] = ext
+            notes.append("rate scan: F = a + b ln(v) (Bell-Evans) extrapolated one decade below the slowest "
+                         "simulated speed; valid only while the Bell-Evans regime holds.")
+        self.figures["pulloff_curve"] = figure_writer(self._draw)
+        return Analysis(quantities=q, curves=self.curves, figures=self.figures, notes=notes, details=details)
+
+    def _quantities(self) -> dict:
+        """The slowest speed's pull-off force (mean of its pulls), z0, the effective works of adhesion and the
+        residual drag on the asperity."""
+        slow = self.per_speed[0]
         best = slow["results"][0]
         F, f_err = slow["force"], slow["stderr"]
+        self.F = F
+        R_m = self.R_m
         z0q = _z0_quantity(best) if len(slow["results"]) == 1 else _z0_mean([r for r in slow["results"]])
         drag = np.array([r["drag"]["value"] for r in slow["results"]])
         drag_err = np.array([r["drag"]["stderr"] for r in slow["results"]])
         v_slow = U.m_per_s_to_angstrom_per_fs(slow["speed_m_s"])
-        gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(info["tip_mobile_mass_g_mol"] * v_slow /
-                                                           s.thermostat_damping_fs)
+        self.gamma_lab = gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(
+            self.info["tip_mobile_mass_g_mol"] * v_slow / self.s.thermostat_damping_fs)
         err = lambda x: x / (2 * math.pi * R_m) if x else None
-        q = {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"], repeats=len(slow["results"]),
-                                  kind=f"maximum tensile force on retraction (mean of {len(slow['results'])}; "
-                                       f"stderr: {slow['how']})"),
-             "separation_at_max_tension": quantity_record(best["separation_at_max"], None, "m"),
-             "interaction_range_z0": z0q,
-             "work_of_adhesion_eff_jkr": quantity_record(F / (1.5 * math.pi * R_m), f_err / (1.5 * math.pi * R_m) if f_err else None,
-                                            "J/m^2", kind="F / (1.5 pi R)"),
-             "work_of_adhesion_eff_dmt": quantity_record(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
-                                            kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit: a "
-                                                 "nanometre asperity has a small Tabor parameter)"),
-             "residual_drag_force": quantity_record(float(U.kcal_per_mol_A_to_N(drag.mean())),
-                                       float(U.kcal_per_mol_A_to_N(math.sqrt(np.sum(drag_err ** 2)) / len(drag))),
-                                       "N", kind="mean thermostat force on the moving asperity along the pulling "
-                                                 "axis on retraction (holder reaction - interaction + momentum change)",
-                                       lab_frame_drag_N=float(U.kcal_per_mol_A_to_N(-gamma_lab)))}
+        return {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"],
+                                                  repeats=len(slow["results"]),
+                                                  kind=f"maximum tensile force on retraction (mean of "
+                                                       f"{len(slow['results'])}; stderr: {slow['how']})"),
+                "separation_at_max_tension": quantity_record(best["separation_at_max"], None, "m"),
+                "interaction_range_z0": z0q,
+                "work_of_adhesion_eff_jkr": quantity_record(F / (1.5 * math.pi * R_m),
+                                                            f_err / (1.5 * math.pi * R_m) if f_err else None,
+                                                            "J/m^2", kind="F / (1.5 pi R)"),
+                "work_of_adhesion_eff_dmt": quantity_record(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
+                                               kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit: a "
+                                                    "nanometre asperity has a small Tabor parameter)"),
+                "residual_drag_force": quantity_record(float(U.kcal_per_mol_A_to_N(drag.mean())),
+                                          float(U.kcal_per_mol_A_to_N(math.sqrt(np.sum(drag_err ** 2)) / len(drag))),
+                                          "N", kind="mean thermostat force on the moving asperity along the pulling "
+                                                    "axis on retraction (holder reaction - interaction + momentum "
+                                                    "change)",
+                                          lab_frame_drag_N=float(U.kcal_per_mol_A_to_N(-gamma_lab)))}
+
+    def _notes(self, q: dict) -> list[str]:
+        s, slow, F, R_m = self.s, self.per_speed[0], self.F, self.R_m
         notes = [f"separation = gap between the lowest asperity atom and the highest flat atom at the minimised "
-                 f"start ({s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
+                 f"start ({self.s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
                  f"flat's deformation); force = compute group/group (asperity body vs flat, kspace yes), "
                  f"positive = repulsive.",
                  f"pull-off force: mean of {len(slow['results'])} retraction(s) at {slow['speed_m_s']:g} m/s; "
@@ -233,60 +284,52 @@ class PullOff(Workflow):
                     "lab": " (lab frame, every mobile atom together with the flat: it drags the moving asperity)"}[
                      s.tip_thermostat]
                  + f"; residual drag measured {q['residual_drag_force']['value'] * 1e9:+.3f} nN against "
-                   f"{-gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
+                   f"{-self.gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
                    f"(gamma M v) would apply.",
                  f"validation, not calibration: at MD scale (R = {s.asperity_radius_A:g} A) the contact is "
-                 f"DMT-like (Tabor mu ~ 0.06), so F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the number "
-                 f"to compare with the flat-slab work of adhesion W_F (the calibration report does).",
+                 f"DMT-like (a small Tabor parameter), so F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the "
+                 f"number to compare with the flat-slab work of adhesion W_F (the calibration report does).",
                  f"R = {s.asperity_radius_A:g} A (the requested radius of the carved, faceted dome)."]
         if s.surface == "ots":
-            g = info.get("asperity_sam", {})
+            g = self.info.get("asperity_sam", {})
             notes.append(f"OTS chains on the asperity: {g.get('chains')} on dome silanols within "
                          f"graft_max_polar_deg of the apex ({g.get('chains_per_projected_nm2', float('nan')):.2f} per "
                          f"nm^2 of projected cap, lateral spacing >= {g.get('min_spacing_A', float('nan')):.2f} A); "
                          "they point along the pulling axis, not along the local normal (the builder grafts along "
                          "one axis); the chain-end surface is the dome translated by the chain vector, so its "
                          "curvature radius is still R.")
-        details = {"per_speed": [{"speed_m_s": p["speed_m_s"], "max_tensile_force_N": p["force"],
-                                  "stderr_N": p["stderr"], "forces_N": p["forces"]} for p in per_speed],
-                   "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j,
-                              "max_tensile_force_N": r["max_tensile_force"],
-                              "separation_at_max_m": r["separation_at_max"], "z0_m": r["z0"],
-                              "z0_stderr_m": r["z0_stderr"], "z0_zero_to_min_m": r["z0_zero_to_min"],
-                              "zero_force_separation_m": r["zero_force_separation"],
-                              "local_noise_N": r["local_noise"],
-                              "residual_drag_N": float(U.kcal_per_mol_A_to_N(r["drag"]["value"])),
-                              "residual_drag_stderr_N": float(U.kcal_per_mol_A_to_N(r["drag"]["stderr"])),
-                              "traction_fit": {k: v for k, v in r["traction_fit"].items()
-                                               if isinstance(v, (int, float, str, dict))}}
-                             for v, j, name, r in pulls],
-                   "s0_A": float(s0), "holder_z0_A": zh0, "smoothing_window": smooth,
-                   "lab_frame_drag_estimate_N": float(U.kcal_per_mol_A_to_N(-gamma_lab)),
-                   "tip_mobile_mass_g_mol": info["tip_mobile_mass_g_mol"]}
-        if len(speeds) >= 2:
-            ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in per_speed]),
-                                       target_rate=float(min(speeds)) / 10.0, temperature_K=s.temperature_K)
-            q["pull_off_force_extrapolated"] = quantity_record(ext["F0"], ext["stderr"], "N",
-                                                  kind=f"F = a + b ln(v) fitted to {len(speeds)} speeds, "
-                                                       f"evaluated at {ext['target_rate']:g} m/s")
-            details["rate_extrapolation"] = ext
-            notes.append("rate scan: F = a + b ln(v) (Bell-Evans) extrapolated one decade below the slowest "
-                         "simulated speed; valid only while the Bell-Evans regime holds.")
+        return notes
 
-        def draw(ax):
-            for (v, j, name, r) in pulls:
-                c = r["curve"]
-                ax.plot(c["separation"] * 1e9, c["force"] * 1e9, lw=0.5, alpha=0.5)
-                ax.plot(c["separation"] * 1e9, c["force_smoothed"] * 1e9, lw=1.5, label=f"{name} {v:g} m/s")
-            ax.plot(U.angstrom_to_m(sep(d_app)) * 1e9, U.kcal_per_mol_A_to_N(d_app["fz"]) * 1e9, lw=0.5,
-                    color="grey", label="approach/hold")
-            ax.axhline(0, color="k", lw=0.5)
-            ax.set_xlabel("separation (nm)")
-            ax.set_ylabel("force on asperity (nN)")
-            ax.set_title(f"pull-off {F * 1e9:.3f} nN, R = {s.asperity_radius_A:g} Å")
-            ax.legend(fontsize=7)
-        figures["pulloff_curve"] = figure_writer(draw)
-        return Analysis(quantities=q, curves=curves, figures=figures, notes=notes, details=details)
+    def _details(self) -> dict:
+        return {"per_speed": [{"speed_m_s": p["speed_m_s"], "max_tensile_force_N": p["force"],
+                               "stderr_N": p["stderr"], "forces_N": p["forces"]} for p in self.per_speed],
+                "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j,
+                           "max_tensile_force_N": r["max_tensile_force"],
+                           "separation_at_max_m": r["separation_at_max"], "z0_m": r["z0"],
+                           "z0_stderr_m": r["z0_stderr"], "z0_zero_to_min_m": r["z0_zero_to_min"],
+                           "zero_force_separation_m": r["zero_force_separation"],
+                           "local_noise_N": r["local_noise"],
+                           "residual_drag_N": float(U.kcal_per_mol_A_to_N(r["drag"]["value"])),
+                           "residual_drag_stderr_N": float(U.kcal_per_mol_A_to_N(r["drag"]["stderr"])),
+                           "traction_fit": {k: v for k, v in r["traction_fit"].items()
+                                            if isinstance(v, (int, float, str, dict))}}
+                          for v, j, name, r in self.pulls],
+                "s0_A": float(self.s0), "holder_z0_A": self.zh0, "smoothing_window": self.smooth,
+                "lab_frame_drag_estimate_N": float(U.kcal_per_mol_A_to_N(-self.gamma_lab)),
+                "tip_mobile_mass_g_mol": self.info["tip_mobile_mass_g_mol"]}
+
+    def _draw(self, ax) -> None:
+        for (v, j, name, r) in self.pulls:
+            c = r["curve"]
+            ax.plot(c["separation"] * 1e9, c["force"] * 1e9, lw=0.5, alpha=0.5)
+            ax.plot(c["separation"] * 1e9, c["force_smoothed"] * 1e9, lw=1.5, label=f"{name} {v:g} m/s")
+        ax.plot(U.angstrom_to_m(self.sep(self.d_app)) * 1e9, U.kcal_per_mol_A_to_N(self.d_app["fz"]) * 1e9, lw=0.5,
+                color="grey", label="approach/hold")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_xlabel("separation (nm)")
+        ax.set_ylabel("force on asperity (nN)")
+        ax.set_title(f"pull-off {self.F * 1e9:.3f} nN, R = {self.s.asperity_radius_A:g} Å")
+        ax.legend(fontsize=7)
 
 
 def _thermostat_fix(name: str, group: str, settings: Mapping[str, Any], step: int, salt: int) -> list[str]:
