@@ -272,6 +272,20 @@ def figure(result: dict, path_png: Path) -> None:
     atomic_save_figure(fig, path_png, dpi=110)
 
 
+def markdown(result: dict) -> str:
+    """The levels' table (docs/benchmarks.md) from a result."""
+    ref = result["reference"]
+    rows = ["| level | seconds | pull-off error | hysteresis error | contact-area error (approach) | "
+            "pull-off error vs Richardson |", "|---|---|---|---|---|---|",
+            f"| `bem` {ref['grid']}^2 (reference) | {ref['seconds']:.1f} | {ref['pull_off_force_N']:.3g} N | "
+            f"{ref['hysteresis_energy_J']:.3g} J | | Richardson shift {100 * ref['discretisation_rel']['pull_off']:+.1f} % |"]
+    for r in result["levels"]:
+        rows.append(f"| `{r['name']}` | {r['seconds']:.2f} | {100 * r['pull_off_rel_error']:+.0f} % | "
+                    f"{100 * r['hysteresis_rel_error']:+.0f} % | {100 * r['area_rel_error']:.0f} % | "
+                    f"{100 * r['pull_off_rel_error_vs_richardson']:+.0f} % |")
+    return "\n".join(rows)
+
+
 def run(args) -> dict:
     start = time.perf_counter()
     mat = materials(args.params)
@@ -321,10 +335,13 @@ def main(argv=None):
     p.add_argument("--params", default="calibrated", help="parameter set giving dgamma, z0 and the moduli")
     p.add_argument("--json", type=Path, help="write the numbers and curves here")
     p.add_argument("--png", type=Path, help="write the figure here")
-    p.add_argument("--replot", type=Path, help="only draw --png from this result JSON")
+    p.add_argument("--replot", type=Path, help="only draw --png (if given) and print the table from this JSON")
     args = p.parse_args(argv)
     if args.replot:
-        figure(json.loads(args.replot.read_text()), args.png)
+        old = json.loads(args.replot.read_text())
+        if args.png:
+            figure(old, args.png)
+        print(markdown(old))
         return
     if args.map and not args.cutoff:
         p.error("--map needs --cutoff (the summit cutoff wavelength, m)")
