@@ -158,77 +158,18 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
     if not len(sites):
         raise ValueError(f"substrate group {site_group!r} is empty: nothing to graft on")
     area = float(substrate.cell[0] * substrate.cell[1])
-    target = int(round(coverage * area / 100.0))
-    pos = substrate.positions.copy()
     offsets = {int(i): np.asarray(v, float) for i, v in (head_offsets or {}).items()}
-    for i, v in offsets.items():
-        pos[i, :2] += v                      # the spacing rule applies to where the chains stand
-    accepted: list[int] = []
-    acc_pos: list[np.ndarray] = []
-    for k in rng.permutation(len(sites)).tolist():
-        i = int(sites[k])
-        if len(accepted) == target:
-            break
-        if _xy_spacing_ok(pos[i], acc_pos, substrate.cell, min_spacing):
-            accepted.append(i)
-            acc_pos.append(pos[i])
-    if len(accepted) < target:
-        raise ValueError(
-            f"only {len(accepted)} of {target} grafting sites fit at {min_spacing} A spacing on this substrate "
-            f"({len(accepted) / area * 100:.2f} chains/nm^2 < requested {coverage}); cristobalite face='111' "
-            f"offers 4.50 sites/nm^2 on a 5.06 A lattice")
-    accepted.sort()
-    # delete the silanol H of each anchor O, retype the O
-    nb = [[] for _ in range(substrate.n_atoms)]
-    for i, j in substrate.bonds.tolist():
-        nb[i].append(j)
-        nb[j].append(i)
-    h_del = []
-    for o in accepted:
-        hs = [h for h in nb[o] if substrate.types[h] == "HOY"]
-        if len(hs) != 1 or substrate.types[o] != "OC24":
-            raise ValueError(f"site atom {o} is not a silanol O (type {substrate.types[o]}, H neighbours {hs})")
-        h_del.append(hs[0])
-    types = substrate.types.copy().astype(object)
-    charges = substrate.charges.copy()
-    oc23 = ff.atom_type("OC23")
-    types[accepted] = "OC23"
-    charges[accepted] = oc23.charge
-    # the anchor O stays but is no longer a silanol; record it through a group so that remove_atoms re-indexes it
-    groups = {k: (np.setdiff1d(v, accepted) if k.startswith("silanol_O") else v) for k, v in substrate.groups.items()}
-    groups["sam_anchor_O"] = np.array(accepted, int)
-    base = replace(substrate, types=types, charges=charges, groups=groups)
-    base = remove_atoms(base, h_del)
+    accepted = _pick_sites(substrate, sites, coverage, min_spacing, offsets, rng)
+    base = _condense_anchors(substrate, accepted, ff)
     anchors = np.asarray(base.group("sam_anchor_O"), int)
     # chains
     tpos, ttypes, tbonds = _chain_template(ff, chain_length, tilt_deg, tilt_azimuth_deg)
     shifts = np.zeros((len(accepted), 3))
     if offsets:                              # anchors keep the order of ``accepted`` through remove_atoms
         shifts = head_shifts(np.array([offsets.get(i, np.zeros(2)) for i in accepted]), template=tpos)
-    n0 = base.n_atoms
+    merged = _attach_chains(base, anchors, (tpos, ttypes, tbonds), shifts, ff, vacuum)
     per = len(ttypes)
-    mol0 = int(base.mol_ids.max())
-    all_pos, all_types, all_mol, bonds = [], [], [], []
-    for c, o in enumerate(anchors.tolist()):
-        off = n0 + c * per
-        all_pos.append(base.positions[o] + tpos + shifts[c])
-        all_types += ttypes
-        all_mol += [mol0 + 1 + c] * per
-        bonds += [(off + i, off + j) for i, j in tbonds]
-        bonds.append((o, off))                        # anchor O - head Si
-    chain_pos = np.concatenate(all_pos)
-    chains = from_types(chain_pos, all_types, ff, mol_ids=all_mol, cell=base.cell, pbc=base.pbc)
-    merged = merge([base, chains], cell=base.cell)
-    merged = replace(merged, bonds=np.concatenate([merged.bonds, np.array(bonds, int)]), bond_types=[])
-    zmax = merged.positions[:, 2].max()
-    cell = np.array([base.cell[0], base.cell[1], zmax + vacuum])
-    sam_idx = np.arange(n0, n0 + len(anchors) * per)
-    head_si = n0 + np.arange(len(anchors)) * per
-    ch3 = n0 + np.arange(len(anchors)) * per + per - 1
-    groups = {k: v for k, v in merged.groups.items()}
-    groups.update(sam=sam_idx, sam_head_si=head_si, sam_ch3=ch3, sam_anchor_O=anchors)
-    merged = replace(merged, cell=cell, groups=groups, info={})
-    merged = with_bonded_terms(merged, ff)
+    ch3 = base.n_atoms + np.arange(len(anchors)) * per + per - 1
     p = merged.positions
     thickness = float(p[ch3, 2].mean() - p[anchors, 2].mean())
     top_sil = merged.groups.get("silanol_O_top", np.array([], int))
@@ -250,3 +191,82 @@ def ots_sam(substrate: System | None = None, coverage: float = 4.5, *, tilt_deg:
     if offsets:
         info["head_offset_max_A"] = float(np.hypot(shifts[:, 0], shifts[:, 1]).max())
     return replace(merged, info=_plain(info))
+
+
+def _pick_sites(substrate: System, sites: np.ndarray, coverage: float, min_spacing: float,
+                offsets: Mapping[int, np.ndarray], rng: np.random.Generator) -> list[int]:
+    """Grafting sites (substrate atom indices, sorted) drawn in seeded random order from ``sites``, each at least
+    ``min_spacing`` laterally from those taken (where the chains stand: sites moved by ``offsets``), until
+    ``coverage`` chains/nm^2; ValueError if the sites cannot hold it."""
+    area = float(substrate.cell[0] * substrate.cell[1])
+    target = int(round(coverage * area / 100.0))
+    pos = substrate.positions.copy()
+    for i, v in offsets.items():
+        pos[i, :2] += v                      # the spacing rule applies to where the chains stand
+    accepted: list[int] = []
+    acc_pos: list[np.ndarray] = []
+    for k in rng.permutation(len(sites)).tolist():
+        i = int(sites[k])
+        if len(accepted) == target:
+            break
+        if _xy_spacing_ok(pos[i], acc_pos, substrate.cell, min_spacing):
+            accepted.append(i)
+            acc_pos.append(pos[i])
+    if len(accepted) < target:
+        raise ValueError(
+            f"only {len(accepted)} of {target} grafting sites fit at {min_spacing} A spacing on this substrate "
+            f"({len(accepted) / area * 100:.2f} chains/nm^2 < requested {coverage}); cristobalite face='111' "
+            f"offers 4.50 sites/nm^2 on a 5.06 A lattice")
+    accepted.sort()
+    return accepted
+
+
+def _condense_anchors(substrate: System, accepted: list[int], ff: ForceField) -> System:
+    """The substrate with each anchor silanol condensed: its H deleted, its O retyped OC24 -> OC23 (and charged as
+    one), recorded in group 'sam_anchor_O' (so remove_atoms re-indexes it) and out of the silanol groups."""
+    nb = [[] for _ in range(substrate.n_atoms)]
+    for i, j in substrate.bonds.tolist():
+        nb[i].append(j)
+        nb[j].append(i)
+    h_del = []
+    for o in accepted:
+        hs = [h for h in nb[o] if substrate.types[h] == "HOY"]
+        if len(hs) != 1 or substrate.types[o] != "OC24":
+            raise ValueError(f"site atom {o} is not a silanol O (type {substrate.types[o]}, H neighbours {hs})")
+        h_del.append(hs[0])
+    types = substrate.types.copy().astype(object)
+    charges = substrate.charges.copy()
+    types[accepted] = "OC23"
+    charges[accepted] = ff.atom_type("OC23").charge
+    groups = {k: (np.setdiff1d(v, accepted) if k.startswith("silanol_O") else v) for k, v in substrate.groups.items()}
+    groups["sam_anchor_O"] = np.array(accepted, int)
+    return remove_atoms(replace(substrate, types=types, charges=charges, groups=groups), h_del)
+
+
+def _attach_chains(base: System, anchors: np.ndarray, template, shifts: np.ndarray, ff: ForceField,
+                   vacuum: float) -> System:
+    """One chain (``template`` = positions relative to the anchor O, types, bonds) on every anchor O, moved by its
+    ``shifts``, bonded head Si - anchor O; the box ``vacuum`` above the highest atom; the SAM's groups; bonded
+    terms typed."""
+    tpos, ttypes, tbonds = template
+    n0 = base.n_atoms
+    per = len(ttypes)
+    mol0 = int(base.mol_ids.max())
+    all_pos, all_types, all_mol, bonds = [], [], [], []
+    for c, o in enumerate(anchors.tolist()):
+        off = n0 + c * per
+        all_pos.append(base.positions[o] + tpos + shifts[c])
+        all_types += ttypes
+        all_mol += [mol0 + 1 + c] * per
+        bonds += [(off + i, off + j) for i, j in tbonds]
+        bonds.append((o, off))                        # anchor O - head Si
+    chains = from_types(np.concatenate(all_pos), all_types, ff, mol_ids=all_mol, cell=base.cell, pbc=base.pbc)
+    merged = merge([base, chains], cell=base.cell)
+    merged = replace(merged, bonds=np.concatenate([merged.bonds, np.array(bonds, int)]), bond_types=[])
+    zmax = merged.positions[:, 2].max()
+    cell = np.array([base.cell[0], base.cell[1], zmax + vacuum])
+    head_si = n0 + np.arange(len(anchors)) * per
+    groups = {k: v for k, v in merged.groups.items()}
+    groups.update(sam=np.arange(n0, n0 + len(anchors) * per), sam_head_si=head_si, sam_ch3=head_si + per - 1,
+                  sam_anchor_O=anchors)
+    return with_bonded_terms(replace(merged, cell=cell, groups=groups, info={}), ff)

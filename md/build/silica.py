@@ -35,7 +35,7 @@ Silica (INTERFACE FF types, ``inputs/forcefields/silica_interface.toml``)
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -230,16 +230,20 @@ def _max_matching(edges: list[tuple[int, int]], rng: np.random.Generator) -> lis
     return chosen
 
 
-def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np.ndarray], np.ndarray],
-                         areas: Mapping[str, float], target_density: float, normal: Callable, rng: np.random.Generator,
-                         ff: ForceField, tolerance: float) -> tuple[System, dict[str, Any]]:
-    """Kept Si + their O + silanol H, condensed region by region to ``target_density`` (OH/nm^2).
+@dataclass(frozen=True)
+class _Silanols:
+    """The O of the kept Si that lost a partner Si (silanols), each with its kept Si (``own``), the removed partner
+    (``gone``) and the face label of every Si; ``bridging`` the O whose two Si are both kept."""
+    si_keep: np.ndarray
+    silanol: np.ndarray
+    own: np.ndarray
+    gone: np.ndarray
+    label_of_si: np.ndarray
+    n_sil_of_si: np.ndarray
+    bridging: np.ndarray
 
-    ``regions(si_positions) -> region label per Si`` assigns each surface Si to a face ('top', 'bottom',
-    'dome', ...) whose area (A^2) is in ``areas``. Returns the System (no bonded types yet) and an info dict.
-    """
-    cell = bulk.cell
-    pbc3 = (True, True, True)
+
+def _find_silanols(bulk: _Bulk, keep: np.ndarray, regions: Callable[[np.ndarray], np.ndarray]) -> _Silanols:
     si_keep = np.flatnonzero(keep)
     kept_of_o = keep[bulk.si_of_o]                           # (n_o, 2)
     o_keep = np.flatnonzero(kept_of_o.any(axis=1))
@@ -250,14 +254,19 @@ def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np
     s_gone = np.where(first_kept, bulk.si_of_o[silanol, 1], bulk.si_of_o[silanol, 0])
     label_of_si = np.full(len(bulk.si), "", dtype=object)
     label_of_si[si_keep] = regions(bulk.si_pos[si_keep])
-    n_sil_of_si = np.bincount(s_own, minlength=len(bulk.si))
+    return _Silanols(si_keep=si_keep, silanol=silanol, own=s_own, gone=s_gone, label_of_si=label_of_si,
+                     n_sil_of_si=np.bincount(s_own, minlength=len(bulk.si)),
+                     bridging=o_keep[kept_of_o[o_keep].all(axis=1)])
 
-    # bridging Si pairs already present (to avoid creating two-membered rings)
-    bridged = {tuple(sorted(p)) for p in bulk.si_of_o[o_keep[kept_of_o[o_keep].all(axis=1)]].tolist()}
 
-    # candidate condensations: silanol pairs sharing a removed Si, on different Si, both Si with >= 2 silanols
+def _condensation_candidates(bulk: _Bulk, sil: _Silanols) -> dict[tuple[int, int], tuple[int, int]]:
+    """Silanol pairs (indices into ``sil.silanol``) that may condense, by the Si pair they would bridge: sharing a
+    removed Si, on different Si of one face, both Si with >= 2 silanols, not already bridged (no two-membered
+    rings). Pairs straddling two faces are not condensed (keeps the per-face bookkeeping exact)."""
+    s_own, n_sil_of_si = sil.own, sil.n_sil_of_si
+    bridged = {tuple(sorted(p)) for p in bulk.si_of_o[sil.bridging].tolist()}
     by_gone: dict[int, list[int]] = {}
-    for k, g in enumerate(s_gone.tolist()):
+    for k, g in enumerate(sil.gone.tolist()):
         by_gone.setdefault(g, []).append(k)
     cand: dict[tuple[int, int], tuple[int, int]] = {}
     for ks in by_gone.values():
@@ -271,9 +280,14 @@ def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np
                 if n_sil_of_si[sa] < 2 or n_sil_of_si[sb] < 2:
                     continue
                 cand[key] = (a, b)
-    # pairs straddling two regions are not condensed (keeps the per-region bookkeeping exact)
-    cand = {k: v for k, v in cand.items() if label_of_si[k[0]] == label_of_si[k[1]]}
-    info: dict[str, Any] = {}
+    return {k: v for k, v in cand.items() if sil.label_of_si[k[0]] == sil.label_of_si[k[1]]}
+
+
+def _condense(sil: _Silanols, cand: Mapping[tuple[int, int], tuple[int, int]], areas: Mapping[str, float],
+              target_density: float, rng: np.random.Generator) -> tuple[list[tuple[int, int]], dict[str, dict]]:
+    """Per face: as many condensations (drawn from a maximum matching of the candidates) as bring its silanols to
+    ``target_density`` OH/nm^2; returns the condensed silanol pairs and the per-face record."""
+    label_of_si, s_own = sil.label_of_si, sil.own
     used_si: set[int] = set()
     cond_pairs: list[tuple[int, int]] = []          # (silanol index a, silanol index b)
     per_region: dict[str, dict[str, Any]] = {}
@@ -292,77 +306,111 @@ def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np
                             "silanols": n_after, "density_nm2": n_after / (area / 100.0),
                             "max_density_nm2": n_oh / (area / 100.0),
                             "min_density_nm2": (n_oh - 2 * len(match)) / (area / 100.0)}
-    removed_sil = {x for pair in cond_pairs for x in pair}
+    return cond_pairs, per_region
 
-    # ---- assemble atoms
-    pos_si = bulk.si_pos[si_keep]
-    si_new = np.full(len(bulk.si), -1)
-    si_new[si_keep] = np.arange(len(si_keep))
-    bridging_o = o_keep[kept_of_o[o_keep].all(axis=1)]
-    positions = [pos_si]
-    types = ["SC4"] * len(si_keep)
-    bonds: list[tuple[int, int]] = []
-    n = len(si_keep)
-    # bridging O of the crystal
-    for o in bridging_o.tolist():
-        s1, s2 = bulk.si_of_o[o]
-        p = bulk.si_pos[s1] + minimum_image(bulk.o_pos[o] - bulk.si_pos[s1], cell, pbc3)
-        positions.append(p[None])
-        types.append("OC23")
-        bonds += [(si_new[s1], n), (si_new[s2], n)]
-        n += 1
-    # bridging O made by condensation
-    for a, b in cond_pairs:
-        sa, sb = s_own[a], s_own[b]
-        pa = bulk.si_pos[sa] + minimum_image(bulk.o_pos[silanol[a]] - bulk.si_pos[sa], cell, pbc3)
-        pb = pa + minimum_image(bulk.o_pos[silanol[b]] - pa, cell, pbc3)
-        positions.append((0.5 * (pa + pb))[None])
-        types.append("OC23")
-        bonds += [(si_new[sa], n), (si_new[sb], n)]
-        n += 1
-    n_condensed_o = len(cond_pairs)
-    # silanols
-    r_oh = _bond_r0(ff, "OC24", "HOY")
-    bend = math.radians(180.0 - _angle_theta0(ff, "SC4", "OC24", "HOY"))
-    sil_o_idx: dict[str, list[int]] = {}
-    sil_h_idx: dict[str, list[int]] = {}
-    for k in range(len(silanol)):
-        if k in removed_sil:
-            continue
-        s = s_own[k]
-        ps = bulk.si_pos[s]
-        po = ps + minimum_image(bulk.o_pos[silanol[k]] - ps, cell, pbc3)
-        u = _unit(po - ps)
-        nrm = normal(po, label_of_si[s])
-        perp = nrm - np.dot(nrm, u) * u
-        if np.linalg.norm(perp) < 1e-6:
-            perp = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
-            phi = rng.uniform(0, 2 * math.pi)
-            perp = _unit(perp)
-            perp = math.cos(phi) * perp + math.sin(phi) * np.cross(u, perp)
-        perp = _unit(perp)
-        ph = po + r_oh * (math.cos(bend) * u + math.sin(bend) * perp)
-        positions += [po[None], ph[None]]
-        types += ["OC24", "HOY"]
-        bonds += [(si_new[s], n), (n, n + 1)]
-        lab = str(label_of_si[s])
-        sil_o_idx.setdefault(lab, []).append(n)
-        sil_h_idx.setdefault(lab, []).append(n + 1)
-        n += 2
-    positions = np.concatenate(positions)
+
+def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np.ndarray], np.ndarray],
+                         areas: Mapping[str, float], target_density: float, normal: Callable, rng: np.random.Generator,
+                         ff: ForceField, tolerance: float) -> tuple[System, dict[str, Any]]:
+    """Kept Si + their O + silanol H, condensed region by region to ``target_density`` (OH/nm^2).
+
+    ``regions(si_positions) -> region label per Si`` assigns each surface Si to a face ('top', 'bottom',
+    'dome', ...) whose area (A^2) is in ``areas``. Returns the System (no bonded types yet) and an info dict.
+    """
+    sil = _find_silanols(bulk, keep, regions)
+    cond_pairs, per_region = _condense(sil, _condensation_candidates(bulk, sil), areas, target_density, rng)
+    removed_sil = {x for pair in cond_pairs for x in pair}
+    atoms = _SilicaAtoms(bulk, sil)
+    atoms.add_bridging(cond_pairs)
+    atoms.add_silanols(removed_sil, ff, normal, rng)
     # Q-distribution of the kept Si
-    n_oh_of_si = np.zeros(len(si_keep), int)
-    for k in range(len(silanol)):
+    n_oh_of_si = np.zeros(len(sil.si_keep), int)
+    for k in range(len(sil.silanol)):
         if k not in removed_sil:
-            n_oh_of_si[si_new[s_own[k]]] += 1
+            n_oh_of_si[atoms.si_new[sil.own[k]]] += 1
     q_counts = {f"Q{4 - m}": int(np.sum(n_oh_of_si == m)) for m in range(0, 3)}
     geminal = int(np.sum(n_oh_of_si == 2))
-    system = from_types(positions, types, ff, cell=cell, pbc=(True, True, False), bonds=bonds)
+    system = from_types(np.concatenate(atoms.positions), atoms.types, ff, cell=bulk.cell, pbc=(True, True, False),
+                        bonds=atoms.bonds)
     groups = {}
-    for lab, idx in sil_o_idx.items():
+    for lab, idx in atoms.sil_o_idx.items():
         groups[f"silanol_O_{lab}"] = idx
-        groups[f"silanol_H_{lab}"] = sil_h_idx[lab]
+        groups[f"silanol_H_{lab}"] = atoms.sil_h_idx[lab]
     system = replace(system, groups=groups)
+    _check_density(bulk, per_region, target_density, tolerance)
+    return system, {"silanol_regions": per_region, "q_distribution": q_counts, "geminal_si": geminal,
+                    "condensed_bridges": len(cond_pairs)}
+
+
+class _SilicaAtoms:
+    """The hydroxylated silica's atoms as they are assembled: kept Si, bridging O (the crystal's, then those made by
+    condensation), silanol O and H; positions, type names, bonds and the silanol atoms per face."""
+
+    def __init__(self, bulk: _Bulk, sil: _Silanols):
+        self.bulk, self.sil = bulk, sil
+        self.si_new = np.full(len(bulk.si), -1)
+        self.si_new[sil.si_keep] = np.arange(len(sil.si_keep))
+        self.positions = [bulk.si_pos[sil.si_keep]]
+        self.types = ["SC4"] * len(sil.si_keep)
+        self.bonds: list[tuple[int, int]] = []
+        self.n = len(sil.si_keep)
+        self.sil_o_idx: dict[str, list[int]] = {}
+        self.sil_h_idx: dict[str, list[int]] = {}
+
+    def add_bridging(self, cond_pairs: list[tuple[int, int]]) -> None:
+        """The crystal's bridging O, then one O midway between each condensed silanol pair's O."""
+        bulk, sil, si_new, pbc3 = self.bulk, self.sil, self.si_new, (True, True, True)
+        for o in sil.bridging.tolist():
+            s1, s2 = bulk.si_of_o[o]
+            p = bulk.si_pos[s1] + minimum_image(bulk.o_pos[o] - bulk.si_pos[s1], bulk.cell, pbc3)
+            self.positions.append(p[None])
+            self.types.append("OC23")
+            self.bonds += [(si_new[s1], self.n), (si_new[s2], self.n)]
+            self.n += 1
+        for a, b in cond_pairs:
+            sa, sb = sil.own[a], sil.own[b]
+            pa = bulk.si_pos[sa] + minimum_image(bulk.o_pos[sil.silanol[a]] - bulk.si_pos[sa], bulk.cell, pbc3)
+            pb = pa + minimum_image(bulk.o_pos[sil.silanol[b]] - pa, bulk.cell, pbc3)
+            self.positions.append((0.5 * (pa + pb))[None])
+            self.types.append("OC23")
+            self.bonds += [(si_new[sa], self.n), (si_new[sb], self.n)]
+            self.n += 1
+
+    def add_silanols(self, removed_sil: set[int], ff: ForceField, normal: Callable, rng: np.random.Generator) -> None:
+        """Every silanol not condensed: its O where the crystal had it, its H at the force field's O-H length and
+        Si-O-H angle, in the plane of the Si-O bond and the face normal (a random azimuth where they are parallel)."""
+        bulk, sil, pbc3 = self.bulk, self.sil, (True, True, True)
+        r_oh = _bond_r0(ff, "OC24", "HOY")
+        bend = math.radians(180.0 - _angle_theta0(ff, "SC4", "OC24", "HOY"))
+        for k in range(len(sil.silanol)):
+            if k in removed_sil:
+                continue
+            s = sil.own[k]
+            ps = bulk.si_pos[s]
+            po = ps + minimum_image(bulk.o_pos[sil.silanol[k]] - ps, bulk.cell, pbc3)
+            u = _unit(po - ps)
+            nrm = normal(po, sil.label_of_si[s])
+            perp = nrm - np.dot(nrm, u) * u
+            if np.linalg.norm(perp) < 1e-6:
+                perp = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
+                phi = rng.uniform(0, 2 * math.pi)
+                perp = _unit(perp)
+                perp = math.cos(phi) * perp + math.sin(phi) * np.cross(u, perp)
+            perp = _unit(perp)
+            ph = po + r_oh * (math.cos(bend) * u + math.sin(bend) * perp)
+            self.positions += [po[None], ph[None]]
+            self.types += ["OC24", "HOY"]
+            self.bonds += [(self.si_new[s], self.n), (self.n, self.n + 1)]
+            lab = str(sil.label_of_si[s])
+            self.sil_o_idx.setdefault(lab, []).append(self.n)
+            self.sil_h_idx.setdefault(lab, []).append(self.n + 1)
+            self.n += 2
+
+
+def _check_density(bulk: _Bulk, per_region: Mapping[str, Mapping[str, Any]], target_density: float,
+                   tolerance: float) -> None:
+    """Raises ValueError (naming the face, what is reachable and the face that reaches it) where a face's silanol
+    density misses ``target_density`` by more than ``tolerance`` of it."""
     for name, d in per_region.items():
         achieved, lo, hi = d["density_nm2"], d["min_density_nm2"], d["max_density_nm2"]
         if target_density > 0 and abs(achieved - target_density) > tolerance * target_density:
@@ -372,9 +420,6 @@ def _hydroxylated_silica(bulk: _Bulk, keep: np.ndarray, *, regions: Callable[[np
                 f"{2 / d['area_nm2']:.3f} (condensation Q2->Q3 only); got {achieved:.2f}. "
                 + ("Use face='001' for 3.9-7.8 OH/nm^2." if bulk.face == "111" else
                    "Use face='111' for 4.50 OH/nm^2 (Q3)." if bulk.face == "001" else ""))
-    info.update({"silanol_regions": per_region, "q_distribution": q_counts, "geminal_si": geminal,
-                 "condensed_bridges": n_condensed_o})
-    return system, info
 
 
 def _finish_silica(system: System, ff: ForceField, vacuum: float, frozen_depth: float) -> System:
