@@ -6,7 +6,8 @@ mean elastic displacement is zero, so the mean gap equals s for a map of zero me
 Rey, Pham-Ba & Molinari, J. Open Source Softw. 5 (2020) 2121; PyPI `tamaas`) solves each state by the
 Polonsky-Keer conjugate-gradient method (Polonsky & Keer, Wear 231 (1999) 206) on the gap, with the adhesion
 functional of Rey, Anciaux & Molinari, Comput. Mech. 60 (2017) 69. No summit idealisation: every contact grows,
-merges and interacts elastically with the others through the half-space.
+merges and interacts elastically with the others through the half-space (and, the map being periodic, with
+its periodic images: the cell's size is part of the reference).
 
 Cohesive law: Tamaas' `MaugisAdhesionFunctional` is Dugdale's, a constant tension gamma/rho wherever the gap is
 below rho, work of separation gamma. It is given the project's Maugis-Dugdale summit law exactly
@@ -37,7 +38,7 @@ import numpy as np
 from nanoimpact.errors import InputError
 
 from .branch_laws import DUGDALE_FACTOR
-from .quasistatic import ForceCycle, _turn
+from .quasistatic import ForceCycle, path_turn
 
 __all__ = ["BEMContact", "BEMStats", "bem_cycle", "dugdale_range"]
 
@@ -193,7 +194,7 @@ def bem_cycle(heights, physical_size, e_star: float, work_of_adhesion: float, z0
     contact = BEMContact(heights, physical_size, e_star, work_of_adhesion, z0, tolerance=tolerance,
                          length_unit=length_unit)
     path = np.asarray(path, float)
-    turn = _turn(path)
+    turn = path_turn(path)
     force, area = np.zeros(path.size), np.zeros(path.size)
     solves = free = bad = 0
     max_err = 0.0

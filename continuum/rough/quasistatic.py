@@ -28,7 +28,7 @@ import numpy as np
 
 from nanoimpact.errors import InputError
 
-__all__ = ["ForceCycle", "separation_path", "gw_cycle", "discrete_cycle", "thresholds"]
+__all__ = ["ForceCycle", "separation_path", "path_turn", "gw_cycle", "discrete_cycle", "thresholds"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,7 +74,8 @@ def separation_path(start: float, deepest: float, step: float) -> np.ndarray:
     return np.concatenate([down, down[-2::-1]])
 
 
-def _turn(path: np.ndarray) -> int:
+def path_turn(path: np.ndarray) -> int:
+    """Index of the deepest state of a closed approach-retraction path; InputError for any other path."""
     k = int(np.argmin(path))
     if not (np.all(np.diff(path[:k + 1]) < 0) and np.all(np.diff(path[k:]) > 0) and path[0] == path[-1]):
         raise InputError("path", f"{path.size} separations", "must decrease strictly to its deepest state, then "
@@ -97,7 +98,7 @@ def gw_cycle(surface, area: float, path, summit_mean_height: float) -> ForceCycl
     area `area` (m^2) along `path` (separations above the heights' mean plane, m); the summits' own mean plane
     lies `summit_mean_height` (m) above that plane."""
     path = np.asarray(path, float)
-    turn = _turn(path)
+    turn = path_turn(path)
     d = path - summit_mean_height
     zeta = thresholds(d, surface.delta_in, surface.delta_out)
     force = area * np.asarray(surface.pressure(d, zeta), float)
@@ -110,7 +111,7 @@ def discrete_cycle(law, heights, path) -> ForceCycle:
     following `law` (a `continuum.rough.branch_laws.SummitLaw`), along `path` (m)."""
     path = np.asarray(path, float)
     z = np.asarray(heights, float).ravel()
-    turn = _turn(path)
+    turn = path_turn(path)
     deepest = float(np.max(z) - path[turn]) if z.size else 0.0
     if deepest > law.delta_max:
         raise InputError("path", f"deepest {path[turn]:.3g} m", f"compresses the tallest summit by {deepest:.3g} m, "
