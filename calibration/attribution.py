@@ -117,10 +117,26 @@ def revert_table(table: Mapping[str, Any], revert: Revert) -> dict:
                            "set's values (claim attribution)")
     meta["reverted"] = {k: {"calibrated": c, "base": "scene default" if b is None else b}
                         for k, c, b in zip(revert.keys, revert.calibrated, revert.base)}
-    for key in revert.keys:
+    base_origin = _base_origin(meta.get("base"))
+    for key, base in zip(revert.keys, revert.base):
         (meta.get("calibration") or {}).pop(key, None)
-        (meta.get("sources") or {}).pop(key, None)
+        origin = meta.setdefault("origin", {})
+        origin.pop(key, None)
+        if base is not None:
+            origin[key] = base_origin.get(key) or {"kind": "chosen", "reason": "the base set's value, put back "
+                                                   "for claim attribution"}
     return out
+
+
+def _base_origin(base: str | None) -> dict:
+    """The base set's [meta.origin] ({} without a base)."""
+    if not base:
+        return {}
+    import tomllib
+
+    from continuum.scene import find_params
+
+    return dict((tomllib.loads(find_params(base).read_text()).get("meta") or {}).get("origin") or {})
 
 
 def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],

@@ -2,7 +2,10 @@
 
 Which MD quantity feeds which scene key (`MAPPING`), SI in and out; the only conversion is none:
 scene files take contact angles in degrees, as the MD results give them. Everything the MD does
-not measure (moduli, roughness statistics, SAM thickness) comes from a named base set.
+not measure (moduli, roughness statistics, SAM thickness) comes from a named base set, with the base set's
+origin ([meta.origin], continuum.origins); an MD value's origin is `md` with its run hash. A choice of the
+base set that the project can replace by a measured or derived value (`REPLACED_CHOICES`: the summit modulus
+becomes the materials' E*, the adhesion law the Tabor parameter's pick) is left out of the calibrated set.
 
 Work of adhesion: the MD adhesion workflow gives the energy difference dE/A (`work_of_adhesion`)
 and, by thermodynamic integration of the mean force over separation windows, the free energy of
@@ -11,7 +14,7 @@ separation (`work_of_adhesion_free_energy`, with its statistical stderr and the 
 (Israelachvili, Intermolecular and Surface Forces, 3rd ed., section 17.2), so the free energy is used when
 the result has it, with stderr = hypot(statistical, discretisation); dE/A is recorded beside it
 ([meta.calibration] -> `energy_estimate`), and a result without the free energy falls back to dE/A, which
-the set's sources and the report then name as "not a free energy". (The adhesion workflow before version
+the set's origin and the report then name as "not a free energy". (The adhesion workflow before version
 2 started its windows outside the adhesive well and gave W_F 20x too small; those runs no longer match
 the run hash and are not read.)
 
@@ -20,8 +23,8 @@ z0 = 1.026 W_F / sigma0 (Maugis 1992, the LJ 9-3 law), with sigma0 the curve's p
 the continuum's Maugis-Dugdale stress 1.03 dgamma / z0 reproduces the measured sigma0 with the W_F used for
 dgamma; its stderr (from the peak fit's covariance and W_F's error) goes into the uncertainty bands like every
 other. An adhesion result without a flat-slab z0 (before version 3) falls back to the pull-off z0 (a 9-3 fit
-against the rigid holder's travel: it absorbs the asperity's compliance and overstates z0), and the sources
-say so. The pull-off results are otherwise a validation: F / (2 pi R) (DMT, the limit an MD-scale asperity is
+against the rigid holder's travel: it absorbs the asperity's compliance and overstates z0), and the origin's
+note says so. The pull-off results are otherwise a validation: F / (2 pi R) (DMT, the limit an MD-scale asperity is
 in) is compared with W_F in [meta.validation].
 
 A value outside the scene schema's range, or not finite, or a contact angle the analysis could not
@@ -36,7 +39,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from continuum.scene import SceneError, check_value, find_params
+from continuum.origins import check_origins
+from continuum.scene import SceneError, check_value, find_params, flatten
 from continuum.schema import FIELD_BY_PATH
 
 from nanoimpact import data
@@ -200,33 +204,83 @@ def _get_nested(table: dict, key: str):
     return node
 
 
+#: Base-set choices a calibration replaces, where the base declares them `chosen`, by what the project measures
+#: or derives from the materials (the key is left out of the calibrated set, so the loader's default applies).
+REPLACED_CHOICES = {
+    "surfaces.roughness.summit_modulus": "the pair's effective modulus E* of the two materials (the bodies' "
+                                         "Young's moduli and Poisson ratios, whose origins the set gives); a SAM "
+                                         "with a layer modulus enters through the coated-summit model",
+    "physics.adhesion_law": "'auto': the MD-measured range z0 lets the summits' Tabor parameter pick JKR, "
+                            "Maugis-Dugdale or DMT",
+}
+
+
+def _base_table(base: str) -> tuple[dict, dict]:
+    """(the base set's table without [meta], its [meta.origin])."""
+    table = tomllib.loads(Path(find_params(base)).read_text())
+    meta = table.pop("meta", {}) or {}
+    return table, dict(meta.get("origin") or {})
+
+
+def _delete_nested(table: dict, key: str) -> None:
+    *parents, leaf = key.split(".")
+    node = table
+    for p in parents:
+        node = node.get(p)
+        if not isinstance(node, dict):
+            return
+    node.pop(leaf, None)
+    if not node and parents:
+        _delete_nested(table, ".".join(parents))
+
+
+def replace_choices(table: dict, origin: dict) -> dict:
+    """Drop the base set's `chosen` values that :data:`REPLACED_CHOICES` names (in place); returns
+    {key: {"base_value", "base_reason", "now"}} for [meta.replaced]."""
+    out = {}
+    for key, now in REPLACED_CHOICES.items():
+        entry = origin.get(key) or {}
+        if entry.get("kind") != "chosen" or _get_nested(table, key) is None:
+            continue
+        out[key] = {"base_value": _get_nested(table, key), "base_reason": entry.get("reason"), "now": now}
+        _delete_nested(table, key)
+        origin.pop(key)
+    return out
+
+
+def _effective_source(src: Source, results: dict) -> Source:
+    """The fallback where the preferred result has none of the key's quantities (an older protocol)."""
+    if src.fallback is not None and not any(q in (results.get(src.recipe) or {}).get("quantities", {})
+                                            for q in src.quantities):
+        return src.fallback
+    return src
+
+
 def build_parameter_set(results: dict[str, dict], base: str, name: str, *, description: str = "",
                         mapping=MAPPING, extra_meta: dict | None = None) -> tuple[dict, list[dict]]:
     """The set as a TOML-ready dict and one row per mapped key (used / rejected / missing).
 
-    `results` maps recipe name -> MD result.json dict. `base` is a parameter-set name or file.
+    `results` maps recipe name -> MD result.json dict. `base` is a parameter-set name or file. Every value of the
+    set carries its origin ([meta.origin], continuum.origins): `md` with the run hash for a value used here, the
+    base set's own origin for a value kept from it; the base's choices in :data:`REPLACED_CHOICES` are left out
+    ([meta.replaced] says which and what replaces them).
     """
-    base_path = find_params(base)
-    table = tomllib.loads(Path(base_path).read_text())
-    meta = table.pop("meta", {}) or {}
-    sources = dict(meta.get("sources", {}))
+    table, origin = _base_table(base)
+    replaced = replace_choices(table, origin)
     rows, calib, rejected = [], {}, {}
     water_mismatch = water_model_mismatch(results)
     for src in mapping:
-        if src.fallback is not None and not any(q in (results.get(src.recipe) or {}).get("quantities", {})
-                                                for q in src.quantities):
-            src = src.fallback                  # the preferred result has no such quantity (an older protocol)
+        src = _effective_source(src, results)
         res = results.get(src.recipe)
         row = {"key": src.key, "recipe": src.recipe, "base_value": _get_nested(table, src.key)}
+        rows.append(row)
         if res is None:
             row.update(status="missing", why=f"no {src.recipe} result")
-            rows.append(row)
             continue
         picked = _pick(res, src)
         if picked[0] is None:
             row.update(status="rejected", why=picked[1], run_hash=res.get("run_hash"))
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "why": picked[1]}
-            rows.append(row)
             continue
         qname, value, stderr, units = picked
         row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
@@ -236,79 +290,15 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             row.update(status="rejected", why=why)
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "quantity": qname,
                                  "value": value, "why": why, "kept": "base set value"}
-        else:
-            row["status"] = "used"
-            _set_nested(table, src.key, value)
-            entry = {"value": value, "units": units, "recipe": src.recipe, "quantity": qname,
-                     "fidelity": res.get("fidelity"), "run_hash": res.get("run_hash")}
-            if stderr is not None:
-                entry["stderr"] = stderr
-            qs = res.get("quantities", {})
-            if qname == "contact_angle_upper_bound":
-                how = ("W_SL by thermodynamic integration reaches 2 gamma_lv within 2 stderr" if _ti_wets(res) else
-                       "no angle measurable")
-                entry["note"] = (f"MD: the water wets (theta < {2 * value:.3g} deg, {how}); entered as "
-                                 f"uniform on [0, {2 * value:.3g}] deg: mean and stderr of that interval")
-            if qname == "contact_angle" and value <= 0.0:
-                entry["note"] = ("MD: W_SL by thermodynamic integration exceeds 2 gamma_lv by more than 2 stderr: the "
-                                 "water wets completely, theta = 0 (Young-Dupre)")
-            if res.get("workflow") == "wsl_ti":
-                ws = qs.get("work_of_adhesion_sl") or {}
-                entry["work_of_adhesion_sl"] = {"value": ws.get("value"), "stderr": ws.get("stderr"),
-                                                "discretisation_error": ws.get("discretisation_error"),
-                                                "units": "J/m^2", "note": "W_SL by thermodynamic integration; "
-                                                "theta = arccos(W_SL / gamma_lv - 1) of the same water model"}
-            flags = []
-            if qname == "contact_angle" and (qs.get("contact_angle_drift") or {}).get("drifting"):
-                entry["drifting"] = True
-                flags.append("the block angles still drift (see the MD result's notes): not equilibrated")
-            shape = (res.get("details") or {}).get("shape_check") or {}
-            if qname == "contact_angle" and shape.get("circular") is False:
-                entry["not_circular"] = True
-                flags.append(f"the mean droplet is not a circular cap: its readings spread by "
-                             f"{shape.get('spread_deg', float('nan')):.1f} deg, a systematic the stderr does not hold")
-            if flags:
-                entry["note"] = "; ".join(flags)
-            if src.note and qname in ("contact_angle", "contact_angle_upper_bound"):
-                entry["note"] = src.note + ("; " + entry["note"] if "note" in entry else "")
-            if qname == "interaction_range_z0":
-                q = qs[qname]
-                if src.note:
-                    entry["note"] = src.note
-                if "peak_traction_sigma0" in qs:
-                    sg = qs["peak_traction_sigma0"]
-                    entry["sigma0"] = {"value": sg.get("value"), "stderr": sg.get("stderr"), "units": "Pa",
-                                       "note": "peak tensile traction of the flat-slab curve; the continuum's "
-                                               "Maugis-Dugdale stress is 1.03 dgamma / z0"}
-                if q.get("dugdale_range_h0_m") is not None:
-                    entry["dugdale_range_h0"] = q["dugdale_range_h0_m"]
-            if qname == "work_of_adhesion_free_energy":
-                entry["stderr_statistical"] = qs[qname].get("stderr")
-                entry["discretisation_error"] = qs[qname].get("discretisation_error")
-                de = qs.get("work_of_adhesion", {})
-                if de.get("value") is not None:
-                    entry["energy_estimate"] = {"value": de["value"], "stderr": de.get("stderr"),
-                                                "note": "dE/A, potential-energy difference (includes T dS/A); "
-                                                        "recorded, not used"}
-            calib[src.key] = entry
-            kind = {"work_of_adhesion": "potential-energy difference dE/A (not a free energy)",
-                    "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
-                                                    "incl. the window grid's discretisation error",
-                    "contact_angle_upper_bound": "the water wets: uniform on [0, the run's upper bound]",
-                    "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
-                                             if src.recipe.startswith("adhesion") else
-                                             "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
-            if res.get("workflow") == "wsl_ti" and "work_of_adhesion_sl" in entry:
-                ws = entry["work_of_adhesion_sl"]
-                w_err = math.hypot(ws.get("stderr") or 0.0, ws.get("discretisation_error") or 0.0)
-                kind = (f"Young-Dupre from W_SL = {ws['value']:.4g} +- {w_err:.2g} J/m^2 by thermodynamic integration"
-                        + (", >= 2 gamma_lv: the water wets" if _ti_wets(res) else ""))
-            err = f"+- {stderr:.3g}" if stderr is not None else "(no stderr)"
-            sources[src.key] = (f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}, "
-                                f"run {str(res.get('run_hash'))[:16]}")
-        rows.append(row)
+            continue
+        row["status"] = "used"
+        _set_nested(table, src.key, value)
+        calib[src.key] = _calibration_entry(src, res, qname, value, stderr, units)
+        origin[src.key] = _md_origin(src, res, calib[src.key])
     out_meta = {"description": description or f"MD-calibrated set '{name}' on base '{Path(base).stem}'",
-                "base": Path(base).stem, "sources": sources, "calibration": calib}
+                "base": Path(base).stem, "origin": origin, "calibration": calib}
+    if replaced:
+        out_meta["replaced"] = replaced
     validation = pulloff_validation(results)
     if validation:
         out_meta["validation"] = validation
@@ -317,6 +307,94 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
     if extra_meta:
         out_meta.update(extra_meta)
     return {"meta": out_meta, **table}, rows
+
+
+def _calibration_entry(src: Source, res: dict, qname: str, value: float, stderr, units: str) -> dict:
+    """The [meta.calibration] entry of a used MD value: value, stderr, run, and what the quantity is."""
+    entry = {"value": value, "units": units, "recipe": src.recipe, "quantity": qname,
+             "fidelity": res.get("fidelity"), "run_hash": res.get("run_hash")}
+    if stderr is not None:
+        entry["stderr"] = stderr
+    qs = res.get("quantities", {})
+    if qname == "contact_angle_upper_bound":
+        how = ("W_SL by thermodynamic integration reaches 2 gamma_lv within 2 stderr" if _ti_wets(res) else
+               "no angle measurable")
+        entry["note"] = (f"MD: the water wets (theta < {2 * value:.3g} deg, {how}); entered as "
+                         f"uniform on [0, {2 * value:.3g}] deg: mean and stderr of that interval")
+    if qname == "contact_angle" and value <= 0.0:
+        entry["note"] = ("MD: W_SL by thermodynamic integration exceeds 2 gamma_lv by more than 2 stderr: the "
+                         "water wets completely, theta = 0 (Young-Dupre)")
+    if res.get("workflow") == "wsl_ti":
+        ws = qs.get("work_of_adhesion_sl") or {}
+        entry["work_of_adhesion_sl"] = {"value": ws.get("value"), "stderr": ws.get("stderr"),
+                                        "discretisation_error": ws.get("discretisation_error"),
+                                        "units": "J/m^2", "note": "W_SL by thermodynamic integration; "
+                                        "theta = arccos(W_SL / gamma_lv - 1) of the same water model"}
+    if qname in ("contact_angle", "contact_angle_upper_bound"):
+        _angle_flags(entry, src, res, qname)
+    if qname == "interaction_range_z0":
+        _z0_details(entry, src, qs)
+    if qname == "work_of_adhesion_free_energy":
+        entry["stderr_statistical"] = qs[qname].get("stderr")
+        entry["discretisation_error"] = qs[qname].get("discretisation_error")
+        de = qs.get("work_of_adhesion", {})
+        if de.get("value") is not None:
+            entry["energy_estimate"] = {"value": de["value"], "stderr": de.get("stderr"),
+                                        "note": "dE/A, potential-energy difference (includes T dS/A); "
+                                                "recorded, not used"}
+    return entry
+
+
+def _angle_flags(entry: dict, src: Source, res: dict, qname: str) -> None:
+    """A droplet angle's caveats in the entry's note: drifting block angles, a non-circular cap, a fallback."""
+    qs = res.get("quantities", {})
+    flags = []
+    if qname == "contact_angle" and (qs.get("contact_angle_drift") or {}).get("drifting"):
+        entry["drifting"] = True
+        flags.append("the block angles still drift (see the MD result's notes): not equilibrated")
+    shape = (res.get("details") or {}).get("shape_check") or {}
+    if qname == "contact_angle" and shape.get("circular") is False:
+        entry["not_circular"] = True
+        flags.append(f"the mean droplet is not a circular cap: its readings spread by "
+                     f"{shape.get('spread_deg', float('nan')):.1f} deg, a systematic the stderr does not hold")
+    if flags:
+        entry["note"] = "; ".join(flags)
+    if src.note:
+        entry["note"] = src.note + ("; " + entry["note"] if "note" in entry else "")
+
+
+def _z0_details(entry: dict, src: Source, qs: dict) -> None:
+    """z0's peak traction sigma0 and Dugdale range, and the fallback's note."""
+    q = qs["interaction_range_z0"]
+    if src.note:
+        entry["note"] = src.note
+    if "peak_traction_sigma0" in qs:
+        sg = qs["peak_traction_sigma0"]
+        entry["sigma0"] = {"value": sg.get("value"), "stderr": sg.get("stderr"), "units": "Pa",
+                           "note": "peak tensile traction of the flat-slab curve; the continuum's "
+                                   "Maugis-Dugdale stress is 1.03 dgamma / z0"}
+    if q.get("dugdale_range_h0_m") is not None:
+        entry["dugdale_range_h0"] = q["dugdale_range_h0_m"]
+
+
+def _md_origin(src: Source, res: dict, entry: dict) -> dict:
+    """The [meta.origin] entry of a used MD value: kind 'md', the run hash, and one line saying what was measured."""
+    qname, value, units, stderr = entry["quantity"], entry["value"], entry["units"], entry.get("stderr")
+    kind = {"work_of_adhesion": "potential-energy difference dE/A (not a free energy)",
+            "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
+                                            "incl. the window grid's discretisation error",
+            "contact_angle_upper_bound": "the water wets: uniform on [0, the run's upper bound]",
+            "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
+                                     if src.recipe.startswith("adhesion") else
+                                     "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
+    if res.get("workflow") == "wsl_ti" and "work_of_adhesion_sl" in entry:
+        ws = entry["work_of_adhesion_sl"]
+        w_err = math.hypot(ws.get("stderr") or 0.0, ws.get("discretisation_error") or 0.0)
+        kind = (f"Young-Dupre from W_SL = {ws['value']:.4g} +- {w_err:.2g} J/m^2 by thermodynamic integration"
+                + (", >= 2 gamma_lv: the water wets" if _ti_wets(res) else ""))
+    err = f"+- {stderr:.3g}" if stderr is not None else "(no stderr)"
+    return {"kind": "md", "run_hash": str(res.get("run_hash")), "recipe": src.recipe,
+            "note": f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}"}
 
 
 def pulloff_validation(results: dict[str, dict]) -> dict:
@@ -387,13 +465,14 @@ def to_toml(table: dict, header: str = "") -> str:
 
 
 def write_parameter_set(table: dict, path: Path, header: str = "") -> Path:
-    """Write atomically and check that the file parses back and loads as a parameter set."""
+    """Write atomically and check that the file parses back and that every value has its origin."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     text = to_toml(table, header)
     parsed = tomllib.loads(text)
     if parsed.get("surfaces") != table.get("surfaces"):
         raise RuntimeError("parameter set did not round-trip through TOML")
+    check_origins(parsed.get("meta"), flatten(parsed, str(path), skip=("meta",)), str(path))
     atomic_write_text(path, text)
     return path
 

@@ -87,6 +87,13 @@ class CalibrationReport:
     versions: Mapping[str, str] = field(default_factory=versions)
 
     @property
+    def set_meta(self) -> Mapping[str, Any]:
+        """The written set's [meta] (origins, replaced choices), read from `set_path`."""
+        import tomllib
+
+        return tomllib.loads(Path(self.set_path).read_text()).get("meta") or {}
+
+    @property
     def used(self) -> tuple[ValueRow, ...]:
         return tuple(r for r in self.rows if r.status == "used")
 
@@ -164,9 +171,31 @@ def _validation_lines(validation: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+def _chosen_lines(meta: Mapping[str, Any]) -> list[str]:
+    """What the set still chooses (origin `chosen`, with each reason), then what it replaced, then a count of the
+    rest by origin: first in the report, because a prediction rests on these choices."""
+    origin = meta.get("origin") or {}
+    chosen = [(k, e) for k, e in origin.items() if e.get("kind") == "chosen"]
+    lines = ["## Still chosen", "",
+             (f"{len(chosen)} of the set's {len(origin)} values are declared choices, not measurements "
+              "([meta.origin], docs/calibration.md):" if chosen else
+              f"None: every one of the set's {len(origin)} values is measured or a material constant."), ""]
+    lines += [f"- `{k}`: {e['reason']}" for k, e in chosen]
+    replaced = meta.get("replaced") or {}
+    if replaced:
+        lines += ["", "Choices of the base set replaced here:", ""]
+        lines += [f"- `{k}`: the base's {v.get('base_value')!r} ({v.get('base_reason')}) gives way to {v.get('now')}"
+                  for k, v in replaced.items()]
+    kinds: dict[str, int] = {}
+    for e in origin.values():
+        kinds[e.get("kind")] = kinds.get(e.get("kind"), 0) + 1
+    lines += ["", "Origins: " + ", ".join(f"{n} {k}" for k, n in kinds.items()) + ".", ""]
+    return lines
+
+
 def report_markdown(rec: CalibrationReport) -> str:
     cal, t, m = rec.calibration, rec.timings, rec.machine
-    lines = [f"# Calibration `{cal.name}` (base `{cal.base}`)", "",
+    lines = [f"# Calibration `{cal.name}` (base `{cal.base}`)", "", *_chosen_lines(rec.set_meta),
              f"Recipe `{cal.path}`; machine: {m['cores']} cores, {m['platform']}, Python {m['python']}; "
              f"nanoimpact {rec.versions.get('nanoimpact')}, NumPy {rec.versions.get('numpy')}, SciPy "
              f"{rec.versions.get('scipy')}. MD compute (the runs themselves, from their results): "
@@ -186,7 +215,7 @@ def report_markdown(rec: CalibrationReport) -> str:
     sets = sorted({c["set"] for c in rec.paper_checks})
     lines += _validation_lines(rec.validation)
     lines += ["", "MD jobs: " + "; ".join(f"{k}: {v['source']}" for k, v in rec.md_sources.items()), "",
-              "A rejected or missing value keeps the base set's value (its [meta.sources] entry says so).",
+              "A rejected or missing value keeps the base set's value (with the base set's [meta.origin] entry).",
               _work_sentence(rec.rows),
               "", "## The paper's claims per set", "",
               "| claim | " + " | ".join(sets) + " |", "|---|" + "---|" * len(sets)]

@@ -36,13 +36,18 @@ def bounce_table(bounces: list[dict]) -> str:
 
 
 def check_params_set(spec: str) -> Path:
-    """A parameter set (name or file) that exists, parses and whose every value passes the scene checks."""
+    """A parameter set (name or file) that exists, parses, whose every value passes the scene checks and has an
+    origin ([meta.origin], continuum.origins)."""
     from continuum.scene import FIELD_BY_PATH, check_value, find_params, flatten, read_toml
 
+    from continuum.origins import check_origins
+
     path = find_params(spec)
-    flat = flatten(read_toml(path, "params"), str(path), skip=("meta",))
+    raw = read_toml(path, "params")
+    flat = flatten(raw, str(path), skip=("meta",))
     for key, value in flat.items():
         check_value(FIELD_BY_PATH[key], value, str(path))
+    check_origins(raw.get("meta"), flat, str(path))
     return path
 
 

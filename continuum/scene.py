@@ -20,6 +20,7 @@ from nanoimpact import data
 from nanoimpact.errors import DataNotFound, InputError
 from nanoimpact.fields import Resolved, frozen_dataclass, resolved, section_members
 
+from .origins import check_origins
 from .reference.hertz import effective_modulus
 from .rough.surface_map import map_statistics, statistics_block
 from .rough.topography import KEY_FILE, KEY_SYNTH, TopographyError
@@ -299,6 +300,7 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
                                  str(params_file))
         for path, value in flat_params.items():
             check_value(FIELD_BY_PATH[path], value, str(params_file))
+        check_origins(params_meta, flat_params, str(params_file))
         flat_scene = {**flat_scene, "params": str(params_spec)}
 
     values, sources = {}, {}
@@ -314,6 +316,9 @@ def resolve_scene(scene_file: str | Path | None = None, *, table: dict | None = 
             continue
         else:
             values[f.path], sources[f.path] = f.default, "default"
+    if values.get("surfaces.sam.coverage") != "both" and sources.get("surfaces.sam.layer_modulus") == set_label:
+        # a parameter set describes its SAM whether or not a scene covers the surfaces with it
+        values["surfaces.sam.layer_modulus"], sources["surfaces.sam.layer_modulus"] = None, f"{set_label} (no SAM)"
     if values.get("name") is None:
         values["name"] = Path(scene_file).stem if scene_file is not None else "scene"
         sources["name"] = "file name"

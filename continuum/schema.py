@@ -79,10 +79,11 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.sam.work_of_adhesion", float, "J/m^2", "Work of adhesion between the two SAM-covered "
           "surfaces.", None, low=0.0, high=10.0),
     Field("surfaces.sam.contact_angle", doc="Water contact angle on the SAM.", default=None, **_ANGLE),
-    Field("surfaces.sam.layer_modulus", float, "Pa", "Young's modulus of the SAM as a compliant layer in series "
-          "with every summit (thin-layer, Winkler limit; needs surfaces.sam.thickness). Not set: the layer is rigid "
-          "and only shifts every gap equally.", None, low=1e6, high=1e12),
-    Field("surfaces.sam.layer_poisson_ratio", doc="Poisson's ratio of the SAM layer (confined modulus).",
+    Field("surfaces.sam.layer_modulus", float, "Pa", "Young's modulus of the SAM as a compliant layer on every "
+          "summit (rough contact; needs surfaces.sam.thickness): the summits' contact modulus becomes the coated "
+          "pair's equivalent modulus (Perriot & Barthel 2004; docs/model.md, Coated summits). Not set: the layer is "
+          "rigid and only shifts every gap equally.", None, low=1e6, high=1e12),
+    Field("surfaces.sam.layer_poisson_ratio", doc="Poisson's ratio of the SAM layer (its plane-strain modulus).",
           default=0.3, **_POISSON),
     Field("surfaces.sam.interaction_range", float, "m", "Range z0 of the SAM-SAM attraction (Tabor parameter, "
           "Maugis-Dugdale stress) when both surfaces are covered; not set: surfaces.interaction_range.", None,
@@ -98,8 +99,9 @@ FIELDS: tuple[Field, ...] = (
           low=1e6, high=1e20),
     Field("surfaces.roughness.summit_radius", float, "m", "Tip radius of every summit (beta).", None,
           low=1e-10, high=1e-2),
-    Field("surfaces.roughness.summit_modulus", float, "Pa", "Effective modulus E* of the summit contacts "
-          "(e.g. a compliant surface layer); default: E* of the two surfaces.", None, low=1e6, high=1e13),
+    Field("surfaces.roughness.summit_modulus", float, "Pa", "Effective modulus E* of the contacts "
+          "of bare summits; default: E* of the two surfaces' materials. A SAM with a layer modulus coats them.", None,
+          low=1e6, high=1e13),
     Field("surfaces.roughness.datum", str, "", "Where release_height is measured from: the tallest summit "
           "expected in the nominal footprint (default), or the summits' mean plane.", "tallest_summit",
           choices=("tallest_summit", "mean_plane")),
@@ -245,7 +247,8 @@ def json_schema() -> dict:
                              description="A scene file or parameter set (TOML, SI units; angles in degrees). "
                                          "Required keys may come from the scene's parameter set, so none is "
                                          "required here; the loader checks the merged scene. See docs/scenes.md.")
-    doc["properties"]["meta"] = {"type": "object", "description": "Parameter sets: sources and provenance."}
+    doc["properties"]["meta"] = {"type": "object", "description": "Parameter sets: description, provenance, and "
+                                 "[meta.origin], each value's origin (continuum.origins)."}
     return doc
 
 

@@ -54,9 +54,15 @@ def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
     assert w["quantity"] == "work_of_adhesion_free_energy"
     assert w["stderr"] == pytest.approx(0.05) and w["stderr_statistical"] == 0.03   # hypot(0.03, grid 0.04)
     assert w["discretisation_error"] == 0.04 and w["energy_estimate"]["value"] == 0.21
-    assert "free energy" in table["meta"]["sources"]["surfaces.work_of_adhesion"]
+    origin = table["meta"]["origin"]
+    assert origin["surfaces.work_of_adhesion"]["kind"] == "md" and "free energy" in origin["surfaces.work_of_adhesion"]["note"]
+    assert origin["surfaces.work_of_adhesion"]["run_hash"] == results["adhesion_silica"]["run_hash"]
     assert cal["menisci.surface_tension"]["run_hash"] == _results()["surface_tension_spce"]["run_hash"]
-    assert s["roughness"]["summit_modulus"] == 10e9            # from the base set
+    assert s["roughness"]["summit_radius"] == 0.2e-6            # from the base set, with its origin
+    assert origin["surfaces.roughness.summit_radius"]["kind"] == "chosen"
+    # the base's chosen summit modulus and adhesion law give way to the materials' E* and the Tabor parameter
+    assert "summit_modulus" not in s["roughness"] and "physics" not in table
+    assert set(table["meta"]["replaced"]) == {"surfaces.roughness.summit_modulus", "physics.adhesion_law"}
     assert all(r["status"] == "used" for r in rows)
     path = write_parameter_set(table, tmp_path / "cal.toml", header="test set")
     assert tomllib.loads(path.read_text())["meta"]["calibration"]["surfaces.sam.contact_angle"]["value"] == 108.0
@@ -70,7 +76,7 @@ def test_without_a_free_energy_the_energy_difference_is_used_and_named():
     table, _ = build_parameter_set(res, "paper", "cal")
     assert table["surfaces"]["work_of_adhesion"] == 0.21
     assert table["meta"]["calibration"]["surfaces.work_of_adhesion"]["quantity"] == "work_of_adhesion"
-    assert "not a free energy" in table["meta"]["sources"]["surfaces.work_of_adhesion"]
+    assert "not a free energy" in table["meta"]["origin"]["surfaces.work_of_adhesion"]["note"]
 
 
 def test_unusable_md_values_keep_the_base_value_and_say_so():
@@ -150,6 +156,7 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     from calibration.report import CalibrationReport, ValueRow
 
     table, rows = build_parameter_set(_results(), "paper", "cal")
+    write_parameter_set(table, tmp_path / "cal.toml")
     recipe = CalibrationRecipe(name="cal", base="paper", path="recipe.toml", compare_sets=[],
                                uncertainty=Uncertainty(scene="s", ranges={}, overrides={}))
     band = {"median": 0.5, "p05": 0.4, "p95": 0.6, "n": 4}
@@ -174,6 +181,11 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     md = report.write()
     text = md.read_text()
     assert "1 of 2 claims hold" in text and "`claim_b`: needs t2" in text
+    # what the set still chooses comes first, each with its reason; the replaced base choices after it
+    assert text.index("## Still chosen") < text.index("## MD values")
+    reason = table["meta"]["origin"]["surfaces.roughness.summit_radius"]["reason"]
+    assert f"- `surfaces.roughness.summit_radius`: {reason}" in text
+    assert "- `surfaces.roughness.summit_modulus`: the base's 10000000000.0" in text
     assert '`claim_b`: needs t2; got {"v": 1}. **Why:** holds again when only W is put back.' in text
     assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 | 0.03 | " \
            "none quoted | - |" in text

@@ -117,7 +117,10 @@ def test_good_scene_converts_degrees_and_derives_mass_from_density():
 
 def test_params_set_is_overridden_by_scene_values_and_sources_recorded(tmp_path):
     pset = tmp_path / "mine.toml"
-    pset.write_text("[surfaces]\nwork_of_adhesion = 0.3\n[surfaces.body]\nyoungs_modulus = 1e11\n")
+    pset.write_text("[meta.origin]\n"
+                    '"surfaces.work_of_adhesion" = { kind = "chosen", reason = "test" }\n'
+                    '"surfaces.body.youngs_modulus" = { kind = "material", source = "test" }\n'
+                    "[surfaces]\nwork_of_adhesion = 0.3\n[surfaces.body]\nyoungs_modulus = 1e11\n")
     table = _with("surfaces.body.youngs_modulus", 2e11)
     resolved = resolve_scene(table=table, params=str(pset))
     assert resolved.scene.surfaces.body.youngs_modulus == 2e11
@@ -133,7 +136,9 @@ def test_params_set_is_overridden_by_scene_values_and_sources_recorded(tmp_path)
 def test_command_line_params_replace_the_scenes_set(tmp_path):
     scene_file = ROOT / "inputs" / "scenes" / "hertz_roller.toml"
     alt = tmp_path / "soft.toml"
-    alt.write_text("[surfaces.body]\nyoungs_modulus = 1e10\npoisson_ratio = 0.3\n"
+    origin = "".join(f'"surfaces.{side}.{k}" = {{ kind = "chosen", reason = "a soft test material" }}\n'
+                     for side in ("body", "substrate") for k in ("youngs_modulus", "poisson_ratio"))
+    alt.write_text("[meta.origin]\n" + origin + "[surfaces.body]\nyoungs_modulus = 1e10\npoisson_ratio = 0.3\n"
                    "[surfaces.substrate]\nyoungs_modulus = 1e10\npoisson_ratio = 0.3\n")
     resolved = resolve_scene(scene_file, params=str(alt))
     assert resolved.scene.surfaces.body.youngs_modulus == 1e10

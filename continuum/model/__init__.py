@@ -21,13 +21,13 @@ from __future__ import annotations
 from .decisions import (LAW_NAMES, NEGLIGIBLE_DEFLECTION, NEGLIGIBLE_LOSS, NEGLIGIBLE_PULL, TABOR_DMT, TABOR_JKR,
                         AdhesionDecision, DryRunVerdict, HalfSpaceDecision, MenisciDecision, adhesion_decision,
                         dry_run_verdict, half_space_decision, loop_per_summit, menisci_decision, summit_law)
-from .regime import Regime, meniscus_parameters, regime_of, sam_layer, summit_e_star
+from .regime import Regime, coated_summits, meniscus_parameters, regime_of, summit_e_star
 from .select import FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, LARGE_TABLE_SECONDS, rough_law, select_law
 
 __all__ = [
     "AdhesionDecision", "DryRunVerdict", "HalfSpaceDecision", "MenisciDecision", "Regime",
     "adhesion_decision", "dry_run_verdict", "half_space_decision", "menisci_decision", "regime_of",
-    "meniscus_parameters", "sam_layer", "summit_e_star", "summit_law", "loop_per_summit",
+    "meniscus_parameters", "coated_summits", "summit_e_star", "summit_law", "loop_per_summit",
     "rough_law", "select_law",
     "FAST_TABLE_MIN_SIGMA_OVER_DELTA_C", "LARGE_TABLE_SECONDS", "LAW_NAMES", "NEGLIGIBLE_DEFLECTION",
     "NEGLIGIBLE_LOSS", "NEGLIGIBLE_PULL", "TABOR_DMT", "TABOR_JKR",

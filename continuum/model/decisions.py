@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 from .. import menisci as men
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
-from .regime import Regime, meniscus_parameters, sam_layer, summit_e_star
+from .regime import Regime, meniscus_parameters, summit_e_star
 
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
 TABOR_JKR, TABOR_DMT = 5.0, 0.1
@@ -51,7 +51,7 @@ def summit_law(name: str, scene: Scene):
 
     surf = scene.surfaces
     beta, w, e_s = surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star(scene)
-    return make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range, layer=sam_layer(scene),
+    return make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range,
                            detachment=scene.physics.detachment, delta_max=30.0 * surf.roughness.sigma)
 
 
@@ -59,7 +59,7 @@ def loop_per_summit(name: str, scene: Scene) -> float:
     """Energy (J) one summit loses per approach-retreat cycle under `name`."""
     if name == "none":
         return 0.0
-    if name == "jkr" and sam_layer(scene) is None:
+    if name == "jkr":
         surf = scene.surfaces
         return float(jkr_ref.loop_area(surf.roughness.summit_radius, surf.interface_work_of_adhesion,
                                        summit_e_star(scene), detachment=scene.physics.detachment))
@@ -70,9 +70,9 @@ def pull_off_per_summit(name: str, scene: Scene) -> float:
     """Pull-off force (N) of one summit under `name`."""
     surf = scene.surfaces
     beta, w = surf.roughness.summit_radius, surf.interface_work_of_adhesion
-    if name == "jkr" and sam_layer(scene) is None:
+    if name == "jkr":
         return float(jkr_ref.pull_off_force(beta, w))
-    if name == "dmt" and sam_layer(scene) is None:
+    if name == "dmt":
         return 2.0 * math.pi * beta * w
     return float(summit_law(name, scene).pull_off_force)
 
@@ -135,8 +135,8 @@ def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
                 fuller_tabor_theta=regime.fuller_tabor_theta)
     mu = regime.tabor_parameter
     if phys.adhesion_law != "auto":
-        return AdhesionDecision(phys.adhesion_law, "scene", f"physics.adhesion_law = '{phys.adhesion_law}' set in the scene",
-                                **base)
+        return AdhesionDecision(phys.adhesion_law, "scene", f"physics.adhesion_law = '{phys.adhesion_law}' given by the "
+                                "scene or its parameter set (result.json -> scene.sources says which)", **base)
     if w <= 0.0:
         return AdhesionDecision("none", "work_of_adhesion", "auto: no work of adhesion, Hertz contact", **base)
     if scene.contact == "smooth":
@@ -150,7 +150,7 @@ def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
     loop = loop_per_summit(law, scene)
     n_pull = pull_off_per_summit(law, scene)
     estimate = regime.estimate
-    if estimate is not None:
+    if estimate is not None and estimate.impact_energy > 0:        # no impact (a quasi-static curve): no loss to weigh
         loss = estimate.contacts * loop / estimate.impact_energy
         pull = estimate.contacts * n_pull / estimate.peak_force if estimate.peak_force > 0 else math.inf
         base.update(estimated_loss_fraction=loss, estimated_pull_fraction=pull, loop_energy_per_summit=loop)

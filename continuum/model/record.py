@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 
 from ..scene import Scene
-from .regime import Regime
+from .regime import Regime, coated_summits
 
 #: The estimate's record says what it is.
 ESTIMATE_WHAT = ("quasi-static first approach of Hertz summits on a rigid substrate absorbing the first impact's "
@@ -31,14 +31,16 @@ def sam_record(scene: Scene) -> dict:
         return {"used": False, "why": "surfaces.sam.coverage = 'none'"}
     rec = {"used": True, "thickness": sam.thickness, "work_of_adhesion": sam.work_of_adhesion,
            "contact_angle_deg": math.degrees(sam.contact_angle) if sam.contact_angle is not None else None}
-    if sam.layer_modulus is None:
-        rec["layer"] = {"used": False, "why": "no surfaces.sam.layer_modulus: a rigid uniform layer conforming to "
-                                              "the summits shifts all gaps equally and does not enter the mechanics"}
+    coated = coated_summits(scene)
+    if coated is None:
+        why = ("no surfaces.sam.layer_modulus: a rigid uniform layer conforming to the summits shifts all gaps "
+               "equally and does not enter the mechanics" if sam.layer_modulus is None else
+               "smooth contact: the coated-summit model is for rough contact")
+        rec["layer"] = {"used": False, "why": why}
     else:
-        rec["layer"] = {"used": True, "total_thickness": 2.0 * sam.thickness, "modulus": sam.layer_modulus,
-                        "poisson_ratio": sam.layer_poisson_ratio,
-                        "why": "compliant layers on both surfaces in series with every summit contact "
-                               "(thin-layer limit, continuum.rough.summit_laws)"}
+        rec["layer"] = {"used": True, "modulus": sam.layer_modulus, "poisson_ratio": sam.layer_poisson_ratio,
+                        **coated, "why": "a compliant layer on each summit: the summits' contact modulus is the "
+                                         "coated pair's equivalent modulus (docs/model.md, Coated summits)"}
     rec["why"] = "both surfaces covered: SAM-SAM work of adhesion and contact angle"
     return rec
 

@@ -1,5 +1,6 @@
-"""The numbers that place a scene, computed once: summit modulus and layers, Tabor and Fuller-Tabor
-parameters, plasticity index, the first impact's estimate, and the menisci's parameters.
+"""The numbers that place a scene, computed once: summit modulus (coated summits where the SAM has a layer
+modulus), Tabor and Fuller-Tabor parameters, plasticity index, the first impact's estimate, and the menisci's
+parameters.
 
 Every decision (`continuum.model.decisions`) and record (`continuum.model.record`) reads them from one
 `Regime`, so no number is computed twice with different guards.
@@ -15,21 +16,45 @@ from ..estimates import RoughImpactEstimate, rough_impact_estimate
 from ..scene import Scene
 
 
-def summit_e_star(scene: Scene) -> float:
-    """Contact modulus of the summits (Pa): surfaces.roughness.summit_modulus, else the bodies' E*."""
+def substrate_e_star(scene: Scene) -> float:
+    """Contact modulus of the bare summits (Pa): surfaces.roughness.summit_modulus, else the bodies' E*."""
     rough = scene.surfaces.roughness
     return rough.summit_modulus if rough.summit_modulus is not None else scene.surfaces.e_star
 
 
-def sam_layer(scene: Scene) -> tuple[float, float, float] | None:
-    """(total thickness m, Young's modulus Pa, Poisson's ratio) of the SAM layers in series, or None.
+def coated_summits(scene: Scene) -> dict | None:
+    """The SAM as a compliant layer on every summit (continuum.physics.coated), or None without a layer modulus.
 
-    Both surfaces carry a layer of surfaces.sam.thickness, so a summit contact compresses two.
-    """
-    sam = scene.surfaces.sam
-    if sam is None or sam.layer_modulus is None:
+    Both surfaces carry a layer of surfaces.sam.thickness. The substrates' plane-strain moduli are the bodies'
+    E/(1 - nu^2), or 2 x surfaces.roughness.summit_modulus on each side where that is given. Returns the coated
+    E* (Pa), the reference contact radius (m) it is evaluated at, and the inputs."""
+    from ..physics import coated
+
+    sam, surf = scene.surfaces.sam, scene.surfaces
+    if sam is None or sam.layer_modulus is None or scene.contact != "rough":
         return None
-    return 2.0 * sam.thickness, sam.layer_modulus, sam.layer_poisson_ratio
+    rough = surf.roughness
+    e_f = coated.plane_strain_modulus(sam.layer_modulus, sam.layer_poisson_ratio)
+    if rough.summit_modulus is not None:
+        e_1 = e_2 = 2.0 * rough.summit_modulus
+    else:
+        e_1 = coated.plane_strain_modulus(surf.body.youngs_modulus, surf.body.poisson_ratio)
+        e_2 = coated.plane_strain_modulus(surf.substrate.youngs_modulus, surf.substrate.poisson_ratio)
+    e_star, a_ref = coated.coated_summit_modulus(rough.summit_radius, surf.interface_work_of_adhesion, rough.sigma,
+                                                 sam.thickness, e_f, e_1, e_2)
+    return {"e_star": e_star, "reference_radius": a_ref, "reference_radius_over_thickness": a_ref / sam.thickness,
+            "substrate_e_star": substrate_e_star(scene), "layer_plane_strain_modulus": e_f,
+            "thickness_each_side": sam.thickness,
+            "reference": "JKR zero-load radius" if surf.interface_work_of_adhesion > 0 else "sqrt(beta sigma)",
+            "model": "Perriot & Barthel (2004) equivalent modulus of each coated summit, compliances in series, "
+                     "frozen at the reference radius (continuum.physics.coated)"}
+
+
+def summit_e_star(scene: Scene) -> float:
+    """Contact modulus of the summits (Pa): the coated summits' E* where the SAM has a layer modulus, else
+    surfaces.roughness.summit_modulus, else the bodies' E*."""
+    coated = coated_summits(scene)
+    return coated["e_star"] if coated is not None else substrate_e_star(scene)
 
 
 def first_impact_speed(scene: Scene) -> float:

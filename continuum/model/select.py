@@ -13,7 +13,7 @@ from . import factory
 from . import record as rec
 from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, for_discrete_summits, half_space_decision,
                         menisci_decision, summit_law)
-from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of, sam_layer
+from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
@@ -64,7 +64,7 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
     e_s = regime.e_star
     table = scene.numerics.table
-    generic = adhesion in ("dmt", "maugis_dugdale") or sam_layer(scene) is not None
+    generic = adhesion in ("dmt", "maugis_dugdale")
     cost = None
     slaw = None
     if rough.mode != "discrete":

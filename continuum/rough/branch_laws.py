@@ -40,13 +40,8 @@ Models (SI; E* Johnson's contact modulus, dgamma Dupre's work of adhesion)
     meets the non-contact part at c_e exactly (tested: c, delta and P agree to 1e-9).
   Folds of this curve give the jumps: for large lambda the summit snaps into contact at
   delta -> 0 and out at -> -delta_c (JKR); for small lambda the curve has no fold and no loop (DMT).
-* A compliant layer in series (a SAM of total thickness t, Young's modulus E_l, Poisson ratio nu_l):
-  the loaded disc of radius r (a for JKR and DMT's Hertz part, the cohesive radius c for
-  Maugis-Dugdale) presses the layer with stiffness k = M pi r^2/t + 2 E_l* r, M = E_l(1-nu_l)/
-  ((1+nu_l)(1-2 nu_l)) the confined modulus (thin bonded layer, Winkler limit: Johnson, Contact
-  Mechanics §5.8) plus the layer-material half-space term that takes over when r < t (flat punch,
-  E_l* = E_l/(1-nu_l^2)); every curve point moves by delta += P/k. The folds, the jump-out and the
-  loop follow from the modified curve; a stiff layer recovers the bare law.
+* A SAM as a compliant layer on each summit does not enter here: the laws take the coated summits' contact
+  modulus E* (``continuum.physics.coated``, ``continuum.model.regime.coated_summits``).
 
 Cost: building a Maugis-Dugdale law solves Maugis' equation at ~2000 contact radii (~0.2 s); JKR and
 DMT are closed form. Branches are tabulated on ~4000 points and evaluated by linear interpolation
@@ -265,50 +260,38 @@ class SummitLaw:
 
 
 # ----------------------------------------------------------------------------- curves
-def _layer_shift(force, loaded_radius, layer):
-    """delta shift (m) of a compliant layer in series: P / (M pi r^2/t + 2 E_l* r)."""
-    if layer is None:
-        return 0.0
-    t, e_l, nu = layer
-    m = e_l * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
-    e_ls = e_l / (1 - nu * nu)
-    r = np.maximum(loaded_radius, 1e-300)
-    k = m * np.pi * r * r / t + 2.0 * e_ls * r
-    return np.where(loaded_radius > 0, force / k, 0.0)
-
-
 def _radii(a_max, a_min, n):
     u = np.linspace(0.0, 1.0, n)
     return a_min + (a_max - a_min) * u**2
 
 
-def jkr_law(beta, w, e_star, *, delta_max, layer=None, n=4000) -> SummitLaw:
-    """JKR summit with Fuller-Tabor jumps (displacement-controlled release), optional layer."""
+def jkr_law(beta, w, e_star, *, delta_max, n=4000) -> SummitLaw:
+    """JKR summit with Fuller-Tabor jumps (displacement-controlled release)."""
     a_touch = float(jkr_ref.contact_radius_at_touch(beta, w, e_star))
     a_max = math.sqrt(beta * (delta_max + 2 * float(jkr_ref.critical_approach(beta, w, e_star)))) * 1.2 + 2 * a_touch
     a = _radii(a_max, 0.0, n)
     p = np.asarray(jkr_ref.force_from_radius(a, beta, w, e_star), float)
-    d = np.asarray(jkr_ref.approach_from_radius(a, beta, w, e_star), float) + _layer_shift(p, a, layer)
-    return SummitLaw("jkr", beta, w, e_star, (d, p, a, a), delta_max=delta_max, extra={"layer": layer})
+    d = np.asarray(jkr_ref.approach_from_radius(a, beta, w, e_star), float)
+    return SummitLaw("jkr", beta, w, e_star, (d, p, a, a), delta_max=delta_max)
 
 
-def dmt_law(beta, w, e_star, *, delta_max, layer=None, n=4000) -> SummitLaw:
-    """DMT summit: Hertz minus 2 pi beta dgamma in contact, no loop; optional layer (Hertz part)."""
+def dmt_law(beta, w, e_star, *, delta_max, n=4000) -> SummitLaw:
+    """DMT summit: Hertz minus 2 pi beta dgamma in contact, no loop."""
     a_max = math.sqrt(beta * delta_max) * 1.2
     a = _radii(a_max, 0.0, n)
     p_h = 4.0 * e_star * a**3 / (3.0 * beta)
-    d = a * a / beta + _layer_shift(p_h, a, layer)
+    d = a * a / beta
     p = p_h - 2.0 * math.pi * beta * w
     # the free state holds for delta < 0; the curve starts at touch with the adhesive force at once
     d = np.concatenate([[0.0], d])
     p = np.concatenate([[0.0], p])
     a = np.concatenate([[0.0], a])
     d[1] = np.nextafter(0.0, 1.0)
-    return SummitLaw("dmt", beta, w, e_star, (d, p, a, a), delta_max=delta_max, extra={"layer": layer})
+    return SummitLaw("dmt", beta, w, e_star, (d, p, a, a), delta_max=delta_max)
 
 
-def maugis_dugdale_law(beta, w, e_star, z0, *, delta_max, layer=None, n_contact=2000, n_free=400) -> SummitLaw:
-    """Maugis-Dugdale summit (sigma0 = 1.03 dgamma/z0) with non-contact and contact parts; optional layer."""
+def maugis_dugdale_law(beta, w, e_star, z0, *, delta_max, n_contact=2000, n_free=400) -> SummitLaw:
+    """Maugis-Dugdale summit (sigma0 = 1.03 dgamma/z0) with non-contact and contact parts."""
     sigma0 = DUGDALE_FACTOR * w / z0
     h0 = w / sigma0
     lam = float(md_ref.md_parameter(beta, w, e_star, sigma0))
@@ -318,26 +301,24 @@ def maugis_dugdale_law(beta, w, e_star, z0, *, delta_max, layer=None, n_contact=
     c = np.linspace(0.0, c_e, n_free)
     d_nc = c * c / (2 * beta) - 4 / math.pi * k * c - h0
     p_nc = -math.pi * sigma0 * c * c
-    d_nc = d_nc + _layer_shift(p_nc, c, layer)
     a_top = math.sqrt((delta_max + 4 * d_s) / d_s) * 1.2 + 2.0          # A with Dbar ~ A^2 beyond delta_max
     A = _radii(a_top, 1e-6, n_contact)
     pbar, dbar = md_ref.md_force_and_approach(A, lam)
     m = np.asarray(md_ref.md_m_of_A(A, lam), float)
     p_c = np.asarray(pbar, float) * p_s
     cz = m * A * a_s
-    d_c = np.asarray(dbar, float) * d_s + _layer_shift(p_c, cz, layer)
+    d_c = np.asarray(dbar, float) * d_s
     d = np.concatenate([d_nc, d_c])
     p = np.concatenate([p_nc, p_c])
     a = np.concatenate([c, cz])
     ac = np.concatenate([np.zeros_like(c), A * a_s])
     return SummitLaw("maugis_dugdale", beta, w, e_star, (d, p, a, ac), delta_max=delta_max,
-                     extra={"maugis_lambda": lam, "dugdale_stress": sigma0, "dugdale_range_h0": h0, "z0": z0,
-                            "layer": layer})
+                     extra={"maugis_lambda": lam, "dugdale_stress": sigma0, "dugdale_range_h0": h0, "z0": z0})
 
 
-def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: float = 0.3e-9, layer=None,
+def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: float = 0.3e-9,
                     detachment: str = "displacement", delta_max: float) -> SummitLaw:
-    """Law by name ('jkr', 'dmt', 'maugis_dugdale'); layer = (thickness m, modulus Pa, Poisson) or None.
+    """Law by name ('jkr', 'dmt', 'maugis_dugdale').
 
     Only displacement-controlled release exists here (summits under a roller are displacement
     driven); detachment = 'load' is refused.
@@ -345,9 +326,9 @@ def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: floa
     if detachment != "displacement":
         raise ValueError(f"detachment = {detachment!r}: the branch laws release under displacement control only")
     if name == "jkr":
-        return jkr_law(beta, w, e_star, delta_max=delta_max, layer=layer)
+        return jkr_law(beta, w, e_star, delta_max=delta_max)
     if name == "dmt":
-        return dmt_law(beta, w, e_star, delta_max=delta_max, layer=layer)
+        return dmt_law(beta, w, e_star, delta_max=delta_max)
     if name == "maugis_dugdale":
-        return maugis_dugdale_law(beta, w, e_star, z0, delta_max=delta_max, layer=layer)
+        return maugis_dugdale_law(beta, w, e_star, z0, delta_max=delta_max)
     raise ValueError(f"summit law {name!r}: 'jkr', 'dmt' or 'maugis_dugdale'")
