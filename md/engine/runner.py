@@ -74,8 +74,9 @@ class Interrupted(RuntimeError):
 
 # ================================================================================================ leg runner
 
-def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk_counter: list[int],
-             stop_after_chunks: int | None, extra_commands: Sequence[str]) -> dict[str, Any]:
+def _leg_state_for_start(leg: Leg, leg_dir: Path, resume: bool) -> dict[str, Any]:
+    """The leg's state to run from: the stored one when resuming (samples and frames past its last restart
+    dropped), else a fresh leg directory and state."""
     state = leg_state(leg_dir) if resume else {}
     if state.get("done"):
         return state
@@ -83,16 +84,82 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
         if leg_dir.exists():
             shutil.rmtree(leg_dir)
         leg_dir.mkdir(parents=True)
-        state = {"step": 0, "restart": None, "dynamics_wall_s": 0.0, "setup_wall_s": 0.0, "chunks": 0,
-                 "done": False, "n_atoms": leg.n_atoms, "total_steps": leg.total_steps}
-    else:
-        dropped = truncate_samples(leg_dir / "samples.csv", state["step"])
-        for f in (leg_dir / "frames").glob("*.npz"):
-            if int(f.stem) > state["step"]:
-                f.unlink()
-                dropped += 1
-        state["resumed_from"] = state["step"]
-        state["dropped_on_resume"] = state.get("dropped_on_resume", 0) + dropped
+        return {"step": 0, "restart": None, "dynamics_wall_s": 0.0, "setup_wall_s": 0.0, "chunks": 0,
+                "done": False, "n_atoms": leg.n_atoms, "total_steps": leg.total_steps}
+    dropped = truncate_samples(leg_dir / "samples.csv", state["step"])
+    for f in (leg_dir / "frames").glob("*.npz"):
+        if int(f.stem) > state["step"]:
+            f.unlink()
+            dropped += 1
+    state["resumed_from"] = state["step"]
+    state["dropped_on_resume"] = state.get("dropped_on_resume", 0) + dropped
+    return state
+
+
+def _chunk_commands(leg: Leg, k: int, stage_start: bool, n: int, leg_dir: Path) -> tuple[list[str], bool]:
+    """The LAMMPS commands of one chunk of ``n`` steps of stage ``k`` (the stage's ``begin`` if the chunk starts
+    it; sampling, frames of sampled stages, the restart written to ``restart.tmp``) and whether it stores frames;
+    the chunk's sample and frame files are removed first."""
+    stage = leg.stages[k]
+    cmds: list[str] = list(stage.begin) if stage_start else []
+    chunk_file = leg_dir / "chunk_samples.dat"
+    dump_file = leg_dir / "chunk_frames.dump"
+    for f in (chunk_file, dump_file):
+        if f.exists():
+            f.unlink()
+    si = leg.sample_interval
+    cmds.append(f"fix _samp all ave/time {si} 1 {si} {' '.join(leg.columns.values())} file {chunk_file.as_posix()}")
+    use_frames = leg.frames is not None and stage.sampled
+    if use_frames:
+        cmds += [f"dump _frames {leg.frames.group} custom {leg.frames.interval} {dump_file.as_posix()} "
+                 f"id x y z", "dump_modify _frames sort id"]
+    cmds.append(f"run {n}")
+    cmds.append("unfix _samp")
+    if use_frames:
+        cmds.append("undump _frames")
+    cmds.append(f"write_restart {(leg_dir / 'restart.tmp').as_posix()}")
+    return cmds, use_frames
+
+
+def _store_chunk(leg_dir: Path, k: int, step: int, end: int, use_frames: bool) -> None:
+    """Append the chunk's samples (steps in (step, end]) to samples.csv, durably, and store its frames as one
+    ``frames/<end>.npz``."""
+    rows = parse_ave_time(leg_dir / "chunk_samples.dat")
+    if rows.size:
+        rows = rows[(rows[:, 0] > step) & (rows[:, 0] <= end)]
+        with open(leg_dir / "samples.csv", "a") as fh:
+            for r in rows:
+                fh.write(",".join([str(int(r[0])), str(k)] + [repr(float(x)) for x in r[1:]]) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+    if use_frames:
+        fr = [f for f in parse_dump(leg_dir / "chunk_frames.dump") if step < f[0] <= end]
+        if fr:
+            buf = io.BytesIO()
+            np.savez(buf, steps=np.array([f[0] for f in fr]), ids=fr[0][1],
+                     positions=np.stack([f[2] for f in fr]), box=np.stack([f[3] for f in fr]))
+            atomic_write_bytes(leg_dir / "frames" / f"{end}.npz", buf.getvalue())
+
+
+def _commit_chunk(leg: Leg, leg_dir: Path, state: dict[str, Any], end: int) -> Path:
+    """Commit the chunk's restart, then the state; keep the last :data:`RESTARTS_KEPT` restarts."""
+    final = leg_dir / f"restart.{end}"
+    os.replace(leg_dir / "restart.tmp", final)
+    state.update(step=end, restart=final.name, chunks=state["chunks"] + 1, done=end >= leg.total_steps)
+    atomic_write_text(leg_dir / "state.json", json.dumps(state, indent=1))
+    restarts = sorted(leg_dir.glob("restart.[0-9]*"), key=lambda p: int(p.suffix[1:]))
+    for p in restarts[:-RESTARTS_KEPT]:
+        p.unlink()
+    return final
+
+
+def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk_counter: list[int],
+             stop_after_chunks: int | None, extra_commands: Sequence[str]) -> dict[str, Any]:
+    """Run (or resume) one leg chunk by chunk: each chunk's samples and frames are stored, then its restart and
+    the leg's state committed, so an interrupted leg resumes from its last restart."""
+    state = _leg_state_for_start(leg, leg_dir, resume)
+    if state.get("done"):
+        return state
     (leg_dir / "frames").mkdir(exist_ok=True)
     samples_csv = leg_dir / "samples.csv"
     if not samples_csv.exists():
@@ -108,59 +175,16 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
         engine.start(head)
         if np_ <= 1:
             state["setup_wall_s"] += time.perf_counter() - t0
-        exprs = " ".join(leg.columns.values())
         while step < leg.total_steps:
             k, s0, s1 = leg.stage_at(step)
-            stage = leg.stages[k]
             n = min(leg.chunk_steps, s1 - step)
             end = step + n
-            cmds: list[str] = []
-            if step == s0:
-                cmds += list(stage.begin)
-            chunk_file = leg_dir / "chunk_samples.dat"
-            dump_file = leg_dir / "chunk_frames.dump"
-            for f in (chunk_file, dump_file):
-                if f.exists():
-                    f.unlink()
-            si = leg.sample_interval
-            cmds.append(f"fix _samp all ave/time {si} 1 {si} {exprs} file {chunk_file.as_posix()}")
-            use_frames = leg.frames is not None and stage.sampled
-            if use_frames:
-                cmds += [f"dump _frames {leg.frames.group} custom {leg.frames.interval} {dump_file.as_posix()} "
-                         f"id x y z", "dump_modify _frames sort id"]
-            cmds.append(f"run {n}")
-            cmds.append("unfix _samp")
-            if use_frames:
-                cmds.append("undump _frames")
-            restart_tmp = leg_dir / "restart.tmp"
-            cmds.append(f"write_restart {restart_tmp.as_posix()}")
+            cmds, use_frames = _chunk_commands(leg, k, step == s0, n, leg_dir)
             t1 = time.perf_counter()
             engine.chunk(cmds)
             state["dynamics_wall_s"] += time.perf_counter() - t1
-            # (1) samples and frames of this chunk: step in (step, end]
-            rows = parse_ave_time(chunk_file)
-            if rows.size:
-                rows = rows[(rows[:, 0] > step) & (rows[:, 0] <= end)]
-                with open(samples_csv, "a") as fh:
-                    for r in rows:
-                        fh.write(",".join([str(int(r[0])), str(k)] + [repr(float(x)) for x in r[1:]]) + "\n")
-                    fh.flush()
-                    os.fsync(fh.fileno())
-            if use_frames:
-                fr = [f for f in parse_dump(dump_file) if step < f[0] <= end]
-                if fr:
-                    buf = io.BytesIO()
-                    np.savez(buf, steps=np.array([f[0] for f in fr]), ids=fr[0][1],
-                             positions=np.stack([f[2] for f in fr]), box=np.stack([f[3] for f in fr]))
-                    atomic_write_bytes(leg_dir / "frames" / f"{end}.npz", buf.getvalue())
-            # (2) commit the restart, then the state
-            final = leg_dir / f"restart.{end}"
-            os.replace(restart_tmp, final)
-            state.update(step=end, restart=final.name, chunks=state["chunks"] + 1, done=end >= leg.total_steps)
-            atomic_write_text(leg_dir / "state.json", json.dumps(state, indent=1))
-            restarts = sorted(leg_dir.glob("restart.[0-9]*"), key=lambda p: int(p.suffix[1:]))
-            for p in restarts[:-RESTARTS_KEPT]:
-                p.unlink()
+            _store_chunk(leg_dir, k, step, end, use_frames)
+            final = _commit_chunk(leg, leg_dir, state, end)
             step = end
             if np_ > 1 and step < leg.total_steps:      # the next mpirun starts from this restart
                 engine.start(leg.restart_head(final) + leg.define(step) + list(extra_commands))
@@ -241,7 +265,6 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
                 resume: bool, np_: int, progress: bool, force: bool, stop_after_chunks: int | None,
                 extra_commands: Sequence[str], say: Callable[[str], None]) -> RunOutcome:
     """:func:`run_job`'s work on ``run_dir``; the caller holds its lock."""
-    fidelity, settings = job.fidelity, job.settings
     result_path = run_dir / "result.json"
     if result_path.exists() and not force and not extra_commands:
         result = json.loads(result_path.read_text())
@@ -255,7 +278,7 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         result_path.unlink()
     run_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_text(run_dir / "hash.json", json.dumps(hashed, indent=1, sort_keys=True))
-    plan = wf.plan(settings, run_dir)
+    plan = wf.plan(job.settings, run_dir)
     total = sum(l.total_steps for l in plan.legs)
     done = 0
     if resume:
@@ -264,8 +287,21 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
             done += int(st.get("step", 0)) if st else 0
         if done:
             say(f"resuming {run_dir.name} at {done} of {total} steps")
-    say(f"{job.name} [{fidelity}]: {len(plan.legs)} leg(s), {plan.n_atoms} atoms, {total} MD steps, "
+    say(f"{job.name} [{job.fidelity}]: {len(plan.legs)} leg(s), {plan.n_atoms} atoms, {total} MD steps, "
         f"run directory {run_dir}")
+    t_start = time.perf_counter()
+    legs_state = _run_legs(job, plan, run_dir, done=done, total=total, np_=np_, resume=resume, progress=progress,
+                           stop_after_chunks=stop_after_chunks, extra_commands=extra_commands)
+    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_,
+                                 reanalysed=resume and done == total, t_start=t_start)
+    atomic_write_text(result_path, json.dumps(clean_json(result), indent=1))
+    say(f"wrote {result_path}")
+    return RunOutcome(json.loads(result_path.read_text()), run_dir, False, export(run_dir, out))
+
+
+def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int, resume: bool, progress: bool,
+              stop_after_chunks: int | None, extra_commands: Sequence[str]) -> dict[str, Any]:
+    """Every leg of ``plan`` in order (:func:`_run_leg`), behind a progress bar if asked; their final states."""
     bar = None
     if progress:
         try:
@@ -276,7 +312,6 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
             bar = None
     legs_state: dict[str, Any] = {}
     counter = [0]
-    t_start = time.perf_counter()
     try:
         for leg in plan.legs:
             if bar is not None:
@@ -287,8 +322,14 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
     finally:
         if bar is not None:
             bar.close()
-    ctx = RunContext(run_dir, plan, settings)
-    analysis = wf.analyse(ctx)
+    return legs_state
+
+
+def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path, legs_state: Mapping[str, Any], *,
+                        np_: int, reanalysed: bool, t_start: float) -> dict[str, Any]:
+    """The workflow's analysis of the finished legs, its curves and figures exported (a figure that fails is
+    named in the notes, never loses the run), and the run's ``result.json`` record."""
+    analysis = wf.analyse(RunContext(run_dir, plan, job.settings))
     export_dir = run_dir / "export"
     if export_dir.exists():
         shutil.rmtree(export_dir)
@@ -305,19 +346,19 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
     dyn_wall = sum(float(s.get("dynamics_wall_s", 0.0)) for s in legs_state.values())
     atom_steps = sum(l.n_atoms * l.total_steps for l in plan.legs)
     prov = _provenance(job, plan, legs_state, np_)
-    if resume and done == total:
+    if reanalysed:
         # every leg had finished: this invocation only re-ran the analysis (e.g. after an analysis fix)
         prov["reanalysed_without_md"] = True
     notes = list(analysis.notes)
     if figure_errors:
         notes.append(f"figures not drawn: {figure_errors}")
-    result = {
+    return {
         "schema_version": SCHEMA_VERSION,
         "run_hash": digest,
         "recipe": job.name,
         "workflow": job.workflow,
         "description": job.description,
-        "fidelity": fidelity,
+        "fidelity": job.fidelity,
         "quantities": analysis.quantities,
         "n_atoms": plan.n_atoms,
         "steps": md_steps,
@@ -327,7 +368,7 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         "atom_steps_per_s": atom_steps / dyn_wall if dyn_wall > 0 else None,
         "np": np_,
         "seeds": plan.seeds,
-        "settings": dict(settings),
+        "settings": dict(job.settings),
         "system": plan.system_info,
         "legs": {name: {k: s.get(k) for k in ("total_steps", "n_atoms", "chunks", "dynamics_wall_s", "setup_wall_s",
                                               "resumed_from", "dropped_on_resume")} for name, s in legs_state.items()},
@@ -336,6 +377,3 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         "details": analysis.details,
         "files": sorted(p.name for p in export_dir.iterdir()),
     }
-    atomic_write_text(result_path, json.dumps(clean_json(result), indent=1))
-    say(f"wrote {result_path}")
-    return RunOutcome(json.loads(result_path.read_text()), run_dir, False, export(run_dir, out))
