@@ -13,7 +13,9 @@ from .laws.base import ContactLaw
 
 
 def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rtol: float = 1e-9) -> ImpactRun:
-    """One impact at `speed` (m/s) from the datum; the run ends at release or when stuck."""
+    """One impact at `speed` (m/s) from the datum on virgin surfaces (`ContactLaw.forget_history`); the run
+    ends at release or when stuck."""
+    law.forget_history()
     return simulate(law, mass, gravity, impact_velocity=speed,
                     settings=DriverSettings(rtol=rtol, max_bounces=1, max_time=1.0, samples_per_flight=2))
 

@@ -63,6 +63,12 @@ class ContactLaw(ABC):
     def reset(self) -> None:
         """Start a new contact (history cleared)."""
 
+    def forget_history(self) -> None:
+        """Return the surfaces to their virgin state, for an independent run (a fresh body on a fresh spot).
+
+        Laws whose state outlives a contact (a plastic flattening the next impact meets) clear it here;
+        `reset` keeps it. Others have nothing to forget."""
+
     @abstractmethod
     def force(self, gap: float) -> float:
         """Upward contact force (N) at `gap` (m) on the current branch."""

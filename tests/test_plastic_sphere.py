@@ -1,0 +1,119 @@
+"""The adhesive elastic-plastic sphere law in the driver against the Thornton-Ning closed forms.
+
+The closed forms (`continuum.reference.thornton_ning`) are independent of the driver: energies of
+the JKR curve and of the plastic line, a quadratic for the maximum approach. The driver integrates
+the motion (DOP853 at rtol 1e-10) with the law's force, so agreement to ~1e-7 tests the law's
+force, its history (the flattened branch), and the release it reports.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from continuum.driver import DriverSettings, simulate
+from continuum.escape import escape_velocity, single_impact
+from continuum.laws.jkr import JKRSphere
+from continuum.laws.plastic_sphere import PlasticJKRSphere
+from continuum.reference import jkr as ref
+from continuum.reference import thornton_ning as tn
+from nanoimpact.errors import InputError
+
+# The issue's case: a 4.9 um sphere, E = 1.2 GPa, nu = 0.3, rho = 1350 kg/m^3, w = 0.2 J/m^2,
+# limiting contact pressure 35.3 MPa, on silicon (E = 169 GPa, nu = 0.28).
+R = 4.9e-6 / 2.0
+E_STAR = 1.0 / ((1.0 - 0.3**2) / 1.2e9 + (1.0 - 0.28**2) / 169e9)
+RHO, W, P_Y = 1350.0, 0.2, 35.3e6
+MASS = float(tn.sphere_mass(R, RHO))
+RTOL = 1e-10
+
+
+def _law(p_y=P_Y, detachment="displacement", radius=R, w=W):
+    return PlasticJKRSphere(radius, w, E_STAR, p_y, detachment)
+
+
+@pytest.mark.parametrize("detachment", ["displacement", "load"])
+@pytest.mark.parametrize("speed", [1.2, 2.0, 20.0])
+def test_first_bounce_restitution_is_thornton_ning(speed, detachment):
+    run = single_impact(_law(detachment=detachment), MASS, 0.0, speed, RTOL)
+    expected = float(tn.restitution(speed, R, W, E_STAR, RHO, P_Y, detachment))
+    assert run.status == "escaped"
+    assert run.bounces[0].restitution == pytest.approx(expected, rel=1e-6)
+    assert run.audit["max_relative_error"] < 1e-6
+
+
+def test_plastic_loss_and_flattening_are_thornton_ning():
+    """Booked loss and the flattened radius R_p, delta_p of the law equal the closed form's."""
+    speed = 20.0
+    law = _law()
+    run = single_impact(law, MASS, 0.0, speed, RTOL)
+    ie = tn.impact(speed, R, W, E_STAR, RHO, P_Y)
+    b = run.bounces[0]
+    assert b.energy_booked == pytest.approx(float(ie.plastic_loss[0] + ie.adhesive_loss[0]), rel=1e-6)
+    diag = law.diagnostics()
+    assert diag["plastic_radius"] == pytest.approx(float(ie.plastic_radius[0]), rel=1e-6)
+    assert diag["plastic_approach"] == pytest.approx(float(ie.plastic_approach[0]), rel=1e-5)
+    assert b.peak_force == pytest.approx(float(ie.max_force[0]), rel=1e-6)
+
+
+def test_done_when_case_loses_a_large_share_and_captures_faster():
+    """Restitution at 20 m/s far below the elastic JKR value; capture velocity above the elastic one."""
+    elastic = single_impact(JKRSphere(R, W, E_STAR), MASS, 0.0, 20.0, RTOL).bounces[0].restitution
+    plastic = single_impact(_law(), MASS, 0.0, 20.0, RTOL).bounces[0].restitution
+    loop = float(ref.loop_area(R, W, E_STAR))
+    assert elastic == pytest.approx(math.sqrt(1.0 - loop / (0.5 * MASS * 400.0)), rel=1e-8)
+    assert elastic > 0.999 and plastic < 0.5
+    v_el = float(tn.capture_velocity_elastic(R, W, E_STAR, RHO))
+    v_tn = float(tn.capture_velocity(R, W, E_STAR, RHO, P_Y))
+    esc = escape_velocity(_law(), MASS, 0.0, 0.5 * v_el, 2.0 * v_tn, rel_tol=1e-4, rtol=RTOL)
+    assert esc["lower"] <= v_tn * (1 + 1e-6) and esc["upper"] >= v_tn * (1 - 1e-6)
+    assert esc["escape_velocity"] > 1.5 * v_el
+
+
+def test_second_impact_reloads_elastically_on_the_flattened_radius():
+    """A slower second impact on the flattened spot stays below delta*: elastic JKR on R_p, shifted by delta_p.
+
+    Its restitution is then sqrt(1 - W_loop(R_p) / (m v^2/2)) and it dissipates no plasticity."""
+    law = _law()
+    first = single_impact(law, MASS, 0.0, 20.0, RTOL)
+    r_p, d_p = law.diagnostics()["plastic_radius"], law.diagnostics()["plastic_approach"]
+    run = simulate(law, MASS, 0.0, impact_velocity=2.0, settings=DriverSettings(rtol=RTOL, max_bounces=1))
+    ke = 0.5 * MASS * 4.0
+    expected = math.sqrt(1.0 - float(ref.loop_area(r_p, W, E_STAR)) / ke)
+    assert first.bounces[0].restitution < 0.5
+    assert run.bounces[0].restitution == pytest.approx(expected, rel=1e-6)
+    assert law.diagnostics()["plastic_radius"] == r_p and law.diagnostics()["plastic_approach"] == d_p
+    assert law.diagnostics()["impacts_yielded"] == 1
+    # it met the flattened spot at delta_p: the deepest approach is delta_p + the JKR approach on R_p
+    a_max = float(ref.radius_from_approach(run.bounces[0].max_penetration - d_p, r_p, W, E_STAR))
+    assert 0.5 * MASS * 4.0 == pytest.approx(float(ref.energy_from_radius(a_max, r_p, W, E_STAR)), rel=1e-6)
+
+
+def test_forget_history_restores_the_virgin_sphere():
+    law = _law()
+    single_impact(law, MASS, 0.0, 20.0, RTOL)
+    law.forget_history()
+    assert law.diagnostics()["plastic_radius"] == R and law.diagnostics()["plastic_approach"] == 0.0
+
+
+def test_restitution_falls_with_speed_above_yield_as_v_to_minus_quarter():
+    """Above the yield velocity, e(v) falls; at high speed as v^-1/4 (Johnson 1985 §11.5; Thornton 1997)."""
+    p_y, w = 60e6, 0.01                           # weaker adhesion: a finite yield velocity (0.66 m/s)
+    speeds = np.array([2.0, 6.0, 20.0, 60.0])
+    v_y = float(tn.yield_velocity(p_y, R, w, E_STAR, RHO))
+    assert v_y < speeds[0]
+    e = [single_impact(_law(p_y, w=w), MASS, 0.0, float(v), RTOL).bounces[0].restitution for v in speeds]
+    closed = tn.restitution(speeds, R, w, E_STAR, RHO, p_y)
+    np.testing.assert_allclose(e, closed, rtol=1e-6)
+    assert np.all(np.diff(e) < 0.0)
+    slope = math.log(e[-1] / e[-2]) / math.log(speeds[-1] / speeds[-2])
+    assert slope == pytest.approx(-0.25, abs=0.01)
+
+
+def test_bad_limiting_pressure_names_the_key():
+    p_a = float(tn.adhesive_stress_scale(R, W, E_STAR))
+    with pytest.raises(InputError, match="limiting_pressure"):
+        _law(p_y=0.5 * p_a)
+    with pytest.raises(InputError, match="limiting_pressure"):
+        _law(p_y=2.0 * E_STAR)
