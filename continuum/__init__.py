@@ -7,7 +7,7 @@ The front door (imported lazily, so `import continuum.reference.hertz` stays lig
 """
 from nanoimpact import __version__
 
-_API = ("run_scene", "load_scene", "read_result", "ImpactResult", "ModelDecision", "EnergyAudit")
+_API = ("run_scene", "load_scene", "read_result", "ImpactResult", "ModelDecision", "EnergyAudit", "EnsembleResult")
 __all__ = ["__version__", *_API]
 
 

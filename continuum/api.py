@@ -22,9 +22,10 @@ import numpy as np
 from .driver import Bounce
 from .impact import run_impact, write_impact
 from .results import TIMESERIES_COLUMNS, load_result
+from .rough.ensemble import EnsembleResult
 from .scene import ResolvedScene, resolve_scene
 
-__all__ = ["run_scene", "load_scene", "read_result", "ImpactResult", "ModelDecision", "EnergyAudit"]
+__all__ = ["run_scene", "load_scene", "read_result", "ImpactResult", "ModelDecision", "EnergyAudit", "EnsembleResult"]
 
 #: Keys of a model record that say what was decided and why; every other key is a number behind it.
 _DECISION_KEYS = ("used", "decided_by", "why")
@@ -70,7 +71,9 @@ class EnergyAudit:
 
 @dataclass(frozen=True)
 class ImpactResult:
-    """One impact run. `record` is exactly what result.json holds; the other fields are typed views."""
+    """One impact run. `record` is exactly what result.json holds; the other fields are typed views. `ensemble`:
+    the discrete realisations' distributions where the run had an ensemble (surfaces.roughness.mode), else None;
+    the bounces and trace are then the mean-field run's."""
 
     record: Mapping[str, Any]
     bounces: tuple[Bounce, ...]
@@ -79,6 +82,7 @@ class ImpactResult:
     energy_audit: EnergyAudit
     warnings: tuple[str, ...]
     trace: Mapping[str, np.ndarray] | None = None
+    ensemble: EnsembleResult | None = None
 
     @classmethod
     def from_record(cls, record: Mapping[str, Any], trace: Mapping[str, np.ndarray] | None = None) -> "ImpactResult":
@@ -87,7 +91,9 @@ class ImpactResult:
         return cls(record=record, bounces=tuple(Bounce(**b) for b in record["bounces"]), models=models,
                    regimes=dict(record["models"].get("regimes", {})),
                    energy_audit=EnergyAudit.from_record(record["energy_audit"]),
-                   warnings=tuple(record.get("warnings", ())), trace=trace)
+                   warnings=tuple(record.get("warnings", ())), trace=trace,
+                   ensemble=(EnsembleResult.from_record(record["ensemble"], record["ensemble"].get("release_height_m"))
+                             if record.get("ensemble") else None))
 
     @property
     def n_bounces(self) -> int:
@@ -136,15 +142,18 @@ def load_scene(scene: str | Path | Mapping[str, Any], params: str | Path | None 
 
 def run_scene(scene: str | Path | Mapping[str, Any] | ResolvedScene, params: str | Path | None = None,
               overrides: Mapping[str, Any] | None = None,
-              progress: Callable[[Bounce], None] | None = None) -> ImpactResult:
-    """Run one impact scene and return its typed result (nothing is written; call `.write(dir)`)."""
+              progress: Callable[[Bounce], None] | None = None, executor: Any = None,
+              workers: int | None = None) -> ImpactResult:
+    """Run one impact scene and return its typed result (nothing is written; call `.write(dir)`). An ensemble
+    (surfaces.roughness.mode 'ensemble', or 'auto' with few summits) runs its members on `executor`
+    (`nanoimpact.executors` name with `workers`, or an open executor; None: in this process)."""
     if isinstance(scene, ResolvedScene):
         if params is not None or overrides:
             raise ValueError("params and overrides apply when the scene is read: pass them to load_scene")
         resolved = scene
     else:
         resolved = load_scene(scene, params, overrides)
-    record, trace = run_impact(resolved, progress=progress)
+    record, trace = run_impact(resolved, progress=progress, executor=executor, workers=workers)
     return ImpactResult.from_record(record, trace)
 
 

@@ -57,6 +57,38 @@ def configure_impact(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", help="output folder (default: out/<scene name>)")
     p.add_argument("--params", help="parameter set NAME (inputs/params/NAME.toml) or FILE; replaces the scene's")
     p.add_argument("--fidelity", choices=("fast", "standard", "reference"), help="numerical preset")
+    p.add_argument("--executor", choices=("local", "processes", "dask"), default="processes",
+                   help="where an ensemble's members run (surfaces.roughness.mode 'ensemble' or 'auto'; default: "
+                        "processes, a local pool of --workers)")
+    p.add_argument("--workers", type=positive_int, help="parallel processes for an ensemble (default: CPU count)")
+    p.add_argument("--scheduler", help="dask scheduler address (tcp://host:port) of an existing cluster")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=scene_override,
+                   help="override a scene key (TOML value, file units), e.g. --set surfaces.roughness.mode=auto; "
+                        "repeatable; wins over the scene and its parameter set")
+
+
+def scene_override(text: str) -> tuple[str, object]:
+    """KEY=VALUE of --set: VALUE read as a TOML value (a bare word that is not one is a string)."""
+    import tomllib
+
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip():
+        raise argparse.ArgumentTypeError(f"--set {text!r}: expected KEY=VALUE, e.g. surfaces.roughness.mode=auto")
+    try:
+        return key.strip(), tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        return key.strip(), value.strip()
+
+
+def ensemble_summary(ens: dict) -> str:
+    """Two lines on an ensemble: stick probabilities, rebound counts and first rebounds (median, 5-95 %)."""
+    p, r = ens["stick_probability"], ens["rebounds"]
+    first = ens.get("first_rebound_over_h0") or ens["first_rebound_m"]
+    unit = "h0" if "first_rebound_over_h0" in ens else "m"
+    return (f"ensemble of {ens['members']} realisations (master seed {ens['master_seed']}, {ens['wall_s']:.2f} s): "
+            f"stick probability {p['first_impact']['value']:.3f} at the first impact, {p['within_run']['value']:.3f} "
+            f"within the run\n  rebounds median {r['p50']:g} (5-95 %: {r['p5']:g}-{r['p95']:g}); first rebound median "
+            f"{first['p50']:.3g} {unit} (5-95 %: {first['p5']:.3g}-{first['p95']:.3g})")
 
 
 def cmd_impact(args) -> int:
@@ -64,8 +96,8 @@ def cmd_impact(args) -> int:
     from continuum.scene import SceneError, resolve_scene
 
     check_out_dir(args.out)
-    overrides = {"numerics.fidelity": args.fidelity} if args.fidelity else None
-    resolved = resolve_scene(args.scene, params=args.params, overrides=overrides, override_label="command line")
+    overrides = {**({"numerics.fidelity": args.fidelity} if args.fidelity else {}), **dict(args.set)}
+    resolved = resolve_scene(args.scene, params=args.params, overrides=overrides or None, override_label="command line")
     out = Path(args.out) if args.out else Path("out") / resolved.scene.name
     check_out_dir(out)
     sc = resolved.scene
@@ -79,7 +111,17 @@ def cmd_impact(args) -> int:
             log.debug("  impact %d: e = %.6f", b.index + 1, b.restitution)
 
     try:
-        result, trace = run_impact(resolved, progress=progress)
+        check_executor(args.executor, args.workers, args.scheduler)
+        ex = None
+        if args.scheduler:
+            from nanoimpact.executors import executor as make_executor
+            ex = make_executor(args.executor, args.workers, args.scheduler)
+        try:
+            result, trace = run_impact(resolved, progress=progress, executor=ex or args.executor,
+                                       workers=args.workers)
+        finally:
+            if ex is not None:
+                ex.close()
     except SceneError:
         raise
     except ValueError as exc:            # refusals that need the model (datum, depth range): nothing written
@@ -89,9 +131,12 @@ def cmd_impact(args) -> int:
     audit = result["energy_audit"]["max_relative_error"]
     print(f"status: {result['status']} after {result['n_bounces']} impacts; energy audit max error {audit:.2e}; "
           f"wall {result['timing']['wall_s']:.3f} s")
+    if "ensemble" in result:
+        print(ensemble_summary(result["ensemble"]))
     for w in result["warnings"]:
         print(f"warning: {w}")
-    print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png")
+    print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png"
+          + (", ensemble.png" if "ensemble" in result else ""))
     return 0
 
 
@@ -107,6 +152,11 @@ def configure_paper(q: argparse.ArgumentParser) -> None:
     q.add_argument("--scheduler", help="dask scheduler address (tcp://host:port) of an existing cluster")
     q.add_argument("--strict", action="store_true",
                    help=f"exit {EXIT_PARTIAL} when any of the paper's claims fails (everything is still written)")
+    q.add_argument("--seeds", type=int, default=None,
+                   help="discrete-summit seeds per set on which the sampled claims are judged (default 8)")
+    q.add_argument("--uncertainty", action="append", default=[], metavar="SET=CSV",
+                   help="judge the sampled claims of SET also on the rows of CSV (a calibration's uncertainty.csv, "
+                        "its Latin hypercube); repeatable")
 
 
 def cmd_paper(args) -> int:
@@ -121,14 +171,32 @@ def cmd_paper(args) -> int:
     for s in sets:
         check_params_set(s)
     check_executor(args.executor, args.workers, args.scheduler)
+    seeds, uncertainty = paper_samples(args)
     record = make_paper(sets, args.out, fidelity=args.fidelity, workers=args.workers, executor_name=args.executor,
-                        scheduler=args.scheduler, progress=log.info)
-    failed = [c for c in record["checks"] if not c["pass"]]
-    print(f"checks: {len(record['checks']) - len(failed)} pass, {len(failed)} fail "
-          f"(see {args.out}/summary.md and checks.json); wall {record['wall_s']:.1f} s")
-    for c in failed:
-        print(f"  FAIL [{c['set']}] {c['name']}: {c['threshold']}")
-    return EXIT_PARTIAL if failed and args.strict else 0
+                        scheduler=args.scheduler, progress=log.info, seeds=seeds, uncertainty=uncertainty)
+    states = [c["state"] for c in record["checks"]]
+    print(f"checks: {states.count('pass')} pass, {states.count('fail')} fail, {states.count('not_evaluable')} not "
+          f"evaluable (see {args.out}/summary.md and checks.json); wall {record['wall_s']:.1f} s")
+    for c in record["checks"]:
+        if c["state"] != "pass":
+            print(f"  {c['state'].upper()} [{c['set']}] {c['kind']} {c['name']}: {c.get('reason') or c['threshold']}")
+    return EXIT_PARTIAL if "fail" in states and args.strict else 0
+
+
+def paper_samples(args) -> tuple[int, dict[str, list[dict]]]:
+    """--seeds (>= 0) and --uncertainty SET=CSV (each file read; its rows are scene overrides)."""
+    from continuum.paper.samples import DEFAULT_SEEDS, read_uncertainty_csv
+
+    seeds = DEFAULT_SEEDS if args.seeds is None else args.seeds
+    if seeds < 0:
+        raise InputError("--seeds", seeds, "an integer >= 0")
+    rows = {}
+    for spec in args.uncertainty:
+        name, sep, path = spec.partition("=")
+        if not sep or not Path(path).is_file():
+            raise InputError("--uncertainty", spec, "SET=CSV, CSV an existing file (a calibration's uncertainty.csv)")
+        rows[Path(name.strip()).stem] = read_uncertainty_csv(path)
+    return seeds, rows
 
 
 COMMANDS = (

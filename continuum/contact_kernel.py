@@ -22,7 +22,9 @@ tolerance; `tests/test_contact_kernel.py` checks both):
   history from before it (Hairer, Norsett & Wanner, section II.6 on discontinuities).
 
 Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid-substrate rough roller's bicubic footprint
-tables, `continuum.laws.rough_rigid`; `LAW_POWER`: F = k (-h)^n, Hertz, used to validate the
+tables, `continuum.laws.rough_rigid`; `LAW_DISCRETE`: a seeded realisation of JKR or Hertz summits on a
+rigid substrate, `continuum.laws.discrete_roller`, with closed-form JKR or Hertz summits or, `LAW_DISCRETE_BRANCH`,
+tabulated branches of any summit law; `LAW_POWER`: F = k (-h)^n, Hertz, used to validate the
 integrator against closed forms) give their parameters as a float array `P`, their tables as a
 tuple of arrays `T` and their history as a float array `S` that the kernel updates in place.
 
@@ -43,6 +45,8 @@ from .dop853_tableau import A, B, C, D, E3, E5
 #: Law kinds.
 LAW_RIGID_TABLE = 0
 LAW_POWER = 1
+LAW_DISCRETE = 2
+LAW_DISCRETE_BRANCH = 3
 
 #: Ends of a kernel call (info[END]).
 END_RELEASE, END_STUCK, END_REST, END_MAX_TIME, END_STOP_TIME = 0, 1, 2, 3, 4
@@ -64,6 +68,18 @@ SAMPLE_COLUMNS = 7
 RIGID_STATE_SIZE = 5
 #: Power law: P = (k, n).
 P_K, P_N = 0, 1
+#: Discrete law: P slots (its S slots are the rigid-table law's); T[0] holds the kept summits' effective heights
+#: below the datum, e_i - z_top (m, descending, T[0][0] = 0).
+(P_D_END_GAP, P_D_RELEASE, P_D_LOOP, P_D_INV_DELTA0, P_D_PSCALE, P_D_ESCALE, P_D_HERTZ_K, P_D_ADHESIVE,
+ P_D_LOWEST) = range(9)
+DISCRETE_PARAMS = 9
+#: Discrete summits with tabulated branches (`continuum.rough.branch_laws.SummitLaw`: Maugis-Dugdale, DMT): P slots;
+#: T = (e_i - z_top, approach delta, force, energy, retreat delta, force, energy, unused 2-D).
+(P_B_END_GAP, P_B_IN, P_B_OUT, P_B_REACH, P_B_LOOP, P_B_LOWEST) = range(6)
+BRANCH_PARAMS = 6
+#: JKR constants of `continuum.physics.jkr_kernel`: the fold d = -D_C and the Horner coefficients of h(s).
+_D_C = 0.75 * 4.0 ** (-1.0 / 3.0)
+_H_COEF = np.array((16.0 / 15.0, 16.0 / 15.0, 16.0 / 15.0, -1.6, -1.6, -1.6, -0.6, -0.6, -0.6, -0.6))
 
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 _ERROR_EXPONENT = -1.0 / 8.0          # -1/(error estimator order + 1), order 7 (Hairer's dop853.f)
@@ -150,6 +166,150 @@ def ppoly3(x, c, a):
     return ((c[0, i] * d + c[1, i]) * d + c[2, i]) * d + c[3, i]
 
 
+# ----------------------------------------------------------------------------- discrete summits
+@njit(cache=True)
+def _jkr_root(d):
+    """(d clamped to the fold, stable root s of s^4 - s = d): `continuum.physics.jkr_kernel.stable_root_scalar`,
+    the same closed form (Ferrari's resolvent by Cardano, one Newton polish) with np.cbrt for math.cbrt."""
+    d = max(d, -_D_C)
+    cc = np.cbrt(1.0 / 16.0 + math.sqrt(max(1.0 / 256.0 + d * d * d / 27.0, 0.0)))
+    dd = -d / (3.0 * cc)
+    w = math.sqrt(0.25 / (cc * cc + d / 3.0 + dd * dd))
+    s = 0.5 * (w + math.sqrt(max(2.0 / w - w * w, 0.0)))
+    s3 = s * s * s
+    fp = 4.0 * s3 - 1.0
+    if fp > 1e-3:
+        s -= (s3 * s - s - d) / fp
+    return d, s
+
+
+@njit(cache=True)
+def _count_at_least(e, level):
+    """Number of entries of the descending array `e` that are >= level."""
+    lo, hi = 0, e.size
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if e[mid] >= level:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True)
+def _discrete_attached(gap, S, P, T):
+    """Summits attached at `gap`: a prefix of T[0]. On a rigid substrate the history rule (attach at delta >= 0,
+    let go below -Delta) leaves attached exactly the summits with e_i >= gap on a new deepest approach, else those
+    reached (e_i >= h_min) that have not let go (e_i >= gap - Delta). Flags a level below the kept summits."""
+    level = gap if gap <= S[S_H_MIN] else max(S[S_H_MIN], gap - P[P_D_RELEASE])
+    if level < P[P_D_LOWEST]:
+        S[S_BEYOND_FLAG] = 1.0
+    return _count_at_least(T[0], level)
+
+
+@njit(cache=True)
+def _discrete_sum(gap, S, P, T, energy):
+    """Sum over the attached summits of the force (N) or, `energy` True, the stored energy (J) of each: JKR on its
+    stable branch in s = sqrt(a/a0) (`continuum.physics.jkr_kernel`), or Hertz without adhesion."""
+    e = T[0]
+    k = _discrete_attached(gap, S, P, T)
+    total = 0.0
+    for i in range(k):
+        dl = e[i] - gap
+        if P[P_D_ADHESIVE] != 0.0:
+            d, s = _jkr_root(dl * P[P_D_INV_DELTA0])
+            s3 = s * s * s
+            if energy:
+                h = _H_COEF[0]
+                for c in range(1, _H_COEF.size):
+                    h = h * s + _H_COEF[c]
+                total += P[P_D_ESCALE] * d / (s * (s * s + s + 1.0)) * h
+            else:
+                total += P[P_D_PSCALE] * s3 * (8.0 / 3.0 * s3 - 4.0)
+        elif dl > 0.0:
+            total += P[P_D_HERTZ_K] * dl * math.sqrt(dl) * (0.4 * dl if energy else 1.0)
+    return total
+
+
+@njit(cache=True)
+def _lin(x, xs, ys):
+    """Linear interpolation of the table (xs increasing, ys) at x, clamped to its ends (numpy.interp)."""
+    n = xs.size
+    if x <= xs[0]:
+        return ys[0]
+    if x >= xs[n - 1]:
+        return ys[n - 1]
+    lo, hi = 0, n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    w = (x - xs[lo]) / (xs[hi] - xs[lo])
+    return ys[lo] + w * (ys[hi] - ys[lo])
+
+
+@njit(cache=True)
+def _branch_counts(gap, S, P, T):
+    """(summits on the retreat branch, summits within reach, summits jumped in) at `gap`: prefixes of T[0]. On a
+    rigid substrate a summit has jumped in iff its deepest approach e_i - h_min reached delta_in, and it follows
+    its retreat branch R until delta = e_i - gap falls below delta_out; every other summit within reach
+    (delta >= -reach) is on its approach branch A (A = R above delta_in)."""
+    e = T[0]
+    h = min(gap, S[S_H_MIN])
+    jumped = _count_at_least(e, h + P[P_B_IN])
+    on_r = _count_at_least(e, max(h + P[P_B_IN], gap + P[P_B_OUT]))
+    level = gap - P[P_B_REACH]
+    if min(level, gap + P[P_B_OUT]) < P[P_B_LOWEST]:
+        S[S_BEYOND_FLAG] = 1.0
+    return on_r, _count_at_least(e, level), jumped
+
+
+@njit(cache=True)
+def _branch_sum(gap, S, P, T, energy):
+    """Force (N) or, `energy` True, stored energy (J) of the summits in reach, each on its branch."""
+    e = T[0]
+    on_r, reach, _ = _branch_counts(gap, S, P, T)
+    total = 0.0
+    for i in range(max(on_r, reach)):
+        dl = e[i] - gap
+        if i < on_r:
+            total += _lin(dl, T[4], T[6]) if energy else _lin(dl, T[4], T[5])
+        else:
+            total += _lin(dl, T[1], T[3]) if energy else _lin(dl, T[1], T[2])
+    return total
+
+
+@njit(cache=True)
+def _branch_dissipated(gap, S, P, T):
+    """One loop per summit that jumped in and then out; at the release gap every summit has let go."""
+    if S[S_H_MIN] == math.inf:
+        return 0.0
+    on_r, _, jumped = _branch_counts(gap, S, P, T)
+    if gap >= P[P_B_END_GAP]:
+        on_r = 0
+    return P[P_B_LOOP] * max(jumped - on_r, 0)
+
+
+@njit(cache=True)
+def _discrete_dissipated(gap, S, P, T):
+    """One loop per summit reached and let go; at the release gap every summit has let go."""
+    if S[S_H_MIN] == math.inf:
+        return 0.0
+    if gap >= P[P_D_END_GAP]:
+        return P[P_D_LOOP] * S[S_COUNT_MIN]
+    return P[P_D_LOOP] * max(S[S_COUNT_MIN] - _discrete_attached(gap, S, P, T), 0.0)
+
+
+@njit(cache=True)
+def _discrete_accept(gap, S, P, T):
+    if gap < S[S_H_MIN]:
+        S[S_H_MIN] = gap
+        S[S_COUNT_MIN] = _count_at_least(T[0], gap)
+    S[S_MAX_CONTACTS] = max(S[S_MAX_CONTACTS], float(_discrete_attached(gap, S, P, T)))
+
+
 # ----------------------------------------------------------------------------- laws
 @njit(cache=True)
 def _rigid_window(gap, S, P):
@@ -187,6 +347,10 @@ def law_force(kind, gap, S, P, T):
     """Upward contact force (N) at `gap` (m) on the current branch (S: the law's history)."""
     if kind == LAW_POWER:
         return P[P_K] * (-gap) ** P[P_N] if gap < 0.0 else 0.0
+    if kind == LAW_DISCRETE:
+        return _discrete_sum(gap, S, P, T, False)
+    if kind == LAW_DISCRETE_BRANCH:
+        return _branch_sum(gap, S, P, T, False) if gap < P[P_B_END_GAP] else 0.0
     if gap >= P[P_END_GAP]:
         return 0.0
     if gap < P[P_H_LO]:
@@ -200,6 +364,10 @@ def law_stored(kind, gap, S, P, T):
     """Energy (J) stored in the contact relative to touch."""
     if kind == LAW_POWER:
         return P[P_K] * (-gap) ** (P[P_N] + 1.0) / (P[P_N] + 1.0) if gap < 0.0 else 0.0
+    if kind == LAW_DISCRETE:
+        return _discrete_sum(gap, S, P, T, True) if gap < P[P_D_END_GAP] else 0.0
+    if kind == LAW_DISCRETE_BRANCH:
+        return _branch_sum(gap, S, P, T, True) if gap < P[P_B_END_GAP] else 0.0
     if gap >= P[P_END_GAP] or (S[S_H_MIN] == math.inf and gap >= P[P_REACH]):
         return 0.0
     if gap < P[P_H_LO]:
@@ -211,6 +379,10 @@ def law_stored(kind, gap, S, P, T):
 @njit(cache=True)
 def law_dissipated(kind, gap, S, P, T):
     """Energy (J) this contact would have booked as lost at `gap`."""
+    if kind == LAW_DISCRETE:
+        return _discrete_dissipated(gap, S, P, T)
+    if kind == LAW_DISCRETE_BRANCH:
+        return _branch_dissipated(gap, S, P, T)
     if kind == LAW_POWER or S[S_H_MIN] == math.inf:
         return 0.0
     return P[P_LOOP] * max(S[S_COUNT_MIN] - _rigid_attached(gap, S, P, T), 0.0)
@@ -220,6 +392,16 @@ def law_dissipated(kind, gap, S, P, T):
 def law_accept(kind, gap, S, P, T):
     """History update after an accepted state (`RigidRoughRoller.accept`)."""
     if kind == LAW_POWER:
+        return
+    if kind == LAW_DISCRETE:
+        _discrete_accept(gap, S, P, T)
+        return
+    if kind == LAW_DISCRETE_BRANCH:
+        if gap < S[S_H_MIN]:
+            S[S_H_MIN] = gap
+        on_r, reach, jumped = _branch_counts(gap, S, P, T)
+        S[S_COUNT_MIN] = jumped
+        S[S_MAX_CONTACTS] = max(S[S_MAX_CONTACTS], float(on_r))
         return
     if gap < P[P_H_LO]:
         S[S_BEYOND_ACCEPTED] += 1.0
@@ -441,7 +623,7 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
     pull = np.array([0.0, 0.0, math.inf, 0.0])
     for i in range(INFO_SIZE):
         info[i] = 0.0
-    S[S_BEYOND_FLAG] = 0.0 if kind == LAW_RIGID_TABLE else S[S_BEYOND_FLAG]
+    S[S_BEYOND_FLAG] = 0.0 if kind != LAW_POWER else S[S_BEYOND_FLAG]
     after_max = False
     t = t0
     _rhs(kind, y[0], y[1], S, P, T, mass, gravity, K, 0)
@@ -456,7 +638,7 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
     ev_k = np.empty(4, dtype=np.int64)
     end = -1
     while True:
-        if kind == LAW_RIGID_TABLE and S[S_BEYOND_FLAG] != 0.0:
+        if kind != LAW_POWER and S[S_BEYOND_FLAG] != 0.0:
             end = ABORT_BEYOND_TABLES
             break
         if n > buf.shape[0]:
@@ -599,7 +781,7 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
             end = END_MAX_TIME
             info[I_T], info[I_GAP], info[I_V] = t1, y[0], y[1]
             break
-    if kind == LAW_RIGID_TABLE and S[S_BEYOND_FLAG] != 0.0:
+    if kind != LAW_POWER and S[S_BEYOND_FLAG] != 0.0:
         end = ABORT_BEYOND_TABLES
     if n > buf.shape[0]:
         end = ABORT_BUFFER

@@ -23,11 +23,20 @@ def first_impact_speed(resolved: ResolvedScene) -> float:
     return s.impact_velocity
 
 
-def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | None = None) -> tuple[dict, dict]:
-    """Simulate a resolved scene; returns (result record for result.json, time-series arrays)."""
-    scene = resolved.scene
+def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | None = None,
+               executor=None, workers: int | None = None) -> tuple[dict, dict]:
+    """Simulate a resolved scene; returns (result record for result.json, time-series arrays).
+
+    Rough contact: surfaces.roughness.mode is settled first (`realisation_decision`; 'auto' by the expected
+    summits in contact). An ensemble runs its members on `executor` (a `nanoimpact.executors` name or an open
+    executor; None: in this process) and adds result.json -> ensemble; the trajectory (bounces, time series) is
+    then the mean-field law's, with the members' summit law, for comparison."""
     start = time.perf_counter()
+    resolved, realisation = _settle_realisation(resolved)
+    scene = resolved.scene
     law, models = select_law(scene, first_impact_speed(resolved))
+    if realisation is not None:
+        models["realisation"] = realisation.record()
     run, release = _simulate(resolved, law, models, progress)
     if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
         # auto menisci, pending: the dry run settles it (continuum.model.decisions.dry_run_verdict)
@@ -56,7 +65,39 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         "provenance": provenance(resolved.input_hash),
         "timing": {"wall_s": wall},
     }
+    if realisation is not None and realisation.mode == "ensemble":
+        result["ensemble"] = _ensemble_record(resolved, run, executor, workers)
+        result["timing"]["wall_s"] = time.perf_counter() - start
     return result, run.trace.arrays()
+
+
+def _settle_realisation(resolved: ResolvedScene):
+    """(resolved scene with surfaces.roughness.mode settled, the decision); (resolved, None) for smooth contact."""
+    from dataclasses import replace
+
+    from .ensemble_run import with_realisation
+    from .model.decisions import realisation_decision
+    from .model.regime import regime_of
+
+    scene = resolved.scene
+    if scene.contact != "rough":
+        return resolved, None
+    decision = realisation_decision(scene, regime_of(scene, first_impact_speed(resolved)))
+    if decision.mode != scene.surfaces.roughness.mode:
+        resolved = replace(resolved, scene=with_realisation(scene, decision.mode))
+    return resolved, decision
+
+
+def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> dict:
+    """result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them."""
+    from .ensemble_run import run_ensemble
+
+    ens = run_ensemble(resolved.scene, executor=executor, workers=workers)
+    heights = [b.rebound_height for b in run.bounces if b.rebound_height is not None]
+    mean_field = {"rebounds": len(heights), "first_rebound_m": heights[0] if heights else 0.0,
+                  "status": run.status, "stuck": run.stuck,
+                  "what": "the mean-field law of the trajectory (bounces, timeseries), same summit law"}
+    return ens.to_record(mean_field=mean_field)
 
 
 def regime_numbers(scene, models: dict, run) -> dict:
@@ -119,4 +160,9 @@ def write_impact(out_dir: str | Path, result: dict, trace: dict) -> Path:
     def draw_force(path):
         plots.save(plots.force_vs_time(trace, result["bounces"]), path, f"{name}: force during each impact")
 
-    return write_run(out_dir, result, trace, {"height.png": draw_height, "impacts.png": draw_force})
+    figures = {"height.png": draw_height, "impacts.png": draw_force}
+    if "ensemble" in result:
+        def draw_ensemble(path):
+            plots.save(plots.ensemble_spread(result["ensemble"]), path, f"{name}: spread over summit realisations")
+        figures["ensemble.png"] = draw_ensemble
+    return write_run(out_dir, result, trace, figures)

@@ -47,6 +47,29 @@ def force_vs_time(trace: dict, bounces: list[dict], ax=None, max_impacts: int = 
     return ax
 
 
+def ensemble_spread(ensemble: dict, ax=None):
+    """An ensemble's members: first rebound height / h0 against the member's number of rebounds (one dot per
+    member, jittered sideways), with the mean-field run's point and the stick probabilities in the legend."""
+    ax = ax or Figure(figsize=(7, 3.5)).subplots()
+    runs = ensemble["member_runs"]
+    h0 = ensemble.get("release_height_m") or 1.0
+    counts = np.array([m["rebounds"] for m in runs], float)
+    first = np.array([m["rebound_heights"][0] if m["rebound_heights"] else 0.0 for m in runs]) / h0
+    jitter = np.random.default_rng(0).uniform(-0.15, 0.15, counts.size)     # display only
+    p = ensemble["stick_probability"]
+    ax.plot(counts + jitter, first, "o", ms=3, alpha=0.6, color="C0",
+            label=f"{len(runs)} members: stuck at 1st impact {p['first_impact']['value']:.2f}, "
+                  f"within the run {p['within_run']['value']:.2f}")
+    mf = ensemble.get("mean_field")
+    if mf is not None:
+        ax.plot([mf["rebounds"]], [mf["first_rebound_m"] / h0], "*", ms=12, color="C3", label="mean field")
+    ax.set_xlabel("rebounds before the run ended")
+    ax.set_ylabel("first rebound / release height" if ensemble.get("release_height_m") else "first rebound (m)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return ax
+
+
 #: Margins of the run figures (one axes on 7 x 3.5 in): room for 6-character tick labels, the axis labels and a
 #: title. Fixed instead of `tight_layout`, which measured every text extent (0.15 s a figure, a third of the
 #: cost of writing a run's figures).

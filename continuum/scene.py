@@ -20,6 +20,7 @@ from nanoimpact import data
 from nanoimpact.errors import DataNotFound, InputError
 from nanoimpact.fields import Resolved, frozen_dataclass, resolved, section_members
 
+from .limiting_pressure import check_sphere_limits, partner_limits
 from .origins import check_origins
 from .reference.hertz import effective_modulus
 from .rough.surface_map import map_statistics, statistics_block
@@ -362,6 +363,7 @@ def _build(v: dict, origin: str) -> Scene:
     sam = _sam(si, v, origin)
     _check_law(si, sam, origin)
     _check_menisci(si, sam, origin)
+    _check_plasticity(si, sam, origin)
     return _assemble(si, mass, length, roughness, sam)
 
 
@@ -438,19 +440,42 @@ def _check_law(si: dict, sam, origin: str) -> None:
         if adhesion <= 0.0:
             key = "surfaces.sam.work_of_adhesion" if sam is not None else "surfaces.work_of_adhesion"
             raise SceneError(key, adhesion, f"must be > 0 J/m^2 when physics.adhesion_law = '{law}'", origin)
-    if si["contact"] == "rough" and si["surfaces.roughness.mode"] == "discrete" and law in ("dmt", "maugis_dugdale"):
-        raise SceneError("physics.adhesion_law", law, "discrete summits use JKR or Hertz; DMT and Maugis-Dugdale "
-                         "summits run in surfaces.roughness.mode = 'averaged'", origin)
+    mode = si["surfaces.roughness.mode"]
+
+
+def _check_plasticity(si: dict, sam, origin: str) -> None:
+    """The yield keys give a limiting contact pressure between the sphere's adhesive stress scale and E*
+    (`continuum.limiting_pressure`); physics.plasticity = 'on' needs an adhesive smooth sphere and a yield key."""
+    choice = si["physics.plasticity"]
+    if choice == "off":
+        return
+    sphere = si["contact"] == "smooth" and si["body.shape"] == "sphere"
+    w = (sam.work_of_adhesion if sam is not None else si["surfaces.work_of_adhesion"])
+    w = w if si["physics.adhesion_law"] != "none" else 0.0
+    try:
+        limits = partner_limits(si)
+        if sphere:
+            e_star = float(effective_modulus(si["surfaces.body.youngs_modulus"], si["surfaces.body.poisson_ratio"],
+                                             si["surfaces.substrate.youngs_modulus"],
+                                             si["surfaces.substrate.poisson_ratio"]))
+            check_sphere_limits(limits, si["body.radius"], w, e_star)
+    except InputError as err:
+        raise SceneError(err.key, err.value, err.allowed, origin) from None
+    if choice == "on" and not (sphere and w > 0.0 and limits):
+        raise SceneError("physics.plasticity", "on", "the elastic-plastic law is for an adhesive smooth sphere "
+                         "(contact = 'smooth', body.shape = 'sphere', work of adhesion > 0, adhesion law not 'none') "
+                         "with surfaces.body or surfaces.substrate yield_strength or hardness", origin)
 
 
 def _check_menisci(si: dict, sam, origin: str) -> None:
-    """Menisci need averaged rough contact, 0 < RH < 1 and both faces' water contact angles."""
+    """Menisci need mean-field rough contact, 0 < RH < 1 and both faces' water contact angles."""
+    mode = si["surfaces.roughness.mode"]
     menisci = si["physics.menisci"]
     rh = si["environment.relative_humidity"]
     if menisci == "on":
-        if si["contact"] != "rough" or si["surfaces.roughness.mode"] != "averaged":
-            raise SceneError("physics.menisci", "on", "menisci are modelled for averaged rough contact only "
-                             "(contact = 'rough', surfaces.roughness.mode = 'averaged')", origin)
+        if si["contact"] != "rough" or mode not in ("mean_field", "auto"):
+            raise SceneError("physics.menisci", "on", "menisci are modelled for mean-field rough contact only "
+                             "(contact = 'rough', surfaces.roughness.mode = 'mean_field' or 'auto')", origin)
         if rh <= 0.0:
             raise SceneError("environment.relative_humidity", rh, "must be > 0 when physics.menisci = 'on'", origin)
     if menisci != "off" and si["contact"] == "rough" and rh > 0.0:

@@ -62,16 +62,24 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.body.poisson_ratio", doc="Poisson's ratio of the body.", default=REQUIRED, **_POISSON),
     Field("surfaces.body.contact_angle", doc="Water contact angle on the body (menisci).",
           default=None, **_ANGLE),
+    Field("surfaces.body.yield_strength", float, "Pa", "Tensile yield strength Y of the body: a smooth sphere's "
+          "limiting contact pressure 2.8 Y (Tabor) in the Thornton-Ning elastic-plastic law (physics.plasticity; "
+          "the softer partner's counts). Optional.", None, low=1e6, high=1e12),
+    Field("surfaces.body.hardness", float, "Pa", "Indentation hardness H of the body: a smooth sphere's limiting "
+          "contact pressure (H is used when both it and the yield strength are given). Optional.", None,
+          low=1e6, high=1e12),
     Field("surfaces.substrate.youngs_modulus", doc="Young's modulus of the substrate.", default=REQUIRED,
           **_MODULUS),
     Field("surfaces.substrate.poisson_ratio", doc="Poisson's ratio of the substrate.", default=REQUIRED,
           **_POISSON),
     Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci).",
           default=None, **_ANGLE),
-    Field("surfaces.substrate.yield_strength", float, "Pa", "Tensile yield strength of the substrate: warn "
+    Field("surfaces.substrate.yield_strength", float, "Pa", "Tensile yield strength of the substrate: a smooth "
+          "sphere's limiting contact pressure 2.8 Y (as surfaces.body.yield_strength); rough and line contact warn "
           "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
-    Field("surfaces.substrate.hardness", float, "Pa", "Indentation hardness of the summits: the plasticity index "
-          "uses it (optional).", None, low=1e6, high=1e12),
+    Field("surfaces.substrate.hardness", float, "Pa", "Indentation hardness of the substrate (and its summits): a "
+          "smooth sphere's limiting contact pressure; the plasticity index of rough contact (optional).", None,
+          low=1e6, high=1e12),
     Field("surfaces.sam.coverage", str, "", "Self-assembled monolayer: 'none', or 'both' (both surfaces covered; "
           "the SAM-SAM work of adhesion replaces surfaces.work_of_adhesion).", "none", choices=("none", "both")),
     Field("surfaces.sam.thickness", float, "m", "SAM thickness (OTS ~2-2.5 nm). A uniform layer that conforms to "
@@ -105,11 +113,16 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.roughness.datum", str, "", "Where release_height is measured from: the tallest summit "
           "expected in the nominal footprint (default), or the summits' mean plane.", "tallest_summit",
           choices=("tallest_summit", "mean_plane")),
-    Field("surfaces.roughness.mode", str, "", "'averaged' (GW statistics on a grid) or 'discrete' (a seeded "
-          "random realisation of individual summits along the footprint, same laws).", "averaged",
-          choices=("averaged", "discrete")),
-    Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation.", 0,
-          low=0, high=2**63 - 1),
+    Field("surfaces.roughness.mode", str, "", "'mean_field' (the Greenwood-Williamson average of the summits), "
+          "'discrete' (one seeded realisation of individual summits along the footprint, same laws), 'ensemble' "
+          "(surfaces.roughness.members discrete realisations, reported as distributions next to the mean-field "
+          "run), or 'auto': an ensemble when the first impact's expected summits in contact are fewer than "
+          "continuum.model.decisions.ENSEMBLE_BELOW_CONTACTS (measured, docs/model.md 'Few summits'), else the mean "
+          "field.", "mean_field", choices=("auto", "mean_field", "discrete", "ensemble")),
+    Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation; of an ensemble, "
+          "the master seed its members' seeds are derived from (numpy SeedSequence).", 0, low=0, high=2**63 - 1),
+    Field("surfaces.roughness.members", int, "1", "Realisations in an ensemble (mode 'ensemble', or 'auto' where "
+          "it runs one).", 64, low=2, high=100000),
     Field("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography reads: "
           "NanoScope .di, Gwyddion .gwy, Nanosurf .nid, Asylum .ibw, matrix text, .npy); a relative path is looked "
           "up beside the scene file, then in the data folders. Its summit statistics fill sigma, summit_density and "
@@ -162,6 +175,11 @@ FIELDS: tuple[Field, ...] = (
           "auto", choices=("auto", "none", "jkr", "dmt", "maugis_dugdale")),
     Field("physics.detachment", str, "", "JKR detachment criterion: 'displacement' (let go at -delta_c, as "
           "the paper) or 'load' (let go at -P_c).", "displacement", choices=("displacement", "load")),
+    Field("physics.plasticity", str, "", "Smooth sphere: the Thornton-Ning (1998) adhesive elastic-plastic law "
+          "(JKR to yield, then a limiting contact pressure from the softer partner's hardness or 2.8 x yield "
+          "strength; the flattening is carried into later impacts). 'auto': on when the first impact is faster "
+          "than the yield velocity, off (recorded) when no yield key is given. Summits stay elastic.", "auto",
+          choices=("auto", "on", "off")),
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",
           "implicit", choices=("implicit", "constant")),

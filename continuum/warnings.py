@@ -21,13 +21,17 @@ def result_warnings(scene, law, bounces) -> list[str]:
     diag = law.diagnostics()
     if scene.contact == "rough":
         n = diag.get("max_contacts", 0.0)
-        if n < MIN_CONTACTS and surf.roughness.mode == "averaged":
+        mode = surf.roughness.mode
+        if n < MIN_CONTACTS and mode == "mean_field":
             out.append(f"averaged rough contact with only {n:.3g} summits attached at most (< {MIN_CONTACTS:g}): "
-                       "the Greenwood-Williamson average is not reliable here; compare with "
-                       "surfaces.roughness.mode = 'discrete'")
+                       "the Greenwood-Williamson average is not reliable here; run surfaces.roughness.mode = "
+                       "'ensemble' (or 'auto') for the distribution over realisations")
+        elif n < MIN_CONTACTS and mode == "ensemble":
+            out.append(f"the mean-field trajectory has only {n:.3g} summits attached at most: it describes no single "
+                       "impact; the prediction is the ensemble block's distribution")
         elif n < MIN_CONTACTS:
             out.append(f"discrete realisation with {n:.3g} summits attached at most: its result depends on the "
-                       "seed; run several seeds to see the spread")
+                       "seed; surfaces.roughness.mode = 'ensemble' gives the spread")
         if diag.get("edge_touched"):
             out.append("attached summits reached the edge of the grid: the footprint was larger than the grid's "
                        "design depth; raise numerics.grid_points or report this case")
@@ -67,10 +71,6 @@ def model_warnings(models: dict) -> list[str]:
     """Warnings about the models chosen (from result.json -> models)."""
     out = []
     adhesion = models.get("adhesion", {})
-    if "map_suggests" in adhesion:
-        out.append(f"the Tabor parameter ({adhesion.get('tabor_parameter', float('nan')):.3g}) puts the summits in the "
-                   f"'{adhesion['map_suggests']}' regime, but discrete summits are JKR only: run the averaged mode to "
-                   "use that law")
     men = models.get("menisci", {})
     ratio = men.get("kelvin_gap_over_summit_radius")
     if men.get("used") and ratio is not None and ratio > MAX_KELVIN_GAP_OVER_RADIUS:

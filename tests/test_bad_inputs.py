@@ -290,9 +290,7 @@ def calibration_cases():
              ("both-heights", {"impact_velocity": 0.1}, "release_height"),
              ("saturated", {"environment.relative_humidity": 1.0, "physics.menisci": "auto"},
               "environment.relative_humidity"),
-             ("sam-layer-no-sam", {"surfaces.sam.layer_modulus": 1e9}, "surfaces.sam.layer_modulus"),
-             ("discrete-dmt", {"surfaces.roughness.mode": "discrete", "physics.adhesion_law": "dmt"},
-              "physics.adhesion_law")]
+             ("sam-layer-no-sam", {"surfaces.sam.layer_modulus": 1e9}, "surfaces.sam.layer_modulus")]
     for label, overrides, expect in cross:
         yield f"cal-cross-{label}", _cal(quick, ("uncertainty", "overrides"), overrides), argv, expect
     for cal in CALIBRATIONS:

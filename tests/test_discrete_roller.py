@@ -201,7 +201,7 @@ def _rebounds(seeds, rtol_discrete, w=W, **rough):
     def scene(**kw):
         return resolve_scene(table=_table(**rough, **kw), overrides={"surfaces.work_of_adhesion": w}).scene
 
-    sa = scene(mode="averaged")
+    sa = scene(mode="mean_field")
     averaged, _ = rough_law(sa)
     avg = _simulate(averaged, sa, rtol=1e-8).bounces[0].rebound_height / H0
     out = []

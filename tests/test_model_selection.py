@@ -105,18 +105,16 @@ def test_the_dry_run_settles_a_pending_meniscus_decision_at_t_a():
     assert dry_run_verdict(scene, [], "escaped").longest_contact_s == 0.0
 
 
-def test_discrete_summits_record_the_law_that_runs_and_what_the_map_suggests():
-    """Discrete summits run JKR where Johnson & Greenwood's map says Maugis-Dugdale: models.adhesion.law is
-    the law that runs (as models.contact_law says), map_suggests the map's, and a warning says so."""
+def test_discrete_summits_run_the_law_the_map_picks():
+    """Where Johnson & Greenwood's map says Maugis-Dugdale, discrete summits run Maugis-Dugdale too (tabulated
+    branches, continuum.rough.branch_laws), as the mean field does."""
     from continuum.model import select_law
     from continuum.scene import resolve_scene
-    from continuum.warnings import model_warnings
 
     scene = resolve_scene("rough_silica", params="paper", overrides={
         "surfaces.roughness.mode": "discrete", "surfaces.interaction_range": 3e-9,
         "physics.adhesion_law": "auto"}).scene
     law, models = select_law(scene, 1e-3)
     assert models["adhesion"]["tabor_parameter"] < 5.0
-    assert (models["adhesion"]["law"], models["adhesion"]["map_suggests"]) == ("jkr", "maugis_dugdale")
-    assert "jkr" in law.name
-    assert any("maugis_dugdale" in w for w in model_warnings(models))
+    assert models["adhesion"]["law"] == "maugis_dugdale" and "map_suggests" not in models["adhesion"]
+    assert law.name == "rough_roller_discrete_maugis_dugdale"

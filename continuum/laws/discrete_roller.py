@@ -36,6 +36,12 @@ U_JKR(-Delta)), booked at `accept`, with a trial state's pending releases report
 `dissipated`. At the release gap Delta every summit has let go (the tallest effective summit sits
 at delta = -Delta there): `on_release` books the loops of those still attached.
 
+Compiled form (rigid substrate only): on a rigid substrate the history rule leaves attached exactly a prefix of
+the summits sorted by effective height (those reached, e_i - z_top >= h_min, that have not let go, e_i - z_top
+>= gap - Delta), so the deepest accepted gap h_min is the whole history and a contact runs in the compiled
+kernel (`continuum.contact_kernel.LAW_DISCRETE`, the same per-summit closed forms), ~100x faster than the
+Python stepper; a state below the kept summits hands the contact back to the Python stepper, which keeps more.
+
 Cost: each force evaluation touches only the prefix of the summits sorted by effective height
 that are attached or within reach, so it is O(contacts). The force is discontinuous (a summit
 jumps onto the JKR curve at -8/9 P_c and leaves it at -5/9 P_c), so the driver's adaptive
@@ -88,6 +94,11 @@ class DiscreteRoughRoller(RoughRollerBase):
         `continuum.rough.datum.tallest_summit`.
     depth_max : float, optional
         Keep summits that touch within this depth (m) below the datum; default 8 sigma.
+    summit_law : continuum.rough.branch_laws.SummitLaw, optional
+        Tabulated approach and retreat branches of one summit (Maugis-Dugdale, DMT, coated summits) in place of
+        the closed-form JKR/Hertz summits: a summit jumps in at delta_in, follows its retreat branch until
+        delta_out, and every other summit within reach (delta >= -reach) exerts its approach branch's force (the
+        Maugis-Dugdale attraction before contact). JKR is the case delta_in = 0, delta_out = -Delta, reach 0.
     """
 
     name = "rough_roller_discrete_jkr"
@@ -97,7 +108,7 @@ class DiscreteRoughRoller(RoughRollerBase):
                  length: float, e_star: float, *, seed: int, detachment: str = "displacement",
                  half_space: bool = True, grid_points: int = 256, footprint_half_width: float | None = None,
                  depth_max: float | None = None, depth_safety: float = 1.5, coupling_tol: float = 1e-11,
-                 max_coupling_iterations: int = 20):
+                 max_coupling_iterations: int = 20, summit_law=None):
         if detachment not in ("displacement", "load"):
             raise ValueError(f"detachment = {detachment!r}: must be 'displacement' or 'load'")
         if not work_of_adhesion >= 0.0:
@@ -125,9 +136,21 @@ class DiscreteRoughRoller(RoughRollerBase):
         else:
             self.delta_c = self.pull_off_force = self.release_stretch = self.loop_energy = 0.0
             self.force_scale = 4.0 / 3.0 * e * math.sqrt(b) * self.sigma**1.5
-        self.end_gap = self.release_stretch                # every summit has let go there
+        self.slaw = summit_law
+        self._delta_in, self._reach = 0.0, 0.0
+        if summit_law is not None:
+            self.adhesive = True
+            self.name = f"rough_roller_discrete_{summit_law.name}"
+            self._delta_in, self._reach = float(summit_law.delta_in), float(summit_law.reach)
+            self.touch_gap = self._reach        # the tallest summit's attraction starts here: the contact begins
+            self.release_stretch = max(-float(summit_law.delta_out), 0.0)
+            self.delta_c = self.release_stretch
+            self.pull_off_force = float(summit_law.pull_off_force)
+            self.loop_energy = float(summit_law.loop_energy)
+            self.force_scale = max(self.pull_off_force, 4.0 / 3.0 * e * math.sqrt(b) * self.sigma**1.5)
+        self.end_gap = max(self.release_stretch, self._reach)   # every summit has let go, and is out of reach
         self._hertz_k = 4.0 / 3.0 * e * math.sqrt(b)
-        if self.adhesive:
+        if self.adhesive and summit_law is None:
             self._a0 = float(ref.contact_radius_at_touch(b, g, e))
             self._delta0 = self._a0**2 / b
             self._inv_delta0 = 1.0 / self._delta0
@@ -215,6 +238,8 @@ class DiscreteRoughRoller(RoughRollerBase):
         its argument checks (the history rule never asks for delta < -Delta); then P, U, dP/d delta
         and a are explicit in s. Returns arrays "force" (N) and, lazily via `_energy` etc., the rest.
         """
+        if self.slaw is not None:
+            return {"delta": delta, "force": self.slaw.force(delta, "retreat")}
         if not self.adhesive:
             dp = np.maximum(delta, 0.0)
             return {"delta": delta, "force": self._hertz_k * dp * np.sqrt(dp)}
@@ -238,6 +263,8 @@ class DiscreteRoughRoller(RoughRollerBase):
 
     def _energy(self, q: dict) -> np.ndarray:
         """Stored energy U(delta) (J) along the stable branch, U(0) = 0 (the kernel's closed form)."""
+        if self.slaw is not None:
+            return self.slaw.energy(q["delta"], "retreat")
         if not self.adhesive:
             dp = np.maximum(q["delta"], 0.0)
             return 0.4 * self._hertz_k * dp * dp * np.sqrt(dp)
@@ -245,6 +272,9 @@ class DiscreteRoughRoller(RoughRollerBase):
 
     def _stiffness(self, q: dict) -> np.ndarray:
         """dP/d delta (N/m); -inf exactly at the fold."""
+        if self.slaw is not None:           # central difference on the tabulated retreat branch
+            h = 1e-6 * self.sigma
+            return (self.slaw.force(q["delta"] + h, "retreat") - self.slaw.force(q["delta"] - h, "retreat")) / (2 * h)
         if not self.adhesive:
             return 1.5 * self._hertz_k * np.sqrt(np.maximum(q["delta"], 0.0))
         s = q["s"]
@@ -256,6 +286,8 @@ class DiscreteRoughRoller(RoughRollerBase):
 
     def _area(self, q: dict) -> np.ndarray:
         """Real contact area pi a^2 (m^2) of each summit."""
+        if self.slaw is not None:
+            return math.pi * self.slaw.contact_radius(q["delta"], "retreat") ** 2
         if not self.adhesive:
             return math.pi * self.beta * np.maximum(q["delta"], 0.0)
         a = self._a0 * q["s"] ** 2
@@ -306,9 +338,11 @@ class DiscreteRoughRoller(RoughRollerBase):
 
     def approach_force(self, gap: float) -> float:
         """Force (N) of a monotonic first approach to `gap` on a rigid substrate (grid sizing)."""
-        k = self._count_above(self.z_top + gap)
+        k = self._count_above(self.z_top + gap - self._reach)
         if k == 0:
             return 0.0
+        if self.slaw is not None:
+            return float(np.sum(self.slaw.force(self.eff[:k] - self.z_top - gap, "approach")))
         return float(np.sum(self._laws(self.eff[:k] - self.z_top - gap)["force"]))
 
     def approach_forces(self, depths: np.ndarray) -> np.ndarray:
@@ -325,17 +359,21 @@ class DiscreteRoughRoller(RoughRollerBase):
         base = self.z_top + gap
         if base + min(de_lo, 0.0) < self.z_top - self.depth_keep:
             self._deepen(2.0 * (self.z_top - base - min(de_lo, 0.0)))
-        k = max(self.k_att, self._count_above(base + min(de_lo, 0.0)))
+        k = max(self.k_att, self._count_above(base + min(de_lo, 0.0) - self._reach))
         if de_of is None:
             de = None
             delta = self.eff[:k] - base
         else:
             de = de_of(k)
             delta = self.eff[:k] - base - de
-        att = (self.attached[:k] | (delta >= 0.0)) & (delta >= -self.release_stretch)
+        att = (self.attached[:k] | (delta >= self._delta_in)) & (delta >= -self.release_stretch)
         q = self._laws(delta[att])
         force = np.zeros(k)
         force[att] = q["force"]
+        if self.slaw is not None:           # summits in reach, not jumped in: the approach branch
+            free = ~att & (delta >= -self._reach)
+            q["free_delta"] = delta[free]
+            force[free] = self.slaw.force(q["free_delta"], "approach")
         return k, delta, att, q, force, de
 
     def _evaluate(self, gap: float) -> dict:
@@ -409,6 +447,8 @@ class DiscreteRoughRoller(RoughRollerBase):
     def stored_energy(self, gap):
         s = self._state(gap)
         summits = float(np.sum(self._energy(s["q"])))
+        if "free_delta" in s["q"]:
+            summits += float(np.sum(self.slaw.energy(s["q"]["free_delta"], "approach")))
         elastic = 0.5 * float(np.dot(s["force"], s["de"])) if s["de"] is not None else 0.0
         return summits + elastic
 
@@ -438,6 +478,64 @@ class DiscreteRoughRoller(RoughRollerBase):
             p, de = self._grid(s)
             self.max_deflection = max(self.max_deflection, float(np.max(np.abs(de))))
             self.max_pressure = max(self.max_pressure, float(np.max(p)))
+
+    def compiled(self, t0: float):
+        """The kept summits as the compiled kernel reads them (`continuum.contact_kernel.LAW_DISCRETE`); None with
+        the half-space on (its coupled fixed point runs in Python)."""
+        from .. import contact_kernel as ck
+        from ..compiled_contact import EMPTY_TABLES, CompiledLaw
+
+        if self.use_half_space:
+            return None
+        if self.slaw is not None:
+            return self._compiled_branches()
+        if getattr(self, "_compiled_for", None) is not self.eff:
+            P = np.zeros(ck.DISCRETE_PARAMS)
+            P[ck.P_D_END_GAP], P[ck.P_D_RELEASE], P[ck.P_D_LOOP] = self.end_gap, self.release_stretch, self.loop_energy
+            P[ck.P_D_HERTZ_K], P[ck.P_D_ADHESIVE] = self._hertz_k, 1.0 if self.adhesive else 0.0
+            if self.adhesive:
+                P[ck.P_D_INV_DELTA0], P[ck.P_D_PSCALE] = self._inv_delta0, self._pscale
+                P[ck.P_D_ESCALE] = self._pscale * self._delta0
+            P[ck.P_D_LOWEST] = -self.depth_keep
+            self._compiled_tables = (P, (np.ascontiguousarray(self.eff - self.z_top),) + EMPTY_TABLES[1:])
+            self._compiled_for = self.eff
+        P, T = self._compiled_tables
+        return CompiledLaw(ck.LAW_DISCRETE, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+
+    def _compiled_branches(self):
+        """`continuum.contact_kernel.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two branches."""
+        from .. import contact_kernel as ck
+        from ..compiled_contact import EMPTY_TABLES, CompiledLaw
+
+        if getattr(self, "_compiled_for", None) is not self.eff:
+            P = np.zeros(ck.BRANCH_PARAMS)
+            P[ck.P_B_END_GAP], P[ck.P_B_IN], P[ck.P_B_OUT] = self.end_gap, self._delta_in, -self.release_stretch
+            P[ck.P_B_REACH], P[ck.P_B_LOOP], P[ck.P_B_LOWEST] = self._reach, self.loop_energy, -self.depth_keep
+            a, r = self.slaw.approach, self.slaw.retreat
+            tables = tuple(np.ascontiguousarray(x, float) for x in
+                           (self.eff - self.z_top, a.delta, a.force, a.energy, r.delta, r.force, r.energy))
+            self._compiled_tables = (P, tables + EMPTY_TABLES[7:])
+            self._compiled_for = self.eff
+        P, T = self._compiled_tables
+        return CompiledLaw(ck.LAW_DISCRETE_BRANCH, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        """Take back a compiled contact: the summits reached at its deepest gap h_min are the history (the detach
+        rule is applied to them at any later gap), and the run-wide diagnostics."""
+        h_min = float(state[0])
+        if not math.isfinite(h_min):
+            return
+        reached = int(state[1])
+        self.attached[:] = False
+        self.attached[:reached] = True
+        self.k_att = reached
+        self._cache_gap = None
+        self.max_contacts = max(self.max_contacts, int(state[2]))
+        self.max_depth = max(self.max_depth, -h_min)
+        if -h_min > self.strip_depth:
+            self.beyond_strip = True
+        if reached and np.any(self.outside[:reached]):
+            self.edge_touched = True
 
     def on_release(self):
         """Every summit still attached lets go at the release gap: book their loops with the others'."""
@@ -477,8 +575,10 @@ class DiscreteRoughRoller(RoughRollerBase):
                 **self._grid_record()}
 
     def describe(self):
-        return {"name": self.name, "mode": "discrete",
-                "source": "seeded realisation of GW (1966) summits, each JKR + Fuller-Tabor hysteresis; paper eqs 9-17",
+        source = ("seeded realisation of GW (1966) summits, each JKR + Fuller-Tabor hysteresis; paper eqs 9-17"
+                  if self.slaw is None else f"seeded realisation of GW (1966) summits, each on the tabulated branches "
+                  f"of a {self.slaw.name} summit (continuum.rough.branch_laws)")
+        return {"name": self.name, "mode": "discrete", "source": source,
                 "radius": self.radius, "length": self.length, "e_star": self.e_star,
                 "half_space": self.use_half_space, "grid_points": self.n, "seed": self.seed,
                 "sigma": self.sigma, "summit_density": self.stats.density, "summit_radius": self.beta,

@@ -97,8 +97,6 @@ class AdhesionDecision:
     estimated_loss_fraction: float | None = None
     estimated_pull_fraction: float | None = None
     loop_energy_per_summit: float | None = None
-    map_suggests: str | None = None
-    """The map's law where the geometry could not run it (discrete summits: JKR instead)."""
 
     @property
     def used(self) -> bool:
@@ -118,11 +116,7 @@ class AdhesionDecision:
                         "estimated_pull_fraction": self.estimated_pull_fraction,
                         "loop_energy_per_summit": self.loop_energy_per_summit,
                         "negligible_below": {"loss": NEGLIGIBLE_LOSS, "pull": NEGLIGIBLE_PULL}})
-        # "law" is the law that runs; where the geometry overrode the map (discrete summits run JKR), "map_suggests"
-        # names the map's choice
         rec.update({"law": self.law, "decided_by": self.decided_by, "why": self.why})
-        if self.map_suggests is not None:
-            rec["map_suggests"] = self.map_suggests
         return rec
 
 
@@ -161,15 +155,6 @@ def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
                                     "adhesion left out", **base)
     return AdhesionDecision(law, "tabor_parameter", f"auto: Tabor mu = {mu:.3g} of the summits -> {LAW_NAMES[law]}",
                             **base)
-
-
-def for_discrete_summits(decision: AdhesionDecision) -> AdhesionDecision:
-    """Discrete summits run JKR or Hertz only: a DMT or Maugis-Dugdale choice becomes JKR, and says so."""
-    if decision.law not in ("dmt", "maugis_dugdale"):
-        return decision
-    return replace(decision, law="jkr", map_suggests=decision.law,
-                   why=decision.why + "; discrete summits are JKR or Hertz only: JKR used (force 'averaged' mode for "
-                                      "this law)")
 
 
 # ----------------------------------------------------------------------------- half-space
@@ -251,8 +236,11 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
     rh = env.relative_humidity
     if choice == "off":
         return MenisciDecision("off", "scene", "physics.menisci = 'off' set in the scene", rh)
-    if scene.contact != "rough" or surf.roughness.mode != "averaged":
-        return MenisciDecision("off", "geometry", "menisci are modelled for averaged rough contact only", rh)
+    if scene.contact != "rough":
+        return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact only", rh)
+    if surf.roughness.mode != "mean_field":
+        return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact only (surfaces."
+                               f"roughness.mode = '{surf.roughness.mode}')", rh)
     if rh <= 0.0:
         return MenisciDecision("off", "relative_humidity", "dry: environment.relative_humidity = 0", rh)
     t1, t2 = surf.contact_angles
@@ -307,3 +295,136 @@ def dry_run_verdict(scene: Scene, durations, status: str) -> DryRunVerdict:
              "change any rebound (the body is already held)")
     return DryRunVerdict(max(released, default=0.0), meniscus_parameters(scene)["condensation_time"], len(durations),
                          final)
+
+
+# ----------------------------------------------------------------------------- realisation (few summits)
+#: 'auto' runs an ensemble of discrete realisations below this many expected summits in contact at the first
+#: impact (the Hertz estimate's count, continuum.estimates): above it the mean field's first-impact energy loss lies
+#: within ENSEMBLE_TOLERANCE of the ensemble mean. Measured by benchmarks/bench_ensemble_threshold.py (the
+#: departure falls like A / sqrt(N_c), A = 0.45 +- 0.12; N* = (A / tolerance)^2 = 80 (47-125 within A's standard
+#: error); docs/figures/ensemble_threshold.json, docs/model.md "Few summits: ensembles").
+ENSEMBLE_BELOW_CONTACTS = 80.0
+#: The relative departure of the first impact's energy loss (mean field against the ensemble mean) that 'auto'
+#: accepts. A declared choice: the departure decays only like 1/sqrt(N_c), so a tolerance at the solver's level
+#: (1e-6) would ask for ensembles at every realistic N_c; 5 % keeps them wherever the mean field is biased by more
+#: than that (the json also gives the threshold at 1 %).
+ENSEMBLE_TOLERANCE = 0.05
+
+
+@dataclass(frozen=True)
+class RealisationDecision:
+    """How the summits are realised: 'mean_field', 'discrete' or 'ensemble', and the count that decided it."""
+
+    mode: str
+    decided_by: str
+    why: str
+    expected_contacts: float | None
+    members: int | None = None
+    seed: int | None = None
+
+    def record(self) -> dict:
+        rec = {"mode": self.mode, "expected_contacts": self.expected_contacts,
+               "ensemble_below_contacts": ENSEMBLE_BELOW_CONTACTS, "tolerance_over_h0": ENSEMBLE_TOLERANCE,
+               "threshold_source": "benchmarks/bench_ensemble_threshold.py -> docs/figures/ensemble_threshold.json"}
+        if self.mode == "ensemble":
+            rec.update(members=self.members, master_seed=self.seed)
+        rec.update(used=True, decided_by=self.decided_by, why=self.why)
+        return rec
+
+
+def realisation_decision(scene: Scene, regime: Regime) -> RealisationDecision:
+    """Mean field or an ensemble of discrete realisations for a rough `scene` (its regime carries the estimate)."""
+    rough = scene.surfaces.roughness
+    n_c = regime.estimate.contacts if regime.estimate is not None else None
+    ens = dict(members=rough.members, seed=rough.seed)
+    if rough.mode != "auto":
+        return RealisationDecision(rough.mode, "scene", f"surfaces.roughness.mode = '{rough.mode}' set in the scene",
+                                   n_c, **(ens if rough.mode == "ensemble" else {}))
+    if n_c >= ENSEMBLE_BELOW_CONTACTS:
+        return RealisationDecision("mean_field", "expected_contacts",
+                                   f"auto: {n_c:.3g} summits expected in contact >= {ENSEMBLE_BELOW_CONTACTS:g}: the "
+                                   "mean field agrees with the ensemble mean within the measured tolerance", n_c)
+    few = f"auto: {n_c:.3g} summits expected in contact < {ENSEMBLE_BELOW_CONTACTS:g}"
+    mean_field = replace(scene, surfaces=replace(scene.surfaces, roughness=replace(rough, mode="mean_field")))
+    if menisci_decision(mean_field).choice != "off":
+        return RealisationDecision("mean_field", "menisci",
+                                   f"{few}, but menisci may form and discrete members carry none: the mean field "
+                                   "runs with them, and no spread is computed", n_c)
+    return RealisationDecision("ensemble", "expected_contacts",
+                               f"{few}: the mean field describes no single impact; an ensemble of {rough.members} "
+                               "discrete realisations gives the distribution", n_c, **ens)
+
+
+# ----------------------------------------------------------------------------- plasticity (smooth sphere)
+@dataclass(frozen=True)
+class PlasticityDecision:
+    """Whether a smooth sphere runs the Thornton-Ning adhesive elastic-plastic law, and the numbers that decided
+    it: the softer partner's limiting contact pressure (Pa, `continuum.limiting_pressure`) and the yield velocity
+    (m/s, `continuum.reference.thornton_ning.yield_velocity`) against the first impact's speed (m/s)."""
+
+    used: bool
+    decided_by: str
+    why: str
+    limiting_pressure: float | None = None
+    from_key: str | None = None
+    yield_velocity: float | None = None
+    impact_speed: float | None = None
+    partners: tuple = ()
+    """Each partner with a yield key: `continuum.limiting_pressure.PartnerLimit`."""
+
+    def record(self) -> dict:
+        rec: dict = {}
+        if self.partners:
+            rec["partners"] = [{"key": p.key, "value": p.value, "limiting_pressure": p.limiting_pressure}
+                               for p in self.partners]
+        if self.yield_velocity is not None:
+            rec.update(limiting_pressure=self.limiting_pressure, from_key=self.from_key,
+                       yield_velocity=self.yield_velocity, impact_speed=self.impact_speed,
+                       source="Thornton & Ning, Powder Technol. 99 (1998) 154")
+        rec.update(used=self.used, decided_by=self.decided_by, why=self.why)
+        return rec
+
+
+def _yield_values(scene: Scene) -> dict:
+    """The yield keys and moduli of both partners, keyed by scene path (SI)."""
+    surf = scene.surfaces
+    return {f"{prefix}.{name}": getattr(mat, name) for prefix, mat in (("surfaces.body", surf.body),
+                                                                          ("surfaces.substrate", surf.substrate))
+            for name in ("yield_strength", "hardness", "youngs_modulus")}
+
+
+def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> PlasticityDecision:
+    """Elastic-plastic smooth sphere or not, for the adhesion law that runs (`adhesion`) and the first impact's
+    `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key."""
+    from ..limiting_pressure import partner_limits, softer_partner
+    from ..reference import thornton_ning as tn
+
+    choice = scene.physics.plasticity
+    if choice == "off":
+        return PlasticityDecision(False, "scene", "physics.plasticity = 'off' set in the scene")
+    if scene.contact == "rough" or scene.body.shape != "sphere":
+        return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; summits and "
+                                  "rollers stay elastic (the plasticity index and yield warnings say where they "
+                                  "would yield)")
+    limits = tuple(partner_limits(_yield_values(scene)))
+    soft = softer_partner(list(limits))
+    if soft is None:
+        return PlasticityDecision(False, "yield_strength", "no yield key (surfaces.body or surfaces.substrate "
+                                  "yield_strength or hardness): the sphere is elastic")
+    if adhesion == "none":
+        return PlasticityDecision(False, "adhesion_law", "the elastic-plastic law here is the adhesive one "
+                                  "(Thornton & Ning 1998); without adhesion the sphere stays elastic (Hertz)",
+                                  partners=limits)
+    body, surf = scene.body, scene.surfaces
+    density = body.mass / (4.0 / 3.0 * math.pi * body.radius**3)
+    v_y = float(tn.yield_velocity(soft.limiting_pressure, body.radius, surf.interface_work_of_adhesion,
+                                  surf.e_star, density))
+    numbers = dict(limiting_pressure=soft.limiting_pressure, from_key=soft.key, yield_velocity=v_y,
+                   impact_speed=speed, partners=limits)
+    if choice == "on":
+        return PlasticityDecision(True, "scene", "physics.plasticity = 'on' set in the scene", **numbers)
+    used = speed > v_y
+    why = (f"auto: first impact at {speed:.3g} m/s " + ("> " if used else "<= ") + f"the yield velocity {v_y:.3g} "
+           f"m/s (limiting contact pressure {soft.limiting_pressure:.3g} Pa from {soft.key}): "
+           + ("Thornton-Ning elastic-plastic law" if used else "the contact stays elastic"))
+    return PlasticityDecision(used, "yield_velocity", why, **numbers)

@@ -11,10 +11,13 @@ from ..laws.base import ContactLaw
 from ..scene import Scene
 
 
-def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float) -> tuple[ContactLaw, str]:
-    """The closed-form law of a smooth body under `adhesion` ('none' or 'jkr'), and what it is."""
+def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float,
+               limiting_pressure: float | None = None) -> tuple[ContactLaw, str]:
+    """The closed-form law of a smooth body under `adhesion` ('none' or 'jkr'), and what it is; with a
+    `limiting_pressure` (Pa) the adhesive sphere is the Thornton-Ning elastic-plastic one."""
     from ..laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
     from ..laws.jkr import JKRSphere
+    from ..laws.plastic_sphere import PlasticJKRSphere
 
     body, surf, phys = scene.body, scene.surfaces, scene.physics
     e_star = surf.e_star
@@ -29,6 +32,12 @@ def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float) -> tuple[
                 "smooth cylinder, line_stiffness = 'constant': K of eq 1 frozen at the first impact's peak load "
                 "(paper eq 2)")
     # jkr; scene validation admits only a sphere for smooth contact
+    if limiting_pressure is not None:
+        return (PlasticJKRSphere(body.radius, surf.interface_work_of_adhesion, e_star, limiting_pressure,
+                                 phys.detachment),
+                f"smooth sphere, Thornton-Ning adhesive elastic-plastic: JKR to yield, limiting contact pressure "
+                f"{limiting_pressure:.4g} Pa, JKR unloading about the flattened radius, {phys.detachment}-controlled "
+                "release; the flattening is carried into later impacts")
     return (JKRSphere(body.radius, surf.interface_work_of_adhesion, e_star, phys.detachment),
             f"smooth sphere, JKR with Fuller-Tabor hysteresis, {phys.detachment}-controlled release")
 
@@ -59,13 +68,15 @@ def grid_roller(surface, scene: Scene) -> ContactLaw:
 
 
 def discrete_roller(scene: Scene, stats, work_of_adhesion: float, summit_e_star: float, half_space: bool,
-                    footprint_half_width: float) -> ContactLaw:
-    """A seeded realisation of individual summits (surfaces.roughness.seed) under the roller."""
+                    footprint_half_width: float, summit_law=None) -> ContactLaw:
+    """A seeded realisation of individual summits (surfaces.roughness.seed) under the roller: closed-form JKR or
+    Hertz summits, or `summit_law`'s tabulated branches (Maugis-Dugdale, DMT, coated summits)."""
     from ..laws.discrete_roller import DiscreteRoughRoller
     body, surf = scene.body, scene.surfaces
     return DiscreteRoughRoller(stats, work_of_adhesion, summit_e_star, body.radius, body.length, surf.e_star,
                                seed=surf.roughness.seed, detachment=scene.physics.detachment, half_space=half_space,
-                               grid_points=scene.numerics.grid_points, footprint_half_width=footprint_half_width)
+                               grid_points=scene.numerics.grid_points, footprint_half_width=footprint_half_width,
+                               summit_law=summit_law)
 
 
 def with_menisci(dry: ContactLaw, scene: Scene, stats, parameters: dict) -> ContactLaw:

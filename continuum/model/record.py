@@ -89,7 +89,7 @@ def rough_law_record(scene: Scene, *, datum: dict, regime: dict, surface=None, c
             "summits_in_strip": law.summits_in_strip, "summits_kept": law.summits_kept}
         record["table"] = {"used": False, "why": "discrete mode evaluates each summit's JKR law in closed form"}
     else:
-        record["mode"] = "averaged"
+        record["mode"] = "mean_field"
     if summit_law_record is not None:
         record["summit_law"] = summit_law_record
     return record

@@ -11,8 +11,8 @@ from ..reference import jkr as jkr_ref
 from ..scene import Scene, SceneError
 from . import factory
 from . import record as rec
-from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, for_discrete_summits, half_space_decision,
-                        menisci_decision, summit_law)
+from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, half_space_decision,
+                        menisci_decision, plasticity_decision, summit_law)
 from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
@@ -20,6 +20,12 @@ FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
 #: GW tables estimated to take longer than this (s) are built only after the adhesive approach has been
 #: checked against the averaged model's range (`adhesive_range_check`, < 1 s).
 LARGE_TABLE_SECONDS = 2.0
+
+
+def branch_summits(adhesion: str) -> bool:
+    """Whether summits of law `adhesion` run on tabulated branches (`continuum.rough.branch_laws`): Maugis-Dugdale
+    and DMT; JKR and Hertz summits have closed forms (GW tables, the discrete law's own)."""
+    return adhesion in ("dmt", "maugis_dugdale")
 
 
 def adhesive_range_check(scene: Scene, stats, z_max_sigma: float, speed: float) -> None:
@@ -64,7 +70,7 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
     e_s = regime.e_star
     table = scene.numerics.table
-    generic = adhesion in ("dmt", "maugis_dugdale")
+    generic = branch_summits(adhesion)
     cost = None
     slaw = None
     if rough.mode != "discrete":
@@ -99,7 +105,8 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     surface = None
     if rough.mode == "discrete":
         # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
-        law = factory.discrete_roller(scene, stats, w, e_s, half_space, datum["footprint_half_width"])
+        slaw = summit_law(adhesion, scene) if generic else None
+        law = factory.discrete_roller(scene, stats, w, e_s, half_space, datum["footprint_half_width"], slaw)
         delta_c = law.delta_c
     else:
         surface = factory.averaged_surface(stats, summit_law=slaw, work_of_adhesion=w, summit_e_star=e_s,
@@ -132,8 +139,6 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         regime = regime_of(scene, first_impact_speed)
         estimate = regime.estimate
         adhesion = adhesion_decision(scene, regime)
-        if scene.surfaces.roughness.mode == "discrete":
-            adhesion = for_discrete_summits(adhesion)
         hs = half_space_decision(scene, regime)
         wet = menisci if menisci is not None else (m.choice == "on")
         law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, estimate=estimate, regime=regime)
@@ -142,6 +147,7 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
                                  "why": "contact = 'rough': GW summits on a grid under the roller"}
         models["adhesion"] = {"used": adhesion.used, **adhesion.record()}
         models["half_space"] = hs.record()
+        models["plasticity"] = plasticity_decision(scene, adhesion.law, first_impact_speed).record()
         if menisci is not None:
             m_rec = {**m_rec, "used": menisci}
         if wet:
@@ -151,12 +157,15 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         models["free_flight"] = rec.free_flight_record()
         return law, models
     adhesion = adhesion_decision(scene, regime_of(scene))
-    law, why = factory.smooth_law(scene, adhesion.law, first_impact_speed)
+    plastic = plasticity_decision(scene, adhesion.law, first_impact_speed)
+    law, why = factory.smooth_law(scene, adhesion.law, first_impact_speed,
+                                  plastic.limiting_pressure if plastic.used else None)
     a_rec = adhesion.record()
     if not adhesion.used and scene.surfaces.interface_work_of_adhesion > 0 and scene.physics.adhesion_law == "none":
         a_rec = {**a_rec, "why": "adhesion_law = 'none' (work_of_adhesion ignored)"}
     models["adhesion"] = {"used": adhesion.used, **a_rec}
     models["contact_law"] = {**law.describe(), "why": why}
+    models["plasticity"] = plastic.record()
     models["menisci"] = m_rec
     models["half_space"] = SMOOTH_HALF_SPACE.record()
     models["sam"] = rec.sam_record(scene)

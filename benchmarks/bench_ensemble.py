@@ -1,0 +1,60 @@
+"""Seconds for an ensemble of discrete realisations of `rough_silica` (issue target: 64 members in <= 20 s on the
+2-core machine), on the executors of `nanoimpact.executors`, with the machine's load average beside each number.
+
+    python benchmarks/bench_ensemble.py [--params calibrated] [--members 64] [--json FILE]
+
+Cases: the scene as shipped (physics.half_space = 'on': each member's summits are coupled to the half-space in
+Python) and on a rigid substrate (each contact in the compiled kernel, continuum.contact_kernel). The ensemble's
+own wall time is reported (`EnsembleResult.wall_s`: the members, not the scene's resolution or the mean-field run).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+from continuum.compiled_contact import warm_up
+from continuum.ensemble_run import run_ensemble
+from continuum.scene import resolve_scene
+
+CASES = {"as shipped (half-space on)": {}, "rigid substrate": {"physics.half_space": "off"}}
+
+
+def one(params: str, overrides: dict, members: int, executor: str, workers: int | None) -> dict:
+    resolved = resolve_scene("rough_silica", params=params, overrides=overrides, override_label="bench")
+    load_before = os.getloadavg()[0]
+    start = time.perf_counter()
+    ens = run_ensemble(resolved, members=members, seed=1, executor=executor, workers=workers)
+    total = time.perf_counter() - start
+    return {"executor": executor, "workers": workers, "members": members, "seconds": total,
+            "ensemble_wall_s": ens.wall_s, "member_seconds_sum": sum(o.wall_s for o in ens.outcomes),
+            "stick_probability": ens.stick_probability,
+            "stick_probability_first_impact": ens.stick_probability_first_impact,
+            "load_average_before": load_before, "load_average_after": os.getloadavg()[0]}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--params", default="calibrated")
+    ap.add_argument("--members", type=int, default=64)
+    ap.add_argument("--json", help="write the numbers here")
+    args = ap.parse_args()
+    warm_up()
+    out = {"scene": "rough_silica", "params": args.params, "cpus": os.cpu_count(), "cases": {}}
+    for name, overrides in CASES.items():
+        rows = []
+        for executor, workers in (("processes", os.cpu_count()), ("local", None)):
+            row = one(args.params, overrides, args.members, executor, workers)
+            rows.append(row)
+            print(f"{name:28s} {executor:9s} {args.members} members: {row['seconds']:6.2f} s "
+                  f"(members' own time {row['member_seconds_sum']:.2f} s; stick p {row['stick_probability']:.3f}; "
+                  f"load {row['load_average_before']:.2f} -> {row['load_average_after']:.2f})", flush=True)
+        out["cases"][name] = rows
+    if args.json:
+        Path(args.json).write_text(json.dumps(out, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,138 @@
+"""Run an ensemble of discrete summit realisations of one rough scene on an executor.
+
+    >>> from continuum import load_scene
+    >>> from continuum.ensemble_run import run_ensemble
+    >>> ens = run_ensemble(load_scene("rough_silica", params="calibrated"), members=64, seed=1, executor="processes")
+    >>> ens.stick_probability, ens.stick_probability_first_impact, ens.rebound_counts()
+
+The decisions that do not depend on the realisation (adhesion law, half-space, the summits' modulus and work of
+adhesion, the footprint strip) are made once, from the scene's regime, exactly as a single discrete run makes
+them (`continuum.model.select`); each member then only draws its summits (`continuum.laws.discrete_roller`, a few
+ms) and runs the event-driven driver (on a rigid substrate each contact runs in the compiled kernel,
+`continuum.contact_kernel.LAW_DISCRETE`). A run ends where the driver ends it: a member held by adhesion stops
+at 'stuck'. Members go to `nanoimpact.executors` (local, processes, dask): jobs are module-level and picklable.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, replace
+from typing import Any
+
+from .driver import DriverSettings, simulate
+from .rough.ensemble import EnsembleResult, MemberOutcome, member_seeds
+from .scene import ResolvedScene, Scene
+
+log = logging.getLogger(__name__)
+
+
+def with_realisation(scene: Scene, mode: str, seed: int | None = None) -> Scene:
+    """`scene` with surfaces.roughness.mode (and seed) replaced."""
+    rough = scene.surfaces.roughness
+    rough = replace(rough, mode=mode) if seed is None else replace(rough, mode=mode, seed=int(seed))
+    return replace(scene, surfaces=replace(scene.surfaces, roughness=rough))
+
+
+@dataclass(frozen=True)
+class MemberPlan:
+    """What every member shares (SI): the summits' law inputs, the substrate choice and the strip."""
+
+    work_of_adhesion: float
+    summit_e_star: float
+    half_space: bool
+    footprint_half_width: float
+    speed: float
+    summit_law: Any = None
+    """Tabulated branches (`continuum.rough.branch_laws.SummitLaw`) where the law has no closed form here."""
+
+
+def member_plan(scene: Scene, speed: float) -> MemberPlan:
+    """The realisation-independent decisions of a discrete run of `scene` at first-impact `speed` (m/s)."""
+    from .model import decisions
+    from .model.regime import regime_of
+    from .model.select import branch_summits
+    from .rough.datum import tallest_summit
+
+    regime = regime_of(scene, speed)
+    law = decisions.adhesion_decision(scene, regime).law
+    rough, body = scene.surfaces.roughness, scene.body
+    datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
+    w = scene.surfaces.interface_work_of_adhesion if law != "none" else 0.0
+    return MemberPlan(w, regime.e_star, decisions.half_space_decision(scene, regime).used,
+                      datum["footprint_half_width"], speed,
+                      decisions.summit_law(law, scene) if branch_summits(law) else None)
+
+
+def _release(scene: Scene, z_top: float) -> float | None:
+    """Release height above the realisation's tallest summit (m), as `continuum.impact` measures it."""
+    if scene.release_height is None:
+        return None
+    if scene.surfaces.roughness.datum == "mean_plane":
+        return scene.release_height - z_top
+    return scene.release_height
+
+
+def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
+    """One realisation (seed) of `scene` run to the end; module-level so that executors can pickle it."""
+    from .model import factory
+    from .rough.gw import SummitStatistics
+
+    start = time.perf_counter()
+    member = with_realisation(scene, "discrete", seed)
+    rough, n = member.surfaces.roughness, member.numerics
+    stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
+    law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
+                                  plan.footprint_half_width, plan.summit_law)
+    release = _release(member, float(law.z_top))
+    if release is not None and release <= 0.0:
+        raise ValueError(f"member seed {seed}: the release height lies below the realisation's tallest summit")
+    settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
+                              rest_fraction=n.rest_fraction, samples_per_flight=2)
+    run = simulate(law, member.body.mass, member.environment.gravity, release_height=release,
+                   impact_velocity=member.impact_velocity, settings=settings)
+    heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)
+    return MemberOutcome(seed=int(seed), status=run.status, rebound_heights=heights, release_height=release,
+                         max_contacts=int(law.diagnostics()["max_contacts"]), wall_s=time.perf_counter() - start,
+                         energy_error=float(run.audit["max_relative_error"]))
+
+
+def _member_job(job: tuple) -> MemberOutcome:
+    scene, seed, plan = job
+    return run_member(scene, seed, plan)
+
+
+def run_ensemble(scene: Scene | ResolvedScene, members: int | None = None, seed: int | None = None,
+                 executor: Any = None, workers: int | None = None) -> EnsembleResult:
+    """Run `members` discrete realisations of the rough `scene` (default surfaces.roughness.members) with seeds
+    derived from `seed` (default surfaces.roughness.seed). `executor`: None or a name ('local', 'processes',
+    'dask'; None is 'local') opened and closed here with `workers`, or an open `nanoimpact.executors` executor."""
+    from nanoimpact.executors import executor as make_executor
+
+    from .model.regime import first_impact_speed
+
+    sc = scene.scene if isinstance(scene, ResolvedScene) else scene
+    if sc.contact != "rough":
+        raise ValueError("an ensemble of summit realisations needs contact = 'rough'")
+    rough = sc.surfaces.roughness
+    members = rough.members if members is None else int(members)
+    master = rough.seed if seed is None else int(seed)
+    seeds = member_seeds(master, members)
+    plan = member_plan(sc, first_impact_speed(sc))
+    jobs = [(sc, s, plan) for s in seeds]
+    start = time.perf_counter()
+    own = executor is None or isinstance(executor, str)
+    if own and (executor or "local") != "local":
+        from .compiled_contact import warm_up
+        warm_up()                       # forked workers inherit the loaded kernel
+    ex = make_executor(executor or "local", workers) if own else executor
+    try:
+        outcomes: list = [None] * members
+        for i, outcome in ex.map(_member_job, jobs):
+            outcomes[i] = outcome
+        where = ex.describe()
+    finally:
+        if own:
+            ex.close()
+    wall = time.perf_counter() - start
+    log.info("ensemble of %d members (master seed %d) on %s: %.2f s", members, master, where, wall)
+    return EnsembleResult(master_seed=master, outcomes=tuple(outcomes), executor=where, wall_s=wall)

@@ -1,0 +1,168 @@
+"""An ensemble of discrete summit realisations: member seeds, each member's outcome, and the distributions.
+
+Where only a few summits carry an impact (expected contacts N_c = eta A_nom int phi_s of a few), the
+Greenwood-Williamson average describes no single impact: a realisation's contact count fluctuates by about
+sqrt(N_c), and each summit's hysteresis loop is a sizeable part of the impact energy. The prediction is then a
+distribution over realisations of the same summit statistics (docs/model.md, "Few summits: ensembles"). Each
+member is one seeded realisation (`continuum.laws.discrete_roller`, surfaces.roughness.mode = 'discrete'); this
+module holds what is pure about an ensemble: how member seeds follow from one master seed, what a member's
+run reduces to (`MemberOutcome`), and the statistics reported in result.json -> ensemble (`EnsembleResult`).
+
+Seeds: numpy's `SeedSequence(master).generate_state(members, uint64)`, each word's top bit cleared (the scene's
+seed range is 0 .. 2^63 - 1). SeedSequence hashes the master seed into well-mixed, independent streams
+(O'Neill, PCG; numpy's recommended way to seed parallel generators), so members of one master seed do not
+share draws, and the same master seed and size give the same members on any executor.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+#: Percentiles reported for the rebound count and the first rebound height.
+PERCENTILES = (5, 25, 50, 75, 95)
+#: numpy's percentile method for them ('linear': interpolated between order statistics, numpy's default).
+PERCENTILE_METHOD = "linear"
+
+
+def member_seeds(master: int, members: int) -> tuple[int, ...]:
+    """The `members` seeds (0 .. 2^63 - 1) of an ensemble with master seed `master` (reproducible)."""
+    if members < 1:
+        raise ValueError(f"members = {members!r}: must be >= 1")
+    words = np.random.SeedSequence(int(master)).generate_state(int(members), dtype=np.uint64)
+    return tuple(int(w) & (2**63 - 1) for w in words)
+
+
+@dataclass(frozen=True)
+class MemberOutcome:
+    """What one realisation did (SI): its seed, how the run ended, and each rebound height."""
+
+    seed: int
+    status: str
+    """How the run ended: stuck, rest, max_bounces, max_time (`continuum.driver.ImpactRun.status`)."""
+    rebound_heights: tuple[float, ...]
+    """Height (m, above the realisation's datum) of each rebound, in order; a contact that never let go adds none."""
+    release_height: float | None
+    """The release height used (m), None for a scene given an impact velocity."""
+    max_contacts: int
+    """Most summits attached at once during the run."""
+    wall_s: float
+    energy_error: float = 0.0
+    """The run's energy audit: largest error of its energy books against the first impact's kinetic energy."""
+
+    @property
+    def stuck(self) -> bool:
+        """The body ended held by adhesion (the driver's 'stuck')."""
+        return self.status == "stuck"
+
+    @property
+    def rebounds(self) -> int:
+        return len(self.rebound_heights)
+
+    @property
+    def stuck_at_first_impact(self) -> bool:
+        """Held at the first impact: no rebound at all and the run ended stuck."""
+        return self.stuck and self.rebounds == 0
+
+    @property
+    def first_rebound(self) -> float:
+        """First rebound height (m); 0 where the body stuck at the first impact."""
+        return self.rebound_heights[0] if self.rebound_heights else 0.0
+
+    def to_record(self) -> dict:
+        return {"seed": self.seed, "status": self.status, "rebounds": self.rebounds,
+                "rebound_heights": list(self.rebound_heights), "max_contacts": self.max_contacts,
+                "energy_error": self.energy_error, "wall_s": self.wall_s}
+
+    @classmethod
+    def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "MemberOutcome":
+        return cls(seed=int(rec["seed"]), status=str(rec["status"]),
+                   rebound_heights=tuple(float(h) for h in rec["rebound_heights"]), release_height=release_height,
+                   max_contacts=int(rec["max_contacts"]), wall_s=float(rec["wall_s"]),
+                   energy_error=float(rec["energy_error"]))
+
+
+def _percentiles(values: Sequence[float]) -> dict[str, float]:
+    q = np.percentile(np.asarray(values, float), PERCENTILES, method=PERCENTILE_METHOD)
+    return {f"p{p}": float(v) for p, v in zip(PERCENTILES, q)}
+
+
+def _fraction(flags: Sequence[bool]) -> dict[str, float]:
+    """A fraction of members with its binomial standard error sqrt(p (1 - p) / n)."""
+    n = len(flags)
+    p = sum(bool(f) for f in flags) / n
+    return {"value": p, "standard_error": math.sqrt(p * (1.0 - p) / n), "count": int(sum(bool(f) for f in flags))}
+
+
+@dataclass(frozen=True)
+class EnsembleResult:
+    """The members of one ensemble and the distributions they give (SI; heights also as fractions of h0)."""
+
+    master_seed: int
+    outcomes: tuple[MemberOutcome, ...]
+    executor: str
+    wall_s: float
+
+    @property
+    def members(self) -> int:
+        return len(self.outcomes)
+
+    @property
+    def seeds(self) -> tuple[int, ...]:
+        return tuple(o.seed for o in self.outcomes)
+
+    @property
+    def stick_probability_first_impact(self) -> float:
+        """Fraction of members held at the first impact."""
+        return sum(o.stuck_at_first_impact for o in self.outcomes) / self.members
+
+    @property
+    def stick_probability(self) -> float:
+        """Fraction of members held by adhesion by the end of the run (numerics.max_bounces / max_time)."""
+        return sum(o.stuck for o in self.outcomes) / self.members
+
+    def rebound_counts(self) -> np.ndarray:
+        return np.array([o.rebounds for o in self.outcomes], int)
+
+    def first_rebounds(self) -> np.ndarray:
+        """First rebound heights (m), 0 for members held at the first impact."""
+        return np.array([o.first_rebound for o in self.outcomes], float)
+
+    def to_record(self, mean_field: Mapping[str, Any] | None = None) -> dict:
+        """result.json -> ensemble. `mean_field`: the mean-field run's rebounds and first rebound, for comparison."""
+        h0 = self.outcomes[0].release_height if self.outcomes else None
+        first = self.first_rebounds()
+        rec: dict = {
+            "members": self.members, "master_seed": self.master_seed, "seeds": list(self.seeds),
+            "release_height_m": h0,
+            "seed_rule": "numpy SeedSequence(master_seed).generate_state(members, uint64), top bit cleared",
+            "stick_probability": {
+                "first_impact": _fraction([o.stuck_at_first_impact for o in self.outcomes]),
+                "within_run": _fraction([o.stuck for o in self.outcomes]),
+                "within_run_means": "held by adhesion ('stuck') before numerics.max_bounces or max_time ended the run"},
+            "percentiles": list(PERCENTILES), "percentile_method": PERCENTILE_METHOD,
+            "rebounds": {**_percentiles(self.rebound_counts()), "mean": float(np.mean(self.rebound_counts()))},
+            "first_rebound_m": {**_percentiles(first), "mean": float(np.mean(first)), "std": float(np.std(first)),
+                                "stuck_counts_as": 0.0},
+            "status_counts": {s: sum(o.status == s for o in self.outcomes)
+                              for s in sorted({o.status for o in self.outcomes})},
+            "max_contacts": _percentiles([o.max_contacts for o in self.outcomes]),
+            "energy_audit_max_relative_error": max(o.energy_error for o in self.outcomes),
+            "escape_velocity": {"requested": False,
+                                "why": "no scene key asks for an escape-velocity distribution"},
+            "executor": self.executor, "wall_s": self.wall_s,
+            "member_runs": [o.to_record() for o in self.outcomes]}
+        if h0:
+            rec["first_rebound_over_h0"] = {k: v / h0 for k, v in rec["first_rebound_m"].items()
+                                            if isinstance(v, float) and k != "stuck_counts_as"}
+        if mean_field is not None:
+            rec["mean_field"] = dict(mean_field)
+        return rec
+
+    @classmethod
+    def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "EnsembleResult":
+        outcomes = tuple(MemberOutcome.from_record(m, release_height) for m in rec["member_runs"])
+        return cls(master_seed=int(rec["master_seed"]), outcomes=outcomes, executor=str(rec["executor"]),
+                   wall_s=float(rec["wall_s"]))
