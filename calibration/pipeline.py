@@ -171,10 +171,32 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
     and the overrides at both ends of the ranges (so cross-key rules apply too); and every MD recipe the
     calibration needs (calibration.mdset.MAPPING) loads. The first problem raises CalibrationError.
     """
-    from continuum.scene import SceneError, check_value, find_params, find_scene, read_toml, resolve_scene
-    from continuum.schema import FIELD_BY_PATH
-    from md.recipe import load_recipe
+    path, raw = _read_recipe(spec)
+    origin = str(path)
+    name, base, description = raw.get("name"), raw.get("base"), raw.get("description", "")
+    if not isinstance(name, str) or not _SET_NAME.fullmatch(name):
+        raise CalibrationError("name", _short(name), f"is required: {FIELD_BY_KEY['name'].doc}", origin)
+    if not isinstance(base, str) or not base:
+        raise CalibrationError("base", _short(base), "must be given: a parameter set name or file", origin)
+    _get(raw, "description", origin)
+    base_file = _find_set(base, "base", path)
+    compare = _get(raw, "compare_sets", origin)
+    if not all(compare):
+        raise CalibrationError("compare_sets", compare, "set names or files cannot be empty", origin)
+    compare_files = []
+    for c in compare:
+        found = _find_set(c, "compare_sets", path)
+        compare_files.append(str(found) if data.is_path_spec(c) else c)
+    uncertainty = _check_uncertainty(raw.get("uncertainty", {}), path, base, base_file)
+    _check_md_recipes(origin)
+    # a base set given as a path is kept as the file found (it may have been found from the recipe's folder)
+    return CalibrationRecipe(name=name, base=str(base_file) if data.is_path_spec(base) else base,
+                             description=description, compare_sets=compare_files, path=str(path),
+                             uncertainty=uncertainty)
 
+
+def _read_recipe(spec: str | Path) -> tuple[Path, dict]:
+    """The recipe's file and its TOML table, every top-level key known."""
     try:
         path = data.find("calibration", spec, key="recipe")
     except DataNotFound as exc:
@@ -188,32 +210,26 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
         if key not in RECIPE_KEYS:
             raise CalibrationError(key, _short(value), f"unknown key; keys allowed here: {', '.join(RECIPE_KEYS)}",
                                    origin)
-    name, base, description = raw.get("name"), raw.get("base"), raw.get("description", "")
-    if not isinstance(name, str) or not _SET_NAME.fullmatch(name):
-        raise CalibrationError("name", _short(name), f"is required: {FIELD_BY_KEY['name'].doc}", origin)
-    if not isinstance(base, str) or not base:
-        raise CalibrationError("base", _short(base), "must be given: a parameter set name or file", origin)
-    _get(raw, "description", origin)
+    return path, raw
+
+
+def _find_set(spec: str, key: str, recipe: Path) -> Path:
+    """The parameter set `spec` names (found as `_locate` finds it) after checking it reads; `key` names it."""
+    from continuum.scene import SceneError, find_params, read_toml
+
     try:
-        base_file = _locate(find_params, base, path)
-        read_toml(base_file, "params")
+        found = _locate(find_params, spec, recipe)
+        read_toml(found, "params")
     except SceneError as exc:
-        raise CalibrationError("base", base, exc.allowed if exc.key == "params" else str(exc), origin) from None
+        raise CalibrationError(key, spec, exc.allowed if exc.key == "params" else str(exc), str(recipe)) from None
+    return found
 
-    compare = _get(raw, "compare_sets", origin)
-    if not all(compare):
-        raise CalibrationError("compare_sets", compare, "set names or files cannot be empty", origin)
-    compare_files = []
-    for c in compare:
-        try:
-            found = _locate(find_params, c, path)
-            read_toml(found, "params")
-        except SceneError as exc:
-            raise CalibrationError("compare_sets", c, exc.allowed if exc.key == "params" else str(exc),
-                                   origin) from None
-        compare_files.append(str(found) if data.is_path_spec(c) else c)
 
-    unc = raw.get("uncertainty", {})
+def _check_uncertainty(unc, path: Path, base: str, base_file: Path) -> Uncertainty:
+    """`[uncertainty]` checked key by key, then the scene resolved at both ends of the ranges."""
+    from continuum.scene import SceneError, find_scene
+
+    origin = str(path)
     if not isinstance(unc, dict):
         raise CalibrationError("uncertainty", unc, f"must be a table with keys {', '.join(UNCERTAINTY_KEYS)}", origin)
     for key, value in unc.items():
@@ -230,8 +246,18 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
         scene_file = _locate(find_scene, scene_spec, path)
     except SceneError as exc:
         raise CalibrationError("uncertainty.scene", scene_spec, exc.allowed, origin) from None
+    ranges = _check_ranges(_dotted(unc.get("ranges", {}), "uncertainty.ranges", origin), origin)
+    overrides = _check_overrides(_dotted(unc.get("overrides", {}), "uncertainty.overrides", origin), ranges, origin)
+    _resolve_at_range_ends(scene_file, scene_spec, base, base_file, ranges, overrides, max_bounces, origin)
+    return Uncertainty(samples=samples, seed=seed, scene=str(scene_file), max_bounces=max_bounces, ranges=ranges,
+                       overrides=overrides)
 
-    ranges = _dotted(unc.get("ranges", {}), "uncertainty.ranges", origin)
+
+def _check_ranges(ranges: dict, origin: str) -> dict:
+    """`uncertainty.ranges`: real-valued scene keys, each [low, high] with both ends allowed."""
+    from continuum.scene import SceneError, check_value
+    from continuum.schema import FIELD_BY_PATH
+
     for key, rng in ranges.items():
         where, f = f"uncertainty.ranges.{key}", FIELD_BY_PATH.get(key)
         if f is None:
@@ -248,7 +274,14 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
                 check_value(f, end, origin)
             except SceneError:
                 raise CalibrationError(where, rng, f"both ends must be {f.allowed()}", origin) from None
-    overrides = _dotted(unc.get("overrides", {}), "uncertainty.overrides", origin)
+    return ranges
+
+
+def _check_overrides(overrides: dict, ranges: dict, origin: str) -> dict:
+    """`uncertainty.overrides`: scene keys with allowed values, none of them the set, the bounces or a range."""
+    from continuum.scene import SceneError, check_value
+    from continuum.schema import FIELD_BY_PATH
+
     for key, value in overrides.items():
         where = f"uncertainty.overrides.{key}"
         if key not in FIELD_BY_PATH:
@@ -261,6 +294,14 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
             check_value(FIELD_BY_PATH[key], value, origin)
         except SceneError as exc:
             raise CalibrationError(where, value, exc.allowed, origin) from None
+    return overrides
+
+
+def _resolve_at_range_ends(scene_file, scene_spec, base, base_file, ranges, overrides, max_bounces, origin) -> None:
+    """The uncertainty scene resolves with the base set and the overrides at both ends of the ranges, so the
+    scene's cross-key rules apply to the samples too."""
+    from continuum.scene import SceneError, resolve_scene
+
     for end in ((0, 1) if ranges else (0,)):
         trial = {**overrides, **{k: r[end] for k, r in ranges.items()}, "numerics.max_bounces": max_bounces}
         try:
@@ -271,19 +312,19 @@ def load_calibration(spec: str | Path) -> CalibrationRecipe:
             raise CalibrationError(exc.key, _short(exc.value), exc.allowed,
                                    f"{origin}: uncertainty.scene {scene_spec!r} with base {base!r} and the "
                                    f"overrides{at}{inner}") from None
+
+
+def _check_md_recipes(origin: str) -> None:
+    """Every MD recipe the calibration needs loads."""
+    from md.recipe import load_recipe
+
     for recipe in recipes_needed():
         try:
             load_recipe(recipe)
         except InputError as exc:
             raise CalibrationError(exc.key, _short(exc.value), exc.allowed,
                                    f"{origin}: MD recipe {recipe}, which the calibration needs"
-                                   + (f" ({exc.origin})" if getattr(exc, "origin", "") else "")) from None
-    # a base set given as a path is kept as the file found (it may have been found from the recipe's folder)
-    return CalibrationRecipe(
-        name=name, base=str(base_file) if data.is_path_spec(base) else base, description=description,
-        compare_sets=compare_files, path=str(path),
-        uncertainty=Uncertainty(samples=samples, seed=seed, scene=str(scene_file), max_bounces=max_bounces,
-                                ranges=ranges, overrides=overrides))
+                                   + (f" ({exc.origin})" if exc.origin else "")) from None
 
 
 def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, workers: int | None,
@@ -500,49 +541,17 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     timings = {}
-    # 1. MD jobs
-    t = time.perf_counter()
-    recipes = recipes_first()
-    progress(f"calibrate {cal.name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}' (a fallback "
-             f"recipe runs only where its preferred result lacks the quantity)")
-    plan = md_plan(recipes, md_fidelity, md_cache, results_dir)
-    todo = [r for r, how in plan.items() if how in ("runs", "resumes")]
-    progress("  MD plan: " + "; ".join(f"{how}: {', '.join(r for r, h in plan.items() if h == how)}"
-                                       for how in ("committed", "md cache", "resumes", "runs")
-                                       if how in plan.values())
-             + (f" ({len(todo)} to run: minutes to hours each at quick, docs/md.md has their cost)" if todo else
-                " (no MD to run)"))
     ex = executor(executor_name, workers, scheduler)
-    results, sources = {}, {}
     try:
-        def run_md(names):
-            tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir)) for r in names]
-            for _, job in ex.map(md_job, tasks):
-                results[job["recipe"]] = job["result"]
-                sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],
-                                          "run_hash": job["result"].get("run_hash")}
-                progress(f"  MD {job['recipe']}: {job['source']} ({job['wall_s']:.1f} s)")
-        run_md(recipes)
-        extra = fallbacks_needed(results)
-        if extra:                   # a preferred result without the key's quantity (an older protocol)
-            progress(f"  MD fallbacks needed: {', '.join(extra)}")
-            run_md(extra)
+        # 1. MD jobs
+        t = time.perf_counter()
+        results, sources = _run_md_jobs(ex, cal.name, md_fidelity, executor_name, md_cache, results_dir, progress)
         timings["md_s"] = time.perf_counter() - t
         # 2. the set
         machine = {"cores": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}
         md_compute = {r: _md_wall(res) for r, res in results.items()}
-        table, rows = build_parameter_set(results, cal.base, cal.name, description=cal.description,
-                                          extra_meta={"md_fidelity": md_fidelity, "machine": machine,
-                                                      "pipeline_md_wall_s": timings["md_s"],
-                                                      "md_compute_wall_s": md_compute,
-                                                      "md_compute_total_s": sum(md_compute.values()),
-                                                      "created_by": f"nanoimpact calibrate {cal.path}"})
-        set_path = Path(params_out) if params_out else data.writable_root() / "params" / f"{cal.name}.toml"
-        write_parameter_set(table, set_path, header=(
-            f"The `{cal.name}` parameter set, written by `nanoimpact calibrate {cal.path} --md-fidelity "
-            f"{md_fidelity}`: MD-measured values on the `{cal.base}` base set; [meta.calibration] gives each "
-            "value's stderr and MD run hash, [meta.rejected] what was not used and why."))
-        progress(f"  wrote {set_path}")
+        table, rows, set_path = _write_set(cal, results, md_fidelity, machine, timings["md_s"], md_compute,
+                                           params_out, progress)
         # 3. the paper's cases
         t = time.perf_counter()
         from continuum.paper.report import make_paper
@@ -557,27 +566,11 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         timings["attribution_s"] = time.perf_counter() - t
         # 4. uncertainty
         t = time.perf_counter()
-        unc = cal.uncertainty
-        keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc.ranges, unc.samples, unc.seed)
-        sample_out = [None] * len(samples)
-        tasks = [(unc.scene, str(set_path), {**unc.overrides, **smp}, unc.max_bounces) for smp in samples]
-        for i, s in ex.map(uncertainty_sample, tasks, on_error="collect"):
-            # a sample whose job failed (a crash, a lost worker) is counted and reported like a refused one
-            sample_out[i] = {"overrides": tasks[i][2], "error": s.reason} if isinstance(s, Failure) else s
+        keys, sample_out = _run_uncertainty(ex, cal.uncertainty, table, set_path)
         timings["uncertainty_s"] = time.perf_counter() - t
     finally:
         ex.close()
-    bands = {"first_rebound_over_h0": _band(s.get("rebounds_over_h0", [None])[0] if s.get("rebounds_over_h0") else 0.0
-                                            for s in sample_out if "error" not in s),
-             "rebound_count": _band(s["rebound_count"] for s in sample_out if "error" not in s),
-             "escape_velocity_m_per_s": _band(s.get("escape_velocity") for s in sample_out if "error" not in s),
-             "covers": keys or ["(no input with an uncertainty: every band is a single point)"],
-             "max_bounces": unc.max_bounces,
-             "rebound_count_capped": sum(s["rebound_count"] >= unc.max_bounces for s in sample_out
-                                         if "error" not in s),
-             "samples": len(samples), "failed_samples": sum("error" in s for s in sample_out),
-             "truncated": truncation(table["meta"].get("calibration", {})),
-             "seed": unc.seed, "scene": unc.scene}
+    bands = _bands(sample_out, keys, cal.uncertainty, table)
     _write_uncertainty(out, keys, sample_out, bands)
     timings["total_s"] = time.perf_counter() - t_all
     report = CalibrationReport(name=cal.name, set_path=Path(set_path), out=out, calibration=cal,
@@ -587,6 +580,81 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
                                validation=table["meta"].get("validation", {}))
     progress(f"calibrate: report {report.write()}; total {timings['total_s']:.1f} s")
     return report
+
+
+def _run_md_jobs(ex, name: str, md_fidelity: str, executor_name: str, md_cache, results_dir,
+                 progress) -> tuple[dict, dict]:
+    """Every MD recipe the calibration needs, committed, cached or run on `ex`; then the fallbacks whose
+    preferred result lacks the key's quantity. Returns (results by recipe, where each came from)."""
+    recipes = recipes_first()
+    progress(f"calibrate {name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}' (a fallback "
+             f"recipe runs only where its preferred result lacks the quantity)")
+    plan = md_plan(recipes, md_fidelity, md_cache, results_dir)
+    todo = [r for r, how in plan.items() if how in ("runs", "resumes")]
+    progress("  MD plan: " + "; ".join(f"{how}: {', '.join(r for r, h in plan.items() if h == how)}"
+                                       for how in ("committed", "md cache", "resumes", "runs")
+                                       if how in plan.values())
+             + (f" ({len(todo)} to run: minutes to hours each at quick, docs/md.md has their cost)" if todo else
+                " (no MD to run)"))
+    results, sources = {}, {}
+
+    def run_md(names):
+        tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir)) for r in names]
+        for _, job in ex.map(md_job, tasks):
+            results[job["recipe"]] = job["result"]
+            sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],
+                                      "run_hash": job["result"].get("run_hash")}
+            progress(f"  MD {job['recipe']}: {job['source']} ({job['wall_s']:.1f} s)")
+
+    run_md(recipes)
+    extra = fallbacks_needed(results)
+    if extra:                   # a preferred result without the key's quantity (an older protocol)
+        progress(f"  MD fallbacks needed: {', '.join(extra)}")
+        run_md(extra)
+    return results, sources
+
+
+def _write_set(cal: CalibrationRecipe, results: dict, md_fidelity: str, machine: dict, md_s: float,
+               md_compute: dict, params_out, progress) -> tuple[dict, list, Path]:
+    """The calibrated parameter set built from the MD results and written; returns (table, rows, its path)."""
+    table, rows = build_parameter_set(results, cal.base, cal.name, description=cal.description,
+                                      extra_meta={"md_fidelity": md_fidelity, "machine": machine,
+                                                  "pipeline_md_wall_s": md_s, "md_compute_wall_s": md_compute,
+                                                  "md_compute_total_s": sum(md_compute.values()),
+                                                  "created_by": f"nanoimpact calibrate {cal.path}"})
+    set_path = Path(params_out) if params_out else data.writable_root() / "params" / f"{cal.name}.toml"
+    write_parameter_set(table, set_path, header=(
+        f"The `{cal.name}` parameter set, written by `nanoimpact calibrate {cal.path} --md-fidelity "
+        f"{md_fidelity}`: MD-measured values on the `{cal.base}` base set; [meta.calibration] gives each "
+        "value's stderr and MD run hash, [meta.rejected] what was not used and why."))
+    progress(f"  wrote {set_path}")
+    return table, rows, set_path
+
+
+def _run_uncertainty(ex, unc: Uncertainty, table: dict, set_path: Path) -> tuple[list, list]:
+    """The Latin-hypercube samples of the set's uncertain inputs, each run on `ex`; a sample whose job failed
+    (a crash, a lost worker) is counted and reported like a refused one. Returns (sampled keys, outcomes)."""
+    keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc.ranges, unc.samples, unc.seed)
+    sample_out = [None] * len(samples)
+    tasks = [(unc.scene, str(set_path), {**unc.overrides, **smp}, unc.max_bounces) for smp in samples]
+    for i, s in ex.map(uncertainty_sample, tasks, on_error="collect"):
+        sample_out[i] = {"overrides": tasks[i][2], "error": s.reason} if isinstance(s, Failure) else s
+    return keys, sample_out
+
+
+def _bands(sample_out: list, keys: list, unc: Uncertainty, table: dict) -> dict:
+    """The bands of the first rebound, the rebound count and the escape velocity over the samples that ran."""
+    ran = [s for s in sample_out if "error" not in s]
+    return {"first_rebound_over_h0": _band(s.get("rebounds_over_h0", [None])[0] if s.get("rebounds_over_h0")
+                                           else 0.0 for s in ran),
+            "rebound_count": _band(s["rebound_count"] for s in ran),
+            "escape_velocity_m_per_s": _band(s.get("escape_velocity") for s in ran),
+            "covers": keys or ["(no input with an uncertainty: every band is a single point)"],
+            "max_bounces": unc.max_bounces,
+            "rebound_count_capped": sum(s["rebound_count"] >= unc.max_bounces for s in ran),
+            "samples": len(sample_out), "failed_samples": len(sample_out) - len(ran),
+            "truncated": truncation(table["meta"].get("calibration", {})),
+            "seed": unc.seed, "scene": unc.scene}
 
 
 def _write_uncertainty(out: Path, keys, samples, bands) -> None:
