@@ -117,3 +117,65 @@ def test_bad_limiting_pressure_names_the_key():
         _law(p_y=0.5 * p_a)
     with pytest.raises(InputError, match="limiting_pressure"):
         _law(p_y=2.0 * E_STAR)
+
+
+# ----------------------------------------------------------------------------- scenes
+def _scene(hardness=P_Y, **overrides):
+    """The issue's sphere as a scene: hardness 35.3 MPa (= the limiting contact pressure) on the body; the
+    substrate is silicon, E = 169 GPa (the <110> modulus, Hopcroft et al., JMEMS 19 (2010) 229), nu = 0.28."""
+    from continuum.scene import resolve_scene
+    table = {"name": "plastic_sphere", "impact_velocity": 20.0, "contact": "smooth",
+             "body": {"shape": "sphere", "radius": R, "density": RHO},
+             "surfaces": {"work_of_adhesion": W,
+                          "body": {"youngs_modulus": 1.2e9, "poisson_ratio": 0.3},
+                          "substrate": {"youngs_modulus": 169e9, "poisson_ratio": 0.28}},
+             "environment": {"gravity": 0.0}, "physics": {"adhesion_law": "jkr"},
+             "numerics": {"max_bounces": 1}}
+    if hardness is not None:
+        table["surfaces"]["body"]["hardness"] = hardness
+    return resolve_scene(table=table, overrides=overrides or None)
+
+
+def test_scene_runs_the_plastic_law_when_faster_than_the_yield_velocity():
+    from continuum.impact import run_impact
+    result, _ = run_impact(_scene())
+    plastic = result["models"]["plasticity"]
+    assert plastic["used"] and plastic["decided_by"] == "yield_velocity"
+    assert plastic["limiting_pressure"] == P_Y and plastic["from_key"] == "surfaces.body.hardness"
+    assert plastic["impact_speed"] > plastic["yield_velocity"]
+    assert result["models"]["contact_law"]["name"] == "plastic_jkr_sphere"
+    e = result["bounces"][0]["restitution"]
+    assert e == pytest.approx(float(tn.restitution(20.0, R, W, E_STAR, RHO, P_Y)), rel=1e-6)
+
+
+def test_scene_without_yield_key_stays_elastic_and_says_why():
+    from continuum.impact import run_impact
+    result, _ = run_impact(_scene(hardness=None))
+    plastic = result["models"]["plasticity"]
+    assert not plastic["used"] and plastic["decided_by"] == "yield_strength"
+    assert result["models"]["contact_law"]["name"] == "jkr_sphere"
+
+
+def test_softer_partner_sets_the_limiting_pressure():
+    """A yield strength on the substrate (p_y = 2.8 Y) below the body's hardness decides."""
+    from continuum.model.decisions import plasticity_decision
+    scene = _scene(**{"surfaces.substrate.yield_strength": 12e6}).scene
+    d = plasticity_decision(scene, "jkr", 20.0)
+    assert d.from_key == "surfaces.substrate.yield_strength"
+    assert d.limiting_pressure == pytest.approx(tn.TABOR_CONSTRAINT_FACTOR * 12e6)
+
+
+@pytest.mark.parametrize("key,value", [("surfaces.body.yield_strength", 1.1e6), ("surfaces.body.hardness", 2e9)])
+def test_scene_rejects_a_limiting_pressure_out_of_range_naming_the_key(key, value):
+    """Below the adhesive stress scale (the contact would yield on snap-in), or above E*."""
+    from continuum.scene import SceneError
+    with pytest.raises(SceneError) as err:
+        _scene(hardness=None, **{key: value})
+    assert err.value.key == key and f"{key} = " in str(err.value) and "\n" not in str(err.value)
+
+
+def test_plasticity_on_needs_a_yield_key():
+    from continuum.scene import SceneError
+    with pytest.raises(SceneError) as err:
+        _scene(hardness=None, **{"physics.plasticity": "on"})
+    assert err.value.key == "physics.plasticity"

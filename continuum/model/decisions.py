@@ -387,10 +387,11 @@ class PlasticityDecision:
 
 def _yield_values(scene: Scene) -> dict:
     """The yield keys and moduli of both partners, keyed by scene path (SI)."""
-    surf = scene.surfaces
-    return {f"{prefix}.{name}": getattr(mat, name) for prefix, mat in (("surfaces.body", surf.body),
-                                                                          ("surfaces.substrate", surf.substrate))
-            for name in ("yield_strength", "hardness", "youngs_modulus")}
+    out = {}
+    for prefix, mat in (("surfaces.body", scene.surfaces.body), ("surfaces.substrate", scene.surfaces.substrate)):
+        out.update({f"{prefix}.yield_strength": mat.yield_strength, f"{prefix}.hardness": mat.hardness,
+                    f"{prefix}.youngs_modulus": mat.youngs_modulus})
+    return out
 
 
 def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> PlasticityDecision:
