@@ -179,3 +179,26 @@ def test_plasticity_on_needs_a_yield_key():
     with pytest.raises(SceneError) as err:
         _scene(hardness=None, **{"physics.plasticity": "on"})
     assert err.value.key == "physics.plasticity"
+
+
+def test_capture_velocity_size_exponent_departs_from_minus_five_sixths_where_yield_sets_in():
+    """Simulated capture velocities (escape bisection) of one material, p_y = 100 MPa: large spheres capture
+    before they yield, V ~ R^-5/6 (Thornton & Ning's elastic V_s); small ones yield first (the adhesive stress
+    scale grows as R^-1/3) and the exponent steepens to the closed form's."""
+    p_y = 100e6
+
+    def capture(radius):
+        mass = float(tn.sphere_mass(radius, RHO))
+        v_el = float(tn.capture_velocity_elastic(radius, W, E_STAR, RHO))
+        law = PlasticJKRSphere(radius, W, E_STAR, p_y)
+        return escape_velocity(law, mass, 0.0, 0.5 * v_el, 3.0 * v_el, rel_tol=1e-5, rtol=RTOL)["escape_velocity"]
+
+    def exponent(r1, r2, v1, v2):
+        return math.log(v2 / v1) / math.log(r2 / r1)
+
+    large = exponent(2e-6, 4e-6, capture(2e-6), capture(4e-6))
+    small = exponent(0.25e-6, 0.5e-6, capture(0.25e-6), capture(0.5e-6))
+    closed = exponent(0.25e-6, 0.5e-6, *(tn.capture_velocity(r, W, E_STAR, RHO, p_y) for r in (0.25e-6, 0.5e-6)))
+    assert large == pytest.approx(-5.0 / 6.0, abs=1e-4)
+    assert small == pytest.approx(closed, abs=1e-4)
+    assert small < -5.0 / 6.0 - 0.2
