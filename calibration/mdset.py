@@ -285,7 +285,8 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
         qname, value, stderr, units = picked
         row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
                    fidelity=res.get("fidelity"))
-        why = water_mismatch if water_mismatch and src.recipe in WATER_RECIPES else _rejection(src.key, value, qname, res)
+        why = (water_mismatch if water_mismatch and src.recipe in WATER_RECIPES
+               else _rejection(src.key, value, qname, res))
         if why:
             row.update(status="rejected", why=why)
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "quantity": qname,
