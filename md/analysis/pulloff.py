@@ -47,8 +47,6 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False, force
     ``stderr`` (of ``params``, ``z0`` and ``peak``) from the fit's covariance inv(J^T J), scaled by the residual
     variance (unweighted) or by max(1, reduced chi^2) (weighted); nan when the fit has no degrees of freedom.
     """
-    from scipy.optimize import least_squares
-
     d = np.asarray(sep, float).ravel()
     f = np.asarray(force, float).ravel()
     order = np.argsort(d)
@@ -77,6 +75,35 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False, force
     peak_x = _LJ93_PEAK if kind == "lj93" else 1.0
     peak_val = -float(shape(np.array(peak_x)))       # |shape| at its minimum
 
+    best = _least_squares_law(shape, ds, fs, ws, offset, peak_x, peak_val)
+    amp, z0 = best.x[0] * abs(fmin), best.x[1] * scale
+    off = d0 + best.x[2] * scale if offset else 0.0
+    rms = float(np.sqrt(np.mean((best.fun / ws) ** 2))) * abs(fmin)
+    npar = len(best.x)
+    dof = int(ds.size) - npar
+    cov = _covariance(best, dof, weighted=sd is not None, units=np.array([abs(fmin), scale, scale][:npar]))
+    se = lambda g: float(math.sqrt(g @ cov @ g)) if np.all(np.isfinite(cov)) and g @ cov @ g >= 0 else float("nan")
+    g_amp, g_z0 = np.eye(npar)[0], np.eye(npar)[1]
+    out = {"kind": kind, "z0": float(z0), "offset": float(off), "rms": rms,
+           "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0), "dof": dof}
+    stderr = {"z0": se(g_z0), "offset": se(np.eye(npar)[2]) if offset else 0.0, "peak": se(g_amp) * peak_val}
+    if kind == "lj93":
+        w = amp * 3.0 * z0 / 8.0
+        stderr["w"] = se(3.0 / 8.0 * (z0 * g_amp + amp * g_z0))
+        out.update(w=float(w), params={"w": float(w), "z0": float(z0), "offset": float(off)},
+                   h0_maugis=float(w / (amp * peak_val)))
+    else:
+        stderr["Fc"] = se(g_amp)
+        out.update(w=None, params={"Fc": float(amp), "z0": float(z0), "offset": float(off)})
+    out["stderr"] = stderr
+    return out
+
+
+def _least_squares_law(shape, ds, fs, ws, offset: bool, peak_x: float, peak_val: float):
+    """The least-squares fit (scipy) of amp * shape((d - off) / z0) to the scaled points (ds, fs) with weights
+    ``ws``, from several starting offsets (the best kept); RuntimeError if none converges."""
+    from scipy.optimize import least_squares
+
     def model(p, dd):
         amp, z0, off = p[0], p[1], (p[2] if offset else 0.0)
         h = np.maximum(dd - off, 1e-6)
@@ -101,34 +128,20 @@ def fit_traction_law(sep, force, kind: str = "lj93", offset: bool = False, force
             best = sol
     if best is None:
         raise RuntimeError("traction-law fit failed")
-    amp, z0 = best.x[0] * abs(fmin), best.x[1] * scale
-    off = d0 + best.x[2] * scale if offset else 0.0
-    rms = float(np.sqrt(np.mean((best.fun / ws) ** 2))) * abs(fmin)
-    # covariance of (amp, z0[, offset]) in physical units
-    npar, m = len(best.x), int(ds.size)
-    dof = m - npar
+    return best
+
+
+def _covariance(best, dof: int, weighted: bool, units: np.ndarray) -> np.ndarray:
+    """Covariance of the fitted (amp, z0[, offset]) in physical units (``units`` undo the scaling): inv(J^T J)
+    scaled by the residual variance (unweighted) or by max(1, reduced chi^2) (weighted); nan if singular."""
+    npar = len(best.x)
     try:
         cov = np.linalg.inv(best.jac.T @ best.jac)
         chi2 = float(np.sum(best.fun ** 2)) / dof if dof > 0 else float("nan")
-        cov = cov * (chi2 if sd is None else max(1.0, chi2))
-        cov = cov * np.outer(*(2 * [np.array([abs(fmin), scale, scale][:npar])]))
+        cov = cov * (max(1.0, chi2) if weighted else chi2)
+        return cov * np.outer(units, units)
     except np.linalg.LinAlgError:
-        cov = np.full((npar, npar), np.nan)
-    se = lambda g: float(math.sqrt(g @ cov @ g)) if np.all(np.isfinite(cov)) and g @ cov @ g >= 0 else float("nan")
-    g_amp, g_z0 = np.eye(npar)[0], np.eye(npar)[1]
-    out = {"kind": kind, "z0": float(z0), "offset": float(off), "rms": rms,
-           "peak": float(amp * peak_val), "sep_at_peak": float(off + peak_x * z0), "dof": dof}
-    stderr = {"z0": se(g_z0), "offset": se(np.eye(npar)[2]) if offset else 0.0, "peak": se(g_amp) * peak_val}
-    if kind == "lj93":
-        w = amp * 3.0 * z0 / 8.0
-        stderr["w"] = se(3.0 / 8.0 * (z0 * g_amp + amp * g_z0))
-        out.update(w=float(w), params={"w": float(w), "z0": float(z0), "offset": float(off)},
-                   h0_maugis=float(w / (amp * peak_val)))
-    else:
-        stderr["Fc"] = se(g_amp)
-        out.update(w=None, params={"Fc": float(amp), "z0": float(z0), "offset": float(off)})
-    out["stderr"] = stderr
-    return out
+        return np.full((npar, npar), np.nan)
 
 
 def pull_off_analysis(separation_A, force_kcal_per_molA, smooth: int | None = None,

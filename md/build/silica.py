@@ -552,16 +552,7 @@ def silica_asperity(radius: float = 15.0, holder_thickness: float = 10.0, *, nx:
     si = system.select("SC4")
     z_top_new = z_top + z_shift
     dome_si = si[system.positions[si, 2] > z_top_new + 0.01]
-    nb = [[] for _ in range(system.n_atoms)]
-    for i, j in system.bonds.tolist():
-        nb[i].append(j)
-        nb[j].append(i)
-    asp = set(dome_si.tolist())
-    for s in dome_si.tolist():
-        for o in nb[s]:
-            asp.add(o)
-            asp.update(h for h in nb[o] if system.types[h] == "HOY")
-    asp_idx = np.array(sorted(asp), int)
+    asp_idx = _bonded_shell(system, dome_si)
     holder_idx = np.setdiff1d(np.arange(system.n_atoms), asp_idx)
     r_dome = np.linalg.norm(minimum_image(system.positions[dome_si] - (centre + [0, 0, z_shift]), system.cell,
                                           system.pbc), axis=1)
@@ -579,7 +570,18 @@ def silica_asperity(radius: float = 15.0, holder_thickness: float = 10.0, *, nx:
         "total_charge": system.total_charge(), "source": SOURCES[polymorph], **sinfo,
         "omitted_zero_dihedrals": system.info.get("omitted_zero_dihedrals", 0),
     }
-    groups = dict(system.groups)
-    groups["asperity"] = asp_idx
-    groups["holder"] = holder_idx
-    return replace(system, groups=groups, info=_plain(info))
+    return replace(system, groups={**system.groups, "asperity": asp_idx, "holder": holder_idx}, info=_plain(info))
+
+
+def _bonded_shell(system: System, si: np.ndarray) -> np.ndarray:
+    """The Si ``si``, every O bonded to them and those O's silanol H (sorted indices)."""
+    nb = [[] for _ in range(system.n_atoms)]
+    for i, j in system.bonds.tolist():
+        nb[i].append(j)
+        nb[j].append(i)
+    shell = set(si.tolist())
+    for s in si.tolist():
+        for o in nb[s]:
+            shell.add(o)
+            shell.update(h for h in nb[o] if system.types[h] == "HOY")
+    return np.array(sorted(shell), int)

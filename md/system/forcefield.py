@@ -491,29 +491,8 @@ def combine(*forcefields: ForceField | str | Path, rule: str | None = None,
             if f.units.get(key) != val:
                 raise ForceFieldError(f"{f.name}: units {key}={f.units.get(key)!r}, expected {val!r}")
 
-    rules = {f.mixing_rule for f in ffs}
-    notes: list[str] = []
-    if rule is None:
-        if len(rules) != 1:
-            raise ForceFieldError(f"families declare different mixing rules {sorted(rules)}; pass rule=...")
-        rule = rules.pop()
-    elif rule not in MIXING_RULES:
-        raise ForceFieldError(f"unknown mixing rule {rule!r}")
-    else:
-        differing = [f.name for f in ffs if f.mixing_rule != rule]
-        if differing:
-            notes.append(f"rule {rule!r} applied to cross terms although {differing} declare another rule "
-                         "(their own like-pair parameters are kept)")
-
-    atoms: dict[str, AtomType] = {}
-    for f in ffs:
-        for a in f.atom_types:
-            if a.name in atoms:
-                b = atoms[a.name]
-                if (b.mass, b.charge, b.epsilon, b.sigma) != (a.mass, a.charge, a.epsilon, a.sigma):
-                    raise ForceFieldError(f"atom type {a.name!r} defined differently in {b.family!r} and {a.family!r}")
-                continue
-            atoms[a.name] = a
+    rule, notes = _combined_rule(ffs, rule)
+    atoms = _merged_atom_types(ffs)
 
     bonds = _merge_unique("bond", (f.bond_types for f in ffs), lambda t: (_canonical(t.types), t.style))
     angles = _merge_unique("angle", (f.angle_types for f in ffs), lambda t: (_canonical(t.types), t.style))
@@ -528,18 +507,7 @@ def combine(*forcefields: ForceField | str | Path, rule: str | None = None,
     special, sb_notes = _resolve_special(ffs, special_bonds)
     notes.extend(sb_notes)
 
-    explicit: list[PairCoeff] = []
-    for o in overrides:
-        if isinstance(o, PairCoeff):
-            explicit.append(PairCoeff(o.type_i, o.type_j, o.epsilon, o.sigma, "explicit", o.note))
-        else:
-            ti, tj, eps, sig, note = o
-            if not str(note).strip():
-                raise ForceFieldError(f"override {ti}-{tj} needs a source note")
-            explicit.append(PairCoeff(ti, tj, float(eps), float(sig), "explicit", str(note)))
-    for o in explicit:
-        if o.type_i not in atoms or o.type_j not in atoms:
-            raise ForceFieldError(f"override {o.type_i}-{o.type_j}: unknown atom type")
+    explicit = _explicit_overrides(overrides, atoms)
     file_overrides = [o for f in ffs for o in f.pair_overrides]
     explicit = file_overrides + explicit  # caller's overrides win (applied last)
 
@@ -555,6 +523,56 @@ def combine(*forcefields: ForceField | str | Path, rule: str | None = None,
         pair_overrides=tuple(explicit),
         notes=tuple(n for f in ffs for n in f.notes) + tuple(notes), extras=MappingProxyType(extras))
     return _with_pair_table(ff, rule, explicit)
+
+
+def _combined_rule(ffs: Sequence[ForceField], rule: str | None) -> tuple[str, list[str]]:
+    """The mixing rule of the combination (the families' common one, or ``rule``) and a note where ``rule``
+    overrides a family's own."""
+    rules = {f.mixing_rule for f in ffs}
+    notes: list[str] = []
+    if rule is None:
+        if len(rules) != 1:
+            raise ForceFieldError(f"families declare different mixing rules {sorted(rules)}; pass rule=...")
+        rule = rules.pop()
+    elif rule not in MIXING_RULES:
+        raise ForceFieldError(f"unknown mixing rule {rule!r}")
+    else:
+        differing = [f.name for f in ffs if f.mixing_rule != rule]
+        if differing:
+            notes.append(f"rule {rule!r} applied to cross terms although {differing} declare another rule "
+                         "(their own like-pair parameters are kept)")
+    return rule, notes
+
+
+def _merged_atom_types(ffs: Sequence[ForceField]) -> dict[str, AtomType]:
+    """Every family's atom types by name; a name defined differently in two families raises."""
+    atoms: dict[str, AtomType] = {}
+    for f in ffs:
+        for a in f.atom_types:
+            if a.name in atoms:
+                b = atoms[a.name]
+                if (b.mass, b.charge, b.epsilon, b.sigma) != (a.mass, a.charge, a.epsilon, a.sigma):
+                    raise ForceFieldError(f"atom type {a.name!r} defined differently in {b.family!r} and {a.family!r}")
+                continue
+            atoms[a.name] = a
+    return atoms
+
+
+def _explicit_overrides(overrides, atoms: Mapping[str, AtomType]) -> list[PairCoeff]:
+    """The caller's pair overrides as PairCoeff with rule 'explicit'; each needs a source note and known types."""
+    explicit: list[PairCoeff] = []
+    for o in overrides:
+        if isinstance(o, PairCoeff):
+            explicit.append(PairCoeff(o.type_i, o.type_j, o.epsilon, o.sigma, "explicit", o.note))
+        else:
+            ti, tj, eps, sig, note = o
+            if not str(note).strip():
+                raise ForceFieldError(f"override {ti}-{tj} needs a source note")
+            explicit.append(PairCoeff(ti, tj, float(eps), float(sig), "explicit", str(note)))
+    for o in explicit:
+        if o.type_i not in atoms or o.type_j not in atoms:
+            raise ForceFieldError(f"override {o.type_i}-{o.type_j}: unknown atom type")
+    return explicit
 
 
 # ----------------------------------------------------------------------------------------------------------------

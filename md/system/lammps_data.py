@@ -78,16 +78,7 @@ def write_data(system: System | Any, forcefield: ForceField, path: str | Path, *
     kinds = (("bond", system.bonds, system.bond_types, forcefield.bond_types),
              ("angle", system.angles, system.angle_types, forcefield.angle_types),
              ("dihedral", system.dihedrals, system.dihedral_types, forcefield.dihedral_types))
-    term_ids: dict[str, dict[str, int]] = {}
-    for kind, terms, names, fftypes in kinds:
-        table = {t.name: k for k, t in enumerate(fftypes, start=1)}
-        term_ids[kind] = table
-        if len(terms) and len(names) != len(terms):
-            raise KeyError(f"the system's {kind}s carry no type names; "
-                           "build it with md.system.topology.with_bonded_terms")
-        unknown = sorted(set(names.tolist()) - set(table))
-        if unknown:
-            raise KeyError(f"{kind} types {unknown} are not in force field {forcefield.name!r}")
+    term_ids = _term_ids(kinds, forcefield)
     boundary = " ".join("p" if p else "f" for p in system.pbc)
     pos = system.wrapped_positions()
     for k in range(3):
@@ -99,20 +90,7 @@ def write_data(system: System | Any, forcefield: ForceField, path: str | Path, *
     head = title or str(system.info.get("builder", "system"))
     lines = [f"{_HEADER_TAG}: {head} | forcefield={forcefield.name} | boundary={boundary} | units=real "
              f"atom_style=full", ""]
-    lines.append(f"{system.n_atoms} atoms")
-    for kind, terms, _, _ in kinds:
-        if n_types[kind]:
-            lines.append(f"{len(terms)} {kind}s")
-        elif len(terms):
-            raise KeyError(f"the system has {kind}s but force field {forcefield.name!r} defines no {kind} types")
-    lines.append("")
-    lines.append(f"{len(ids)} atom types")
-    for kind in ("bond", "angle", "dihedral"):
-        if n_types[kind]:
-            lines.append(f"{n_types[kind]} {kind} types")
-    lines.append("")
-    for k, ax in enumerate("xyz"):
-        lines.append(f"0.0 {system.cell[k]:.8f} {ax}lo {ax}hi")
+    lines += _counts_and_box(system, kinds, n_types, len(ids), forcefield.name)
     lines += ["", "Masses", ""]
     for a in forcefield.atom_types:
         lines.append(f"{ids[a.name]} {a.mass:.6f}  # {a.name}")
@@ -140,6 +118,41 @@ def write_data(system: System | Any, forcefield: ForceField, path: str | Path, *
         lines.append("")
     path.write_text("\n".join(lines))
     return path
+
+
+def _term_ids(kinds, forcefield: ForceField) -> dict[str, dict[str, int]]:
+    """Per bonded kind: force-field type name -> LAMMPS type id; KeyError where the system's terms carry no type
+    names or a name the force field lacks."""
+    term_ids: dict[str, dict[str, int]] = {}
+    for kind, terms, names, fftypes in kinds:
+        table = {t.name: k for k, t in enumerate(fftypes, start=1)}
+        term_ids[kind] = table
+        if len(terms) and len(names) != len(terms):
+            raise KeyError(f"the system's {kind}s carry no type names; "
+                           "build it with md.system.topology.with_bonded_terms")
+        unknown = sorted(set(names.tolist()) - set(table))
+        if unknown:
+            raise KeyError(f"{kind} types {unknown} are not in force field {forcefield.name!r}")
+    return term_ids
+
+
+def _counts_and_box(system: System, kinds, n_types: Mapping[str, int], n_atom_types: int, ff_name: str) -> list[str]:
+    """The data file's header: atom and term counts, type counts, box bounds."""
+    lines = [f"{system.n_atoms} atoms"]
+    for kind, terms, _, _ in kinds:
+        if n_types[kind]:
+            lines.append(f"{len(terms)} {kind}s")
+        elif len(terms):
+            raise KeyError(f"the system has {kind}s but force field {ff_name!r} defines no {kind} types")
+    lines.append("")
+    lines.append(f"{n_atom_types} atom types")
+    for kind in ("bond", "angle", "dihedral"):
+        if n_types[kind]:
+            lines.append(f"{n_types[kind]} {kind} types")
+    lines.append("")
+    for k, ax in enumerate("xyz"):
+        lines.append(f"0.0 {system.cell[k]:.8f} {ax}lo {ax}hi")
+    return lines
 
 
 def read_atoms(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
