@@ -5,8 +5,10 @@
 For every data set in benchmarks/validation/datasets.toml it predicts the measured quantity with
 (a) the elastic closed form (JKR with Fuller-Tabor hysteresis = Thornton & Ning's elastic limit,
 continuum.reference.jkr), (b) the adhesive elastic-plastic closed form of Thornton & Ning
-(continuum.reference.thornton_ning) and (c) the smooth-sphere simulator (continuum.run_scene,
-JKR law) where an impact run applies. A work of adhesion (or a yield pressure) that was not
+(continuum.reference.thornton_ning) and (c) the smooth-sphere simulator (continuum.run_scene)
+where an impact run applies: with the JKR law, and where the data set states a limiting contact
+pressure also with the Thornton-Ning elastic-plastic law (the pressure given as the body's
+hardness, physics.plasticity = 'auto'). A work of adhesion (or a yield pressure) that was not
 measured is swept over the range datasets.toml states and shown as a band, never fitted. Writes
 docs/figures/validation_<case>.png and .json and the page docs/validation.md; every number on the
 page is read from those results.
@@ -52,8 +54,9 @@ def read_csv(path):
 # ------------------------------------------------------------------------------------------------
 # The smooth-sphere simulator
 # ------------------------------------------------------------------------------------------------
-def _scene(radius, density, w, body, substrate, velocity):
-    return {"name": "validation", "description": "validation: smooth sphere on a flat, JKR",
+def _scene(radius, density, w, body, substrate, velocity, limiting_pressure=None):
+    """A smooth sphere's scene; with `limiting_pressure` (Pa) it is the body's hardness and plasticity is 'auto'."""
+    scene = {"name": "validation", "description": "validation: smooth sphere on a flat, JKR",
             "impact_velocity": float(velocity),
             "body": {"shape": "sphere", "radius": float(radius), "density": float(density)},
             "surfaces": {"work_of_adhesion": float(w),
@@ -61,12 +64,17 @@ def _scene(radius, density, w, body, substrate, velocity):
                          "substrate": {k: substrate[k] for k in ("youngs_modulus", "poisson_ratio")}},
             "physics": {"adhesion_law": "jkr", "detachment": "displacement", "menisci": "off"},
             "numerics": {"max_bounces": 1}}
+    if limiting_pressure is not None:
+        scene["description"] = "validation: smooth sphere on a flat, Thornton-Ning elastic-plastic"
+        scene["surfaces"]["body"]["hardness"] = float(limiting_pressure)
+        scene["physics"]["plasticity"] = "auto"
+    return scene
 
 
-def simulator_restitution(radius, density, w, body, substrate, velocity):
+def simulator_restitution(radius, density, w, body, substrate, velocity, limiting_pressure=None):
     """First-impact restitution of the simulator (0 when the sphere sticks); raises on failure."""
     from continuum import run_scene
-    result = run_scene(_scene(radius, density, w, body, substrate, velocity))
+    result = run_scene(_scene(radius, density, w, body, substrate, velocity, limiting_pressure))
     if result.stuck or not result.bounces:
         return 0.0
     return float(result.bounces[0].restitution)
@@ -206,6 +214,9 @@ def restitution_case(name, ds, simulate):
             point["simulator_work_of_adhesion"] = w_mid
             point["simulator"], point["simulator_error"] = _try_simulator(
                 simulator_restitution, r, rho, w_mid, body, sub, v)
+            point["simulator_plastic"], point["simulator_plastic_error"] = _try_simulator(
+                simulator_restitution, r, rho, w_mid, body, sub, v, p_y)
+            point["tn_at_simulator_w"] = _tn_restitution(v, r, w_mid, e_star, rho, p_y)
         points.append(point)
     v_curve = np.geomspace(0.1, 100.0, 120)
     curves = {"velocity": v_curve.tolist()}
@@ -281,6 +292,10 @@ def figure_restitution(res):
         if p.get("simulator") is not None:
             ax.plot(p["velocity"], p["simulator"], "o", color="tab:blue", mfc="none")
     ax.plot([], [], "o", color="tab:blue", mfc="none", label="simulator (JKR, mid-band w)")
+    for p in res["points"]:
+        if p.get("simulator_plastic") is not None:
+            ax.plot(p["velocity"], p["simulator_plastic"], "x", color="tab:red")
+    ax.plot([], [], "x", color="tab:red", label="simulator (Thornton-Ning law, mid-band w)")
     ax.set(xscale="log", xlabel="impact velocity (m/s)", ylabel="coefficient of restitution",
            ylim=(0, 1.02), title="Ammonium fluorescein, d = 4.9 um, on silicon")
     ax.legend(fontsize=6)
