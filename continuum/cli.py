@@ -174,12 +174,13 @@ def cmd_paper(args) -> int:
     seeds, uncertainty = paper_samples(args)
     record = make_paper(sets, args.out, fidelity=args.fidelity, workers=args.workers, executor_name=args.executor,
                         scheduler=args.scheduler, progress=log.info, seeds=seeds, uncertainty=uncertainty)
-    states = [c["state"] for c in record["checks"]]
+    states = [c.get("state", "pass" if c["pass"] else "fail") for c in record["checks"]]
     print(f"checks: {states.count('pass')} pass, {states.count('fail')} fail, {states.count('not_evaluable')} not "
           f"evaluable (see {args.out}/summary.md and checks.json); wall {record['wall_s']:.1f} s")
-    for c in record["checks"]:
-        if c["state"] != "pass":
-            print(f"  {c['state'].upper()} [{c['set']}] {c['kind']} {c['name']}: {c.get('reason') or c['threshold']}")
+    for c, state in zip(record["checks"], states):
+        if state != "pass":
+            print(f"  {state.upper()} [{c['set']}] {c['name']} ({c.get('kind', 'claim')}): "
+                  f"{c.get('reason') or c['threshold']}")
     return EXIT_PARTIAL if "fail" in states and args.strict else 0
 
 

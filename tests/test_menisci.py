@@ -291,11 +291,10 @@ def test_bridge_sum_with_solid_pull_matches_a_brute_force_grid(gap, s):
         assert b._integral_numpy(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
 
 
-def test_measured_sets_use_the_wet_solid_adhesion_and_the_paper_set_declares_additive():
-    rec = {}
-    for params in ("paper", "calibrated"):
-        scene = resolve_scene(ROOT / "inputs" / "scenes" / "wet_silica.toml", params=params).scene
-        from continuum.models import meniscus_parameters
-        rec[params] = meniscus_parameters(scene)
+def test_a_set_that_declares_nothing_uses_the_wet_solid_adhesion_and_the_paper_set_declares_additive():
+    from continuum.model import meniscus_parameters
+
+    rec = {p: meniscus_parameters(resolve_scene(ROOT / "inputs" / "scenes" / "wet_silica.toml", params=p).scene)
+           for p in ("paper", "silicon")}
     assert rec["paper"]["solid_adhesion"] == "additive" and rec["paper"]["solid_pull"] == 0.0
-    assert rec["calibrated"]["solid_adhesion"] == "wet" and rec["calibrated"]["solid_pull"] > 0.0
+    assert rec["silicon"]["solid_adhesion"] == "wet" and rec["silicon"]["solid_pull"] > 0.0

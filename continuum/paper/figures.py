@@ -178,10 +178,11 @@ def fig8a(sweeps: dict, set_name: str, out: Path, wet: dict | None = None, ax=No
         if stuck:  # a stuck impact never ends: cross at the bottom edge, at its impact velocity
             ax.plot([p["v_impact"] * 1e3 for p in stuck], [0.02] * len(stuck), "x", color=color or "k", ms=5,
                     transform=edge)
-        if s["escape"] and color is not None:
+        found = (s["escape"] or {}).get("escape_velocity")
+        if found and color is not None:
             ax.axvline(s["escape"]["escape_velocity"] * 1e3, color=color, ls=":", lw=0.8)
         rows += [(case, s["sigma"], p["v_impact"], p["v_rebound"], p["duration"], p["stuck"]) for p in s["points"]]
-        if s["escape"]:
+        if found:
             rows.append((case, s["sigma"], s["escape"]["escape_velocity"], "escape_velocity", "", ""))
     si = (wet or {}).get("wet_silica")
     t_a = si["condensation_time"] if si and si["menisci_possible"] else None
@@ -199,7 +200,7 @@ def fig8a(sweeps: dict, set_name: str, out: Path, wet: dict | None = None, ax=No
             ax.loglog([p["v_impact"] * 1e3 for p in wet_stuck], [p["dry"]["duration"] * 1e6 for p in wet_stuck], "x",
                       color="tab:red", ms=7, mew=1.5, label="with menisci: sticks (at its dry impact time)")
         for esc, ls, name in ((si["escape_dry"], "--", "dry"), (si["escape_wet"], "-", "wet")):
-            if esc:
+            if esc and esc.get("escape_velocity"):
                 ax.axvline(esc["escape_velocity"] * 1e3, color="tab:red" if name == "wet" else "k", ls=ls, lw=0.8,
                            label=f"sigma 6 nm escape velocity, {name}: {esc['escape_velocity'] * 1e3:.4g} mm/s")
         ax.axhline(t_a * 1e6, color="k", ls=":", lw=1.2, label=f"t_a = {t_a * 1e6:g} us (condensation time)")
@@ -208,7 +209,7 @@ def fig8a(sweeps: dict, set_name: str, out: Path, wet: dict | None = None, ax=No
         rows += [("wet_silica_menisci", si["sigma"], p["v_impact"], p["wet"]["v_rebound"], p["wet"]["duration"],
                   p["wet"]["stuck"]) for p in pts]
         for name, esc in (("wet_silica_dry", si["escape_dry"]), ("wet_silica_menisci", si["escape_wet"])):
-            if esc:
+            if esc and esc.get("escape_velocity"):
                 rows.append((name, si["sigma"], esc["escape_velocity"], "escape_velocity", "", ""))
     ax.set_xlabel("impact velocity (mm/s)")
     ax.set_ylabel("impact time (us)")
@@ -235,7 +236,7 @@ def fig8b(wet: dict, set_name: str, out: Path, ax=None):
         k = key if key in s["points"][0] else "dry"
         pts = [p for p in s["points"] if not p[k]["stuck"]]
         esc = s["escape_wet"] if k == "wet" else s["escape_dry"]
-        if esc:
+        if esc and esc.get("escape_velocity"):
             v = esc["escape_velocity"]
             label += f" (escape {v * 1e3:.3g} mm/s, limiting gap {v * v / (2 * s['gravity']) * 1e9:.3g} nm)"
         line, = ax.loglog([p[k]["v_rebound"] * 1e3 for p in pts], [p[k]["duration"] * 1e6 for p in pts], "o-", ms=3,
@@ -243,9 +244,9 @@ def fig8b(wet: dict, set_name: str, out: Path, ax=None):
         if ax2 is not None:
             ax2.loglog([p["v_impact"] * 1e3 for p in pts], [p[k]["duration"] * 1e6 for p in pts], "o-", ms=3,
                        color=line.get_color(), label=label)
-            if esc:
+            if esc and esc.get("escape_velocity"):
                 ax2.axvline(esc["escape_velocity"] * 1e3, color=line.get_color(), ls=":", lw=0.8)
-        if esc:
+        if esc and esc.get("escape_velocity"):
             rows.append((case, "escape_velocity", esc["escape_velocity"], "", ""))
         rows += [(case, k, p["v_impact"], p[k]["v_rebound"], p[k]["duration"]) for p in pts]
     ax.set_xlabel("rebound velocity (mm/s)")

@@ -22,18 +22,27 @@ import numpy as np
 
 from nanoimpact.executors import executor as make_executor
 
+from .. import menisci as men
 from ..compiled_contact import warm_up
-from ..escape import escape_velocity, single_impact
+from ..escape import single_impact
 from ..impact import first_impact_speed, run_impact, write_impact
 from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
+from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, seed_overrides
 
 #: Fig 8a velocity sweep: impact speeds as multiples of the 100 nm drop speed.
 FIG8_SPEED_FACTORS = tuple(np.geomspace(0.05, 20.0, 10))
 #: Wet sweeps: impact speeds just above the dry escape velocity, v = v_esc (1 + eps), where the
-#: impact time diverges and outlasts t_a.
-WET_EPS = tuple(np.geomspace(1e-3, 2.0, 12))
+#: impact time grows and may outlast t_a.
+WET_EPS = tuple(np.geomspace(1e-8, 2.0, 12))
+#: Relative bracket of the dry escape velocity in the wet sweep: far below the band of speeds where dry
+#: impacts outlast t_a (~3e-4 wide for the MD-calibrated silica, continuum audit), so the band is resolved.
+WET_DRY_REL_TOL = 1e-9
+#: Relative bracket of the wet escape velocity (the menisci raise it by ~1e-4 to ~1e-2).
+WET_REL_TOL = 1e-7
+#: Speeds sampled inside the band where dry impacts outlast t_a.
+BAND_POINTS = 6
 
 
 def fastest_first(speeds):
@@ -76,11 +85,8 @@ def _sweep_task(case: Case, params: str, fidelity: str | None) -> dict:
         points.append({"v_impact": v, "stuck": run.stuck, "duration": b.duration, "v_rebound": b.v_rebound,
                        "restitution": b.restitution})
     points.sort(key=lambda p: p["v_impact"])
-    escape = None
-    stuck = [p["v_impact"] for p in points if p["stuck"]]
-    free = [p["v_impact"] for p in points if not p["stuck"]]
-    if stuck and free and max(stuck) < min(free):
-        escape = escape_velocity(law, mass, g, max(stuck), min(free), rel_tol=1e-2, rtol=rtol)
+    # the grid's outcomes bracket the escape velocity where they can; below the grid the bracket is extended
+    escape = escape_search(law, mass, g, v0, rtol, ESCAPE_REL_TOL, {p["v_impact"]: p["stuck"] for p in points})
     sigma = scene.surfaces.roughness.sigma if scene.surfaces.roughness is not None else None
     return {"kind": "sweep", "case": case.name, "set": Path(params).stem, "points": points, "escape": escape,
             "v_drop": v0, "sigma": sigma if scene.contact == "rough" else None}
@@ -95,9 +101,10 @@ def _outcome(law, mass, g, v, rtol) -> dict:
 def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     """Near-escape sweep of a wet case: each speed run without and (if bridges can pull) with menisci.
 
-    The dry escape velocity is bracketed on the drop-speed grid and bisected; then speeds just above
-    it (WET_EPS), where the impact time passes t_a, run dry and wet; the wet escape velocity is
-    bisected with the wet law.
+    The dry escape velocity is bracketed (adaptively, from the drop speed) and bisected to WET_DRY_REL_TOL;
+    speeds just above it (WET_EPS) and inside the band where dry impacts outlast t_a (`_t_a_band`) run dry
+    and wet; the wet escape velocity is bisected with the wet law to WET_REL_TOL. The longest dry impact that
+    still rebounds (at the dry bracket's upper end) is the t_a above which menisci change nothing.
     """
     resolved = resolve_case(case, params, fidelity)
     scene = resolved.scene
@@ -107,34 +114,64 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     menisci = menisci_decision(scene)
     wet_possible = menisci.choice != "off"
     wet = select_law(scene, v0, menisci=True)[0] if wet_possible else None
+    m = meniscus_parameters(scene) if wet is not None else {}
+    t_a = m.get("condensation_time")
     grid = [v0 * f for f in FIG8_SPEED_FACTORS]
-    # each dry impact runs once: the grid's outcomes are reused by the near-escape sweep below
     dry_runs = {v: _outcome(dry, mass, g, v, rtol) for v in fastest_first(grid)}
-    stuck = [v for v in grid if dry_runs[v]["stuck"]]
-    free = [v for v in grid if v not in stuck]
-    esc_dry = escape_velocity(dry, mass, g, max(stuck), min(free), rel_tol=1e-3, rtol=rtol) if stuck and free else None
-    speeds = sorted(set(grid) | ({esc_dry["upper"] * (1.0 + e) for e in WET_EPS} if esc_dry else set()))
+    esc_dry = escape_search(dry, mass, g, v0, rtol, WET_DRY_REL_TOL, {v: r["stuck"] for v, r in dry_runs.items()})
+    speeds = set(grid)
+    longest = edge = None
+    if esc_dry.get("escape_velocity"):
+        up = esc_dry["upper"]
+        dry_runs.setdefault(up, _outcome(dry, mass, g, up, rtol))
+        longest = dry_runs[up]["duration"]
+        band, edge = _t_a_band(dry, mass, g, rtol, up, t_a, dry_runs)
+        speeds |= {up * (1.0 + e) for e in WET_EPS} | set(band)
+    speeds = sorted(speeds)
     for v in fastest_first(speeds):
         if v not in dry_runs:
             dry_runs[v] = _outcome(dry, mass, g, v, rtol)
     wet_runs = {v: _outcome(wet, mass, g, v, rtol) for v in fastest_first(speeds)} if wet is not None else {}
-    points = []
-    for v in speeds:
-        p = {"v_impact": v, "dry": dry_runs[v]}
-        if wet is not None:
-            p["wet"] = wet_runs[v]
-        points.append(p)
+    points = [{"v_impact": v, "dry": dry_runs[v], **({"wet": wet_runs[v]} if wet is not None else {})} for v in speeds]
     esc_wet = None
-    if wet is not None and esc_dry is not None:
+    if wet is not None and esc_dry.get("escape_velocity"):
         free_wet = [p["v_impact"] for p in points if not p["wet"]["stuck"]]
-        if free_wet:
-            esc_wet = escape_velocity(wet, mass, g, esc_dry["lower"], min(free_wet), rel_tol=1e-3, rtol=rtol)
-    m = meniscus_parameters(scene) if wet is not None else {}
+        esc_wet = (escape_search(wet, mass, g, esc_dry["upper"], rtol, WET_REL_TOL,
+                                 {esc_dry["lower"]: True, min(free_wet): False}) if free_wet else
+                   {"escape_velocity": None, "reason": "no wet impact rebounds in the sweep"})
     return {"kind": "wet", "case": case.name, "set": Path(params).stem, "points": points, "escape_dry": esc_dry,
-            "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": m.get("condensation_time"),
-            "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length")} if m else None,
+            "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": t_a,
+            "condensation_time_nucleation": _nucleation_time(scene), "longest_dry_rebound_s": longest,
+            "t_a_band_edge": edge,
+            "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length", "solid_adhesion",
+                                          "solid_pull")} if m else None,
             "why_no_menisci": None if wet_possible else menisci.why,
             "gravity": g, "v_drop": v0, "sigma": scene.surfaces.roughness.sigma}
+
+
+def _nucleation_time(scene) -> float | None:
+    """The kinetic t_a the project offers (menisci.condensation_model = 'nucleation') for this scene's RH and T."""
+    env = scene.environment
+    return men.nucleation_condensation_time(env.relative_humidity, env.temperature) if 0 < env.relative_humidity < 1 \
+        else None
+
+
+def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -> tuple[list[float], dict | None]:
+    """Speeds inside the band above the escape velocity where dry impacts rebound after more than t_a: the band's
+    upper end (dry duration = t_a) bisected in ln(v - upper), then BAND_POINTS speeds spread geometrically in it.
+    Returns (speeds, {'speed', 'rel_tol'} of the edge); ([], None) when no dry impact that rebounds lasts t_a (or
+    without menisci)."""
+    if t_a is None or runs[upper]["stuck"] or runs[upper]["duration"] < t_a:
+        return [], None
+    lo, hi = math.log(WET_DRY_REL_TOL), math.log(2.0)        # ln eps: long at lo, short at hi
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        v = upper * (1.0 + math.exp(mid))
+        runs.setdefault(v, _outcome(dry, mass, g, v, rtol))
+        lo, hi = (mid, hi) if runs[v]["duration"] >= t_a else (lo, mid)
+    eps = np.geomspace(WET_DRY_REL_TOL, math.exp(lo), BAND_POINTS)
+    edge = {"speed": upper * (1.0 + math.exp(lo)), "rel_tol": math.exp(hi) - math.exp(lo) + WET_DRY_REL_TOL}
+    return [upper * (1.0 + e) for e in eps], edge
 
 
 def fig4_curves(set_name: str, fidelity: str | None) -> dict:
@@ -157,7 +194,8 @@ def _curves_task(params: str, fidelity: str | None) -> dict:
 def _run(task):
     kind, args = task
     start, cpu = time.perf_counter(), time.process_time()
-    out = {"impact": _impact_task, "sweep": _sweep_task, "wet": _wet_task, "curves": _curves_task}[kind](*args)
+    out = {"impact": _impact_task, "sweep": _sweep_task, "wet": _wet_task, "curves": _curves_task,
+           "bundle": _bundle_task}[kind](*args)
     out["wall_s"] = time.perf_counter() - start
     out["cpu_s"] = time.process_time() - cpu       # on a shared machine the CPU time is the steadier measure
     return out
@@ -172,12 +210,33 @@ def fig8_cases() -> list[Case]:
     return [Case("hertz", "hertz_roller.toml", {"numerics.max_bounces": 1}, ("8a",))] + rough
 
 
-def paper_tasks(sets: list[str], out: Path, fidelity: str | None) -> list[tuple[str, tuple]]:
-    """The runs of every set, set after set; within a set the longest first (the wet near-escape sweeps, then
-    the Fig 8a sweeps, the impacts, Fig 4's curves), so no long run starts last and the first sets finish
-    early: `run_paper` hands each finished set to its caller (its figures) while the pool runs the next."""
+def _bundle_task(params: str, label: str, overrides: dict, fidelity: str | None, cases: dict, full: bool) -> dict:
+    """One sample's bundle of runs (continuum.paper.samples.bundle)."""
+    return {"kind": "bundle", "case": label, "set": Path(params).stem,
+            "bundle": bundle(params, label, overrides, fidelity, cases, full)}
+
+
+def sample_tasks(s: str, fidelity: str | None, seeds: int, uncertainty: list[dict]) -> list[tuple[str, tuple]]:
+    """The sampled claims' bundles of set `s`: the nominal one, `seeds` discrete seeds, the `uncertainty` rows
+    (scene overrides). None when the run leaves out rough silica or OTS (their claims have no nominal case)."""
+    cases = bundle_cases(dry_cases())
+    if cases is None:
+        return []
+    tasks = [("bundle", (s, "nominal", {}, fidelity, cases, True))]
+    tasks += [("bundle", (s, label, o, fidelity, cases, False)) for label, o in seed_overrides(seeds)]
+    tasks += [("bundle", (s, f"uncertainty {i + 1}", o, fidelity, cases, True)) for i, o in enumerate(uncertainty)]
+    return tasks
+
+
+def paper_tasks(sets: list[str], out: Path, fidelity: str | None, seeds: int = 0,
+                uncertainty: dict[str, list[dict]] | None = None) -> list[tuple[str, tuple]]:
+    """The runs of every set, set after set; within a set the longest first (the sampled bundles, the wet
+    near-escape sweeps, then the Fig 8a sweeps, the impacts, Fig 4's curves), so no long run starts last and the
+    first sets finish early: `run_paper` hands each finished set to its caller (its figures) while the pool runs
+    the next. `seeds` and `uncertainty` ({set name: [overrides, ...]}): `sample_tasks`."""
     tasks = []
     for s in sets:
+        tasks += sample_tasks(s, fidelity, seeds, (uncertainty or {}).get(Path(s).stem, []))
         tasks += [("wet", (case, s, fidelity)) for case in wet_cases()]
         tasks += [("sweep", (case, s, fidelity)) for case in fig8_cases()]
         # absolute: the runs write there from the workers, whose working directory may differ (a Dask cluster)
@@ -188,14 +247,18 @@ def paper_tasks(sets: list[str], out: Path, fidelity: str | None) -> list[tuple[
 
 def _set_of(task) -> str:
     kind, args = task
-    return Path(args[0] if kind == "curves" else args[1]).stem
+    return Path(args[0] if kind in ("curves", "bundle") else args[1]).stem
 
 
 def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
               executor_name: str = "processes", scheduler: str | None = None, executor=None,
               progress: Callable[[str], None] = print,
-              on_set_done: Callable[[str, dict], None] | None = None) -> dict:
+              on_set_done: Callable[[str, dict], None] | None = None, seeds: int = 0,
+              uncertainty: dict[str, list[dict]] | None = None) -> dict:
     """Run every dry case and sweep for every parameter set; returns the collected outputs.
+
+    With the sampled claims' bundles (`sample_tasks`): the nominal one always, `seeds` discrete-summit seeds and
+    the `uncertainty` rows ({set name: [scene overrides, ...]}) per set; collected["bundles"][(label, set)].
 
     Runs go to `executor` (an object from nanoimpact.executors, left open: its owner closes it) or, without one,
     to a new `executor_name` executor (default: a local process pool of `workers`, default the CPU count).
@@ -204,11 +267,11 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = paper_tasks(sets, out, fidelity)
+    tasks = paper_tasks(sets, out, fidelity, seeds, uncertainty)
     left = {}
     for task in tasks:
         left[_set_of(task)] = left.get(_set_of(task), 0) + 1
-    collected = {"impacts": {}, "sweeps": {}, "wet": {}, "curves": {}, "wall_s": {}, "cpu_s": {}}
+    collected = {"impacts": {}, "sweeps": {}, "wet": {}, "curves": {}, "bundles": {}, "wall_s": {}, "cpu_s": {}}
     start = time.perf_counter()
     own = executor is None
     warm_up()                       # forked workers inherit the compiled contact kernel
@@ -223,7 +286,8 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
             if item["kind"] == "curves":
                 collected["curves"][item["set"]] = item["curves"]
             else:
-                collected[{"impact": "impacts", "sweep": "sweeps", "wet": "wet"}[item["kind"]]][key] = item
+                group = {"impact": "impacts", "sweep": "sweeps", "wet": "wet", "bundle": "bundles"}[item["kind"]]
+                collected[group][key] = item
             collected["wall_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["wall_s"]
             collected["cpu_s"][f"{item['kind']}:{item['case']}:{item['set']}"] = item["cpu_s"]
             progress(f"  [{done}/{len(tasks)}] {item['kind']} {item['case']} ({item['set']}): {item['wall_s']:.1f} s "

@@ -1,0 +1,162 @@
+"""The paper's sampled claims: one small bundle of runs per sample, and where the samples come from.
+
+A *bundle* is what the sampled reproduction claims read (``claims.bundle_claims``): the 100 nm drops of
+rough silica and OTS-covered silica (sigma = 6 nm, at most ``SAMPLE_MAX_BOUNCES`` impacts), the first
+impact at sigma = 3 nm, both escape velocities (adaptive bracket, bisection to ``ESCAPE_REL_TOL``), both
+impact times at 1.2 times silica's escape velocity, and (averaged summits only) both adhesive loops.
+Every run is on a rigid substrate (the half-space deflection under this roller is femtometres).
+
+Samples of a parameter set:
+- the nominal bundle (the set as declared, averaged GW summits);
+- discrete-summit seeds: ``surfaces.roughness.mode = 'discrete'`` with seeds 1..n (paired: silica and
+  OTS of one seed share the summits), the model's own scatter when few summits carry an impact;
+- uncertainty samples: rows of scene overrides the caller passes in, such as the Latin hypercube the
+  calibration writes to OUT/uncertainty.csv (``read_uncertainty_csv``). The continuum never draws them:
+  the calibration owns the measured values' distributions.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+from ..escape import escape_velocity, single_impact
+from ..impact import first_impact_speed, run_impact
+from ..model import select_law
+from ..scene import SceneError, resolve_scene
+from .cases import RIGID, Case, sigma_case
+
+#: Impacts per sampled drop: the sampled claims read at most this many ("sticks within 20 impacts").
+SAMPLE_MAX_BOUNCES = 20
+#: Discrete-summit seeds per set that `nanoimpact paper` samples by default (8: ~1 s of runs each).
+DEFAULT_SEEDS = 8
+#: Relative bracket width of the escape velocity's bisection in a bundle.
+ESCAPE_REL_TOL = 1e-3
+#: Halvings (or doublings) of the impact speed tried to bracket an escape velocity before giving up.
+MAX_BRACKET_STEPS = 40
+#: Columns of the calibration's uncertainty.csv that are results, not inputs.
+RESULT_COLUMNS = ("rebound1_over_h0", "rebound2_over_h0", "rebound3_over_h0", "rebound_count",
+                  "escape_velocity_m_per_s", "error")
+
+
+def seed_overrides(n: int) -> list[tuple[str, dict]]:
+    """(label, overrides) of `n` discrete-summit realisations, seeds 1..n."""
+    return [(f"seed {s}", {"surfaces.roughness.mode": "discrete", "surfaces.roughness.seed": s})
+            for s in range(1, n + 1)]
+
+
+def read_uncertainty_csv(path: str | Path) -> list[dict]:
+    """Scene overrides per row of a calibration uncertainty.csv: the dotted-key input columns, rows whose
+    `error` column is empty (a refused sample stays refused)."""
+    rows = []
+    with open(path, newline="") as fh:
+        for row in csv.DictReader(fh):
+            if row.get("error"):
+                continue
+            rows.append({k: float(v) for k, v in row.items() if k not in RESULT_COLUMNS and v not in ("", None)})
+    return rows
+
+
+def escape_search(law, mass: float, gravity: float, v_start: float, rtol: float,
+                  rel_tol: float = ESCAPE_REL_TOL, known: dict | None = None) -> dict:
+    """Escape velocity by an adaptive bracket from `v_start` (halve until it sticks, double until it rebounds),
+    then bisection to `rel_tol`. `known` = {speed: stuck} already run. Returns the bisection's dict, or
+    {'escape_velocity': None, 'reason': ...} when no bracket is found within MAX_BRACKET_STEPS."""
+    known = dict(known or {})
+
+    def stuck(v):
+        if v not in known:
+            known[v] = single_impact(law, mass, gravity, v, rtol).stuck
+        return known[v]
+
+    lo = max((v for v, s in known.items() if s), default=None)
+    hi = min((v for v, s in known.items() if not s), default=None)
+    v = v_start
+    for _ in range(MAX_BRACKET_STEPS):
+        if lo is not None and hi is not None and lo < hi:
+            break
+        if stuck(v):
+            lo = v if lo is None else max(lo, v)
+            v = 2.0 * v
+        else:
+            hi = v if hi is None else min(hi, v)
+            v = 0.5 * v
+    if lo is None or hi is None or not lo < hi:
+        return {"escape_velocity": None, "reason": f"no bracket within {v_start * 2.0 ** -MAX_BRACKET_STEPS:.3g}-"
+                f"{v_start * 2.0 ** MAX_BRACKET_STEPS:.3g} m/s ({MAX_BRACKET_STEPS} halvings and doublings)"}
+    out = escape_velocity(law, mass, gravity, lo, hi, rel_tol=rel_tol, rtol=rtol)
+    out["rel_tol"] = rel_tol
+    return out
+
+
+def _sequence(result: dict) -> dict:
+    """The drop's impacts in order: rebound heights / h0 (0 when it stuck), durations (inf when stuck), peaks."""
+    h0 = result["scene"]["si"]["release_height"]
+    b = result["bounces"]
+    return {"rebound_over_h0": [(x["rebound_height"] or 0.0) / h0 for x in b],
+            "duration_s": [x["duration"] if x["duration"] is not None else math.inf for x in b],
+            "peak_force_N": [x["peak_force"] for x in b], "status": result["status"], "impacts": len(b)}
+
+
+def _resolved(case: Case, params: str, overrides: dict, fidelity: str | None, max_bounces: int):
+    o = {**case.overrides, **overrides, "physics.half_space": RIGID,
+         "numerics.max_bounces": min(max_bounces, case.overrides.get("numerics.max_bounces", max_bounces))}
+    if fidelity is not None:
+        o["numerics.fidelity"] = fidelity
+    return resolve_scene(case.path, params=params, overrides=o, override_label=f"paper sample {case.name}")
+
+
+def bundle(params: str, label: str, overrides: dict, fidelity: str | None, cases: dict[str, Case],
+           full: bool) -> dict:
+    """One sample's runs (module docstring). `cases`: the run's rough_silica and rough_ots cases. A sample the
+    scene refuses or a run that fails is returned with its `error` (counted as undecided)."""
+    try:
+        return _bundle(params, label, overrides, fidelity, cases, full)
+    except (SceneError, ValueError, RuntimeError) as exc:
+        return {"label": label, "overrides": overrides, "seed": _is_seed(overrides),
+                "error": f"{type(exc).__name__}: {exc}"}
+
+
+def _is_seed(overrides: dict) -> bool:
+    return overrides.get("surfaces.roughness.mode") == "discrete"
+
+
+def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
+    """The runs of one sample. With `full` (averaged summits: the nominal set and its uncertainty samples)
+    also the escape velocities, the impacts at 1.2 v_esc and Fig 4's loops; a discrete seed runs the drops alone
+    (a discrete impact costs ~0.3 s, an escape search ~15 of them). OTS runs only as many impacts as it needs
+    to show whether it outbounces silica (silica's rebounds + 2)."""
+    out = {"label": label, "overrides": overrides, "seed": _is_seed(overrides)}
+    laws = {}
+    n_si = SAMPLE_MAX_BOUNCES
+    for key, case in (("silica", cases["rough_silica"]), ("ots", cases["rough_ots"])):
+        resolved = _resolved(case, params, overrides, fidelity, n_si)
+        result, _ = run_impact(resolved)
+        out[key] = _sequence(result)
+        n_si = min(SAMPLE_MAX_BOUNCES, out[key]["impacts"] + 2)
+        if full:
+            sc = resolved.scene
+            v0 = first_impact_speed(resolved)
+            laws[key] = (select_law(sc, v0)[0], sc.body.mass, sc.environment.gravity, sc.numerics.rtol, v0)
+    s3 = _resolved(sigma_case(3.0), params, overrides, fidelity, 1)
+    out["sigma3"] = _sequence(run_impact(s3)[0])
+    if not full:
+        return out
+    out["escape"] = {k: escape_search(law, m, g, v0, rtol) for k, (law, m, g, rtol, v0) in laws.items()}
+    v_si = out["escape"]["silica"].get("escape_velocity")
+    if v_si:
+        v = 1.2 * v_si
+        runs = {k: single_impact(law, m, g, v, rtol) for k, (law, m, g, rtol, _) in laws.items()}
+        out["low_speed"] = {"v_impact": v, **{k: {"stuck": r.stuck, "duration": r.bounces[0].duration}
+                                              for k, r in runs.items()}}
+    from .figures import characteristic
+
+    out["loop"] = {k: characteristic(law.surface)["loop_area"] for k, (law, *_) in laws.items()}
+    return out
+
+
+def bundle_cases(dry: list[Case]) -> dict[str, Case] | None:
+    """The run's rough silica and OTS cases, or None when the run leaves either out (then nothing is sampled)."""
+    by = {c.name: c for c in dry}
+    return {k: by[k] for k in ("rough_silica", "rough_ots")} if {"rough_silica", "rough_ots"} <= set(by) else None
+

@@ -1,0 +1,103 @@
+"""How a claim is judged: two kinds, three states, a margin against its numerical tolerance.
+
+Kinds. *Verification*: the code solves its own equations (Hertz limits, closed forms, what holds by
+construction). *Reproduction*: the paper's physical conclusions (SAM against bare silica, trends in
+sigma, wet against dry, impact time against velocity), which a parameter set can fail.
+
+States. ``pass``: the claim holds by more than its numerical tolerance. ``fail``: it is violated
+by more than that tolerance. ``not_evaluable``: the margin lies inside the tolerance (the numerics
+cannot tell), or the quantity the claim needs was not found (the entry gives the reason).
+
+Margin. A signed number in the claim's own units (or relative, as the entry says): positive when
+the claim holds. Tolerance: the numerical uncertainty of that margin (bisection bracket, integrator
+and table tolerances), never a physical threshold.
+
+Samples. A reproduction claim is also judged on each uncertainty sample of the parameter set and
+each discrete-summit seed; ``holds_fraction`` is the fraction of the decided samples (the nominal
+run included) on which it holds, and the claim passes when that fraction is at least
+``HOLDS_FRACTION`` (the continuum audit's proposed criterion).
+"""
+from __future__ import annotations
+
+import math
+
+PASS, FAIL, NOT_EVALUABLE = "pass", "fail", "not_evaluable"
+VERIFICATION, REPRODUCTION = "verification", "reproduction"
+#: A reproduction claim passes when it holds on at least this fraction of its decided samples.
+HOLDS_FRACTION = 0.9
+#: At most this fraction of the samples may be undecided (margin inside tolerance) for a verdict.
+UNDECIDED_FRACTION = 0.1
+
+
+def judge(margin: float | None, tolerance: float) -> str:
+    """pass when margin > tolerance, fail when margin < -tolerance, else not_evaluable (also for None/NaN)."""
+    if margin is None or math.isnan(margin):
+        return NOT_EVALUABLE
+    if margin > tolerance:
+        return PASS
+    if margin < -tolerance:
+        return FAIL
+    return NOT_EVALUABLE
+
+
+def entry(name: str, set_name: str, kind: str, values: dict, threshold: str, margin, tolerance: float,
+          units: str, reason: str | None = None, state: str | None = None) -> dict:
+    """One checks.json entry. `state` defaults to judge(margin, tolerance); `reason` says why a claim is
+    not evaluable (or what decided a fail that has no margin). `pass` mirrors state == 'pass' for readers that
+    only want a yes."""
+    state = state or judge(margin, tolerance)
+    if state == NOT_EVALUABLE and reason is None:
+        reason = (f"margin {margin:.3g} lies inside the numerical tolerance {tolerance:.3g}"
+                  if margin is not None and math.isfinite(margin) else "the quantity was not found")
+    out = {"name": name, "set": set_name, "kind": kind, "state": state, "pass": state == PASS,
+           "margin": _finite_or_none(margin), "tolerance": tolerance, "units": units, "threshold": threshold,
+           "values": values}
+    if reason is not None:
+        out["reason"] = reason
+    return out
+
+
+def not_evaluable(name: str, set_name: str, kind: str, threshold: str, units: str, reason: str,
+                  values: dict | None = None, tolerance: float = 0.0) -> dict:
+    return entry(name, set_name, kind, values or {}, threshold, None, tolerance, units, reason, NOT_EVALUABLE)
+
+
+def _finite_or_none(x):
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else (None if math.isnan(x) else x)
+
+
+def over_samples(nominal: dict, sample_states: list[str], sources: dict, bands: dict | None = None) -> dict:
+    """A reproduction entry judged over its samples: the nominal run plus `sample_states` (one state per
+    seed or uncertainty sample). `sources` says what was sampled ({'seeds': n, 'uncertainty': n, ...})."""
+    states = [nominal["state"]] + list(sample_states)
+    held = states.count(PASS)
+    decided = held + states.count(FAIL)
+    undecided = len(states) - decided
+    fraction = held / decided if decided else None
+    out = dict(nominal, holds_fraction=fraction, samples=len(states), samples_undecided=undecided,
+               sampled=sources)
+    if bands:
+        out["bands"] = bands
+    if nominal["state"] != PASS:            # the set's own model decides first; the samples test robustness
+        out["state"] = nominal["state"]
+    elif undecided > UNDECIDED_FRACTION * len(states):
+        out["state"] = NOT_EVALUABLE
+        out["reason"] = f"{undecided} of {len(states)} samples undecided (margin inside tolerance or not found)"
+    else:
+        out["state"] = PASS if fraction is not None and fraction >= HOLDS_FRACTION else FAIL
+        if out["state"] == FAIL and nominal["state"] == PASS:
+            out["reason"] = f"holds on {held} of {decided} decided samples (< {HOLDS_FRACTION:g})"
+    out["pass"] = out["state"] == PASS
+    return out
+
+
+def band(values) -> dict | None:
+    """min, median, max and count of the finite values (a threshold shape reported as its spread)."""
+    v = sorted(float(x) for x in values if x is not None and math.isfinite(float(x)))
+    if not v:
+        return None
+    mid = v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
+    return {"min": v[0], "median": mid, "max": v[-1], "n": len(v)}
