@@ -46,9 +46,8 @@ ALL = WORKFLOWS
 
 #: Keys that define a run of a workflow only on some systems: workflow -> {key: (system key, value)}; elsewhere the
 #: key keeps its default in the settings but stays out of the run's identity (`Recipe.canonical`, hence the run
-#: hash). W_SL by TI learned OTS after its silica result was committed: on silica the SAM keys change nothing, and
-#: leaving them out keeps that result's hash. (The other workflows hash their SAM keys on every surface, as their
-#: committed results were hashed.)
+#: hash). On silica the SAM keys change nothing in a W_SL run, so they stay out of its hash. (The other workflows
+#: hash their SAM keys on every surface, as their committed results were hashed.)
 CONDITIONAL_KEYS: dict[str, dict[str, tuple[str, Any]]] = {
     "wsl_ti": {"sam_coverage": ("surface", "ots"), "chain_length": ("surface", "ots")}}
 

@@ -5,12 +5,11 @@ they skip -- except when CI is "true", where a missing MDAnalysis is a failure.
 """
 from __future__ import annotations
 
-import importlib.util
 import math
-import os
 
 import numpy as np
 import pytest
+from conftest import require_backend
 
 from md.analysis import (ATM_A_TO_N_PER_M, KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ContactAngle,
                          block_analysis, block_average, density_profile, energy_separation_work,
@@ -569,11 +568,7 @@ def test_rate_extrapolation_recovers_bell_evans_line():
 
 @pytest.fixture
 def mda():
-    if importlib.util.find_spec("MDAnalysis") is None:
-        reason = 'MDAnalysis is not installed (md extra missing: pip install "nanoimpact[md]")'
-        if os.environ.get("CI", "").strip().lower() == "true":
-            pytest.fail(f"CI=true but {reason}; CI must install the md extra", pytrace=False)
-        pytest.skip(reason)
+    require_backend("MDAnalysis", "MDAnalysis")
     import MDAnalysis
 
     return MDAnalysis

@@ -15,15 +15,14 @@ bin, which moves the angle by (bin / 2) / (R sin theta) rad. Tests marked ``md``
 """
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import os
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import require_backend
 
 from md.analysis import (ContactAngle, block_drift, cap_angle_for_base, cap_angle_for_height, dividing_plane,
                          fit_contact_angle, shape_check, wetting_bound, work_of_adhesion_sl)
@@ -112,11 +111,7 @@ def test_contact_angle_class_finds_the_plane_from_a_map_started_below_the_solid(
 
 @pytest.fixture
 def mda():
-    if importlib.util.find_spec("MDAnalysis") is None:
-        reason = 'MDAnalysis is not installed (md extra missing: pip install "nanoimpact[md]")'
-        if os.environ.get("CI", "").strip().lower() == "true":
-            pytest.fail(f"CI=true but {reason}; CI must install the md extra", pytrace=False)
-        pytest.skip(reason)
+    require_backend("MDAnalysis", "MDAnalysis")
     import MDAnalysis
     return MDAnalysis
 
@@ -129,7 +124,6 @@ def _committed_ots_map():
     return rho, np.r_[u - du / 2, u[-1] + du / 2], np.r_[z - dz / 2, z[-1] + dz / 2]
 
 
-@pytest.mark.skipif(not (COMMITTED_OTS / "density_map.csv").exists(), reason="committed OTS quick map not present")
 def test_committed_ots_map_gives_its_angle_at_the_waters_plane_and_a_higher_one_at_ch3():
     """The committed quick OTS map (no new MD): refitting it gives the committed angle as simulated (a regression
     of the refit, not a physics check); the water's half-density plane lies above the mean CH3 height, and reading

@@ -49,7 +49,6 @@ CRISTOBALITE_A = 7.16                     #: A, idealised cubic beta-cristobalit
 QUARTZ = {"a": 4.916, "c": 5.4054, "spacegroup": 154,     # P3_221
           "si": (0.4697, 0.0, 2.0 / 3.0), "o": (0.4135, 0.2669, 0.1191 + 2.0 / 3.0)}  # Levien et al. 1980
 SIO_BOND_CUTOFF = 2.0                     #: A, Si-O bond search radius in the bulk crystals (bonds 1.55-1.61 A)
-SIOH_ANGLE = 115.0                        #: deg, IFF SC4-OC24-HOY theta0 (used to place H)
 #: The silica surface of every recipe (contact angle, adhesion, pull-off): cristobalite (111), isolated Q3
 #: silanols at 4.50 OH/nm^2 on a 5.06 A hexagonal lattice (nearest silanol O-O 5.06 A), the hydrophilic Q3
 #: chemistry IFF was validated with (Emami et al., Chem. Mater. 26 (2014) 2647). The (001) face holds

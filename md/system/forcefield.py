@@ -614,12 +614,6 @@ def lammps_pair_coeffs(ff: ForceField, type_ids: Mapping[str, int] | None = None
     return [t for _, _, t in sorted(lines)]
 
 
-def lammps_mass_lines(ff: ForceField, type_ids: Mapping[str, int] | None = None) -> list[str]:
-    ids = dict(type_ids) if type_ids is not None else lammps_type_ids(ff)
-    return [f"mass {ids[a.name]} {a.mass:.4f}  # {a.name}" for a in sorted(
-        (ff.atom_type(n) for n in ids), key=lambda a: ids[a.name])]
-
-
 def _coeff_lines(command: str, terms: Sequence[Any]) -> list[str]:
     styles = {t.style for t in terms}
     hybrid = len(styles) > 1

@@ -28,7 +28,7 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.topology import System
 
-from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, TRAPPE_UA, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+from md.workflows.common import (ENERGY_NOT_FREE_ENERGY, TRAPPE_UA, Settings, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
                                  fresh_from_data, intersect_ids, minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed,
                                  silica_face_of, stage_list, steps_of, system_summary, surface_slab, thermostat_lines)
 
@@ -574,7 +574,7 @@ class _AdhesionLegs:
                 "registry_offsets_A": [list(o) for o in self.registries]}
 
 
-def _tail_applies(s: Mapping[str, Any], system: System) -> bool:
+def _tail_applies(s: Settings, system: System) -> bool:
     return s.dispersion_tail == "trappe" and bool(np.isin(system.types, TRAPPE_UA).any())
 
 
@@ -599,12 +599,12 @@ REGISTRY_LIFT_A = 4.0
 REGISTRY_LOWER_STEPS = 8
 
 
-def _lifts_registries(s: Mapping[str, Any]) -> bool:
+def _lifts_registries(s: Settings) -> bool:
     """Bare silica on bare silica: interlocked silanols cannot be sheared at contact (lift first)."""
     return all(surface == "silica" for surface in s.surfaces)
 
 
-def registry_approach_lines(s: Mapping[str, Any]) -> list[str]:
+def registry_approach_lines(s: Settings) -> list[str]:
     """LAMMPS commands that lower the (lifted, shifted) upper slab by REGISTRY_LIFT_A in REGISTRY_LOWER_STEPS equal
     steps, minimising after each (the window's fixes hold both backs), then reset the step counter."""
     step = REGISTRY_LIFT_A / REGISTRY_LOWER_STEPS

@@ -28,7 +28,8 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
 from md.system.topology import System
 
-from md.workflows.common import (Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data, intersect_ids,
+from md.workflows.common import (Settings, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
+                                 fresh_from_data, intersect_ids,
                                  minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed, silica_face_of, stage_list, steps_of,
                                  system_summary, surface_slab, thermostat_lines)
 
@@ -332,7 +333,7 @@ class _PullOffAnalysis:
         ax.legend(fontsize=7)
 
 
-def _thermostat_fix(name: str, group: str, settings: Mapping[str, Any], step: int, salt: int) -> list[str]:
+def _thermostat_fix(name: str, group: str, settings: Settings, step: int, salt: int) -> list[str]:
     """A named thermostat fix on ``group`` (Langevin + nve, or Nose-Hoover nvt)."""
     t = settings.temperature_K
     damp = settings.thermostat_damping_fs
@@ -342,7 +343,7 @@ def _thermostat_fix(name: str, group: str, settings: Mapping[str, Any], step: in
             f"fix {name}_nve {group} nve"]
 
 
-def _pulloff_thermostat(s: Mapping[str, Any], step: int, salt: int) -> list[str]:
+def _pulloff_thermostat(s: Settings, step: int, salt: int) -> list[str]:
     """The pull-off thermostats (recipe ``tip_thermostat``): the flat's mobile atoms always; the asperity's mobile
     atoms in its own frame ('comoving': a temp/com bias, so drag and noise act on the thermal velocities only and
     sum to zero over the asperity), not at all ('none': NVE), or together with the
