@@ -434,9 +434,10 @@ def _check_law(si: dict, sam, origin: str) -> None:
             raise SceneError("physics.adhesion_law", law,
                              "a smooth cylinder has no adhesive law here (2-D JKR is not implemented); "
                              "use body.shape = 'sphere' or contact = 'rough'", origin)
-        if law != "jkr" and si["contact"] == "smooth":
-            raise SceneError("physics.adhesion_law", law, "a smooth sphere takes 'none', 'jkr' or 'auto'; "
-                             "DMT and Maugis-Dugdale are summit laws of rough contact", origin)
+        if law != "jkr" and si["contact"] == "smooth" and si["physics.detachment"] != "displacement":
+            raise SceneError("physics.detachment", si["physics.detachment"], f"a smooth sphere under "
+                             f"physics.adhesion_law = '{law}' lets go under displacement control only (its branches "
+                             "have no load-controlled release); use 'displacement' or adhesion_law = 'jkr'", origin)
         if adhesion <= 0.0:
             key = "surfaces.sam.work_of_adhesion" if sam is not None else "surfaces.work_of_adhesion"
             raise SceneError(key, adhesion, f"must be > 0 J/m^2 when physics.adhesion_law = '{law}'", origin)

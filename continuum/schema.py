@@ -171,7 +171,8 @@ FIELDS: tuple[Field, ...] = (
     Field("physics.adhesion_law", str, "", "Summit (or sphere) law: 'none' (Hertz), 'jkr' (JKR with Fuller-Tabor "
           "hysteresis), 'dmt' (no loop), 'maugis_dugdale' (jump-in/out from its own solution), or 'auto': from the "
           "Tabor parameter (> 5 JKR, < 0.1 DMT, else Maugis-Dugdale), left out when its estimated loss per impact "
-          "is negligible. Rough contact takes all five; a smooth sphere 'none', 'jkr' or 'auto'.",
+          "is negligible (rough contact). A smooth sphere takes all five ('auto' by its own Tabor parameter; "
+          "DMT and Maugis-Dugdale with displacement-controlled release only).",
           "auto", choices=("auto", "none", "jkr", "dmt", "maugis_dugdale")),
     Field("physics.detachment", str, "", "JKR detachment criterion: 'displacement' (let go at -delta_c, as "
           "the paper) or 'load' (let go at -P_c).", "displacement", choices=("displacement", "load")),

@@ -137,8 +137,12 @@ def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
         if scene.body.shape == "cylinder":
             return AdhesionDecision("none", "geometry", "auto: a smooth roller has no adhesive line-contact law here "
                                     "(2-D JKR is not implemented); adhesion is left out and the result says so", **base)
-        return AdhesionDecision("jkr", "geometry",
-                                f"auto: smooth sphere, JKR (the only adhesive sphere law; Tabor mu = {mu:.3g})", **base)
+        if phys.detachment != "displacement":
+            return AdhesionDecision("jkr", "detachment", f"auto: smooth sphere, JKR: the only sphere law with a "
+                                    f"load-controlled release (Tabor mu = {mu:.3g})", **base)
+        law = "jkr" if mu > TABOR_JKR else "dmt" if mu < TABOR_DMT else "maugis_dugdale"
+        return AdhesionDecision(law, "tabor_parameter", f"auto: Tabor mu = {mu:.3g} of the smooth sphere -> "
+                                f"{LAW_NAMES[law]}", **{**base, "on_the_map": True})
     law = "jkr" if mu > TABOR_JKR else "dmt" if mu < TABOR_DMT else "maugis_dugdale"
     base["on_the_map"] = True
     loop = loop_per_summit(law, scene)
@@ -412,9 +416,9 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> Plasticity
     if soft is None:
         return PlasticityDecision(False, "yield_strength", "no yield key (surfaces.body or surfaces.substrate "
                                   "yield_strength or hardness): the sphere is elastic")
-    if adhesion == "none":
-        return PlasticityDecision(False, "adhesion_law", "the elastic-plastic law here is the adhesive one "
-                                  "(Thornton & Ning 1998); without adhesion the sphere stays elastic (Hertz)",
+    if adhesion != "jkr":
+        return PlasticityDecision(False, "adhesion_law", "the elastic-plastic law here is Thornton & Ning's (1998), "
+                                  f"built on JKR; under adhesion law '{adhesion}' the sphere stays elastic",
                                   partners=limits)
     body, surf = scene.body, scene.surfaces
     density = body.mass / (4.0 / 3.0 * math.pi * body.radius**3)

@@ -13,10 +13,11 @@ from ..scene import Scene
 
 def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float,
                limiting_pressure: float | None = None) -> tuple[ContactLaw, str]:
-    """The closed-form law of a smooth body under `adhesion` ('none' or 'jkr'), and what it is; with a
-    `limiting_pressure` (Pa) the adhesive sphere is the Thornton-Ning elastic-plastic one."""
+    """The law of a smooth body under `adhesion` ('none', 'jkr', 'dmt', 'maugis_dugdale'), and what it is; with a
+    `limiting_pressure` (Pa) the JKR sphere is the Thornton-Ning elastic-plastic one."""
     from ..laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
     from ..laws.jkr import JKRSphere
+    from ..laws.branch_sphere import BranchSphere
     from ..laws.plastic_sphere import PlasticJKRSphere
 
     body, surf, phys = scene.body, scene.surfaces, scene.physics
@@ -31,7 +32,12 @@ def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float,
         return (LinearSpring(k, {"reference_load": load, "reference_speed": first_impact_speed}),
                 "smooth cylinder, line_stiffness = 'constant': K of eq 1 frozen at the first impact's peak load "
                 "(paper eq 2)")
-    # jkr; scene validation admits only a sphere for smooth contact
+    # adhesive: scene validation admits only a sphere for smooth contact
+    if adhesion in ("dmt", "maugis_dugdale"):
+        return (BranchSphere(adhesion, body.radius, surf.interface_work_of_adhesion, e_star,
+                             surf.interface_interaction_range),
+                f"smooth sphere, {adhesion} approach and retreat branches with their jumps (continuum.rough."
+                "branch_laws), displacement-controlled release")
     if limiting_pressure is not None:
         return (PlasticJKRSphere(body.radius, surf.interface_work_of_adhesion, e_star, limiting_pressure,
                                  phys.detachment),
