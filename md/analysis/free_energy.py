@@ -1,9 +1,9 @@
 """Thermodynamic integration of the solid-liquid work of adhesion W_SL (no contact line, no droplet).
 
 Why
-    A droplet cannot resolve small angles: on IFF (111) silica the contact line of a quick droplet stays where it
-    was started (18 deg from a 20 deg start, 39 deg from a 40 deg start), so its angle measures the start, not the
-    surface. W_SL = gamma_sv + gamma_lv - gamma_sl needs no contact line: it is the reversible work that takes a
+    A droplet cannot resolve small angles: on IFF (111) silica the contact line of a short-run droplet can stay
+    where it was started (docs/md.md shows two starts keeping their angles), so its angle measures the start, not
+    the surface. W_SL = gamma_sv + gamma_lv - gamma_sl needs no contact line: it is the reversible work that takes a
     liquid film off the solid per unit area (Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335, the dry-surface
     method; Leroy, dos Santos & Mueller-Plathe, Macromol. Rapid Commun. 30 (2009) 864, the phantom wall).
 
@@ -98,8 +98,8 @@ def ti_work_of_adhesion_sl(charge_film: dict, lj_film: dict, charge_reference: d
     discretisation errors add linearly (they are systematic). The charge stage's is estimated on the integrand
     that is integrated, film minus reference at the shared nodes: each alone is dominated by the held atoms'
     solid-solid term, exactly quadratic in lambda (so Gauss-Legendre integrates it exactly) but not for the PCHIP
-    the estimate compares with, which would report a spurious error that cancels in the difference (on the quick
-    run: 3.4 kcal/mol from the two alone, 0.27 from their difference). Also returned: each stage's share in J/m^2."""
+    the estimate compares with, which would report a spurious error, far larger than the difference's, that
+    cancels in the difference. Also returned: each stage's share in J/m^2."""
     conv = KCALMOL_PER_A2_TO_J_PER_M2 / float(area_A2)
     electro = charge_reference["value"] - charge_film["value"]
     disp = -lj_film["value"]

@@ -140,7 +140,7 @@ def water_solid_thermostat_lines(settings: Settings, step: int, salt: int = 0) -
 
 
 #: a leg's mean water or solid temperature further than this from the thermostat's is flagged (K): 2 % at 300 K,
-#: where the per-sample scatter of the quick film's water is ~7 K and a leg's mean carries ~0.5 K
+#: many times the statistical error of a leg's mean temperature (each leg's samples give it: ``leg_temperatures``)
 TEMPERATURE_TOLERANCE_K = 6.0
 
 
@@ -184,7 +184,7 @@ def common_define(settings: Settings, mobile: str) -> list[str]:
 #: :func:`minimize_water_lines`), so the silanol O-H bond (IFF 495 kcal/mol/A^2, H: period 9.5 fs) vibrates freely.
 #: At 1 fs (steps up to 10 fs, the timestep of every flexible-O-H recipe) the minimisations are stable; at the 2 fs
 #: of a SHAKE recipe (steps up to 20 fs, two O-H periods) the O-H integration diverges wherever FIRE's global power
-#: test does not see it -- the quick contact_angle_silica substrate (4320 atoms) lost a silanol H at FIRE step 46.
+#: test does not see it: in a slab of thousands of atoms a silanol H is lost ("Bond atoms missing").
 FIRE_TIMESTEP_FS = 1.0
 
 

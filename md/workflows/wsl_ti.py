@@ -39,9 +39,10 @@ FILM_OVERLAP_A = 2.0
 #: vacuum above the film (A); kspace_modify slab 3.0 triples the box for the long-range sum
 FILM_VACUUM_A = 20.0
 #: the film's centre of mass is tethered along z to where it was placed by this spring (kcal/mol/A^2; LAMMPS
-#: ``fix spring tether``): decoupled, the film would otherwise drift. Bound, the film sits below that height (1.7 A
-#: at quick), so the spring's energy there is added back (:func:`md.analysis.tether_correction`); what remains is
-#: an O(kT) translational term, 0.6 kcal/mol against W_SL A of ~170 kcal/mol on the quick interface.
+#: ``fix spring tether``): decoupled, the film would otherwise drift. Bound, the film sits below that height, so the
+#: spring's energy there is added back (:func:`md.analysis.tether_correction`); what remains is an O(kT)
+#: translational term (kT = 0.6 kcal/mol at 300 K), small against W_SL A over any interface of a few nm^2; each
+#: result's notes give both.
 TETHER_K = 1.0
 #: central-difference step of lambda for dU/dlambda (``compute fep`` at lambda +- delta)
 FEP_DELTA = 0.002
