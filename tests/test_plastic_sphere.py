@@ -202,3 +202,19 @@ def test_capture_velocity_size_exponent_departs_from_minus_five_sixths_where_yie
     assert large == pytest.approx(-5.0 / 6.0, abs=1e-4)
     assert small == pytest.approx(closed, abs=1e-4)
     assert small < -5.0 / 6.0 - 0.2
+
+
+def test_bounces_under_gravity_meet_the_flattened_spot():
+    """Thrown up again, the sphere falls back onto its flattened spot (the jump onto it is a time event of the law):
+    every later impact, slower than the first, is elastic JKR on R_p and loses one R_p loop."""
+    law = _law()
+    run = simulate(law, MASS, 9.80665, impact_velocity=20.0, settings=DriverSettings(rtol=RTOL, max_bounces=4,
+                                                                                   max_time=100.0))
+    assert run.status == "max_bounces" and len(run.bounces) == 4
+    r_p = law.diagnostics()["plastic_radius"]
+    loop = float(ref.loop_area(r_p, W, E_STAR))
+    assert run.bounces[0].restitution == pytest.approx(float(tn.restitution(20.0, R, W, E_STAR, RHO, P_Y)), rel=1e-6)
+    for b in run.bounces[1:]:
+        assert b.restitution == pytest.approx(math.sqrt(1.0 - loop / (0.5 * MASS * b.v_impact**2)), rel=1e-6)
+    assert law.diagnostics()["impacts_yielded"] == 1
+    assert run.audit["max_relative_error"] < 1e-6

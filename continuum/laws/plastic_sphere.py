@@ -19,7 +19,10 @@ of adhesion w and contact modulus E* against a flat, with limiting contact press
 The flattening (R_p, delta_p, delta*) belongs to the body's contact spot, so it is kept from one
 impact to the next (the driver calls `reset` before each contact; `forget_history` returns to
 the virgin sphere). On a later impact the sphere meets the flattened spot at delta = delta_p
-(gap -delta_p); until then the force is zero.
+(gap -delta_p); until then it flies free. It jumps onto the JKR curve at the instant of that meeting,
+known in closed form from the touch speed and gravity (`prepare`) and given to the driver as a time
+event, so that no integrator step straddles the jump (a force discontinuity inside a step would
+stall the step-size control).
 
 Energy bookkeeping: the stored energy is the JKR energy of the current elastic branch from its
 touch point (`continuum.reference.jkr.energy_from_radius`); the plastic loss of a contact is the
@@ -48,6 +51,7 @@ class PlasticJKRSphere(ContactLaw):
 
     name = "plastic_jkr_sphere"
     has_history = True
+    time_dependent = True  # only to place the jump onto the flattened spot (time_events)
     bound_is_final = True  # attached, the law is elastic (JKR on R_p) below delta*, which it cannot pass again
 
     def __init__(self, radius: float, work_of_adhesion: float, e_star: float, limiting_pressure: float,
@@ -74,10 +78,24 @@ class PlasticJKRSphere(ContactLaw):
         self._offset = 0.0                     # delta_p of the current elastic branch (m)
         self._limit = self.yield_approach      # delta beyond which the plastic line holds (m)
         self._impacts_yielded = 0
+        self._t_attach = 0.0                   # contact time at which the sphere meets the flattened spot (s)
         self.reset()
+
+    def prepare(self, mass, speed, gravity):
+        """The contact time at which free flight from the touch (speed m/s down, gravity m/s^2) reaches the
+        flattened spot, delta = delta_p: speed t + g t^2/2 = delta_p."""
+        d = max(self._offset, 0.0)
+        self._t_attach = 2.0 * d / (speed + math.sqrt(speed * speed + 2.0 * gravity * d)) if d > 0.0 else 0.0
+
+    def set_time(self, t_contact):
+        self._t = t_contact
+
+    def time_events(self):
+        return [self._t_attach] if self._offset > 0.0 else []
 
     def reset(self) -> None:
         """A new contact on the same spot: the flattening stays, the contact's own loss starts at 0."""
+        self._t = 0.0
         self._attached = self._offset <= 0.0
         self._loss = 0.0                       # plastic loss of this contact, accepted states (J)
         self._yielded_now = False
@@ -101,34 +119,30 @@ class PlasticJKRSphere(ContactLaw):
         stored = float(ref.energy_from_radius(a, *self._p(r_p)))
         return stored, self._loss + work - stored
 
-    def _on_branch(self, gap: float) -> bool:
-        return self._attached or -gap >= self._offset
-
     # ------------------------------------------------------------------ ContactLaw
     def force(self, gap):
-        delta = -gap
-        if delta >= self._limit:
-            return self._line(delta)
-        if not self._on_branch(gap):
+        if not self._attached:
             return 0.0
+        if -gap >= self._limit:
+            return self._line(-gap)
         return self._branch.force(gap + self._offset)
 
     def stiffness(self, gap):
+        if not self._attached:
+            return 0.0
         if -gap >= self._limit:
             return self.plastic_slope
-        if not self._on_branch(gap):
-            return 0.0
         return self._branch.stiffness(gap + self._offset)
 
     def stored_energy(self, gap):
+        if not self._attached:
+            return 0.0
         if -gap > self._limit:
             return self._plastic_trial(-gap)[0]
-        if not self._on_branch(gap):
-            return 0.0
         return self._branch.stored_energy(gap + self._offset)
 
     def dissipated(self, gap):
-        if -gap > self._limit:
+        if self._attached and -gap > self._limit:
             return self._plastic_trial(-gap)[1]
         return self._loss
 
@@ -148,7 +162,9 @@ class PlasticJKRSphere(ContactLaw):
             if not self._yielded_now:
                 self._yielded_now = True
                 self._impacts_yielded += 1
-        if not self._attached and delta >= self._offset:
+        # the driver accepts the state at the time event and restarts there; (t0 + t_attach) - t0 may round
+        # below t_attach, hence the relative 1e-6 (the sphere moves 1e-6 delta_p in that time)
+        if not self._attached and self._t >= self._t_attach * (1.0 - 1e-6):
             self._attached = True
 
     def length_scale(self, mass, speed):
