@@ -146,7 +146,9 @@ def _time_rises(s: str, rough: dict) -> dict:
         d = [p["duration"] for p in sw["points"] if not p["stuck"]]
         values[k] = d
         steps += [d[i] / d[i + 1] - 1.0 for i in range(len(d) - 1)]
-    e = entry("fig8a_rough_impact_time_rises_as_velocity_falls", s, REPRODUCTION, {"durations_s": values},
+    left_out = {k: [p["v_impact"] for p in sw.get("skipped", [])] for k, sw in rough.items() if sw.get("skipped")}
+    e = entry("fig8a_rough_impact_time_rises_as_velocity_falls", s, REPRODUCTION,
+              {"durations_s": values, "speeds_left_out_m_per_s": left_out},
               "impact duration strictly falls with impact velocity, every sigma", min(steps, default=None),
               RUN_RTOL, "1 (smallest relative rise as v falls)")
     return _nominal(e)

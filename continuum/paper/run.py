@@ -27,7 +27,7 @@ from ..compiled_contact import warm_up
 from ..escape import single_impact
 from ..impact import first_impact_speed, run_impact, write_impact
 from ..model import meniscus_parameters, menisci_decision, select_law
-from ..scene import ResolvedScene, resolve_scene
+from ..scene import ResolvedScene, SceneError, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, seed_overrides
 
@@ -77,19 +77,19 @@ def _sweep_task(case: Case, params: str, fidelity: str | None) -> dict:
     v0 = first_impact_speed(resolved)
     law, _ = select_law(scene, v0)
     mass, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
-    points = []
+    points, skipped = [], []
     for factor in fastest_first(FIG8_SPEED_FACTORS):
         v = v0 * factor
-        run = single_impact(law, mass, g, v, rtol)
-        b = run.bounces[0]
-        points.append({"v_impact": v, "stuck": run.stuck, "duration": b.duration, "v_rebound": b.v_rebound,
-                       "restitution": b.restitution})
+        try:
+            points.append({"v_impact": v, **_outcome(law, mass, g, v, rtol)})
+        except SceneError as exc:       # the law refuses a speed (its tables would cost too much): said, not run
+            skipped.append({"v_impact": v, "reason": str(exc)})
     points.sort(key=lambda p: p["v_impact"])
     # the grid's outcomes bracket the escape velocity where they can; below the grid the bracket is extended
     escape = escape_search(law, mass, g, v0, rtol, ESCAPE_REL_TOL, {p["v_impact"]: p["stuck"] for p in points})
     sigma = scene.surfaces.roughness.sigma if scene.surfaces.roughness is not None else None
     return {"kind": "sweep", "case": case.name, "set": Path(params).stem, "points": points, "escape": escape,
-            "v_drop": v0, "sigma": sigma if scene.contact == "rough" else None}
+            "skipped": skipped, "v_drop": v0, "sigma": sigma if scene.contact == "rough" else None}
 
 
 def _outcome(law, mass, g, v, rtol) -> dict:
@@ -116,8 +116,13 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     wet = select_law(scene, v0, menisci=True)[0] if wet_possible else None
     m = meniscus_parameters(scene) if wet is not None else {}
     t_a = m.get("condensation_time")
-    grid = [v0 * f for f in FIG8_SPEED_FACTORS]
-    dry_runs = {v: _outcome(dry, mass, g, v, rtol) for v in fastest_first(grid)}
+    grid, dry_runs, skipped = [], {}, []
+    for v in fastest_first([v0 * f for f in FIG8_SPEED_FACTORS]):
+        try:
+            dry_runs[v] = _outcome(dry, mass, g, v, rtol)
+            grid.append(v)
+        except SceneError as exc:       # the law refuses a speed (its tables would cost too much): said, not run
+            skipped.append({"v_impact": v, "reason": str(exc)})
     esc_dry = escape_search(dry, mass, g, v0, rtol, WET_DRY_REL_TOL, {v: r["stuck"] for v, r in dry_runs.items()})
     speeds = set(grid)
     longest = edge = None
@@ -131,7 +136,13 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     for v in fastest_first(speeds):
         if v not in dry_runs:
             dry_runs[v] = _outcome(dry, mass, g, v, rtol)
-    wet_runs = {v: _outcome(wet, mass, g, v, rtol) for v in fastest_first(speeds)} if wet is not None else {}
+    wet_runs = {}
+    for v in fastest_first(speeds) if wet is not None else []:
+        try:
+            wet_runs[v] = _outcome(wet, mass, g, v, rtol)
+        except SceneError as exc:
+            skipped.append({"v_impact": v, "reason": f"with menisci: {exc}"})
+    speeds = [v for v in speeds if wet is None or v in wet_runs]
     points = [{"v_impact": v, "dry": dry_runs[v], **({"wet": wet_runs[v]} if wet is not None else {})} for v in speeds]
     esc_wet = None
     if wet is not None and esc_dry.get("escape_velocity"):
@@ -142,7 +153,7 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     return {"kind": "wet", "case": case.name, "set": Path(params).stem, "points": points, "escape_dry": esc_dry,
             "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": t_a,
             "condensation_time_nucleation": _nucleation_time(scene), "longest_dry_rebound_s": longest,
-            "t_a_band_edge": edge,
+            "t_a_band_edge": edge, "skipped": skipped,
             "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length", "solid_adhesion",
                                           "solid_pull")} if m else None,
             "why_no_menisci": None if wet_possible else menisci.why,
