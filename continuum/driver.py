@@ -143,83 +143,21 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
     else:
         t, gap, v = 0.0, touch, -abs(impact_velocity)
         height_scale = impact_velocity**2 / (2.0 * gravity) if gravity > 0 else math.inf
-
-    trace = Trace()
+    ledger = _Ledger(mass, gravity)
+    ledger.e0 = ledger.energy(gap, v, 0.0)
     bounces: list[Bounce] = []
-    booked = 0.0                      # dissipated energy booked by the law (J)
     status = "max_bounces"
-    e0 = None                         # total energy at start (J)
-    ek_ref = None                     # first impact kinetic energy (J)
-    worst = 0.0
-    worst_abs = 0.0                   # largest |E(t) - E(0)| (J)
-    turnover = 0.0                    # largest energy in play: kinetic + |stored| + dissipated (J)
-
-    def energy(gap_, v_, stored, extra_booked=0.0):
-        return 0.5 * mass * v_ * v_ + mass * gravity * gap_ + stored + booked + extra_booked
-
-    def record(t_, gap_, v_, force_, phase_, stored, extra_booked=0.0):
-        """Add a sample; `extra_booked` is dissipation of the current contact not yet in `booked`."""
-        nonlocal worst, worst_abs, turnover
-        e = energy(gap_, v_, stored, extra_booked)
-        trace.add(t_, gap_, v_, force_, phase_, e)
-        turnover = max(turnover, 0.5 * mass * v_ * v_ + abs(stored) + booked + extra_booked)
-        if e0 is not None:
-            worst_abs = max(worst_abs, abs(e - e0))
-            if ek_ref:
-                worst = max(worst, abs(e - e0) / ek_ref)
-
-    def record_block(rows: np.ndarray, phase_: int) -> None:
-        """`record` for many samples at once: rows of the compiled kernel (t, gap, v, force, stored, dissipated,
-        kind), kind 1 the instant after release (phase -1, no force, nothing stored, the loss booked)."""
-        nonlocal worst, worst_abs, turnover
-        if len(rows) == 0:
-            return
-        t_, gap_, v_, f_, stored, extra, kind = rows.T
-        after = kind != 0.0
-        f_ = np.where(after, 0.0, f_)
-        stored = np.where(after, 0.0, stored)
-        phases = np.where(after, -1, phase_)
-        kinetic = 0.5 * mass * v_ * v_
-        e = kinetic + mass * gravity * gap_ + stored + booked + extra
-        trace.t.extend(t_.tolist())
-        trace.gap.extend(gap_.tolist())
-        trace.velocity.extend(v_.tolist())
-        trace.force.extend(f_.tolist())
-        trace.phase.extend(phases.tolist())
-        trace.energy.extend(e.tolist())
-        turnover = max(turnover, float(np.max(kinetic + np.abs(stored) + booked + extra)))
-        dev = float(np.max(np.abs(e - e0)))
-        worst_abs = max(worst_abs, dev)
-        if ek_ref:
-            worst = max(worst, dev / ek_ref)
-
-    record.block = record_block
-    e0 = energy(gap, v, 0.0)
     for index in range(settings.max_bounces):
-        # ---------------- free flight (closed form) ----------------
-        dt = flight_time_to(gap, v, gravity, touch) if gap > touch or v > 0.0 else 0.0
-        if not math.isfinite(dt):
-            status = "escaped"
-            record(t, gap, v, 0.0, -1, 0.0)
+        arrival = _fly(ledger, t, gap, v, gravity, touch, settings)
+        if isinstance(arrival, str):
+            status = arrival
             break
-        if t + dt > settings.max_time:
-            dt_end = settings.max_time - t
-            for s in np.linspace(0.0, dt_end, settings.samples_per_flight):
-                record(t + s, gap + v * s - 0.5 * gravity * s * s, v - gravity * s, 0.0, -1, 0.0)
-            status = "max_time"
-            break
-        for s in np.linspace(0.0, dt, settings.samples_per_flight)[:-1]:
-            record(t + s, gap + v * s - 0.5 * gravity * s * s, v - gravity * s, 0.0, -1, 0.0)
-        # arrival: speed from energy conservation (exact), position at the datum
-        v = -math.sqrt(v * v + 2.0 * gravity * (gap - touch))
-        t, gap = t + dt, touch
-        if ek_ref is None:
-            ek_ref = 0.5 * mass * v * v
-
-        # ---------------- contact (adaptive, events) ----------------
-        outcome = _contact(law, mass, gravity, t, gap, v, settings, index, record)
+        t, gap, v = arrival
+        if ledger.ek_ref is None:
+            ledger.ek_ref = 0.5 * mass * v * v
+        outcome = _ContactRun(law, mass, gravity, t, gap, v, settings, index, ledger).run()
         raise_if_interrupted()
-        booked += outcome["booked"]
+        ledger.booked += outcome["booked"]
         b = outcome["bounce"]
         if b is not None:
             bounces.append(b)
@@ -231,129 +169,254 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
             break
         if gravity == 0.0:
             status = "escaped"
-            record(t, gap, v, 0.0, -1, 0.0)
+            ledger(t, gap, v, 0.0, -1, 0.0)
             break
         if b.rebound_height is not None and b.rebound_height < settings.rest_fraction * height_scale:
             status = "rest"
-            record(t, gap, v, 0.0, -1, 0.0)
+            ledger(t, gap, v, 0.0, -1, 0.0)
             break
-    audit = {"max_relative_error": worst, "reference": "first impact kinetic energy",
-             "reference_energy": ek_ref, "dissipated_booked": booked,
-             "max_error_over_turnover": worst_abs / turnover if turnover > 0 else 0.0,
-             "turnover": turnover,
-             "turnover_note": "largest kinetic + |stored| + dissipated energy of the run: where adhesion releases "
-                              "far more energy than the impact brings, table errors scale with it, not with the "
-                              "impact energy"}
-    return ImpactRun(bounces, status, trace, audit, ek_ref or 0.0)
+    return ImpactRun(bounces, status, ledger.trace, ledger.audit(), ledger.ek_ref or 0.0)
 
 
-def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSettings, index, record):
-    """Integrate one contact from touch; returns the bounce record, end state and booked loss."""
-    speed = abs(v0)
-    law.prepare(mass, speed, gravity)
-    law.reset()
-    length = law.length_scale(mass, speed)
-    atol = np.array([settings.rtol * length, settings.rtol * speed]) * 0.1
-    timed = law.time_dependent
-    pending_times = sorted(t0 + te for te in law.time_events()) if timed else []
+class _Ledger:
+    """The run's samples and its energy audit. E(t) = kinetic + gravitational + stored + booked (+ the current
+    contact's dissipation not yet booked) against E(0) = `e0`; relative to the first impact's kinetic energy
+    `ek_ref` and to the turnover, the largest kinetic + |stored| + dissipated energy of the run. Called as
+    `ledger(t, gap, v, force, phase, stored, extra_booked)` for one sample, `ledger.block(rows, phase)` for many."""
 
-    def at(s):
+    def __init__(self, mass: float, gravity: float):
+        self.mass, self.gravity = mass, gravity
+        self.trace = Trace()
+        self.booked = 0.0                 # dissipated energy booked by the law (J)
+        self.e0 = None                    # total energy at start (J)
+        self.ek_ref = None                # first impact kinetic energy (J)
+        self.worst = 0.0
+        self.worst_abs = 0.0              # largest |E(t) - E(0)| (J)
+        self.turnover = 0.0               # largest energy in play: kinetic + |stored| + dissipated (J)
+
+    def energy(self, gap_, v_, stored, extra_booked=0.0):
+        mass = self.mass
+        return 0.5 * mass * v_ * v_ + mass * self.gravity * gap_ + stored + self.booked + extra_booked
+
+    def __call__(self, t_, gap_, v_, force_, phase_, stored, extra_booked=0.0):
+        """Add a sample; `extra_booked` is dissipation of the current contact not yet in `booked`."""
+        e = self.energy(gap_, v_, stored, extra_booked)
+        self.trace.add(t_, gap_, v_, force_, phase_, e)
+        self.turnover = max(self.turnover, 0.5 * self.mass * v_ * v_ + abs(stored) + self.booked + extra_booked)
+        if self.e0 is not None:
+            self.worst_abs = max(self.worst_abs, abs(e - self.e0))
+            if self.ek_ref:
+                self.worst = max(self.worst, abs(e - self.e0) / self.ek_ref)
+
+    def block(self, rows: np.ndarray, phase_: int) -> None:
+        """Many samples at once: rows of the compiled kernel (t, gap, v, force, stored, dissipated, kind), kind 1
+        the instant after release (phase -1, no force, nothing stored, the loss booked)."""
+        if len(rows) == 0:
+            return
+        mass, trace = self.mass, self.trace
+        t_, gap_, v_, f_, stored, extra, kind = rows.T
+        after = kind != 0.0
+        f_ = np.where(after, 0.0, f_)
+        stored = np.where(after, 0.0, stored)
+        phases = np.where(after, -1, phase_)
+        kinetic = 0.5 * mass * v_ * v_
+        e = kinetic + mass * self.gravity * gap_ + stored + self.booked + extra
+        trace.t.extend(t_.tolist())
+        trace.gap.extend(gap_.tolist())
+        trace.velocity.extend(v_.tolist())
+        trace.force.extend(f_.tolist())
+        trace.phase.extend(phases.tolist())
+        trace.energy.extend(e.tolist())
+        self.turnover = max(self.turnover, float(np.max(kinetic + np.abs(stored) + self.booked + extra)))
+        dev = float(np.max(np.abs(e - self.e0)))
+        self.worst_abs = max(self.worst_abs, dev)
+        if self.ek_ref:
+            self.worst = max(self.worst, dev / self.ek_ref)
+
+    def audit(self) -> dict:
+        turnover = self.turnover
+        return {"max_relative_error": self.worst, "reference": "first impact kinetic energy",
+                "reference_energy": self.ek_ref, "dissipated_booked": self.booked,
+                "max_error_over_turnover": self.worst_abs / turnover if turnover > 0 else 0.0,
+                "turnover": turnover,
+                "turnover_note": "largest kinetic + |stored| + dissipated energy of the run: where adhesion releases "
+                                 "far more energy than the impact brings, table errors scale with it, not with the "
+                                 "impact energy"}
+
+
+def _fly(record, t, gap, v, gravity, touch, settings: DriverSettings):
+    """Free flight in closed form from (t, gap, v), sampled into `record`: (t, gap, v) at the next touch, the
+    arrival speed from energy conservation (exact), or how the run ends ('escaped', 'max_time')."""
+    dt = flight_time_to(gap, v, gravity, touch) if gap > touch or v > 0.0 else 0.0
+    if not math.isfinite(dt):
+        record(t, gap, v, 0.0, -1, 0.0)
+        return "escaped"
+    if t + dt > settings.max_time:
+        dt_end = settings.max_time - t
+        for s in np.linspace(0.0, dt_end, settings.samples_per_flight):
+            record(t + s, gap + v * s - 0.5 * gravity * s * s, v - gravity * s, 0.0, -1, 0.0)
+        return "max_time"
+    for s in np.linspace(0.0, dt, settings.samples_per_flight)[:-1]:
+        record(t + s, gap + v * s - 0.5 * gravity * s * s, v - gravity * s, 0.0, -1, 0.0)
+    v = -math.sqrt(v * v + 2.0 * gravity * (gap - touch))
+    return t + dt, touch, v
+
+
+class _ContactRun:
+    """One contact from touch: integrated compiled where the law has a compiled form, else (and after a time event
+    the kernel stops at) stepped here with events; the law's history sees every accepted step and every extremum.
+    `run()` returns the bounce record, the end state and the loss the law booked."""
+
+    def __init__(self, law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSettings, index, record):
+        self.law, self.mass, self.gravity = law, mass, gravity
+        self.t0, self.gap0, self.v0 = t0, gap0, v0
+        self.settings, self.index, self.record = settings, index, record
+        self.speed = speed = abs(v0)
+        law.prepare(mass, speed, gravity)
+        law.reset()
+        self.length = law.length_scale(mass, speed)
+        self.atol = np.array([settings.rtol * self.length, settings.rtol * speed]) * 0.1
+        self.timed = law.time_dependent
+        self.pending_times = sorted(t0 + te for te in law.time_events()) if self.timed else []
+        self.e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
+        self.pull_force, self.after_max = math.inf, False
+        self.profiles: dict = {}
+        self.peak_force = self.max_pen = None
+
+    def at(self, s):
         """Tell a time-dependent law the contact time of the state it evaluates next."""
-        if timed:
-            law.set_time(s - t0)
+        if self.timed:
+            self.law.set_time(s - self.t0)
 
-    def rhs(_t, y):
-        at(_t)
-        return np.array([y[1], law.force(y[0]) / mass - gravity])
+    def rhs(self, _t, y):
+        self.at(_t)
+        return np.array([y[1], self.law.force(y[0]) / self.mass - self.gravity])
 
-    def start(t_start, y_start):
-        at(t_start)
-        first = 1e-3 * length / speed
-        cap = law.max_step(speed)
-        return DOP853(rhs, t_start, np.asarray(y_start, float), t_bound=settings.max_time, rtol=settings.rtol,
-                      atol=atol, first_step=min(first, cap), max_step=cap)
+    def start(self, t_start, y_start):
+        self.at(t_start)
+        first = 1e-3 * self.length / self.speed
+        cap = self.law.max_step(self.speed)
+        return DOP853(self.rhs, t_start, np.asarray(y_start, float), t_bound=self.settings.max_time,
+                      rtol=self.settings.rtol, atol=self.atol, first_step=min(first, cap), max_step=cap)
 
-    e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
-    pull = {"force": math.inf, "after_max": False}
-    profiles: dict = {}
-
-    def sample(s, gap_, v_):
-        at(s)
+    def sample(self, s, gap_, v_):
+        law = self.law
+        self.at(s)
         f = law.force(gap_)
-        record(s, gap_, v_, f, index, law.stored_energy(gap_), law.dissipated(gap_))
-        if pull["after_max"] and f < pull["force"]:
+        self.record(s, gap_, v_, f, self.index, law.stored_energy(gap_), law.dissipated(gap_))
+        if self.after_max and f < self.pull_force:
             snap = law.snapshot(gap_)
             if snap is not None:
-                pull["force"] = f
-                profiles["pull_off"] = {"t": s, "gap": gap_, "force": f, **snap}
+                self.pull_force = f
+                self.profiles["pull_off"] = {"t": s, "gap": gap_, "force": f, **snap}
 
-    def finish(t_end, gap_end, v_end, end, booked):
-        at(t_end)
+    def finish(self, t_end, gap_end, v_end, end, booked):
+        self.at(t_end)
+        mass, gravity, speed, t0 = self.mass, self.gravity, self.speed, self.t0
         e_mech_out = 0.5 * mass * v_end * v_end + mass * gravity * gap_end
         free = end is None
         rebound = None
         if free and gravity > 0.0:
             rebound = gap_end + v_end * v_end / (2.0 * gravity)
-        b = Bounce(index=index, t_contact=t0, t_release=t_end if free else None,
+        b = Bounce(index=self.index, t_contact=t0, t_release=t_end if free else None,
                    duration=(t_end - t0) if free else None, v_impact=speed,
                    v_rebound=abs(v_end) if free else 0.0,
                    restitution=abs(v_end) / speed if free else 0.0,
-                   peak_force=peak_force, max_penetration=max_pen, rebound_height=rebound,
-                   energy_lost=e_mech_in - e_mech_out if free else math.nan, energy_booked=booked,
-                   profiles=profiles or None)
+                   peak_force=self.peak_force, max_penetration=self.max_pen, rebound_height=rebound,
+                   energy_lost=self.e_mech_in - e_mech_out if free else math.nan, energy_booked=booked,
+                   profiles=self.profiles or None)
         return {"bounce": b, "t": t_end, "gap": gap_end, "v": v_end, "end": end, "booked": booked}
 
-    compiled = law.compiled(t0) if settings.compiled else None
-    kernel = None
-    if compiled is not None:
-        from .compiled_contact import run_compiled
-        kernel = run_compiled(compiled, mass, gravity, t0, gap0, v0, rtol=settings.rtol, atol=atol,
-                              first_step=1e-3 * length / speed, max_step=law.max_step(speed),
-                              t_bound=settings.max_time, release=law.release_gap(),
-                              bound_is_final=law.bound_is_final, has_history=law.has_history,
-                              samples_per_step=settings.samples_per_step)
-    if kernel is not None:
-        law.compiled_commit(compiled.S, kernel.last_accept - t0)
-        record.block(kernel.samples, index)
-        peak_force, max_pen = kernel.peak_force, kernel.max_penetration
+    def run(self) -> dict:
+        law, settings = self.law, self.settings
+        compiled = law.compiled(self.t0) if settings.compiled else None
+        kernel = None
+        if compiled is not None:
+            from .compiled_contact import run_compiled
+            kernel = run_compiled(compiled, self.mass, self.gravity, self.t0, self.gap0, self.v0, rtol=settings.rtol,
+                                  atol=self.atol, first_step=1e-3 * self.length / self.speed,
+                                  max_step=law.max_step(self.speed), t_bound=settings.max_time,
+                                  release=law.release_gap(), bound_is_final=law.bound_is_final,
+                                  has_history=law.has_history, samples_per_step=settings.samples_per_step)
+        if kernel is not None:
+            done, solver = self._take_kernel(compiled, kernel)
+            if done is not None:
+                return done
+        else:
+            solver = self.start(self.t0, [self.gap0, self.v0])
+            self.at(self.t0)
+            self.peak_force = law.force(self.gap0)
+            self.max_pen = -self.gap0
+            self.sample(self.t0, self.gap0, self.v0)
+        return self._step(solver)
+
+    def _take_kernel(self, compiled, kernel):
+        """Take over what the compiled kernel did: its samples, the profiles the Python stepper takes (at the first
+        maximum approach, and at the lowest force after it), and its end; a time event hands the contact back to
+        the Python stepper. Returns (the contact's outcome or None, the stepper to go on with or None)."""
+        law, profiles = self.law, self.profiles
+        law.compiled_commit(compiled.S, kernel.last_accept - self.t0)
+        self.record.block(kernel.samples, self.index)
+        self.peak_force, self.max_pen = kernel.peak_force, kernel.max_penetration
         if kernel.max_approach is not None:
-            # the profiles the Python stepper takes: at the first maximum approach, and at the lowest force after it
             te, ge = kernel.max_approach
-            at(te)
+            self.at(te)
             snap = law.snapshot(ge)
             if snap is not None:
                 profiles["max_approach"] = {"t": te, "gap": ge, "force": law.force(ge), **snap}
-            pull["after_max"] = True
+            self.after_max = True
         if kernel.pull_off is not None:
             te, ge, fe = kernel.pull_off
-            at(te)
+            self.at(te)
             snap = law.snapshot(ge)
             if snap is not None:
-                pull["force"] = fe
+                self.pull_force = fe
                 profiles["pull_off"] = {"t": te, "gap": ge, "force": fe, **snap}
         if kernel.end != "stop_time":
-            return finish(kernel.t, kernel.gap, kernel.v, kernel.end, kernel.booked)
+            return self.finish(kernel.t, kernel.gap, kernel.v, kernel.end, kernel.booked), None
         # the law's force jumps here (a time event): the Python law samples and accepts it and goes on
         te, ye = kernel.t, [kernel.gap, kernel.v]
-        at(te)
-        sample(te, ye[0], ye[1])
+        self.at(te)
+        self.sample(te, ye[0], ye[1])
         law.accept(ye[0])
-        solver = start(te, ye)
-    else:
-        solver = start(t0, [gap0, v0])
-        at(t0)
-        peak_force = law.force(gap0)
-        max_pen = -gap0
-        sample(t0, gap0, v0)
+        return None, self.start(te, ye)
 
-    while True:
-        release = law.release_gap()       # may grow during a contact (bridges hold beyond the dry release)
-        t_prev, y_prev = solver.t, solver.y.copy()
-        msg = solver.step()
-        if solver.status == "failed":
-            raise RuntimeError(f"contact integration failed at t = {solver.t:.6g} s: {msg}")
-        t1, y1 = solver.t, solver.y.copy()
-        dense = solver.dense_output()
+    def _step(self, solver) -> dict:
+        """DOP853 steps until the contact ends: dense samples between steps, then the step's events in time
+        order; the law accepts every step's end."""
+        law, settings = self.law, self.settings
+        while True:
+            release = law.release_gap()       # may grow during a contact (bridges hold beyond the dry release)
+            t_prev, y_prev = solver.t, solver.y.copy()
+            msg = solver.step()
+            if solver.status == "failed":
+                raise RuntimeError(f"contact integration failed at t = {solver.t:.6g} s: {msg}")
+            t1, y1 = solver.t, solver.y.copy()
+            dense = solver.dense_output()
+            events = self._events(t_prev, y_prev, t1, y1, dense, release)
+            for s in np.linspace(t_prev, t1, settings.samples_per_step + 2)[1:-1]:
+                if events and s >= events[0][0]:
+                    break
+                y = dense(s)
+                self.sample(s, y[0], y[1])
+            done, restart = self._on_events(events, dense, release)
+            if done is not None:
+                return done
+            if restart is not None:
+                solver = self.start(*restart)
+                continue
+            self.at(t1)
+            self.max_pen = max(self.max_pen, -y1[0])
+            self.peak_force = max(self.peak_force, law.force(y1[0]))
+            self.sample(t1, y1[0], y1[1])
+            self.at(t1)
+            law.accept(y1[0])
+            if solver.status == "finished":
+                return self.finish(t1, y1[0], y1[1], "max_time", 0.0)
+
+    def _events(self, t_prev, y_prev, t1, y1, dense, release) -> list:
+        """The events inside the step (time, kind), in time order: maximum approach, turning back, release, and
+        a time event of the law."""
         events = []
         if y_prev[1] < 0.0 <= y1[1]:
             events.append((_root(lambda s: dense(s)[1], t_prev, t1), "max_approach"))
@@ -367,63 +430,55 @@ def _contact(law: ContactLaw, mass, gravity, t0, gap0, v0, settings: DriverSetti
             # the gap crossed the release point and came back within one step (slow release):
             # the endpoints miss it, the turning point does not
             events.append((_root(lambda s: dense(s)[0] - release, t_prev, t_turn), "release"))
-        while pending_times and pending_times[0] <= t_prev:
-            pending_times.pop(0)
-        if pending_times and pending_times[0] <= t1:
+        pending = self.pending_times
+        while pending and pending[0] <= t_prev:
+            pending.pop(0)
+        if pending and pending[0] <= t1:
             # the law's force jumps here (e.g. bridges condense at t_a): end the step exactly there
-            events.append((pending_times.pop(0), "time"))
+            events.append((pending.pop(0), "time"))
         events.sort()
-        for s in np.linspace(t_prev, t1, settings.samples_per_step + 2)[1:-1]:
-            if events and s >= events[0][0]:
-                break
-            y = dense(s)
-            sample(s, y[0], y[1])
+        return events
+
+    def _on_events(self, events, dense, release):
+        """Handle a step's events in order (`release`: the step's release gap). Returns (the contact's outcome or
+        None, (t, y) to restart from or None): extrema of the gap update the history, after which a history law
+        restarts the step there."""
+        law, profiles = self.law, self.profiles
         restart = None
         for te, kind in events:
             ye = dense(te)
-            at(te)
+            self.at(te)
             if kind == "time":
-                sample(te, ye[0], ye[1])
+                self.sample(te, ye[0], ye[1])
                 law.accept(ye[0])
-                restart = (te, [ye[0], ye[1]])
-                break
+                return None, (te, [ye[0], ye[1]])
             if kind in ("max_approach", "turn"):
                 # extrema of the gap: history must see them (paper notes on eq 11)
-                max_pen = max(max_pen, -ye[0])
-                peak_force = max(peak_force, law.force(ye[0]))
-                sample(te, ye[0], 0.0)
+                self.max_pen = max(self.max_pen, -ye[0])
+                self.peak_force = max(self.peak_force, law.force(ye[0]))
+                self.sample(te, ye[0], 0.0)
                 if kind == "max_approach" and "max_approach" not in profiles:
                     snap = law.snapshot(ye[0])
                     if snap is not None:
                         profiles["max_approach"] = {"t": te, "gap": ye[0], "force": law.force(ye[0]), **snap}
-                    pull["after_max"] = True
+                    self.after_max = True
                 law.accept(ye[0])
                 if law.has_history:
                     # stages after the extremum used the old history: cut the step here, restart
                     restart = (te, [ye[0], 0.0])
             if kind == "turn" and law.bound_is_final:
-                end = "stuck" if law.force(ye[0]) < mass * gravity or gravity == 0.0 else "rest"
-                return finish(te, ye[0], 0.0, end, law.dissipated(ye[0]))
+                end = "stuck" if law.force(ye[0]) < self.mass * self.gravity or self.gravity == 0.0 else "rest"
+                return self.finish(te, ye[0], 0.0, end, law.dissipated(ye[0])), None
             if kind == "release":
                 gap_r, v_r = release, ye[1]
-                sample(te, gap_r, v_r)
+                self.sample(te, gap_r, v_r)
                 loss = law.on_release()
                 # the instant after: nothing stored, the law's loss terms are booked as dissipated
-                record(te, gap_r, v_r, 0.0, -1, 0.0, extra_booked=loss)
-                return finish(te, gap_r, v_r, None, loss)
+                self.record(te, gap_r, v_r, 0.0, -1, 0.0, extra_booked=loss)
+                return self.finish(te, gap_r, v_r, None, loss), None
             if restart is not None:
                 break
-        if restart is not None:
-            solver = start(*restart)
-            continue
-        at(t1)
-        max_pen = max(max_pen, -y1[0])
-        peak_force = max(peak_force, law.force(y1[0]))
-        sample(t1, y1[0], y1[1])
-        at(t1)
-        law.accept(y1[0])
-        if solver.status == "finished":
-            return finish(t1, y1[0], y1[1], "max_time", 0.0)
+        return None, restart
 
 
 def _root(fun, a, b):

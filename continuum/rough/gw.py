@@ -290,26 +290,7 @@ class GWJKRSurface(GWTables):
             d, zeta = np.broadcast_arrays(d, zeta)
         shape = d.shape
         h = d.reshape(-1) * self._inv_sigma
-        V, dV, a, u, r = self._lookup(h, j, deriv)
-        e = np.exp(V[:, 0])
-        dH = None
-        if self.truncated:
-            un = (u * r, u * u * r, u)[j]                         # u^nu, nu = 3/2, 5/2, 1
-            uen = un * e
-            H = uen * u
-            if deriv:
-                dH = H * dV[:, 0] - (_HERTZ_NU[j] + 1.0) * uen
-            deep = h < self._hlo
-        else:
-            H = e
-            if deriv:
-                dH = e * dV[:, 0]
-            deep = a < 0.0
-        if np.count_nonzero(deep):
-            k = np.flatnonzero(deep)
-            H[k], hd = self._deep(h, j, k, a, V, dV)
-            if deriv:
-                dH[k] = hd
+        V, dV, H, dH = self._hertz_integral(h, j, deriv)
         hs = self._hs[j]
         if not self.adhesive:
             val = hs * H
@@ -344,48 +325,82 @@ class GWJKRSurface(GWTables):
                 if m.size:
                     kb = k[m]                                 # window thresholds above z_max
         if kf is not None or kb is not None:
-            # one bicubic evaluation for all of them: A(h, xi_eff), and A(h, xi_top) above z_max
-            hf = h[kf] if kf is not None else h[:0]
-            hb = h[kb] if kb is not None else h[:0]
-            A, Ah, Axi = self._window(j, np.concatenate([hf, hb, hb]),
-                                      np.concatenate([(zt[kf] - hf) / lam if kf is not None else hf,
-                                                      (zt[kb] - hb) / lam if kb is not None else hb,
-                                                      (self._tmax - hb) / lam]), deriv)
-            n1, n2 = hf.size, hf.size + hb.size
-            E, dE = self._window_end(j, np.concatenate([hf, hb]), deriv)
-            xr = self._xr
-            if kf is not None:
-                # int_xi^0 = A(h, xi), corrected to meet the release column Wr exactly at xi = -x_r:
-                # + s (Wr - E1), s = -xi/x_r (`_window_end`); at xi = 0 both vanish (approach branch)
-                s = np.clip((hf - zt[kf]) / (lam * xr), 0.0, 1.0)
-                Af = A[:n1] + s * (Wr[kf] - E[:n1])
-                val[kf] += As * Af
-                if deriv:
-                    dval[kf] += As * (Ah[:n1] - Axi[:n1] / lam + s * (dV[kf, 2] - dE[:n1])
-                                      + (Wr[kf] - E[:n1]) / (lam * xr))
-                if parts:
-                    tens[kf] = As * (A0[kf] + Af)
-            if kb is not None:
-                # int_{xi_eff}^{xi_top} = A(h, xi_eff) - A(h, xi_top), corrected linearly in xi_eff to meet
-                # the band column T_rel at xi_eff = -x_r (it is 0 at xi_eff = xi_top either way):
-                # + c M, c = (xi_top - xi_eff)/(xi_top + x_r), M = T_rel - (E1 - A(h, xi_top)).
-                # M and its first w-derivative vanish at the band's end (xi_top = -x_r), so M/(xi_top + x_r)
-                # stays bounded.
-                on = zt[kb] < self._tmax                    # else every summit has let go
-                span = (self._tmax - hb) / lam + xr         # xi_top + x_r > 0 (live band points)
-                c = np.clip((self._tmax - zt[kb]) / (lam * np.maximum(span, 1e-300)), 0.0, 1.0)
-                M = band_b - (E[n1:] - A[n2:])
-                val[kb] = As * (A[n1:n2] - A[n2:] + c * M) * on
-                if deriv:
-                    dtop = Ah[n2:] - Axi[n2:] / lam
-                    dM = dband_b - dE[n1:] + dtop
-                    dc = np.where(span > 1e-9 * xr, c / (lam * np.maximum(span, 1e-300)), 0.0)
-                    dval[kb] = As * ((Ah[n1:n2] - Axi[n1:n2] / lam) - dtop + c * dM + dc * M) * on
+            self._add_window(j, h, zt, kf, kb, band_b if kb is not None else None,
+                             dband_b if kb is not None else None, V, dV, val, dval, tens, deriv, parts)
         if parts and self.truncated:       # within x0 delta_c of z_max no summit is compressive
             tens = np.where(h > self._hband, val, tens)
         if parts:
             return (val - tens).reshape(shape), tens.reshape(shape)
         return val.reshape(shape), (dval * self._inv_sigma).reshape(shape) if deriv else None
+
+    def _hertz_integral(self, h, j, deriv):
+        """The table lookup at h = d/sigma and the Hertz integral H_j (with dH/dh), the states deeper than the
+        tables integrated on the fly: (V, dV, H, dH)."""
+        V, dV, a, u, r = self._lookup(h, j, deriv)
+        e = np.exp(V[:, 0])
+        dH = None
+        if self.truncated:
+            un = (u * r, u * u * r, u)[j]                         # u^nu, nu = 3/2, 5/2, 1
+            uen = un * e
+            H = uen * u
+            if deriv:
+                dH = H * dV[:, 0] - (_HERTZ_NU[j] + 1.0) * uen
+            deep = h < self._hlo
+        else:
+            H = e
+            if deriv:
+                dH = e * dV[:, 0]
+            deep = a < 0.0
+        if np.count_nonzero(deep):
+            k = np.flatnonzero(deep)
+            H[k], hd = self._deep(h, j, k, a, V, dV)
+            if deriv:
+                dH[k] = hd
+        return V, dV, H, dH
+
+    def _add_window(self, j, h, zt, kf, kb, band_b, dband_b, V, dV, val, dval, tens, deriv, parts):
+        """Add, in place, the summits whose threshold lies inside the stretched window: `kf`, the states with
+        d <= z_max, and `kb`, those above z_max whose window thresholds lie above it (`band_b`, `dband_b`: their
+        band column from `_beyond_top`). One bicubic evaluation for all of them: A(h, xi_eff), and A(h, xi_top)
+        above z_max."""
+        As, lam = self._as[j], self._lam
+        Wr, A0 = V[:, 2], V[:, 3]
+        hf = h[kf] if kf is not None else h[:0]
+        hb = h[kb] if kb is not None else h[:0]
+        A, Ah, Axi = self._window(j, np.concatenate([hf, hb, hb]),
+                                  np.concatenate([(zt[kf] - hf) / lam if kf is not None else hf,
+                                                  (zt[kb] - hb) / lam if kb is not None else hb,
+                                                  (self._tmax - hb) / lam]), deriv)
+        n1, n2 = hf.size, hf.size + hb.size
+        E, dE = self._window_end(j, np.concatenate([hf, hb]), deriv)
+        xr = self._xr
+        if kf is not None:
+            # int_xi^0 = A(h, xi), corrected to meet the release column Wr exactly at xi = -x_r:
+            # + s (Wr - E1), s = -xi/x_r (`_window_end`); at xi = 0 both vanish (approach branch)
+            s = np.clip((hf - zt[kf]) / (lam * xr), 0.0, 1.0)
+            Af = A[:n1] + s * (Wr[kf] - E[:n1])
+            val[kf] += As * Af
+            if deriv:
+                dval[kf] += As * (Ah[:n1] - Axi[:n1] / lam + s * (dV[kf, 2] - dE[:n1])
+                                  + (Wr[kf] - E[:n1]) / (lam * xr))
+            if parts:
+                tens[kf] = As * (A0[kf] + Af)
+        if kb is not None:
+            # int_{xi_eff}^{xi_top} = A(h, xi_eff) - A(h, xi_top), corrected linearly in xi_eff to meet
+            # the band column T_rel at xi_eff = -x_r (it is 0 at xi_eff = xi_top either way):
+            # + c M, c = (xi_top - xi_eff)/(xi_top + x_r), M = T_rel - (E1 - A(h, xi_top)).
+            # M and its first w-derivative vanish at the band's end (xi_top = -x_r), so M/(xi_top + x_r)
+            # stays bounded.
+            on = zt[kb] < self._tmax                    # else every summit has let go
+            span = (self._tmax - hb) / lam + xr         # xi_top + x_r > 0 (live band points)
+            c = np.clip((self._tmax - zt[kb]) / (lam * np.maximum(span, 1e-300)), 0.0, 1.0)
+            M = band_b - (E[n1:] - A[n2:])
+            val[kb] = As * (A[n1:n2] - A[n2:] + c * M) * on
+            if deriv:
+                dtop = Ah[n2:] - Axi[n2:] / lam
+                dM = dband_b - dE[n1:] + dtop
+                dc = np.where(span > 1e-9 * xr, c / (lam * np.maximum(span, 1e-300)), 0.0)
+                dval[kb] = As * ((Ah[n1:n2] - Axi[n1:n2] / lam) - dtop + c * dM + dc * M) * on
 
     def _window(self, j, h, xi, deriv):
         """A_j(h, xi) from the 2-D table, with dA/dh and dA/dxi (dimensionless)."""
