@@ -5,7 +5,8 @@ scene files take contact angles in degrees, as the MD results give them. Everyth
 not measure (moduli, roughness statistics, SAM thickness) comes from a named base set, with the base set's
 origin ([meta.origin], continuum.origins); an MD value's origin is `md` with its run hash. A choice of the
 base set that the project can replace by a measured or derived value (`REPLACED_CHOICES`: the summit modulus
-becomes the materials' E*, the adhesion law the Tabor parameter's pick) is left out of the calibrated set.
+becomes the materials' E*, the adhesion law the Tabor parameter's pick, the paper's additive wet adhesion the
+wet work of adhesion) is left out of the calibrated set.
 
 Work of adhesion: the MD adhesion workflow gives the energy difference dE/A (`work_of_adhesion`)
 and, by thermodynamic integration of the mean force over separation windows, the free energy of
@@ -212,6 +213,8 @@ REPLACED_CHOICES = {
                                          "with a layer modulus enters through the coated-summit model",
     "physics.adhesion_law": "'auto': the MD-measured range z0 lets the summits' Tabor parameter pick JKR, "
                             "Maugis-Dugdale or DMT",
+    "menisci.solid_adhesion": "'wet' (the default): inside a bridge the solids adhere with the work of adhesion "
+                              "under the liquid, from the MD-measured dgamma, gamma_lv and contact angles",
 }
 
 

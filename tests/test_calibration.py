@@ -60,9 +60,12 @@ def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
     assert cal["menisci.surface_tension"]["run_hash"] == _results()["surface_tension_spce"]["run_hash"]
     assert s["roughness"]["summit_radius"] == 0.2e-6            # from the base set, with its origin
     assert origin["surfaces.roughness.summit_radius"]["kind"] == "chosen"
-    # the base's chosen summit modulus and adhesion law give way to the materials' E* and the Tabor parameter
+    # the base's chosen summit modulus, adhesion law and additive wet adhesion give way to the materials' E*, the
+    # Tabor parameter and the wet work of adhesion
     assert "summit_modulus" not in s["roughness"] and "physics" not in table
-    assert set(table["meta"]["replaced"]) == {"surfaces.roughness.summit_modulus", "physics.adhesion_law"}
+    assert set(table["meta"]["replaced"]) == {"surfaces.roughness.summit_modulus", "physics.adhesion_law",
+                                              "menisci.solid_adhesion"}
+    assert "solid_adhesion" not in table.get("menisci", {})
     assert all(r["status"] == "used" for r in rows)
     path = write_parameter_set(table, tmp_path / "cal.toml", header="test set")
     assert tomllib.loads(path.read_text())["meta"]["calibration"]["surfaces.sam.contact_angle"]["value"] == 108.0

@@ -41,8 +41,8 @@ def test_the_calibrated_set_measures_what_the_project_can_and_declares_the_rest(
     assert "surfaces.roughness.summit_modulus" not in flat
     for side in ("body", "substrate"):
         assert origin[f"surfaces.{side}.youngs_modulus"]["kind"] == "material"
-    # the regime picks the law: the calibrated set declares none
-    assert "physics.adhesion_law" not in flat
+    # the regime picks the law, and bridges use the wet work of adhesion: the calibrated set declares neither
+    assert "physics.adhesion_law" not in flat and "menisci.solid_adhesion" not in flat
     # an md origin names the committed MD result it was read from
     mds = {k: e for k, e in origin.items() if e["kind"] == "md"}
     assert {"surfaces.work_of_adhesion", "surfaces.interaction_range", "surfaces.sam.interaction_range"} <= set(mds)
