@@ -606,6 +606,131 @@ def _sample(kind, S, P, T, buf, n, t, gap, v, pull, after_max):
 
 
 @njit(cache=True)
+def _events(F, t_prev, h, y_old, y, t1, release, t_stop, ev_t, ev_k):
+    """The events inside the step t_prev -> t1 into (ev_t, ev_k), sorted by time, ties in the driver's order
+    (kinds: 0 maximum approach, 1 release, 2 the law's time event, 3 turning back). Returns their number and the
+    time event still to come (inf once it is taken or passed)."""
+    ne_ = 0
+    if y_old[1] < 0.0 <= y[1]:
+        ev_t[ne_] = _root(F, t_prev, h, y_old, 1, 0.0, t_prev, t1)
+        ev_k[ne_] = 0
+        ne_ += 1
+    t_turn = math.nan
+    if y_old[1] > 0.0 >= y[1]:
+        t_turn = _root(F, t_prev, h, y_old, 1, 0.0, t_prev, t1)
+        ev_t[ne_] = t_turn
+        ev_k[ne_] = 3
+        ne_ += 1
+    if y_old[0] < release <= y[0]:
+        ev_t[ne_] = _root(F, t_prev, h, y_old, 0, release, t_prev, t1)
+        ev_k[ne_] = 1
+        ne_ += 1
+    elif y_old[0] < release and not math.isnan(t_turn) and _dense(F, t_prev, h, y_old, t_turn, 0) >= release:
+        ev_t[ne_] = _root(F, t_prev, h, y_old, 0, release, t_prev, t_turn)
+        ev_k[ne_] = 1
+        ne_ += 1
+    if t_stop <= t_prev:
+        t_stop = math.inf
+    if t_stop <= t1:
+        ev_t[ne_] = t_stop
+        ev_k[ne_] = 2
+        ne_ += 1
+        t_stop = math.inf
+    for i in range(1, ne_):          # insertion sort on (time, kind)
+        j = i
+        while j > 0 and (ev_t[j] < ev_t[j - 1] or (ev_t[j] == ev_t[j - 1] and ev_k[j] < ev_k[j - 1])):
+            ev_t[j], ev_t[j - 1] = ev_t[j - 1], ev_t[j]
+            ev_k[j], ev_k[j - 1] = ev_k[j - 1], ev_k[j]
+            j -= 1
+    return ne_, t_stop
+
+
+@njit(cache=True)
+def _step_samples(kind, S, P, T, buf, n, F, t_prev, h, y_old, t1, samples_per_step, ne_, ev_t, pull, after_max):
+    """Samples inside the step, up to its first event (the driver's np.linspace(t_prev, t1, m + 2)[1:-1])."""
+    div = samples_per_step + 1
+    dt = (t1 - t_prev) / div
+    for i in range(1, samples_per_step + 1):
+        s = t_prev + i * dt
+        if ne_ > 0 and s >= ev_t[0]:
+            break
+        n = _sample(kind, S, P, T, buf, n, s, _dense(F, t_prev, h, y_old, s, 0), _dense(F, t_prev, h, y_old, s, 1),
+                    pull, after_max)
+    return n
+
+
+@njit(cache=True)
+def _release(kind, S, P, T, buf, n, te, release, v_e, pull, after_max, info):
+    """The release event: a sample at the release gap, then the instant after (no force, nothing stored, the
+    law's loss booked as dissipated); the end state and the loss go to `info`. Returns the sample count."""
+    n = _sample(kind, S, P, T, buf, n, te, release, v_e, pull, after_max)
+    loss = law_dissipated(kind, release, S, P, T)
+    if n < buf.shape[0]:
+        buf[n, 0] = te
+        buf[n, 1] = release
+        buf[n, 2] = v_e
+        buf[n, 3] = 0.0
+        buf[n, 4] = 0.0
+        buf[n, 5] = loss
+        buf[n, 6] = 1.0
+    n += 1
+    info[I_T], info[I_GAP], info[I_V] = te, release, v_e
+    info[I_BOOKED] = loss
+    return n
+
+
+@njit(cache=True)
+def _on_events(kind, S, P, T, mass, gravity, F, t_prev, h, y_old, ne_, ev_t, ev_k, release, bound_is_final,
+               has_history, buf, n, pull, after_max, info, max_pen, peak, last_accept):
+    """The step's events in order (the driver's `_on_events`): a time event stops the kernel; an extremum of the
+    gap is sampled and accepted (a history law then restarts the step there); turning back while bound ends the
+    contact stuck or at rest; a release ends it. Returns (end or -1, sample count, after_max, largest approach,
+    peak force, last accepted time, restart, restart time, restart gap)."""
+    end = -1
+    restart = False
+    rt, rg = 0.0, 0.0
+    for e in range(ne_):
+        te = ev_t[e]
+        kind_e = ev_k[e]
+        g_e = _dense(F, t_prev, h, y_old, te, 0)
+        v_e = _dense(F, t_prev, h, y_old, te, 1)
+        if kind_e == 2:
+            end = END_STOP_TIME
+            info[I_T], info[I_GAP], info[I_V] = te, g_e, v_e
+            break
+        if kind_e == 0 or kind_e == 3:
+            max_pen = max(max_pen, -g_e)
+            peak = max(peak, law_force(kind, g_e, S, P, T))
+            n = _sample(kind, S, P, T, buf, n, te, g_e, 0.0, pull, after_max)
+            if kind_e == 0 and info[I_HAS_MAX] == 0.0:
+                info[I_MAX_T] = te
+                info[I_MAX_GAP] = g_e
+                info[I_HAS_MAX] = 1.0
+            if kind_e == 0:
+                after_max = True
+            law_accept(kind, g_e, S, P, T)
+            last_accept = te
+            if has_history:
+                restart = True
+                rt, rg = te, g_e
+        if kind_e == 3 and bound_is_final:
+            if law_force(kind, g_e, S, P, T) < mass * gravity or gravity == 0.0:
+                end = END_STUCK
+            else:
+                end = END_REST
+            info[I_T], info[I_GAP], info[I_V] = te, g_e, 0.0
+            info[I_BOOKED] = law_dissipated(kind, g_e, S, P, T)
+            break
+        if kind_e == 1:
+            n = _release(kind, S, P, T, buf, n, te, release, v_e, pull, after_max, info)
+            end = END_RELEASE
+            break
+        if restart:
+            break
+    return end, n, after_max, max_pen, peak, last_accept, restart, rt, rg
+
+
+@njit(cache=True)
 def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, first_step, max_step, t_bound,
                       release, bound_is_final, has_history, samples_per_step, t_stop, buf, info):
     """One contact from touch (t0, gap0, v0): the driver's `_contact` loop, compiled.
@@ -665,106 +790,18 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
         y[1] = y_new[1]
         _dense_coefficients(kind, S, P, T, mass, gravity, t_prev, y_old, y, K, h, F)
         evals += 3
-        # ---- events, sorted by time (ties in the driver's order: max_approach, release, time, turn)
-        ne_ = 0
-        if y_old[1] < 0.0 <= y[1]:
-            ev_t[ne_] = _root(F, t_prev, h, y_old, 1, 0.0, t_prev, t1)
-            ev_k[ne_] = 0
-            ne_ += 1
-        t_turn = math.nan
-        if y_old[1] > 0.0 >= y[1]:
-            t_turn = _root(F, t_prev, h, y_old, 1, 0.0, t_prev, t1)
-            ev_t[ne_] = t_turn
-            ev_k[ne_] = 3
-            ne_ += 1
-        if y_old[0] < release <= y[0]:
-            ev_t[ne_] = _root(F, t_prev, h, y_old, 0, release, t_prev, t1)
-            ev_k[ne_] = 1
-            ne_ += 1
-        elif y_old[0] < release and not math.isnan(t_turn) and _dense(F, t_prev, h, y_old, t_turn, 0) >= release:
-            ev_t[ne_] = _root(F, t_prev, h, y_old, 0, release, t_prev, t_turn)
-            ev_k[ne_] = 1
-            ne_ += 1
-        if t_stop <= t_prev:
-            t_stop = math.inf
-        if t_stop <= t1:
-            ev_t[ne_] = t_stop
-            ev_k[ne_] = 2
-            ne_ += 1
-            t_stop = math.inf
-        for i in range(1, ne_):          # insertion sort on (time, kind)
-            j = i
-            while j > 0 and (ev_t[j] < ev_t[j - 1] or (ev_t[j] == ev_t[j - 1] and ev_k[j] < ev_k[j - 1])):
-                ev_t[j], ev_t[j - 1] = ev_t[j - 1], ev_t[j]
-                ev_k[j], ev_k[j - 1] = ev_k[j - 1], ev_k[j]
-                j -= 1
-        # ---- samples inside the step, up to the first event (np.linspace(t_prev, t1, m + 2)[1:-1])
-        div = samples_per_step + 1
-        dt = (t1 - t_prev) / div
-        for i in range(1, samples_per_step + 1):
-            s = t_prev + i * dt
-            if ne_ > 0 and s >= ev_t[0]:
-                break
-            n = _sample(kind, S, P, T, buf, n, s, _dense(F, t_prev, h, y_old, s, 0), _dense(F, t_prev, h, y_old, s, 1),
-                        pull, after_max)
-        restart = False
-        rt, rg, rv = 0.0, 0.0, 0.0
-        for e in range(ne_):
-            te = ev_t[e]
-            kind_e = ev_k[e]
-            g_e = _dense(F, t_prev, h, y_old, te, 0)
-            v_e = _dense(F, t_prev, h, y_old, te, 1)
-            if kind_e == 2:
-                end = END_STOP_TIME
-                info[I_T], info[I_GAP], info[I_V] = te, g_e, v_e
-                break
-            if kind_e == 0 or kind_e == 3:
-                max_pen = max(max_pen, -g_e)
-                peak = max(peak, law_force(kind, g_e, S, P, T))
-                n = _sample(kind, S, P, T, buf, n, te, g_e, 0.0, pull, after_max)
-                if kind_e == 0 and info[I_HAS_MAX] == 0.0:
-                    info[I_MAX_T] = te
-                    info[I_MAX_GAP] = g_e
-                    info[I_HAS_MAX] = 1.0
-                if kind_e == 0:
-                    after_max = True
-                law_accept(kind, g_e, S, P, T)
-                last_accept = te
-                if has_history:
-                    restart = True
-                    rt, rg, rv = te, g_e, 0.0
-            if kind_e == 3 and bound_is_final:
-                if law_force(kind, g_e, S, P, T) < mass * gravity or gravity == 0.0:
-                    end = END_STUCK
-                else:
-                    end = END_REST
-                info[I_T], info[I_GAP], info[I_V] = te, g_e, 0.0
-                info[I_BOOKED] = law_dissipated(kind, g_e, S, P, T)
-                break
-            if kind_e == 1:
-                n = _sample(kind, S, P, T, buf, n, te, release, v_e, pull, after_max)
-                loss = law_dissipated(kind, release, S, P, T)
-                if n < buf.shape[0]:
-                    buf[n, 0] = te
-                    buf[n, 1] = release
-                    buf[n, 2] = v_e
-                    buf[n, 3] = 0.0
-                    buf[n, 4] = 0.0
-                    buf[n, 5] = loss
-                    buf[n, 6] = 1.0
-                n += 1
-                end = END_RELEASE
-                info[I_T], info[I_GAP], info[I_V] = te, release, v_e
-                info[I_BOOKED] = loss
-                break
-            if restart:
-                break
+        ne_, t_stop = _events(F, t_prev, h, y_old, y, t1, release, t_stop, ev_t, ev_k)
+        n = _step_samples(kind, S, P, T, buf, n, F, t_prev, h, y_old, t1, samples_per_step, ne_, ev_t, pull,
+                          after_max)
+        end, n, after_max, max_pen, peak, last_accept, restart, rt, rg = _on_events(
+            kind, S, P, T, mass, gravity, F, t_prev, h, y_old, ne_, ev_t, ev_k, release, bound_is_final,
+            has_history, buf, n, pull, after_max, info, max_pen, peak, last_accept)
         if end >= 0:
             break
         if restart:
             t = rt
             y[0] = rg
-            y[1] = rv
+            y[1] = 0.0
             _rhs(kind, y[0], y[1], S, P, T, mass, gravity, K, 0)
             evals += 1
             h_abs = min(first_step, max_step)
@@ -781,6 +818,12 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
             end = END_MAX_TIME
             info[I_T], info[I_GAP], info[I_V] = t1, y[0], y[1]
             break
+    return _close(kind, S, end, n, buf, info, peak, max_pen, pull, last_accept, steps, evals)
+
+
+@njit(cache=True)
+def _close(kind, S, end, n, buf, info, peak, max_pen, pull, last_accept, steps, evals):
+    """How the contact ended (an abort outranks the end it reached) and its summary, into `info`; returns the end."""
     if kind != LAW_POWER and S[S_BEYOND_FLAG] != 0.0:
         end = ABORT_BEYOND_TABLES
     if n > buf.shape[0]:
