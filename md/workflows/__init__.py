@@ -2,7 +2,8 @@
 thermodynamic integration -- and the front door :func:`run_recipe`.
 
 One module per workflow (:mod:`~md.workflows.adhesion`, :mod:`~md.workflows.pulloff`,
-:mod:`~md.workflows.contact_angle`, :mod:`~md.workflows.surface_tension`, :mod:`~md.workflows.wsl_ti`), each declaring the quantities it yields
+:mod:`~md.workflows.contact_angle`, :mod:`~md.workflows.surface_tension`, :mod:`~md.workflows.wsl_ti`), each
+declaring the quantities it yields
 (``Workflow.yields``); what they share is :mod:`~md.workflows.common`, the names :mod:`~md.workflows.registry`, the
 front door :mod:`~md.workflows.facade`.
 

@@ -94,7 +94,8 @@ def split_thermostat_lines(groups: Sequence[str], union: str, settings: Settings
     Why: one thermostat over water and a solid keeps only their *mean* kinetic energy at T. Heat crosses a
     water-solid interface slowly (the hydrophobic one slowest), so whatever the water's relaxation releases, or a
     start leaves unequal, stays unequal for tens of ps while the shared thermostat scales both alike (a start-up
-    imbalance the single thermostat does not remove, not a heat source). The remedy is the standard one for the "hot solvent / cold solute" problem:
+    imbalance the single thermostat does not remove, not a heat source). The remedy is the standard one for the
+    "hot solvent / cold solute" problem:
     separate thermostats per component (Lingenheil, Denschlag, Reichold & Tavan, J. Chem. Theory Comput. 4 (2008)
     1293; GROMACS's separate tc-grps for solvent and solute)."""
     t = settings.temperature_K

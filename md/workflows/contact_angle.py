@@ -24,11 +24,13 @@ from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.topology import System, remove_atoms
 
-from md.workflows.common import (SILANOL_OH, WATER_MODELS, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
-                                 fresh_from_data, held_deep, intersect_ids, minimize_lines, minimize_water_lines, quantity_record,
-                                 restart_header_lines, derived_seed, shake_lines, leg_temperatures, water_solid_thermostat_lines,
-                                 WATER_SOLID_COLUMNS, framed_tail_sites, trappe_tail_sites, silica_face_of, stage_list, steps_of, substrate_water_seeds, system_summary, surface_slab,
-                                 thermostat_lines, water_forcefield_names)
+from md.workflows.common import (common_define, derived_seed, equilibrate_stage, figure_writer, forcefield_of,
+                                 framed_tail_sites, fresh_from_data, held_deep, intersect_ids, leg_temperatures,
+                                 minimize_lines, minimize_water_lines, quantity_record, restart_header_lines,
+                                 shake_lines, SILANOL_OH, silica_face_of, stage_list, steps_of, substrate_water_seeds,
+                                 surface_slab, system_summary, thermostat_lines, trappe_tail_sites,
+                                 water_forcefield_names, WATER_MODELS, WATER_SOLID_COLUMNS,
+                                 water_solid_thermostat_lines, Workflow)
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
 DROPLET_GAP_A = 3.0

@@ -28,10 +28,10 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Leg, Plan, Stage
 from md.system.topology import System
 
-from md.workflows.common import (Settings, Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer,
-                                 fresh_from_data, intersect_ids,
-                                 minimize_lines, quantity_record, restart_header_lines, round_up, derived_seed, silica_face_of, stage_list, steps_of,
-                                 system_summary, surface_slab, thermostat_lines)
+from md.workflows.common import (common_define, derived_seed, equilibrate_stage, figure_writer, forcefield_of,
+                                 fresh_from_data, intersect_ids, minimize_lines, quantity_record,
+                                 restart_header_lines, round_up, Settings, silica_face_of, stage_list, steps_of,
+                                 surface_slab, system_summary, thermostat_lines, Workflow)
 
 # ================================================================================================ pull-off
 

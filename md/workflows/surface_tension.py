@@ -19,9 +19,9 @@ from md.system.lammps_data import write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 
 from md.units import SPCE_WATER_MOLAR_MASS
-from md.workflows.common import (Workflow, common_define, equilibrate_stage, forcefield_of, figure_writer, fresh_from_data,
-                                 minimize_water_lines, quantity_record, restart_header_lines, derived_seed, shake_lines, stage_list, steps_of, thermostat_lines,
-                                 water_forcefield_names)
+from md.workflows.common import (common_define, derived_seed, equilibrate_stage, figure_writer, forcefield_of,
+                                 fresh_from_data, minimize_water_lines, quantity_record, restart_header_lines,
+                                 shake_lines, stage_list, steps_of, thermostat_lines, water_forcefield_names, Workflow)
 
 class SurfaceTension(Workflow):
     """SPC/E film: gamma_lv from the pressure tensor, bulk density from the profile."""

@@ -5,8 +5,8 @@ wsl_ti
     of every OTS recipe is decoupled from the solid in two stages -- the solid's charges scaled to zero, then the
     solid-water Lennard-Jones pairs switched off through a soft core -- and the solid alone (vacuum above) goes
     through the same charge stage as the reference. On OTS the water-TraPPE dispersion beyond the cutoff is added
-    statically from the film leg's framed second half, as on the OTS droplets. W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which
-    derives it), then theta from Young-Dupre, or "wets" with the spreading coefficient when W_SL >= 2 gamma_lv.
+    statically from the film leg's framed second half, as on the OTS droplets.
+    W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which derives it), then theta from Young-Dupre, or "wets" with the spreading coefficient when W_SL >= 2 gamma_lv.
     Why: a droplet's contact line can stay pinned for the whole of a short run, so a droplet cannot say whether the
     surface wets, and its angle depends on its size; W_SL measured directly has neither problem (Leroy &
     Mueller-Plathe, Langmuir 31 (2015) 8335).
@@ -26,11 +26,12 @@ from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
 from md.system.lammps_data import write_data
 from md.system.topology import remove_atoms
-from md.workflows.common import (SILANOL_OH, TRAPPE_UA, WATER_MODELS, framed_tail_sites, trappe_tail_sites, Workflow, common_define, derived_seed, figure_writer,
-                                 forcefield_of, fresh_from_data, held_deep, minimize_lines, minimize_water_lines,
-                                 leg_temperatures, quantity_record, water_solid_thermostat_lines, WATER_SOLID_COLUMNS, restart_header_lines, shake_lines, silica_face_of, stage_list,
-                                 steps_of, substrate_water_seeds, surface_slab, system_summary, thermostat_lines,
-                                 water_forcefield_names)
+from md.workflows.common import (common_define, derived_seed, figure_writer, forcefield_of, framed_tail_sites,
+                                 fresh_from_data, held_deep, leg_temperatures, minimize_lines, minimize_water_lines,
+                                 quantity_record, restart_header_lines, shake_lines, SILANOL_OH, silica_face_of,
+                                 stage_list, steps_of, substrate_water_seeds, surface_slab, system_summary,
+                                 thermostat_lines, trappe_tail_sites, TRAPPE_UA, water_forcefield_names, WATER_MODELS,
+                                 WATER_SOLID_COLUMNS, water_solid_thermostat_lines, Workflow)
 
 #: gap between the solid's highest atom and the film's lowest one when the film is placed (A)
 FILM_GAP_A = 2.5
@@ -100,8 +101,8 @@ class WslTI(Workflow):
     the second half is a sampled stage framing the water O and the CH2/CH3 sites, for the dispersion tail);
     *q0..* (the solid's charges at each Gauss-Legendre node, 1 -> 0, each leg continuing from the last);
     *lj0..* (solid charges 0, solid-water LJ lambda at each node, 1 -> 0); *ref_q0..* (the solid alone, the charge
-    nodes again, each starting from the state its film node starts from with the water deleted). Every node equilibrates ``ti_equilibrate_steps`` and samples
-    ``ti_sample_steps``; dU/dlambda is sampled every ``sample_interval`` steps by two ``compute fep``.
+    nodes again, each starting from the state its film node starts from with the water deleted). Every node
+    equilibrates ``ti_equilibrate_steps`` and samples ``ti_sample_steps``; dU/dlambda is sampled every ``sample_interval`` steps by two ``compute fep``.
 
     With the water present, the water and the solid's mobile atoms have a thermostat each
     (:func:`md.workflows.common.split_thermostat_lines`), and both temperatures are sampled and reported: at the
