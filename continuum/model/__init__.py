@@ -1,8 +1,8 @@
 """Which models a scene needs, the law that runs them, and why (result.json -> models).
 
 "Model only what a scene requires." Every physics entry (`physics.adhesion_law`, `physics.half_space`,
-`physics.menisci`, `physics.plasticity`) defaults to `auto`, decided per scene from numbers recorded beside the choice; a scene
-can force any choice. The package works in four steps, one module each:
+`physics.menisci`, `physics.plasticity`) defaults to `auto`, decided per scene from numbers recorded beside
+the choice; a scene can force any choice. The package works in four steps, one module each:
 
 ``regime``     the numbers that place the scene, computed once (`Regime`, `regime_of`): summit modulus,
                Tabor and Fuller-Tabor parameters, plasticity index, the first impact's estimate, and the
