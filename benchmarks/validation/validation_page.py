@@ -81,8 +81,8 @@ def _restitution(res, ds, simulate):
              f"Measured: the share of the impact energy lost, 1 - e^2, reaches 'up to half' ({_g(lost_max)}) over "
              f"{_band(res['high_velocity_range'])} m/s, read as the largest loss seen there (e >= {floor:.3g}). "
              "Predicted below: e and the share lost 1 - e^2.", "",
-             "| impact velocity (m/s) | elastic closed form e (lost) | Thornton–Ning e (lost) | simulator, JKR e (lost) "
-             "| simulator, Thornton–Ning law e (lost) |",
+             "| impact velocity (m/s) | elastic closed form e (lost) | Thornton–Ning e (lost) "
+             "| simulator, JKR e (lost) | simulator, Thornton–Ning law e (lost) |",
              "|---|---|---|---|---|"]
     agree = []
     for p in res["points"]:
