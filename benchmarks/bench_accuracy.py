@@ -83,7 +83,10 @@ def patch(args) -> tuple[dict, dict]:
     n_ref = args.grid or (128 if args.quick else 256)
     if args.map:
         hmap = load_height_map(args.map, size=args.size)
-        topo = hmap.topography().shortcut(cutoff_wavelength=args.cutoff)
+        from SurfaceTopography import Topography
+
+        wrapped = Topography(np.array(hmap.heights), hmap.physical_size, periodic=True)   # as the BEM sees it
+        topo = wrapped.shortcut(cutoff_wavelength=args.cutoff)
         cutoff, source = args.cutoff, dict(hmap.source)
         base = np.asarray(topo.heights())
     else:
