@@ -12,6 +12,7 @@ variant whose recipe file lies beside its result): the calibration never reads i
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,15 +66,29 @@ def committed_results(results_dir: Path = RESULTS_DIR) -> list[CommittedResult]:
 
 
 def _number(x: float) -> str:
-    return f"{x:.3g}" if x != 0 else "0"
+    """Three significant digits, trailing zeros kept (64.0, not 64)."""
+    return f"{x:#.3g}".rstrip(".") if x != 0 else "0"
+
+
+def _decimals(error: float) -> int:
+    """Decimals that show ``error`` (> 0) to its second significant digit."""
+    return min(6, max(0, 1 - math.floor(math.log10(error))))
+
+
+def _with_error(value: float, stderr: float) -> tuple[str, str]:
+    """Value and stderr to the stderr's second significant digit (the usual way to quote a measurement)."""
+    d = _decimals(stderr)
+    return f"{value:.{d}f}", f"{stderr:.{d}f}"
 
 
 def _quantity_cells(q: dict[str, Any]) -> tuple[str, str, str]:
     """(value, stderr, unit) of one quantity, in display units."""
     unit, factor = DISPLAY_UNITS.get(q.get("units", ""), (q.get("units", ""), 1.0))
-    value = "–" if q.get("value") is None else _number(q["value"] * factor)
-    stderr = "–" if q.get("stderr") is None else _number(q["stderr"] * factor)
-    return value, stderr, unit
+    if q.get("value") is None:
+        return "–", "–", unit
+    if q.get("stderr"):
+        return (*_with_error(q["value"] * factor, q["stderr"] * factor), unit)
+    return _number(q["value"] * factor), "–" if q.get("stderr") is None else "0", unit
 
 
 def _flags(q: dict[str, Any]) -> str:
@@ -87,7 +102,8 @@ def _flags(q: dict[str, Any]) -> str:
     if q.get("repulsive_end") is False:
         flags.append("no repulsive end: lower bound")
     if q.get("discretisation_error") is not None:
-        flags.append(f"grid ± {_number(q['discretisation_error'] * factor)}")
+        grid = abs(q["discretisation_error"]) * factor
+        flags.append(f"grid ± {grid:.{_decimals(grid)}f}" if grid > 0 else "grid ± 0")
     if q.get("registries") is not None:
         flags.append(f"{q['registries']} registries")
     return "; ".join(flags)
