@@ -3,9 +3,9 @@
 
     python benchmarks/bench_ensemble.py [--params calibrated,paper] [--members 64] [--half-space N] [--json FILE]
 
-Members on a rigid substrate (each contact in the compiled kernel, continuum.contact_kernel), the scene's
-physics.half_space = 'on' replaced by 'auto' (off here: the deflection is femtometres). `--half-space N` also
-times N members as shipped (half-space on: the coupled fixed point in Python, ~1 s per impact). The ensemble's
+Members on a rigid substrate (each contact in the compiled kernel, continuum.contact_kernel): the scene's
+physics.half_space = 'auto' leaves it out (the deflection is femtometres). `--half-space N` also times N members
+with physics.half_space = 'on' (the coupled fixed point in Python, ~1 s per impact). The ensemble's
 own wall time is reported (`EnsembleResult.wall_s`: the members, not the scene's resolution or the mean-field run).
 """
 from __future__ import annotations
@@ -40,15 +40,18 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--params", default="calibrated,paper")
     ap.add_argument("--members", type=int, default=64)
-    ap.add_argument("--half-space", type=int, default=0, metavar="N", help="also time N members as shipped")
+    ap.add_argument("--half-space", type=int, default=0, metavar="N", help="also time N members, half-space on")
+    ap.add_argument("--executors", default="processes,local", help="which of processes, local to time")
     ap.add_argument("--json", help="write the numbers here")
     args = ap.parse_args()
     warm_up()
     out = {"scene": "rough_silica", "cpus": os.cpu_count(), "cases": {}}
-    runs = [(p, "rigid", RIGID, args.members, ex) for p in args.params.split(",")
-            for ex in (("processes", os.cpu_count()), ("local", None))]
+    executors = {"processes": ("processes", os.cpu_count()), "local": ("local", None)}
+    runs = [(p, "rigid", RIGID, args.members, executors[ex]) for p in args.params.split(",")
+            for ex in args.executors.split(",")]
     if args.half_space:
-        runs += [(p, "half-space on", {}, args.half_space, ("processes", os.cpu_count())) for p in args.params.split(",")]
+        runs += [(p, "half-space on", {"physics.half_space": "on"}, args.half_space, ("processes", os.cpu_count()))
+                 for p in args.params.split(",")]
     for params, name, overrides, members, (executor, workers) in runs:
         row = one(params, overrides, members, executor, workers)
         out["cases"].setdefault(f"{params} {name}", []).append(row)

@@ -481,7 +481,9 @@ def uncertainty_sample(task: tuple) -> dict:
     from continuum.scene import SceneError, resolve_scene
 
     try:
-        resolved = resolve_scene(scene, params=params, overrides={**overrides, "numerics.max_bounces": max_bounces},
+        # the sample reads the mean-field trajectory: an ensemble that 'auto' would add goes unread
+        resolved = resolve_scene(scene, params=params, overrides={"surfaces.roughness.mode": "mean_field", **overrides,
+                                                                  "numerics.max_bounces": max_bounces},
                                  override_label="uncertainty sample")
         result, _ = run_impact(resolved)
     except (SceneError, ValueError, RuntimeError) as exc:      # refused or failed: counted and reported

@@ -86,8 +86,9 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
     release = _release(member, float(law.z_top))
     if release is not None and release <= 0.0:
         raise ValueError(f"member seed {seed}: the release height lies below the realisation's tallest summit")
+    # a member keeps its rebounds, not its time series: no samples inside steps (the steps are the same)
     settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
-                              rest_fraction=n.rest_fraction, samples_per_flight=2)
+                              rest_fraction=n.rest_fraction, samples_per_flight=2, samples_per_step=0)
     run = simulate(law, member.body.mass, member.environment.gravity, release_height=release,
                    impact_velocity=member.impact_velocity, settings=settings)
     heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)

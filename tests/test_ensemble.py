@@ -166,3 +166,55 @@ def test_result_json_carries_the_ensemble_and_the_front_door_types_it(tmp_path):
     assert (out / "ensemble.png").is_file()
     assert json.loads((out / "result.json").read_text())["ensemble"]["members"] == 6
     assert all(isinstance(o, MemberOutcome) for o in r.ensemble.outcomes)
+
+
+def test_the_shipped_scene_at_auto_runs_an_ensemble_of_rigid_members_with_the_calibrated_set():
+    """rough_silica as shipped (mode and half-space 'auto'): under the paper roller the half-space deflection is
+    orders below 1e-3 sigma and a few summits carry the impact, so the calibrated set runs an ensemble."""
+    r = run_scene("rough_silica", params="calibrated", overrides={"surfaces.roughness.members": 3,
+                                                                  "numerics.max_bounces": 2})
+    models = r.record["models"]
+    assert models["half_space"]["used"] is False and models["half_space"]["deflection_over_sigma"] < 1e-3
+    assert models["realisation"]["mode"] == "ensemble"
+    assert models["realisation"]["expected_contacts"] < ENSEMBLE_BELOW_CONTACTS
+    p = r.record["ensemble"]["stick_probability"]
+    assert 0.0 <= p["first_impact"]["value"] <= p["within_run"]["value"] <= 1.0
+
+
+def _member_law(scene, seed):
+    from continuum.ensemble_run import with_realisation
+    from continuum.model import factory
+    from continuum.rough.gw import SummitStatistics
+
+    plan = member_plan(scene, first_impact_speed(scene))
+    scene = with_realisation(scene, "discrete", seed)
+    rough = scene.surfaces.roughness
+    stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
+    return factory.discrete_roller(scene, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
+                                   plan.footprint_half_width, plan.summit_law)
+
+
+def test_tabulated_first_approach_forces_are_the_summit_sums_at_each_depth():
+    """The depth search's batch of forces (one interpolation over all depths) is each depth's own summit sum."""
+    scene = _scene(**{"physics.adhesion_law": "maugis_dugdale"})
+    law = _member_law(scene, 11)
+    depths = np.linspace(0.0, 4.0 * scene.surfaces.roughness.sigma, 257)
+    one_by_one = np.array([law.approach_force(-d) for d in depths])
+    assert np.count_nonzero(one_by_one) > 100
+    assert np.allclose(law.approach_forces(depths), one_by_one, rtol=1e-12, atol=1e-12 * np.max(np.abs(one_by_one)))
+
+
+@pytest.mark.parametrize("law", ["jkr", "maugis_dugdale"])
+def test_samples_inside_steps_do_not_change_a_members_rebounds(law):
+    """Members keep no time series (samples_per_step = 0): the samples are read off each step's dense output
+    and do not steer the steps, so the rebounds are those of a fully sampled run, to the last bit."""
+    from continuum.driver import DriverSettings, simulate
+
+    scene = _scene(**{"physics.adhesion_law": law, "numerics.max_bounces": 6})
+    runs = []
+    for per_step in (3, 0):
+        run = simulate(_member_law(scene, 5), scene.body.mass, scene.environment.gravity,
+                       release_height=scene.release_height,
+                       settings=DriverSettings(rtol=scene.numerics.rtol, max_bounces=6, samples_per_step=per_step))
+        runs.append([b.rebound_height for b in run.bounces])
+    assert len(runs[0]) >= 2 and runs[0] == runs[1]

@@ -81,7 +81,7 @@ def run_point(sigma, modulus, work, release):
     overrides = {"surfaces.roughness.sigma": sigma, "surfaces.roughness.summit_modulus": modulus,
                  "surfaces.work_of_adhesion": work, "release_height": release,
                  "physics.adhesion_law": "auto", "physics.half_space": "auto",
-                 "numerics.fidelity": "fast", "numerics.max_bounces": 2}
+                 "surfaces.roughness.mode": "mean_field", "numerics.fidelity": "fast", "numerics.max_bounces": 2}
     return run_impact(resolve_scene(SCENE, overrides=overrides, override_label="extremes"))
 
 

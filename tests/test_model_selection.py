@@ -29,12 +29,14 @@ def _assert_same_rebounds(left, right, h0):
 
 def test_half_space_left_out_under_the_paper_roller_is_safe():
     auto, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
-                                       overrides={"physics.half_space": "auto", "numerics.max_bounces": 6}))
+                                       overrides={"physics.half_space": "auto", "numerics.max_bounces": 6,
+                                                  "surfaces.roughness.mode": "mean_field"}))
     rec = auto["models"]["half_space"]
     assert rec["used"] is False and rec["decided_by"] == "deflection_over_sigma"
     assert rec["deflection_over_sigma"] < 1e-3
     forced, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
-                                         overrides={"physics.half_space": "on", "numerics.max_bounces": 6}))
+                                         overrides={"physics.half_space": "on", "numerics.max_bounces": 6,
+                                                    "surfaces.roughness.mode": "mean_field"}))
     _assert_same_rebounds(auto, forced, 100e-9)
 
 

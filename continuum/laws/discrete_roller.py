@@ -346,8 +346,22 @@ class DiscreteRoughRoller(RoughRollerBase):
         return float(np.sum(self._laws(self.eff[:k] - self.z_top - gap)["force"]))
 
     def approach_forces(self, depths: np.ndarray) -> np.ndarray:
-        """First-approach forces (N) at `depths` (m below the datum), one summit sum each."""
-        return np.array([self.approach_force(-d) for d in depths])
+        """First-approach forces (N) at `depths` (m below the datum), one summit sum each.
+
+        A tabulated summit law interpolates every depth's summits in one call and sums the rows with the summits
+        out of reach zeroed (the same terms as `approach_force`, summed in another order: equal to rounding);
+        closed-form summits go depth by depth."""
+        depths = np.asarray(depths, float)
+        if self.slaw is None or depths.size == 0:
+            return np.array([self.approach_force(-d) for d in depths])
+        counts = np.searchsorted(self._neg_eff, -(self.z_top - depths - self._reach), side="right")
+        k_max = int(counts.max())
+        if k_max == 0:
+            return np.zeros(depths.size)
+        delta = (self.eff[:k_max] - self.z_top)[None, :] + depths[:, None]       # approach_force's, rounding too
+        f = self.slaw.force(delta, "approach")
+        f[np.arange(k_max)[None, :] >= counts[:, None]] = 0.0
+        return f.sum(axis=1)
 
     def _summits_at(self, gap: float, de_lo: float, de_of=None):
         """Trial state over the prefix of summits that are attached or within reach.
