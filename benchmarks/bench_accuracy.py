@@ -33,6 +33,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import platform
 import sys
 import time
@@ -41,6 +42,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from SurfaceTopography import Topography
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -83,8 +85,6 @@ def patch(args) -> tuple[dict, dict]:
     n_ref = args.grid or (128 if args.quick else 256)
     if args.map:
         hmap = load_height_map(args.map, size=args.size)
-        from SurfaceTopography import Topography
-
         wrapped = Topography(np.array(hmap.heights), hmap.physical_size, periodic=True)   # as the BEM sees it
         topo = wrapped.shortcut(cutoff_wavelength=args.cutoff)
         cutoff, source = args.cutoff, dict(hmap.source)
@@ -94,8 +94,6 @@ def patch(args) -> tuple[dict, dict]:
         hmap = synthesise_height_map(synthesis)
         topo, cutoff, source = hmap.topography(), synthesis.short_cutoff, dict(hmap.source)
         base = np.asarray(topo.heights())
-    from SurfaceTopography import Topography
-
     periodic = Topography(base - base.mean(), topo.physical_sizes, periodic=True)
     grids = {}
     for n in (n_ref // 2, n_ref):
@@ -313,7 +311,7 @@ def run(args) -> dict:
                                                                 mat["dugdale_stress"])),
                    touch_zone_radius_pixels=math.sqrt(2 * beta * mat["dugdale_range"]) / pixel)
     result = {"benchmark": "benchmarks/bench_accuracy.py", "mode": "quick" if args.quick else "full",
-              "machine": {"cores": __import__("os").cpu_count(), "platform": platform.platform(),
+              "machine": {"cores": os.cpu_count(), "platform": platform.platform(),
                           "python": platform.python_version()},
               "materials": mat, "surface": surface,
               "path": {"start_m": float(path[0]), "deepest_m": float(path.min()), "states": int(path.size)},
