@@ -91,30 +91,17 @@ from scipy import fft as sfft
 from scipy.linalg import toeplitz
 from scipy.sparse.linalg import LinearOperator, gmres
 
+from .reference.hertz import line_half_width
+
 PressureLaw = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray]"]
 
 __all__ = [
     "LineHalfSpace", "Grid", "choose_grid", "solve_hard_contact", "solve_coupled",
-    "HardContactSolution", "CoupledSolution", "hertz_line", "strip_displacement",
+    "HardContactSolution", "CoupledSolution", "strip_displacement",
 ]
 
 
 # --------------------------------------------------------------------------- closed forms
-def hertz_line(load_per_length: float, radius: float, e_star: float, x_ref: float | None = None) -> dict:
-    """Hertz line contact of a cylinder on a flat (Johnson 1985 §4.2, Johnson's E*).
-
-    Returns ``half_width`` b = sqrt(4 W' R/(pi E*)), ``peak_pressure`` p0 = 2 W'/(pi b), and,
-    when ``x_ref`` is given, ``approach`` = (W'/(pi E*)) (2 ln(2 x_ref/b) + 1): the centre
-    displacement relative to surface points at distance x_ref (equal to Johnson eq 5.39 /
-    paper eq 1 when x_ref = roller length l).
-    """
-    b = math.sqrt(4.0 * load_per_length * radius / (math.pi * e_star))
-    out = {"half_width": b, "peak_pressure": 2.0 * load_per_length / (math.pi * b) if b > 0 else 0.0}
-    if x_ref is not None and b > 0:
-        out["approach"] = load_per_length / (math.pi * e_star) * (2.0 * math.log(2.0 * x_ref / b) + 1.0)
-    return out
-
-
 def strip_displacement(x, half_width: float, pressure: float, e_star: float, x_ref: float, center: float = 0.0):
     """Displacement (m) of uniform pressure on the strip |x - center| <= a (Johnson eq 2.25c).
 
@@ -270,7 +257,8 @@ def choose_grid(radius: float, load_per_length: float, e_star: float, *, n_point
     """
     candidates = {}
     if load_per_length > 0:
-        candidates["hertz"] = span * hertz_line(load_per_length, radius, e_star)["half_width"]
+        # Hertz half-width per unit length: the roller of length 1 m under load_per_length (Johnson §4.2)
+        candidates["hertz"] = span * float(line_half_width(load_per_length, radius, 1.0, e_star))
     if h_ref is not None and gap_height is not None and gap_height > h_ref:
         candidates["gap"] = gap_margin * math.sqrt(2.0 * radius * (gap_height - h_ref))
     if min_half_span > 0:

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from continuum.halfspace import (LineHalfSpace, choose_grid, hertz_line, solve_coupled,
-                                 solve_hard_contact, strip_displacement)
+from continuum.halfspace import LineHalfSpace, choose_grid, solve_coupled, solve_hard_contact, strip_displacement
+from continuum.reference import hertz
 
 E_STAR, RADIUS, LOAD, LENGTH = 100e9, 5e-6, 1.0, 3.3e-3  # Pa, m, N/m, m (x_ref = roller length)
 
@@ -43,7 +43,10 @@ def moment_half_width(hs, p):
     return 2.0 * math.sqrt(m2)
 
 
-HZ = hertz_line(LOAD, RADIUS, E_STAR, x_ref=LENGTH)
+# Johnson's Hertz line contact (continuum.reference.hertz), the roller of length LENGTH under LOAD per length
+HZ = {"half_width": float(hertz.line_half_width(LOAD * LENGTH, RADIUS, LENGTH, E_STAR)),
+      "peak_pressure": float(hertz.line_peak_pressure(LOAD * LENGTH, RADIUS, LENGTH, E_STAR)),
+      "approach": float(hertz.line_approach(LOAD * LENGTH, RADIUS, LENGTH, E_STAR))}
 
 
 # ----------------------------------------------------------------------------- operator
