@@ -37,6 +37,45 @@ def adhesive_range_check(scene: Scene, stats, z_max_sigma: float, speed: float) 
     law.quasi_static_depth(0.5 * scene.body.mass * speed * speed, scene.body.mass * scene.environment.gravity)
 
 
+def _mean_field_cost(scene: Scene, adhesion: str, half_space: bool, w: float, e_s: float, stats, datum: dict,
+                     table: str, est, speed: float):
+    """The mean-field rough law's table resolution, its summit law (branch summits), the impact estimate and the
+    tables' cost, checked before any table is built: a scene beyond the bounds is refused with a SceneError
+    (`continuum.estimates.check_table_cost`). Returns (table, summit law or None, estimate, cost)."""
+    rough, phys = scene.surfaces.roughness, scene.physics
+    generic = branch_summits(adhesion)
+    slaw = None
+    if not generic and table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
+            jkr_ref.critical_approach(rough.summit_radius, w, e_s)):
+        table = "standard"      # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
+    if not half_space and est is None:
+        est = impact_estimate(scene, speed)
+    if generic:
+        slaw = summit_law(adhesion, scene)
+        release_stretch, end_gap = max(-slaw.delta_out, 0.0), max(-slaw.delta_out, slaw.reach, 0.0)
+    else:
+        release_stretch = end_gap = (float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) *
+                                     (1.0 if phys.detachment == "displacement"
+                                      else -jkr_ref.LOAD_DETACH_APPROACH_RATIO) if w > 0 else 0.0)
+    try:
+        cost = check_table_cost(stats=stats, work_of_adhesion=w, summit_e_star=e_s, z_max_sigma=datum["z_max"],
+                                detachment=phys.detachment, resolution=table, gw_tables=not generic,
+                                rigid=not half_space, rigid_resolution=table,
+                                release_stretch=release_stretch, end_gap=end_gap,
+                                depth_estimate=est.depth if est else None, sigma_key_value=rough.sigma)
+    except SceneError:
+        # Refused for size. The Hertz estimate leaves adhesion out, and an adhesive approach can pull the
+        # roller beyond the averaged model's range, where every way out of the size refusal would be refused
+        # too: say so instead (the approach branch by quadrature, no tables; < 1 s).
+        if w > 0 and not generic:
+            adhesive_range_check(scene, stats, datum["z_max"], speed)
+        raise
+    if w > 0 and not generic and cost.get("gw_table", {}).get("estimated_seconds", 0.0) > LARGE_TABLE_SECONDS:
+        # a large table (seconds, hundreds of MB) is worth building only if the impact stays in range
+        adhesive_range_check(scene, stats, datum["z_max"], speed)
+    return table, slaw, est, cost
+
+
 def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None = None,
               with_menisci: bool = False, speed: float | None = None, estimate=None,
               regime: Regime | None = None) -> tuple[ContactLaw, dict]:
@@ -71,37 +110,9 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     e_s = regime.e_star
     table = scene.numerics.table
     generic = branch_summits(adhesion)
-    cost = None
-    slaw = None
+    cost = slaw = None
     if rough.mode != "discrete":
-        if not generic and table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
-                jkr_ref.critical_approach(rough.summit_radius, w, e_s)):
-            table = "standard"      # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
-        if not half_space and est is None:
-            est = impact_estimate(scene, speed)
-        if generic:
-            slaw = summit_law(adhesion, scene)
-            release_stretch, end_gap = max(-slaw.delta_out, 0.0), max(-slaw.delta_out, slaw.reach, 0.0)
-        else:
-            release_stretch = end_gap = (float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) *
-                                         (1.0 if phys.detachment == "displacement"
-                                          else -jkr_ref.LOAD_DETACH_APPROACH_RATIO) if w > 0 else 0.0)
-        try:
-            cost = check_table_cost(stats=stats, work_of_adhesion=w, summit_e_star=e_s, z_max_sigma=datum["z_max"],
-                                    detachment=phys.detachment, resolution=table, gw_tables=not generic,
-                                    rigid=not half_space, rigid_resolution=table,
-                                    release_stretch=release_stretch, end_gap=end_gap,
-                                    depth_estimate=est.depth if est else None, sigma_key_value=rough.sigma)
-        except SceneError:
-            # Refused for size. The Hertz estimate leaves adhesion out, and an adhesive approach can pull the
-            # roller beyond the averaged model's range, where every way out of the size refusal would be refused
-            # too: say so instead (the approach branch by quadrature, no tables; < 1 s).
-            if w > 0 and not generic:
-                adhesive_range_check(scene, stats, datum["z_max"], speed)
-            raise
-        if w > 0 and not generic and cost.get("gw_table", {}).get("estimated_seconds", 0.0) > LARGE_TABLE_SECONDS:
-            # a large table (seconds, hundreds of MB) is worth building only if the impact stays in range
-            adhesive_range_check(scene, stats, datum["z_max"], speed)
+        table, slaw, est, cost = _mean_field_cost(scene, adhesion, half_space, w, e_s, stats, datum, table, est, speed)
     surface = None
     if rough.mode == "discrete":
         # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
