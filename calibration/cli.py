@@ -21,7 +21,7 @@ from pathlib import Path
 from nanoimpact.cli import ArgumentParser, Command, add_verbosity, check_out_dir, positive_int, setup_logging
 from nanoimpact import __version__, data
 from nanoimpact.executors import check_executor
-from nanoimpact.errors import InputError, NanoimpactError, run_command
+from nanoimpact.errors import InputError, NanoimpactError, RunInterrupted, run_command
 
 log = logging.getLogger("calibration.cli")      # not __name__: it is __main__ under python -m
 
@@ -168,10 +168,14 @@ def _apply_globals(args: argparse.Namespace) -> None:
 def _labelled(prog: str, fn, *a) -> int:
     try:
         return fn(*a)
-    except (NanoimpactError, KeyboardInterrupt) as exc:   # name the subcommand in the line run_command prints
-        if not getattr(exc, "prog", None):
+    except NanoimpactError as exc:            # name the subcommand in the line run_command prints
+        if not exc.prog:
             exc.prog = prog
         raise
+    except KeyboardInterrupt:
+        interrupted = RunInterrupted("interrupted")
+        interrupted.prog = prog
+        raise interrupted from None
 
 
 _parsers: dict[str, argparse.ArgumentParser] = {}

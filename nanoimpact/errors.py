@@ -21,6 +21,8 @@ class NanoimpactError(Exception):
     """Base class of the errors the command line turns into one line and an exit code."""
 
     exit_code = EXIT_FAILED
+    #: the command that raised it (`nanoimpact impact`), named at the start of the line; None: the program's name
+    prog: str | None = None
 
 
 class InputError(NanoimpactError, ValueError):
@@ -103,6 +105,7 @@ def run_command(fn, *args, prog: str = "nanoimpact", stream=None) -> int:
     except SystemExit as exc:                 # argparse's --help / --version, or an explicit sys.exit
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_FAILED)
     except (NanoimpactError, KeyboardInterrupt) as exc:
-        print(f"{getattr(exc, 'prog', None) or prog}: {one_line(exc)}", file=stream or sys.stderr)
+        label = exc.prog if isinstance(exc, NanoimpactError) and exc.prog else prog
+        print(f"{label}: {one_line(exc)}", file=stream or sys.stderr)
         return exit_code(exc)
     return EXIT_OK if code is None else int(code)
