@@ -54,9 +54,9 @@ from md import units
 from md.engine.hashing import forcefield_hashes, lammps_version, package_version, run_hash
 from md.engine.lammps import InProcess, MpiRun
 from md.engine.plan import Job, Leg, Plan, Planner
-from md.engine.store import (RunContext, RunOutcome, run_dir_for, clean_json, export, leg_state, parse_ave_time,
+from md.engine.store import (RunContext, RunOutcome, run_dir_for, export, leg_state, parse_ave_time,
                              parse_dump, truncate_samples, write_csv)
-from nanoimpact.fileio import atomic_write_bytes, atomic_write_text
+from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, clean_json
 from nanoimpact.lock import run_lock
 from nanoimpact.provenance import git_commit
 

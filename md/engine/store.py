@@ -19,10 +19,10 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from md.engine.plan import Leg, Plan
-from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, clean_json  # noqa: F401 (clean_json: re-exported)
+from nanoimpact.fileio import atomic_write_bytes, atomic_write_text
 
 __all__ = ["DEFAULT_CACHE", "cache_root", "read_samples", "read_frames", "parse_ave_time", "parse_dump",
-           "leg_state", "truncate_samples", "export", "write_csv", "clean_json", "RunContext", "RunOutcome"]
+           "leg_state", "truncate_samples", "export", "write_csv", "RunContext", "RunOutcome"]
 
 DEFAULT_CACHE = Path("~/.cache/nanoimpact/md")
 
