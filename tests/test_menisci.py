@@ -20,7 +20,8 @@ R, L = 5e-6, 3.28e-3
 Z_TOP = 4.07 * SIGMA
 F0, DK = 1.7e-7, 1.0765e-9
 WET = {"environment.relative_humidity": 0.4, "surfaces.body.contact_angle": 20.0,
-       "surfaces.substrate.contact_angle": 20.0, "physics.half_space": "off"}
+       "surfaces.substrate.contact_angle": 20.0, "physics.half_space": "off",
+       "surfaces.roughness.mode": "mean_field"}        # menisci are modelled on the averaged GW law
 
 
 # ------------------------------------------------------------------------------ closed forms
