@@ -8,7 +8,8 @@
 The decisions that do not depend on the realisation (adhesion law, half-space, the summits' modulus and work of
 adhesion, the footprint strip) are made once, from the scene's regime, exactly as a single discrete run makes
 them (`continuum.model.select`); each member then only draws its summits (`continuum.laws.discrete_roller`, a few
-ms) and runs the event-driven driver (on a rigid substrate each contact runs in the compiled kernel,
+ms), or, where the scene names a height map, cuts a patch of the map's summits at a random offset
+(`continuum.rough.ensemble.patch_summits`), and runs the event-driven driver (on a rigid substrate each contact runs in the compiled kernel,
 `continuum.contact_kernel.LAW_DISCRETE`). A run ends where the driver ends it: a member held by adhesion stops
 at 'stuck'. Members go to `nanoimpact.executors` (local, processes, dask): jobs are module-level and picklable.
 """
@@ -17,10 +18,12 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
 from .driver import DriverSettings, simulate
-from .rough.ensemble import EnsembleResult, MemberOutcome, member_seeds
+from .rough.ensemble import (EnsembleResult, MemberOutcome, SummitField, member_seeds, patch_offset, patch_summits,
+                             tiles)
 from .scene import ResolvedScene, Scene
 
 log = logging.getLogger(__name__)
@@ -44,6 +47,8 @@ class MemberPlan:
     speed: float
     summit_law: Any = None
     """Tabulated branches (`continuum.rough.branch_laws.SummitLaw`) where the law has no closed form here."""
+    field: SummitField | None = None
+    """The scene's height map's summits: each member is a patch of it (None: draws from the statistics)."""
 
 
 def member_plan(scene: Scene, speed: float) -> MemberPlan:
@@ -61,6 +66,36 @@ def member_plan(scene: Scene, speed: float) -> MemberPlan:
     return MemberPlan(w, regime.e_star, decisions.half_space_decision(scene, regime).used,
                       datum["footprint_half_width"], speed,
                       decisions.summit_law(law, scene) if branch_summits(law) else None)
+
+
+def summit_field(resolved: ResolvedScene) -> SummitField | None:
+    """The summits of the scene's height map (measured or synthetic), found on the map taken as periodic at the
+    cutoff its statistics used (`continuum.rough.topography.identify_summits`); None for a scene without a map."""
+    from .rough.surface_map import height_map
+    from .rough.topography import identify_summits
+
+    scene_dir = Path(resolved.scene_file).parent if resolved.scene_file else None
+    found = height_map(resolved.values, scene_dir)
+    if found is None:
+        return None
+    hmap, cutoff = found
+    summits = identify_summits(hmap.heights, hmap.pixel_size, cutoff, periodic=True)
+    return SummitField(summits.x, summits.y, summits.height, tuple(hmap.physical_size), bool(hmap.periodic),
+                       {"map": dict(hmap.source), "cutoff_m": cutoff})
+
+
+def source_record(field: SummitField | None, plan: MemberPlan, length: float) -> dict:
+    """result.json -> ensemble's `source` (and `patches` for map patches): what the members realise."""
+    if field is None:
+        return {"source": "statistics"}
+    nx, ny = tiles(field, plan.footprint_half_width, length)
+    strip = [2.0 * plan.footprint_half_width, length]
+    return {"source": "map_patches", "patches": {
+        **field.source, "map_size_m": list(field.size), "map_periodic": field.periodic,
+        "summits_on_map": int(field.x.size), "strip_m": strip, "tiles": [nx, ny], "tiled": nx * ny > 1,
+        "rule": "each member's strip starts at a uniform random point of the map (from its seed); the map "
+                "repeats periodically where the strip runs past its edge" +
+                ("" if field.periodic else " (this map is not periodic: the copies meet at seams)")}}
 
 
 def _release(scene: Scene, z_top: float) -> float | None:
@@ -81,8 +116,12 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
     member = with_realisation(scene, "discrete", seed)
     rough, n = member.surfaces.roughness, member.numerics
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
+    offset = summits = None
+    if plan.field is not None:
+        offset = patch_offset(plan.field, seed)
+        summits = patch_summits(plan.field, offset, plan.footprint_half_width, member.body.length)
     law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
-                                  plan.footprint_half_width, plan.summit_law)
+                                  plan.footprint_half_width, plan.summit_law, summits)
     release = _release(member, float(law.z_top))
     if release is not None and release <= 0.0:
         raise ValueError(f"member seed {seed}: the release height lies below the realisation's tallest summit")
@@ -94,7 +133,7 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
     heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)
     return MemberOutcome(seed=int(seed), status=run.status, rebound_heights=heights, release_height=release,
                          max_contacts=int(law.diagnostics()["max_contacts"]), wall_s=time.perf_counter() - start,
-                         energy_error=float(run.audit["max_relative_error"]))
+                         energy_error=float(run.audit["max_relative_error"]), patch_offset=offset)
 
 
 def _member_job(job: tuple) -> MemberOutcome:
@@ -118,7 +157,8 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | None = None, seed:
     members = rough.members if members is None else int(members)
     master = rough.seed if seed is None else int(seed)
     seeds = member_seeds(master, members)
-    plan = member_plan(sc, first_impact_speed(sc))
+    field = summit_field(scene) if isinstance(scene, ResolvedScene) else None
+    plan = replace(member_plan(sc, first_impact_speed(sc)), field=field)
     jobs = [(sc, s, plan) for s in seeds]
     start = time.perf_counter()
     own = executor is None or isinstance(executor, str)
@@ -136,4 +176,5 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | None = None, seed:
             ex.close()
     wall = time.perf_counter() - start
     log.info("ensemble of %d members (master seed %d) on %s: %.2f s", members, master, where, wall)
-    return EnsembleResult(master_seed=master, outcomes=tuple(outcomes), executor=where, wall_s=wall)
+    return EnsembleResult(master_seed=master, outcomes=tuple(outcomes), executor=where, wall_s=wall,
+                          source=source_record(field, plan, sc.body.length))

@@ -92,7 +92,7 @@ def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> dict:
     """result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them."""
     from .ensemble_run import run_ensemble
 
-    ens = run_ensemble(resolved.scene, executor=executor, workers=workers)
+    ens = run_ensemble(resolved, executor=executor, workers=workers)
     heights = [b.rebound_height for b in run.bounces if b.rebound_height is not None]
     mean_field = {"rebounds": len(heights), "first_rebound_m": heights[0] if heights else 0.0,
                   "status": run.status, "stuck": run.stuck,

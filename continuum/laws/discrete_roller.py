@@ -99,6 +99,10 @@ class DiscreteRoughRoller(RoughRollerBase):
         the closed-form JKR/Hertz summits: a summit jumps in at delta_in, follows its retreat branch until
         delta_out, and every other summit within reach (delta >= -reach) exerts its approach branch's force (the
         Maugis-Dugdale attraction before contact). JKR is the case delta_in = 0, delta_out = -Delta, reach 0.
+    summits : (x, y, z) arrays, optional
+        The summits of the strip (m: |x| <= footprint_half_width, 0 <= y <= length, heights) in place of a draw
+        from `stats` (a patch of a height map, `continuum.rough.ensemble.patch_summits`); the seed then draws
+        nothing.
     """
 
     name = "rough_roller_discrete_jkr"
@@ -108,7 +112,7 @@ class DiscreteRoughRoller(RoughRollerBase):
                  length: float, e_star: float, *, seed: int, detachment: str = "displacement",
                  half_space: bool = True, grid_points: int = 256, footprint_half_width: float | None = None,
                  depth_max: float | None = None, depth_safety: float = 1.5, coupling_tol: float = 1e-11,
-                 max_coupling_iterations: int = 20, summit_law=None):
+                 max_coupling_iterations: int = 20, summit_law=None, summits=None):
         if detachment not in ("displacement", "load"):
             raise ValueError(f"detachment = {detachment!r}: must be 'displacement' or 'load'")
         if not work_of_adhesion >= 0.0:
@@ -166,23 +170,47 @@ class DiscreteRoughRoller(RoughRollerBase):
         self.evaluations = 0
         self.deepened = 0
         self.grid_history: list[dict] = []
+        self.given_summits = None if summits is None else tuple(np.asarray(a, float) for a in summits)
         self._realise(8.0 * self.sigma if depth_max is None else float(depth_max))
         self.design_depth = 4.0 * self.sigma
         self._set_grid(self.design_depth)
 
     # ------------------------------------------------------------------ realisation
     def _realise(self, depth_keep: float) -> None:
-        """Draw the realisation from the seed and keep summits with e_i >= z_top - depth_keep.
-
-        Batches of _CHUNK summits (x, y, z drawn in that order per batch) keep memory bounded; the
-        running maximum of e_i only grows, so filtering each batch against it keeps a superset.
-        """
-        rng = np.random.default_rng(self.seed)
-        xf, l, two_r = self.footprint_half_width, self.length, 2.0 * self.radius
-        total = int(rng.poisson(self.stats.density * 2.0 * xf * l))
+        """Draw the realisation from the seed (`_draw`), or take the given summits, and keep those with
+        e_i >= z_top - depth_keep, sorted by e_i."""
+        xf, two_r = self.footprint_half_width, 2.0 * self.radius
+        if self.given_summits is not None:
+            x, y, z = self.given_summits
+            total, raw_top = int(x.size), float(np.max(z, initial=-math.inf))
+        else:
+            x, y, z, total, raw_top = self._draw(depth_keep)
         if total < 1:
             raise ValueError(f"discrete rough contact: the realisation (seed {self.seed}) holds no summit in the "
                              f"strip |x| <= {xf:.3g} m")
+        eff = z - x * x / two_r
+        top = float(eff.max())
+        k = eff >= top - depth_keep
+        order = np.argsort(-eff[k], kind="stable")
+        self.sx, self.sy, self.sz = x[k][order], y[k][order], z[k][order]
+        self.eff = eff[k][order]                       # descending
+        self._neg_eff = -self.eff                      # ascending, for searchsorted
+        self.z_top = float(self.eff[0])                # datum: tallest effective summit (m)
+        self.z_raw_top = raw_top                       # tallest summit height in the strip (m)
+        self.summits_in_strip = total
+        self.depth_keep = depth_keep
+        # deepest approach the strip covers: beyond it, summits outside |x| <= x_f as tall as the
+        # realisation's tallest could touch
+        self.strip_depth = xf * xf / two_r + self.z_top - raw_top
+        self.attached = np.zeros(self.eff.size, bool)
+
+    def _draw(self, depth_keep: float):
+        """(x, y, z, summits in the strip, tallest z) of the seed's draw from the statistics, keeping a superset of
+        the summits with e_i >= max e - depth_keep. Batches of _CHUNK summits (x, y, z drawn in that order per
+        batch) keep memory bounded; the running maximum of e_i only grows, so each batch's filter keeps a superset."""
+        rng = np.random.default_rng(self.seed)
+        xf, l, two_r = self.footprint_half_width, self.length, 2.0 * self.radius
+        total = int(rng.poisson(self.stats.density * 2.0 * xf * l))
         keep_x, keep_y, keep_z = [], [], []
         top, raw_top = -math.inf, -math.inf
         left = total
@@ -199,21 +227,9 @@ class DiscreteRoughRoller(RoughRollerBase):
             keep_x.append(x[k])
             keep_y.append(y[k])
             keep_z.append(z[k])
-        x, y, z = np.concatenate(keep_x), np.concatenate(keep_y), np.concatenate(keep_z)
-        eff = z - x * x / two_r
-        k = eff >= top - depth_keep
-        order = np.argsort(-eff[k], kind="stable")
-        self.sx, self.sy, self.sz = x[k][order], y[k][order], z[k][order]
-        self.eff = eff[k][order]                       # descending
-        self._neg_eff = -self.eff                      # ascending, for searchsorted
-        self.z_top = float(self.eff[0])                # datum: tallest effective summit (m)
-        self.z_raw_top = raw_top                       # tallest summit height in the strip (m)
-        self.summits_in_strip = total
-        self.depth_keep = depth_keep
-        # deepest approach the strip covers: beyond it, summits outside |x| <= x_f as tall as the
-        # realisation's tallest could touch
-        self.strip_depth = xf * xf / two_r + self.z_top - raw_top
-        self.attached = np.zeros(self.eff.size, bool)
+        if total < 1:
+            return np.zeros(0), np.zeros(0), np.zeros(0), 0, raw_top
+        return np.concatenate(keep_x), np.concatenate(keep_y), np.concatenate(keep_z), total, raw_top
 
     def _deepen(self, depth_keep: float) -> None:
         """Keep more of the same realisation (mid-contact): the kept summits come first in the same

@@ -16,7 +16,7 @@ share draws, and the same master seed and size give the same members on any exec
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -35,6 +35,47 @@ def member_seeds(master: int, members: int) -> tuple[int, ...]:
     return tuple(int(w) & (2**63 - 1) for w in words)
 
 
+@dataclass(frozen=True, eq=False)
+class SummitField:
+    """Summits of a height map taken as periodic (`continuum.rough.topography.identify_summits`): positions in
+    [0, Lx) x [0, Ly) (m), heights above the map's mean plane (m), the map's size (m) and where it came from."""
+
+    x: np.ndarray
+    y: np.ndarray
+    height: np.ndarray
+    size: tuple[float, float]
+    periodic: bool
+    source: dict
+
+
+def patch_offset(field: SummitField, seed: int) -> tuple[float, float]:
+    """A member's patch origin on the map (m), uniform over the map, from the member's seed (reproducible)."""
+    rng = np.random.default_rng(int(seed))
+    return float(rng.uniform(0.0, field.size[0])), float(rng.uniform(0.0, field.size[1]))
+
+
+def tiles(field: SummitField, half_width: float, length: float) -> tuple[int, int]:
+    """Copies of the map along x and y that cover the strip |x| <= half_width, 0 <= y <= length (1 where one
+    patch of the map covers it)."""
+    return (max(1, math.ceil(2.0 * half_width / field.size[0])), max(1, math.ceil(length / field.size[1])))
+
+
+def patch_summits(field: SummitField, offset: tuple[float, float], half_width: float,
+                  length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y, z) of the summits under the strip |x| <= half_width, 0 <= y <= length (m) cut from the map at
+    `offset` = (ox, oy): the map point (ox, oy) lies at the strip's corner (-half_width, 0), and the map repeats
+    periodically where the strip runs past its edge (`tiles`)."""
+    lx, ly = field.size
+    u = np.mod(field.x - offset[0], lx)
+    v = np.mod(field.y - offset[1], ly)
+    nx, ny = tiles(field, half_width, length)
+    shape = (nx, ny, u.size)                                   # (copy along x, copy along y, summit)
+    x = np.broadcast_to(u[None, None, :] + lx * np.arange(nx)[:, None, None] - half_width, shape)
+    y = np.broadcast_to(v[None, None, :] + ly * np.arange(ny)[None, :, None], shape)
+    keep = (x <= half_width) & (y <= length)
+    return x[keep], y[keep], np.broadcast_to(field.height, shape)[keep]
+
+
 @dataclass(frozen=True)
 class MemberOutcome:
     """What one realisation did (SI): its seed, how the run ended, and each rebound height."""
@@ -51,6 +92,8 @@ class MemberOutcome:
     wall_s: float
     energy_error: float = 0.0
     """The run's energy audit: largest error of its energy books against the first impact's kinetic energy."""
+    patch_offset: tuple[float, float] | None = None
+    """Where a map-patch member's strip starts on the map (m); None for a draw from the statistics."""
 
     @property
     def stuck(self) -> bool:
@@ -74,14 +117,16 @@ class MemberOutcome:
     def to_record(self) -> dict:
         return {"seed": self.seed, "status": self.status, "rebounds": self.rebounds,
                 "rebound_heights": list(self.rebound_heights), "max_contacts": self.max_contacts,
-                "energy_error": self.energy_error, "wall_s": self.wall_s}
+                "energy_error": self.energy_error, "wall_s": self.wall_s,
+                **({"patch_offset_m": list(self.patch_offset)} if self.patch_offset is not None else {})}
 
     @classmethod
     def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "MemberOutcome":
         return cls(seed=int(rec["seed"]), status=str(rec["status"]),
                    rebound_heights=tuple(float(h) for h in rec["rebound_heights"]), release_height=release_height,
                    max_contacts=int(rec["max_contacts"]), wall_s=float(rec["wall_s"]),
-                   energy_error=float(rec["energy_error"]))
+                   energy_error=float(rec["energy_error"]),
+                   patch_offset=tuple(rec["patch_offset_m"]) if "patch_offset_m" in rec else None)
 
 
 def _percentiles(values: Sequence[float]) -> dict[str, float]:
@@ -104,6 +149,9 @@ class EnsembleResult:
     outcomes: tuple[MemberOutcome, ...]
     executor: str
     wall_s: float
+    source: Mapping[str, Any] = field(default_factory=lambda: {"source": "statistics"})
+    """What the members realise: {"source": "statistics"} (draws from sigma, summit_density, summit_radius) or
+    {"source": "map_patches", ...} (patches of the scene's height map, with the map and its tiling)."""
 
     @property
     def members(self) -> int:
@@ -135,7 +183,7 @@ class EnsembleResult:
         h0 = self.outcomes[0].release_height if self.outcomes else None
         first = self.first_rebounds()
         rec: dict = {
-            "members": self.members, "master_seed": self.master_seed, "seeds": list(self.seeds),
+            "members": self.members, "master_seed": self.master_seed, "seeds": list(self.seeds), **self.source,
             "release_height_m": h0,
             "seed_rule": "numpy SeedSequence(master_seed).generate_state(members, uint64), top bit cleared",
             "stick_probability": {
@@ -164,5 +212,6 @@ class EnsembleResult:
     @classmethod
     def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "EnsembleResult":
         outcomes = tuple(MemberOutcome.from_record(m, release_height) for m in rec["member_runs"])
+        source = {k: rec[k] for k in ("source", "patches") if k in rec} or {"source": "statistics"}
         return cls(master_seed=int(rec["master_seed"]), outcomes=outcomes, executor=str(rec["executor"]),
-                   wall_s=float(rec["wall_s"]))
+                   wall_s=float(rec["wall_s"]), source=source)

@@ -127,8 +127,8 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
                                       values.get(KEY_UNIT), cutoff, tip, values.get(KEY_ROUTE, "direct"), stamp)
     block = {**stats.to_json(), "cutoff_from": origin, "source": dict(hmap.source), "replaced": replaced,
              "fills": {key: attr for key, attr in MAP_KEYS.items()},
-             "note": "the map supplies summit statistics to the mean-field (GW) law; the roller's footprint is not "
-                     "tiled with the map"}
+             "note": "the map supplies summit statistics to the mean-field (GW) law and to discrete draws; the "
+                     "members of an ensemble are patches of the map's own summits (result.json -> ensemble.patches)"}
     return MapStatistics(values={key: getattr(stats, attr) for key, attr in MAP_KEYS.items()}, block=block)
 
 
@@ -138,3 +138,22 @@ def statistics_block(values: dict, sources: dict) -> dict:
             "summit_density": values.get("surfaces.roughness.summit_density"),
             "summit_radius": values.get("surfaces.roughness.summit_radius"), "route": None, "cutoff": None,
             "source": {"kind": "statistics", "keys": {key: sources.get(key) for key in MAP_KEYS}}}
+
+
+def height_map(values: dict, scene_dir: Path | None) -> tuple[HeightMap, float] | None:
+    """The scene's height map and the cutoff wavelength (m) its statistics were taken at (the same cached load as
+    `map_statistics`), or None when the scene names none. For a scene `map_statistics` has already accepted."""
+    file_spec, synthesis = values.get(KEY_FILE), _synthesis(values)
+    if file_spec is None and synthesis is None:
+        return None
+    if synthesis is not None:
+        spec, stamp = synthesis, None
+    else:
+        path = find_topography(file_spec, scene_dir)
+        stat = path.stat()
+        spec, stamp = path.resolve(), (stat.st_size, stat.st_mtime_ns)
+    size = values.get(KEY_SIZE)
+    hmap, stats, _ = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
+                                 values.get(KEY_UNIT), values.get(KEY_CUTOFF), values.get(KEY_TIP),
+                                 values.get(KEY_ROUTE, "direct"), stamp)
+    return hmap, float(stats.cutoff)
