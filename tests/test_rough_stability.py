@@ -2,7 +2,7 @@
 refused for its stated reason.
 
 A coarse grid over sigma 0.1-100 nm, release height 1 nm-10 um, work of adhesion 0-1 J/m^2 and summit E* 1 MPa -
-1 TPa, JKR summits on a rigid substrate, 3 impacts at the `standard` preset. Every point is declared:
+1 TPa, JKR summits on a rigid substrate in the mean-field model, 3 impacts at the `standard` preset. Every point is declared:
 
 * refused, for one of two reasons (docs/model.md, "Bounded cost"): ``RANGE``, the impact would press the roller
   more than 10 sigma below the summits' mean plane, where every summit touches and the averaged rough model does
@@ -68,6 +68,7 @@ def overrides(sigma, release, work, modulus, max_bounces=3):
     return {"surfaces.roughness.sigma": sigma, "release_height": release,
             "surfaces.work_of_adhesion": work, "surfaces.roughness.summit_modulus": modulus,
             "physics.adhesion_law": "jkr" if work > 0 else "none", "physics.half_space": "off",
+            "surfaces.roughness.mode": "mean_field",
             "numerics.fidelity": "standard", "numerics.max_bounces": max_bounces, "numerics.max_time": 1.0}
 
 
