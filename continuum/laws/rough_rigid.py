@@ -41,6 +41,11 @@ from .costs import _BLOCK_STATES, RESOLUTION, table_cost_refusal, table_shape
 from .roller_base import RoughRollerBase
 
 
+#: Footprint tables of quadrature surfaces shared by the rollers of one process ((`_table_key`, depth) -> tables):
+#: the runs of a parameter set meet the same summits and impact speeds again (sweeps, bundles, figures).
+_SHARED_TABLES: dict = {}
+
+
 class RigidRoughRoller(RoughRollerBase):
     """Roller of radius R and length l (m) on averaged GW/JKR summits over a rigid substrate."""
 
@@ -65,7 +70,18 @@ class RigidRoughRoller(RoughRollerBase):
         self._kept_tables: dict = {}
         self._approach_memo: dict = {}
         self._compiled_for = None
+        self._shared_key = self._table_key()
         self.reset()
+
+    def _table_key(self):
+        """What the footprint tables are a function of, besides the design depth, for a quadrature surface
+        (`GWBranchSurface`: its summit law, one shared object per set of arguments, and its statistics and
+        truncation); None for other surfaces (their tables are kept by this law only)."""
+        s = self.surface
+        if s.kind != "generic":
+            return None
+        return (s.law, s.sigma, s.density, s.radius, s.z_max, s.truncated, s.resolution, self.radius, self.length,
+                self.resolution)
 
     # ------------------------------------------------------------------ tables
     def _gauss(self, h: np.ndarray, r: np.ndarray):
@@ -113,6 +129,8 @@ class RigidRoughRoller(RoughRollerBase):
         import time
 
         kept = self._kept_tables
+        if depth not in kept and self._shared_key is not None and (self._shared_key, depth) in _SHARED_TABLES:
+            kept[depth] = _SHARED_TABLES[(self._shared_key, depth)]
         if depth in kept:
             (self._force, self._energy, self._count, self._h_lo, self._h_hi, self.table_depth,
              self.table_points) = kept[depth]
@@ -146,6 +164,10 @@ class RigidRoughRoller(RoughRollerBase):
         if len(kept) >= self.MAX_KEPT_TABLES:
             kept.pop(next(iter(kept)))
         kept[depth] = (self._force, self._energy, self._count, self._h_lo, self._h_hi, depth, self.table_points)
+        if self._shared_key is not None:
+            if len(_SHARED_TABLES) >= 4 * self.MAX_KEPT_TABLES:
+                _SHARED_TABLES.pop(next(iter(_SHARED_TABLES)))
+            _SHARED_TABLES[(self._shared_key, depth)] = kept[depth]
 
     def size_for(self, depth: float, speed: float) -> None:
         """Extend the tables if this impact can reach deeper than they do."""
@@ -278,11 +300,15 @@ class RigidRoughRoller(RoughRollerBase):
         x = np.linspace(-half, half, 257)
         d = self.z_top + gap + x * x / (2.0 * self.radius)
         zeta = d - r
-        p = self.surface.pressure(d, zeta)
+        if self.surface_kind == "generic":
+            # quadrature surfaces (GWBranchSurface) sum the four profiles in one pass over their panels
+            p, comp, tens, area = self.surface.profile(d, zeta)
+        else:
+            p, (comp, tens), area = (self.surface.pressure(d, zeta), self.surface.pressure_parts(d, zeta),
+                                     self.surface.contact_fraction(d, zeta))
         self.max_pressure = max(self.max_pressure, float(np.max(p)))
-        comp, tens = self.surface.pressure_parts(d, zeta)
         return {"x": x, "pressure": p, "compressive": comp, "tensile": tens, "deflection": np.zeros_like(x),
-                "separation": d - self.z_top, "contact_fraction": self.surface.contact_fraction(d, zeta)}
+                "separation": d - self.z_top, "contact_fraction": area}
 
     def diagnostics(self):
         return {"max_contacts": self.max_contacts, "edge_touched": self.edge_touched,

@@ -49,6 +49,7 @@ DMT are closed form. Branches are tabulated on ~4000 points and evaluated by lin
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -71,6 +72,11 @@ class Branch:
     energy: np.ndarray
     contact: np.ndarray
     """True contact radius (m): 0 on non-contact (cohesive-zone) states."""
+
+    def __post_init__(self):
+        # read-only: `make_summit_law` hands one law to every caller with the same arguments
+        for a in (self.delta, self.force, self.radius, self.energy, self.contact):
+            a.flags.writeable = False
 
     def __call__(self, what: str, delta):
         return np.interp(np.asarray(delta, float), self.delta, getattr(self, what))
@@ -316,9 +322,14 @@ def maugis_dugdale_law(beta, w, e_star, z0, *, delta_max, n_contact=2000, n_free
                      extra={"maugis_lambda": lam, "dugdale_stress": sigma0, "dugdale_range_h0": h0, "z0": z0})
 
 
+@functools.lru_cache(maxsize=64)
 def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: float = 0.3e-9,
                     detachment: str = "displacement", delta_max: float) -> SummitLaw:
     """Law by name ('jkr', 'dmt', 'maugis_dugdale').
+
+    A law is a pure function of these arguments and is never modified (its tables are read-only), so
+    each distinct set is built once per process and shared: a Maugis-Dugdale law costs ~0.2 s and a
+    scene asks for its summits' law several times (regime map, estimates, the contact law).
 
     Only displacement-controlled release exists here (summits under a roller are displacement
     driven); detachment = 'load' is refused.

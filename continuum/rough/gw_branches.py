@@ -17,9 +17,10 @@ threshold rises: n * loop * [Phi_t(zeta_new) - Phi_t(zeta_old)].
 
 Evaluation: fixed Gauss-Legendre panels in delta = z - d (8 nodes), with edges at the law's jump
 points, at 0 and at -reach, geometric from there (first width a tenth of the adhesive length scale,
-at most sigma/4), split per state at the threshold and cut at z_max. States are sorted by
-separation and integrated in chunks of 512 over the panels their deepest member needs: 15-20 us per
-state and quantity on a busy 2-core machine for a footprint table's spread of states (65 us unsorted).
+at most sigma/4), split per state at the threshold and cut at z_max. The sums are compiled
+(`continuum.rough.branch_kernel`: one state at a time over its own panels, several quantities in one
+pass, ~5x faster than the NumPy form `_integrals_numpy`, which sorts states by separation and sums
+chunks of 512 over the panels their deepest member needs; the two agree to round-off).
 No tables: the rigid-substrate law tabulates the footprint integral of this surface once per set.
 Accuracy against adaptive quadrature is measured in tests/test_branch_laws.py.
 """
@@ -32,11 +33,15 @@ import warnings
 import numpy as np
 
 from ..reference import jkr as _jkr
+from . import branch_kernel as _bk
 from .summits import SummitStatistics, _gauss_mass
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _CHUNK = 512
+#: (what, part) -> (row of the branch tables, mode) of `branch_kernel.integrals`
+_KINDS = {("pressure", "total"): (0, 0), ("pressure", "compressive"): (0, 1), ("pressure", "tensile"): (0, 2),
+          ("energy", "total"): (1, 0), ("area", "total"): (2, 3)}
 
 
 class GWBranchSurface:
@@ -67,6 +72,9 @@ class GWBranchSurface:
         self.delta_c = (float(_jkr.critical_approach(self.radius, self.work_of_adhesion, self.e_star))
                         if self.adhesive else 0.0)
         self._edges = self._panel_edges()
+        # the branch tables as the compiled quadrature reads them: delta, and rows force, energy, contact radius
+        self._tables = tuple(np.ascontiguousarray(a, float) for br in (law.approach, law.retreat)
+                             for a in (br.delta, np.vstack([br.force, br.energy, br.contact])))
         self.build_seconds = time.perf_counter() - start
 
     def _panel_edges(self) -> np.ndarray:
@@ -97,23 +105,41 @@ class GWBranchSurface:
         return out[()] if out.ndim == 0 else out
 
     def _integral(self, what, d, zeta, part="total"):
+        out = self._integrals(((what, part),), d, zeta)[0]
+        return out[()] if out.ndim == 0 else out
+
+    def _integrals(self, quantities, d, zeta):
+        """The footprint sums of several (what, part) quantities at once, shape (len(quantities),) + d's shape:
+        one pass over the panels (compiled: `continuum.rough.branch_kernel.integrals`)."""
+        d, zeta = np.broadcast_arrays(np.asarray(d, float), np.asarray(zeta, float))
+        shape = d.shape
+        d, zeta = np.ascontiguousarray(d.ravel()), zeta.ravel()
+        x_th, x_top = self._limits(d, zeta)
+        kinds = np.array([_KINDS[q] for q in quantities], np.int64)
+        out = np.zeros((len(quantities), d.size))
+        _bk.integrals(d, np.ascontiguousarray(x_th[:, 0]), np.ascontiguousarray(x_top[:, 0]), self._edges, _GL_X,
+                      _GL_W, self.sigma, *self._tables, kinds, out)
+        return (self.density * out).reshape((len(quantities),) + shape)
+
+    def _integrals_numpy(self, quantities, d, zeta):
+        """`_integrals` in NumPy, states sorted by separation and summed in chunks (the compiled form's reference)."""
         d, zeta = np.broadcast_arrays(np.asarray(d, float), np.asarray(zeta, float))
         shape = d.shape
         d, zeta = d.ravel(), zeta.ravel()
-        out = np.empty(d.size)
+        out = np.empty((len(quantities), d.size))
         # a chunk integrates every state over the panels up to its deepest state's compression:
         # states sorted by separation make the chunks' panel counts follow their own depths
-        # (3-5x cheaper on a table's spread of states than chunks in input order; same sums)
         order = np.argsort(d, kind="stable") if d.size > _CHUNK else None
         for i in range(0, d.size, _CHUNK):
             k = order[i:i + _CHUNK] if order is not None else slice(i, i + _CHUNK)
-            out[k] = self._chunk(what, d[k], zeta[k], part)
-        out = out.reshape(shape)
-        return out[()] if out.ndim == 0 else out
+            out[:, k] = self._chunk(quantities, d[k], zeta[k])
+        return out.reshape((len(quantities),) + shape)
 
-    def _chunk(self, what, d, zeta, part):
+    def _limits(self, d, zeta):
+        """Threshold x_th and top x_top of the summits in delta (m), shape (N, 1); refuses states whose summits
+        would be compressed beyond the law's table."""
         ze = np.maximum(np.minimum(zeta, d + self.delta_in), d + self.delta_out)
-        x_th = (ze - d)[:, None]                      # threshold in delta
+        x_th = (ze - d)[:, None]
         if self.truncated:
             x_top = (self.z_max - d)[:, None]
         else:   # untruncated: summits above d + delta_max carry no mass if that is beyond 8.5 sigma
@@ -124,11 +150,15 @@ class GWBranchSurface:
         if np.any(x_top > self.law.delta_max):
             raise ValueError(f"GW branch surface: a summit would be compressed by {float(np.max(x_top)):.3g} m, beyond "
                              f"its law's table ({self.law.delta_max:.3g} m)")
+        return x_th, x_top
+
+    def _chunk(self, quantities, d, zeta):
+        x_th, x_top = self._limits(d, zeta)
         reach_top = float(np.max(np.minimum(x_top, self.law.delta_max)))
         j_end = int(np.searchsorted(self._edges, reach_top)) + 1
         edges = self._edges[:max(j_end, 2)]
         e0, e1 = edges[None, :-1], edges[None, 1:]
-        total = np.zeros(d.size)
+        total = np.zeros((len(quantities), d.size))
         for branch, (a, b) in (("approach", (e0, np.minimum(np.minimum(e1, x_th), x_top))),
                                ("retreat", (np.maximum(e0, x_th), np.minimum(e1, x_top)))):
             half = 0.5 * np.maximum(b - a, 0.0)
@@ -137,19 +167,26 @@ class GWBranchSurface:
             w = half[..., None] * _GL_W
             z = (d[:, None, None] + x) / self.sigma
             phi = np.exp(-0.5 * z * z) / (_SQRT2PI * self.sigma)
-            if what == "pressure":
-                q = self.law.force(x, branch)
-                if part == "compressive":
+            values = {}
+            for n, (what, part) in enumerate(quantities):
+                if what not in values:
+                    values[what] = self._summit_values(what, x, branch)
+                q = values[what]
+                if what == "pressure" and part == "compressive":
                     q = np.maximum(q, 0.0)
-                elif part == "tensile":
+                elif what == "pressure" and part == "tensile":
                     q = np.minimum(q, 0.0)
-            elif what == "energy":
-                q = self.law.energy(x, branch)
-            else:                                                          # real contact area
-                a_c = self.law.contact_radius(x, branch)
-                q = math.pi * a_c * a_c
-            total += np.sum(q * phi * w, axis=(1, 2))
+                total[n] += np.sum(q * phi * w, axis=(1, 2))
         return self.density * total
+
+    def _summit_values(self, what, x, branch):
+        """One summit's force (N), stored energy (J) or real contact area (m^2) at approaches x on a branch."""
+        if what == "pressure":
+            return self.law.force(x, branch)
+        if what == "energy":
+            return self.law.energy(x, branch)
+        a_c = self.law.contact_radius(x, branch)
+        return math.pi * a_c * a_c
 
     # ------------------------------------------------------------------ public API (as GWJKRSurface)
     def pressure(self, d, zeta):
@@ -167,6 +204,13 @@ class GWBranchSurface:
     def pressure_parts(self, d, zeta):
         """(compressive, tensile) parts of p (Pa)."""
         return self._integral("pressure", d, zeta, "compressive"), self._integral("pressure", d, zeta, "tensile")
+
+    def profile(self, d, zeta):
+        """(p, compressive part, tensile part, contact fraction) at once: what a footprint snapshot records,
+        each the same sum as `pressure`, `pressure_parts` and `contact_fraction` give."""
+        p, comp, tens, area = self._integrals((("pressure", "total"), ("pressure", "compressive"),
+                                               ("pressure", "tensile"), ("area", "total")), d, zeta)
+        return p, comp, tens, area
 
     def energy(self, d, zeta):
         """Stored energy per nominal area (J/m^2), zero for free summits."""

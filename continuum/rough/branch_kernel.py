@@ -1,0 +1,117 @@
+"""Compiled footprint quadrature of a GW surface of branch-law summits: `GWBranchSurface._chunk` in numba.
+
+The rigid rough roller's footprint tables evaluate the surface's pressure and energy at ~1e5 states (d, zeta) per
+build; in NumPy every state carries all the panels of its chunk's deepest state and each quantity is a pass over
+(states x panels x 8) arrays with a linear interpolation in the summit law's branch tables (~4000 points): memory
+bound, most of a Maugis-Dugdale scene's CPU. `integrals` does the same quadrature one state at a time:
+
+    q_n(d, zeta) = sum_branches sum_panels sum_nodes Q_n(x, branch) phi((d + x)/sigma) w,
+
+over the panels [e_j, e_j+1] of `GWBranchSurface._panel_edges` clipped to the branch's interval (approach:
+below the threshold x_th = zeta_eff - d; retreat: above it; both below x_top = z_max - d), 8 Gauss-Legendre
+nodes per panel, phi the Gaussian summit-height density. Panels that a state's interval leaves empty add nothing
+and are skipped; the panel loop ends at the state's own x_top. The interpolation is np.interp's (clamped ends,
+slope times offset plus left value). Only the order of the sums differs from the NumPy form (a loop here, pairwise
+there), so the two agree to round-off: tests/test_gw_branches_fast.py compares them.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["integrals"]
+
+_SQRT2PI = math.sqrt(2.0 * math.pi)
+
+
+@njit(cache=True, error_model="numpy")
+def _cell(x, xp):
+    """np.interp's cell of x in xp (strictly increasing): -1 below xp[0], n - 1 at or above xp[n - 1], else the
+    lo with xp[lo] <= x < xp[lo + 1]."""
+    n = xp.size
+    if x < xp[0]:
+        return -1
+    if x >= xp[n - 1]:
+        return n - 1
+    lo, hi = 0, n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) >> 1
+        if xp[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, error_model="numpy")
+def _cell_from(x, xp, lo):
+    """`_cell` of x, walking up from the cell lo of a smaller x (the nodes of a branch come in increasing order)."""
+    n = xp.size
+    if 0 <= lo < n - 1 and xp[lo] <= x:
+        for _ in range(8):
+            if x < xp[lo + 1]:
+                return lo
+            lo += 1
+            if lo >= n - 1:
+                return n - 1
+    return _cell(x, xp)
+
+
+@njit(cache=True, error_model="numpy")
+def _interp(x, lo, xp, f):
+    """np.interp(x, xp, f) in the cell `_cell` found (clamped ends, slope times offset plus left value)."""
+    if lo < 0:
+        return f[0]
+    if lo >= xp.size - 1:
+        return f[xp.size - 1]
+    if x == xp[lo]:
+        return f[lo]
+    slope = (f[lo + 1] - f[lo]) / (xp[lo + 1] - xp[lo])
+    return slope * (x - xp[lo]) + f[lo]
+
+
+@njit(cache=True, error_model="numpy")
+def integrals(d, x_th, x_top, edges, gl_x, gl_w, sigma, xa, fa, xr, fr, kinds, out):
+    """Add to out[n, i] the quadrature of quantity n at state i (out zeroed by the caller; times the density there).
+
+    d, x_th, x_top: separation, threshold and top of the summits in delta (m), per state; edges: panel edges in
+    delta; xa, fa / xr, fr: the approach / retreat branch tables (delta, and one row of values per table column);
+    kinds[n]: (column of fa/fr, mode) with mode 0 value, 1 positive part, 2 negative part, 3 pi value^2."""
+    nq = kinds.shape[0]
+    norm = _SQRT2PI * sigma
+    for i in range(d.size):
+        di, th, top = d[i], x_th[i], x_top[i]
+        for branch in range(2):
+            xp = xa if branch == 0 else xr
+            fp = fa if branch == 0 else fr
+            lo = -1
+            for j in range(edges.size - 1):
+                e0, e1 = edges[j], edges[j + 1]
+                if e0 >= top:
+                    break
+                if branch == 0:
+                    a, b = e0, min(min(e1, th), top)
+                else:
+                    a, b = max(e0, th), min(e1, top)
+                half = 0.5 * max(b - a, 0.0)
+                if half == 0.0:
+                    continue
+                mid = 0.5 * (a + b)
+                for k in range(gl_x.size):
+                    x = mid + half * gl_x[k]
+                    w = half * gl_w[k]
+                    z = (di + x) / sigma
+                    phi = math.exp(-0.5 * z * z) / norm
+                    lo = _cell_from(x, xp, lo)
+                    for n in range(nq):
+                        q = _interp(x, lo, xp, fp[kinds[n, 0]])
+                        mode = kinds[n, 1]
+                        if mode == 1:
+                            q = max(q, 0.0)
+                        elif mode == 2:
+                            q = min(q, 0.0)
+                        elif mode == 3:
+                            q = math.pi * q * q
+                        out[n, i] += q * phi * w

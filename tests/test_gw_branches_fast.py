@@ -1,0 +1,90 @@
+"""The compiled footprint quadrature of a GW surface of branch-law summits (`continuum.rough.branch_kernel`)
+against its NumPy form and against adaptive quadrature, the one-pass profile against the separate sums, and the
+tables a rigid rough roller shares with another of the same surface against tables built afresh."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from continuum.laws.rough_rigid import RigidRoughRoller
+from continuum.rough.branch_laws import make_summit_law
+from continuum.rough.gw_branches import GWBranchSurface, quadrature_pressure
+from continuum.rough.summits import SummitStatistics
+
+BETA, W, E = 0.2e-6, 0.12, 30e9
+SIGMA, DENSITY = 5e-9, 1e13
+QUANTITIES = (("pressure", "total"), ("pressure", "compressive"), ("pressure", "tensile"), ("energy", "total"),
+              ("area", "total"))
+
+
+def _surface(name, z_max=4.07):
+    law = make_summit_law(name, BETA, W, E, z0=0.3e-9, delta_max=30 * SIGMA)
+    return GWBranchSurface(SummitStatistics(SIGMA, DENSITY, BETA), law, z_max=z_max)
+
+
+def _states(n=3000, seed=3):
+    """Separations from deep contact to beyond the tallest summit, thresholds on both sides of every jump."""
+    rng = np.random.default_rng(seed)
+    d = rng.uniform(-5 * SIGMA, 4.5 * SIGMA, n)
+    return d, d - rng.uniform(-3e-9, 6e-9, n)
+
+
+@pytest.mark.parametrize("name", ["maugis_dugdale", "jkr", "dmt"])
+def test_compiled_quadrature_is_the_numpy_quadrature(name):
+    """Same panels, nodes and interpolation: only the order of the sums differs (round-off, 1e-16 relative per
+    term; a few hundred terms), relative to each quantity's largest magnitude."""
+    surf = _surface(name)
+    d, zeta = _states()
+    fast = surf._integrals(QUANTITIES, d, zeta)
+    ref = surf._integrals_numpy(QUANTITIES, d, zeta)
+    for n, q in enumerate(QUANTITIES):
+        scale = np.max(np.abs(ref[n]))
+        assert scale > 0 or q[1] != "total", q
+        np.testing.assert_allclose(fast[n], ref[n], rtol=0, atol=1e-12 * scale, err_msg=str(q))
+
+
+@pytest.mark.parametrize("name", ["maugis_dugdale", "jkr"])
+def test_compiled_pressure_meets_adaptive_quadrature(name):
+    """p(d, zeta) against scipy.integrate.quad over z split at the jump points (the panels' accuracy)."""
+    surf = _surface(name)
+    for d, back in ((-1.0 * SIGMA, 0.0), (0.5 * SIGMA, 2e-9), (2.0 * SIGMA, -1e-9), (-3.0 * SIGMA, 4e-9)):
+        got = float(surf.pressure(d, d - back))
+        ref = quadrature_pressure(d, d - back, surf)
+        scale = abs(float(surf.pressure(-1.0 * SIGMA, -1.0 * SIGMA)))
+        assert abs(got - ref) < 5e-5 * scale, (d, back, got, ref)
+
+
+def test_profile_is_the_separate_sums():
+    """pressure, its parts and the contact fraction in one pass are the sums each gives alone; the parts add up
+    to the pressure."""
+    surf = _surface("maugis_dugdale")
+    d, zeta = _states(400)
+    p, comp, tens, area = surf.profile(d, zeta)
+    np.testing.assert_array_equal(p, surf.pressure(d, zeta))
+    c2, t2 = surf.pressure_parts(d, zeta)
+    np.testing.assert_array_equal(comp, c2)
+    np.testing.assert_array_equal(tens, t2)
+    np.testing.assert_array_equal(area, surf.contact_fraction(d, zeta))
+    np.testing.assert_allclose(comp + tens, p, rtol=0, atol=1e-12 * np.max(np.abs(p)))
+    assert np.all(comp >= 0) and np.all(tens <= 0) and np.all((area >= 0) & (area <= 1))
+
+
+def test_rollers_of_one_surface_share_identical_tables():
+    """A second roller on an equal surface (the same law object) reads the first one's tables: its forces and
+    energies are those of tables built from scratch for a fresh law, to round-off of the same quadrature."""
+    first = RigidRoughRoller(_surface("maugis_dugdale"), 5e-6, 3.28e-3)
+    second = RigidRoughRoller(_surface("maugis_dugdale"), 5e-6, 3.28e-3)
+    depth = 2 * SIGMA
+    first._build(depth)
+    second._build(depth)
+    assert second._force is first._force
+    law = make_summit_law.__wrapped__("maugis_dugdale", BETA, W, E, z0=0.3e-9, delta_max=30 * SIGMA)
+    fresh = RigidRoughRoller(GWBranchSurface(SummitStatistics(SIGMA, DENSITY, BETA), law, z_max=4.07), 5e-6,
+                             3.28e-3)
+    fresh._build(depth)
+    assert fresh._force is not first._force
+    gaps = np.linspace(-depth, fresh.end_gap, 50)
+    for g in gaps:
+        assert second.force(g) == pytest.approx(fresh.force(g), rel=1e-9, abs=1e-12 * abs(fresh.force(-depth)))
+        assert second.stored_energy(g) == pytest.approx(fresh.stored_energy(g), rel=1e-9,
+                                                        abs=1e-12 * abs(fresh.stored_energy(-depth)))
