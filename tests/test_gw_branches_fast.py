@@ -88,3 +88,20 @@ def test_rollers_of_one_surface_share_identical_tables():
         assert second.force(g) == pytest.approx(fresh.force(g), rel=1e-9, abs=1e-12 * abs(fresh.force(-depth)))
         assert second.stored_energy(g) == pytest.approx(fresh.stored_energy(g), rel=1e-9,
                                                         abs=1e-12 * abs(fresh.stored_energy(-depth)))
+
+
+def test_one_pass_values_are_the_separate_sums():
+    """Pressure and energy summed in one pass are bit for bit the sums each gives alone (independent
+    accumulators), so the rigid roller's tables do not depend on how many quantities a pass carries."""
+    surf = _surface("maugis_dugdale")
+    d, zeta = _states(400)
+    p, e, a = surf.values(("pressure", "energy", "area"), d, zeta)
+    np.testing.assert_array_equal(p, surf.pressure(d, zeta))
+    np.testing.assert_array_equal(e, surf.energy(d, zeta))
+    np.testing.assert_array_equal(a, surf.contact_fraction(d, zeta))
+    roller = RigidRoughRoller(surf, 5e-6, 3.28e-3)
+    h = np.linspace(-2 * SIGMA, roller.end_gap, 40)
+    r = np.full_like(h, roller.release_stretch)
+    force, energy = roller._integrate(("pressure", "energy"), h, r)
+    np.testing.assert_array_equal(force, roller._integrate("pressure", h, r))
+    np.testing.assert_array_equal(energy, roller._integrate("energy", h, r))

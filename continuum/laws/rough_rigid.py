@@ -97,26 +97,38 @@ class RigidRoughRoller(RoughRollerBase):
         w = np.concatenate([parts[0][1], parts[1][1]], axis=-1)
         return s, w
 
-    def _integrate(self, what: str, h: np.ndarray, r: np.ndarray) -> np.ndarray:
-        """2 l sqrt(2R) int_0^{sqrt(r-h)} q(z_max + h + s^2, threshold d - r) ds for q = pressure/energy/contacts.
+    def _integrate(self, what, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """2 l sqrt(2R) int_0^{sqrt(r-h)} q(z_max + h + s^2, threshold d - r) ds for q = pressure/energy/contacts;
+        `what` a name, or a tuple of names (the results stacked on a first axis, each as it would be alone).
 
         Evaluated in blocks of at most `_BLOCK_STATES` surface states, so that the surface's own
         temporaries (a few dozen arrays per state) stay bounded whatever the table size."""
+        names = (what,) if isinstance(what, str) else tuple(what)
         h, r = np.broadcast_arrays(np.asarray(h, float), np.asarray(r, float))
         shape = h.shape
         hf, rf = h.reshape(-1), r.reshape(-1)
-        out = np.empty(hf.size)
+        out = np.empty((len(names), hf.size))
         per = 2 * self.res[3]
         step = max(1, _BLOCK_STATES // per)
-        fun = {"pressure": self.surface.pressure, "energy": self.surface.energy, "contacts": self.surface.contacts}[what]
+        fun = self._surface_values(names)
         for i in range(0, hf.size, step):
             hb, rb = hf[i:i + step], rf[i:i + step]
             s, w = self._gauss(hb, rb)
             d = self.z_top + hb[:, None] + s * s
             zeta = d - rb[:, None]
-            q = fun(d.ravel(), zeta.ravel()).reshape(d.shape)
-            out[i:i + step] = np.sum(q * w, axis=-1)
-        return 2.0 * self.length * math.sqrt(2.0 * self.radius) * out.reshape(shape)
+            q = fun(d.ravel(), zeta.ravel()).reshape((len(names),) + d.shape)
+            out[:, i:i + step] = np.sum(q * w, axis=-1)
+        out = 2.0 * self.length * math.sqrt(2.0 * self.radius) * out.reshape((len(names),) + shape)
+        return out[0] if isinstance(what, str) else out
+
+    def _surface_values(self, names: tuple):
+        """(d, zeta) -> the surface's quantities `names` stacked; a quadrature surface (`GWBranchSurface`) sums
+        pressure and energy in one pass over its panels."""
+        if self.surface_kind == "generic" and "contacts" not in names:
+            return lambda d, zeta: self.surface.values(names, d, zeta)
+        funs = [{"pressure": self.surface.pressure, "energy": self.surface.energy,
+                 "contacts": self.surface.contacts}[n] for n in names]
+        return lambda d, zeta: np.stack([f(d, zeta) for f in funs])
 
     #: Nodes and surface states of the footprint tables for a design depth (`continuum.laws.costs.table_shape`).
     table_shape = staticmethod(table_shape)
@@ -151,8 +163,7 @@ class RigidRoughRoller(RoughRollerBase):
         w = np.linspace(0.0, 1.0, n_w)
         r = self.release_stretch - (self.release_stretch - self._r_in) * w * w
         H, R = np.meshgrid(h, r, indexing="ij")
-        force = self._integrate("pressure", H, R)
-        energy = self._integrate("energy", H, R)
+        force, energy = self._integrate(("pressure", "energy"), H, R)
         self._force = RectBivariateSpline(h, w, force, kx=3, ky=3)
         self._energy = RectBivariateSpline(h, w, energy, kx=3, ky=3)
         contacts = self._integrate("contacts", h, np.full_like(h, self.attach_stretch))

@@ -205,6 +205,11 @@ class GWBranchSurface:
         """(compressive, tensile) parts of p (Pa)."""
         return self._integral("pressure", d, zeta, "compressive"), self._integral("pressure", d, zeta, "tensile")
 
+    def values(self, names, d, zeta):
+        """Pressure (Pa), energy (J/m^2) or contact fraction (names 'pressure', 'energy', 'area') stacked in the
+        order of `names`, summed in one pass: each the same sum as `pressure`, `energy`, `contact_fraction`."""
+        return self._integrals(tuple((n, "total") for n in names), d, zeta)
+
     def profile(self, d, zeta):
         """(p, compressive part, tensile part, contact fraction) at once: what a footprint snapshot records,
         each the same sum as `pressure`, `pressure_parts` and `contact_fraction` give."""
