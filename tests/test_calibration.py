@@ -399,7 +399,8 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     failing = {c["name"] for c in report.claims() if not c["pass"]}
     assert {w["claim"] for w in report.claim_attribution["claims"]} == failing and "attribution_s" in report.timings
     scene = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params=str(tmp_path / "calibrated_smoke.toml"))
-    assert scene.scene.surfaces.roughness.summit_modulus == 10e9
+    # the calibrated set drops the paper's chosen compliant summits: the summits take the materials' E*
+    assert scene.scene.surfaces.roughness.summit_modulus is None
     saved = json.loads((out / "calibration.json").read_text())
     assert saved["bands"]["samples"] == 2 and saved == json.loads(json.dumps(report.to_dict(), default=str))
     assert saved["versions"]["nanoimpact"] and saved["rows"][0]["key"] == report.rows[0].key

@@ -115,7 +115,7 @@ def test_the_value_that_breaks_a_claim_is_found_by_running_the_reverts(tmp_path,
         ex.close()
     assert not list((tmp_path / "paper").glob("*.png"))                     # draw_figures=False drew nothing
     why = {c["claim"]: c for c in got["claims"]}
-    claim = why["fig4_ots_loop_below_0.3_of_silica"]
+    claim = why["fig4_ots_loop_smaller_than_silica"]
     assert claim["cause"] == "single"
     assert claim["restored_by"] == ["adhesion_silica work_of_adhesion_free_energy"]
     assert got["ran"] and len(got["reverts"]) == 2

@@ -140,8 +140,11 @@ def test_compiled_rough_impacts_match_the_python_stepper(scene_file, bounces):
         assert np.allclose(pa["pressure"], pb["pressure"], rtol=0, atol=1e-6 * np.max(np.abs(pb["pressure"])))
         # the pull-off profile is taken at the sample of lowest force: the force is flat there, and round-off
         # in the step sizes moves the samples (by ~1e-11 s), so the sample picked moves along the flat minimum
+        # With a tabulated summit law (the coated OTS summits) the minimum sits on a table kink, not on a flat
+        # minimum: the sample picked then moves the force by the slope times the sample shift, ~3e-4 of it here.
         pa, pb = a.profiles["pull_off"], b.profiles["pull_off"]
-        assert pa["force"] == pytest.approx(pb["force"], rel=1e-5)
+        pull_tol = 1e-5 if _rough(scene_file)[0].surfaces.sam is None else 1e-3
+        assert pa["force"] == pytest.approx(pb["force"], rel=pull_tol)
         assert pa["gap"] == pytest.approx(pb["gap"], rel=1e-3)
     # the audit is the largest sampled energy error: set by the tables (~1e-6 of the turnover), not by rtol, and
     # a maximum over samples, so a step flipped by round-off (numba's FMA use differs between CPUs) moves it by a

@@ -80,7 +80,8 @@ def test_half_space_matters_in_the_heavy_scene_and_not_under_the_paper_roller():
     assert abs(b_on["peak_force"] / b_off["peak_force"] - 1) > 0.01
     assert on["energy_audit"]["max_relative_error"] < 1e-5
     # the paper's roller: femtometres (~20 fm) against sigma = 6 nm
-    paper, _ = run_impact(resolve_scene(SILICA, overrides={"numerics.max_bounces": 1}))
+    paper, _ = run_impact(resolve_scene(SILICA, overrides={"numerics.max_bounces": 1, "physics.half_space": "on",
+                                                               "surfaces.roughness.mode": "mean_field"}))
     assert paper["models"]["diagnostics"]["max_deflection"] < 1e-4 * paper["scene"]["si"]["surfaces"]["roughness"]["sigma"]
     assert math.isfinite(paper["energy_audit"]["max_relative_error"])
 

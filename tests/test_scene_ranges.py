@@ -1,4 +1,4 @@
-"""Every shipped rough scene runs over the roughness range its docs and the paper use (issue 12).
+"""Every shipped rough scene runs over the roughness range its docs and the paper use.
 
 The paper sweeps sigma = 3-30 nm (Fig 7) and the scenes' comments place their surfaces there (or
 at 1 nm, the heavy-roller scene's own value). Swept with the half-space as each scene sets it, the
@@ -57,6 +57,13 @@ def points():
     pts = []
     for name, own in rough_scenes():
         data = tomllib.loads((SCENE_DIR / f"{name}.toml").read_text())
+        roughness = data.get("surfaces", {}).get("roughness", {})
+        if "topography" in roughness or "synthetic" in roughness:
+            # sigma, summit density and radius come from the height map (a sigma override is refused): the map's own
+            # surface is the one point, plus the sticking drop
+            pts.append(pytest.param(name, None, None, id=f"{name}-map"))
+            pts.append(pytest.param(name, None, STICK_RELEASE, id=f"{name}-map-sticks"))
+            continue
         sigmas = sorted(set(SIGMAS) | ({own} if own else set()))
         pts += [pytest.param(name, s, None, id=f"{name}-{s * 1e9:g}nm") for s in sigmas]
         if data.get("release_height") is not None:
@@ -72,7 +79,13 @@ def test_the_shipped_rough_scenes_are_all_swept():
 
 @pytest.mark.parametrize("name,sigma,release", points())
 def test_shipped_rough_scene_runs_over_its_roughness_range(name, sigma, release):
-    overrides = {"surfaces.roughness.sigma": sigma, "numerics.fidelity": "fast", "numerics.max_bounces": 1}
+    overrides = {"numerics.fidelity": "fast", "numerics.max_bounces": 1}
+    if sigma is not None:
+        overrides["surfaces.roughness.sigma"] = sigma
+    else:
+        # the maps' summits are far sharper (beta of tens of nm) than the parameter sets': `fast` tables leave up to
+        # 1.2e-3 of the turnover in the audit there, `standard` below 1e-4 (measured on both shipped maps)
+        overrides["numerics.fidelity"] = "standard"
     if release is not None:
         overrides.update({"release_height": release, "numerics.max_bounces": 2})
     resolved = resolve_scene(SCENE_DIR / f"{name}.toml", overrides=overrides, override_label="scene range")

@@ -122,6 +122,9 @@ class DiscreteRoughRoller(RoughRollerBase):
         self.work_of_adhesion, self.summit_e_star = float(work_of_adhesion), float(summit_e_star)
         self.radius, self.length, self.e_star = float(radius), float(length), float(e_star)
         self.seed = int(seed)
+        # the compiled kernel's arrays, rebuilt when the kept-summit array changes (compiled(), _compiled_branches())
+        self._compiled_for = None
+        self._compiled_tables = None
         self.detachment = detachment
         self.use_half_space = bool(half_space)
         self.n = int(grid_points)
@@ -519,7 +522,7 @@ class DiscreteRoughRoller(RoughRollerBase):
             return None
         if self.slaw is not None:
             return self._compiled_branches()
-        if getattr(self, "_compiled_for", None) is not self.eff:
+        if self._compiled_for is not self.eff:
             P = np.zeros(ck.DISCRETE_PARAMS)
             P[ck.P_D_END_GAP], P[ck.P_D_RELEASE], P[ck.P_D_LOOP] = self.end_gap, self.release_stretch, self.loop_energy
             P[ck.P_D_HERTZ_K], P[ck.P_D_ADHESIVE] = self._hertz_k, 1.0 if self.adhesive else 0.0
@@ -537,7 +540,7 @@ class DiscreteRoughRoller(RoughRollerBase):
         from .. import contact_kernel as ck
         from ..compiled_contact import EMPTY_TABLES, CompiledLaw
 
-        if getattr(self, "_compiled_for", None) is not self.eff:
+        if self._compiled_for is not self.eff:
             P = np.zeros(ck.BRANCH_PARAMS)
             P[ck.P_B_END_GAP], P[ck.P_B_IN], P[ck.P_B_OUT] = self.end_gap, self._delta_in, -self.release_stretch
             P[ck.P_B_REACH], P[ck.P_B_LOOP], P[ck.P_B_LOWEST] = self._reach, self.loop_energy, -self.depth_keep
