@@ -87,9 +87,11 @@ def integrals(d, x_th, x_top, edges, gl_x, gl_w, sigma, xa, fa, xr, fr, kinds, o
             xp = xa if branch == 0 else xr
             fp = fa if branch == 0 else fr
             lo = -1
-            for j in range(edges.size - 1):
+            # panels wholly above the threshold (approach) or below it (retreat) are empty: not visited
+            j0 = 0 if branch == 0 else max(np.searchsorted(edges, th, side="right") - 1, 0)
+            for j in range(j0, edges.size - 1):
                 e0, e1 = edges[j], edges[j + 1]
-                if e0 >= top:
+                if e0 >= top or (branch == 0 and e0 >= th):
                     break
                 if branch == 0:
                     a, b = e0, min(min(e1, th), top)
