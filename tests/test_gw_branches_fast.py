@@ -105,3 +105,19 @@ def test_one_pass_values_are_the_separate_sums():
     force, energy = roller._integrate(("pressure", "energy"), h, r)
     np.testing.assert_array_equal(force, roller._integrate("pressure", h, r))
     np.testing.assert_array_equal(energy, roller._integrate("energy", h, r))
+
+
+def test_a_shared_summit_law_is_the_law_built_afresh():
+    """make_summit_law hands one law per argument set; it is the law a fresh build gives (same branches, jumps
+    and loop), and other arguments give another law."""
+    args = ("maugis_dugdale", BETA, W, E)
+    shared = make_summit_law(*args, z0=0.3e-9, delta_max=30 * SIGMA)
+    assert make_summit_law(*args, z0=0.3e-9, delta_max=30 * SIGMA) is shared
+    assert make_summit_law(*args, z0=0.4e-9, delta_max=30 * SIGMA) is not shared
+    fresh = make_summit_law.__wrapped__(*args, z0=0.3e-9, delta_max=30 * SIGMA)
+    for branch in ("approach", "retreat"):
+        a, b = getattr(shared, branch), getattr(fresh, branch)
+        for what in ("delta", "force", "radius", "energy", "contact"):
+            np.testing.assert_array_equal(getattr(a, what), getattr(b, what))
+    assert (shared.delta_in, shared.delta_out, shared.loop_energy) == (fresh.delta_in, fresh.delta_out,
+                                                                        fresh.loop_energy)

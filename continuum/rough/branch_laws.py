@@ -73,11 +73,6 @@ class Branch:
     contact: np.ndarray
     """True contact radius (m): 0 on non-contact (cohesive-zone) states."""
 
-    def __post_init__(self):
-        # read-only: `make_summit_law` hands one law to every caller with the same arguments
-        for a in (self.delta, self.force, self.radius, self.energy, self.contact):
-            a.flags.writeable = False
-
     def __call__(self, what: str, delta):
         return np.interp(np.asarray(delta, float), self.delta, getattr(self, what))
 
@@ -327,9 +322,11 @@ def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: floa
                     detachment: str = "displacement", delta_max: float) -> SummitLaw:
     """Law by name ('jkr', 'dmt', 'maugis_dugdale').
 
-    A law is a pure function of these arguments and is never modified (its tables are read-only), so
-    each distinct set is built once per process and shared: a Maugis-Dugdale law costs ~0.2 s and a
-    scene asks for its summits' law several times (regime map, estimates, the contact law).
+    A law is a pure function of these arguments and nothing modifies one after it is built, so each
+    distinct set is built once per process and shared (callers must not write into its tables): a
+    Maugis-Dugdale law costs ~0.2 s and a scene asks for its summits' law several times (regime map,
+    estimates, the contact law). The tables stay writeable arrays so that compiled kernels receive the
+    array types they were compiled for.
 
     Only displacement-controlled release exists here (summits under a roller are displacement
     driven); detachment = 'load' is refused.
