@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
 
-from .mdset import _get_nested, _set_nested, write_parameter_set
+from .mdset import _delete_nested, _get_nested, _set_nested, write_parameter_set
 
 __all__ = ["Revert", "ClaimWhy", "reverts", "revert_table", "explain_claims", "attribute_claims"]
 
@@ -91,16 +91,6 @@ def reverts(rows: Iterable[Mapping[str, Any]], set_name: str) -> tuple[Revert, .
                           base=tuple(r.get("base_value") for r in members), units=members[0].get("units") or "",
                           set_name=f"{set_name}--{recipe}--{quantity}"))
     return tuple(out)
-
-
-def _delete_nested(table: dict, key: str) -> None:
-    *parents, leaf = key.split(".")
-    node = table
-    for p in parents:
-        node = node.get(p)
-        if not isinstance(node, dict):
-            return
-    node.pop(leaf, None)
 
 
 def revert_table(table: Mapping[str, Any], revert: Revert) -> dict:
