@@ -116,12 +116,7 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
                 raise TopographyError(key, values[key], f"is derived from the height map; remove it from the "
                                                         f"{source}, or remove the map")
             replaced[key] = {"value": values[key], "source": source}
-    if synthesis is not None:
-        spec, stamp = synthesis, None
-    else:
-        spec = find_topography(file_spec, scene_dir)
-        stat = spec.stat()
-        spec, stamp = spec.resolve(), (stat.st_size, stat.st_mtime_ns)
+    spec, stamp = _map_spec(file_spec, synthesis, scene_dir)
     size = values.get(KEY_SIZE)
     hmap, stats, origin = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
                                       values.get(KEY_UNIT), cutoff, tip, values.get(KEY_ROUTE, "direct"), stamp)
@@ -131,6 +126,16 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
                      "members of an ensemble are patches of the map's own summits (result.json -> ensemble.patches)"}
     return MapStatistics(values={key: getattr(stats, attr) for key, attr in MAP_KEYS.items()}, block=block)
 
+
+
+def _map_spec(file_spec, synthesis, scene_dir: Path | None):
+    """(what to load, cache stamp): the synthesis parameters (no stamp), or the map file's resolved path with its
+    size and modification time, so that the cached load is redone when the file changes."""
+    if synthesis is not None:
+        return synthesis, None
+    path = find_topography(file_spec, scene_dir)
+    stat = path.stat()
+    return path.resolve(), (stat.st_size, stat.st_mtime_ns)
 
 def statistics_block(values: dict, sources: dict) -> dict:
     """result.json's `surface` block of a rough scene given by its statistics (no map)."""
@@ -146,12 +151,7 @@ def height_map(values: dict, scene_dir: Path | None) -> tuple[HeightMap, float] 
     file_spec, synthesis = values.get(KEY_FILE), _synthesis(values)
     if file_spec is None and synthesis is None:
         return None
-    if synthesis is not None:
-        spec, stamp = synthesis, None
-    else:
-        path = find_topography(file_spec, scene_dir)
-        stat = path.stat()
-        spec, stamp = path.resolve(), (stat.st_size, stat.st_mtime_ns)
+    spec, stamp = _map_spec(file_spec, synthesis, scene_dir)
     size = values.get(KEY_SIZE)
     hmap, stats, _ = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
                                  values.get(KEY_UNIT), values.get(KEY_CUTOFF), values.get(KEY_TIP),
