@@ -80,20 +80,24 @@ def _bridges(t_a=25e-6):
     return MeniscusBridges(SummitStatistics(SIGMA, DENSITY, BETA), Z_TOP, R, L, F0, DK, t_a, 3.4e-10)
 
 
-@pytest.mark.parametrize("gap, s", [(-2e-9, -3e-9), (0.3e-9, -0.5e-9), (-5e-9, -5.5e-9), (-1e-9, -8e-9)])
-def test_bridge_sum_matches_a_brute_force_grid_over_x_and_z(gap, s):
-    b = _bridges()
-    s = max(s, gap - DK)
+def _brute_force(fn, gap, s, *args):
+    """The footprint sum of fn(gap of each summit) by trapezoids over x (across the roller) and summit height z:
+    summits attached down to the threshold stretch s, Gaussian heights, the roller's parabola."""
     xmax = math.sqrt(2 * R * -s)
     x = np.linspace(-xmax, xmax, 2001)
     z = np.linspace(Z_TOP - 12e-9, Z_TOP, 12001)
     X, Z = np.meshgrid(x, z, indexing="ij")
     u = Z - Z_TOP - X * X / (2 * R)
-    g = gap - u
     phi = np.exp(-0.5 * (Z / SIGMA) ** 2) / (SIGMA * math.sqrt(2 * math.pi))
-    mask = u >= s
-    force = np.trapezoid(np.trapezoid(np.where(mask, men.bridge_force(g, F0, DK), 0) * phi, z, axis=1), x) * L * DENSITY
-    energy = np.trapezoid(np.trapezoid(np.where(mask, men.bridge_energy(g, F0, DK), 0) * phi, z, axis=1), x) * L * DENSITY
+    values = np.where(u >= s, fn(gap - u, F0, DK, *args), 0)
+    return np.trapezoid(np.trapezoid(values * phi, z, axis=1), x) * L * DENSITY
+
+
+@pytest.mark.parametrize("gap, s", [(-2e-9, -3e-9), (0.3e-9, -0.5e-9), (-5e-9, -5.5e-9), (-1e-9, -8e-9)])
+def test_bridge_sum_matches_a_brute_force_grid_over_x_and_z(gap, s):
+    b = _bridges()
+    s = max(s, gap - DK)
+    force, energy = _brute_force(men.bridge_force, gap, s), _brute_force(men.bridge_energy, gap, s)
     assert b._integral("force", gap, s) == pytest.approx(force, rel=2e-4, abs=0)
     assert b._integral("energy", gap, s) == pytest.approx(energy, rel=2e-4, abs=0)
 
@@ -278,16 +282,8 @@ def test_bridge_sum_with_solid_pull_matches_a_brute_force_grid(gap, s):
     b = _bridges()
     b.set_solid_pull(solid)
     s = max(s, gap - DK)
-    xmax = math.sqrt(2 * R * -s)
-    x = np.linspace(-xmax, xmax, 2001)
-    z = np.linspace(Z_TOP - 12e-9, Z_TOP, 12001)
-    X, Z = np.meshgrid(x, z, indexing="ij")
-    u = Z - Z_TOP - X * X / (2 * R)
-    g = gap - u
-    phi = np.exp(-0.5 * (Z / SIGMA) ** 2) / (SIGMA * math.sqrt(2 * math.pi))
-    mask = u >= s
     for kind, fn in (("force", men.bridge_force), ("energy", men.bridge_energy)):
-        want = np.trapezoid(np.trapezoid(np.where(mask, fn(g, F0, DK, solid), 0) * phi, z, axis=1), x) * L * DENSITY
+        want = _brute_force(fn, gap, s, solid)
         assert b._integral(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
         assert b._integral_numpy(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
 
