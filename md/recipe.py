@@ -51,6 +51,12 @@ ALL = WORKFLOWS
 CONDITIONAL_KEYS: dict[str, dict[str, tuple[str, Any]]] = {
     "wsl_ti": {"sam_coverage": ("surface", "ots"), "chain_length": ("surface", "ots")}}
 
+#: Options whose neutral value runs exactly the protocol a workflow ran before the option existed: workflow ->
+#: {key: neutral value}. At that value the key stays out of the run's identity (`Recipe.canonical`), because the
+#: run it describes is the same run; any other value enters the hash. A protocol option added to a workflow is
+#: registered here with the value that reproduces the runs already committed.
+NEUTRAL_KEYS: dict[str, dict[str, Any]] = {}
+
 
 class RecipeError(InputError):
     """An invalid recipe: names the key, the value and what is allowed."""
@@ -321,11 +327,14 @@ class Recipe:
     def canonical(self, fidelity: str) -> dict[str, Any]:
         """What defines a run at ``fidelity``: workflow, name and the resolved settings (comments, key order
         and the other fidelity tables do not matter), less the keys that do not apply to this system
-        (:data:`CONDITIONAL_KEYS`)."""
+        (:data:`CONDITIONAL_KEYS`) and the protocol options at their neutral value (:data:`NEUTRAL_KEYS`)."""
         settings = self.settings(fidelity)
         for key, (when, value) in CONDITIONAL_KEYS.get(self.workflow, {}).items():
             if settings.get(when) != value:
                 settings.pop(key, None)
+        for key, neutral in NEUTRAL_KEYS.get(self.workflow, {}).items():
+            if key in settings and settings[key] == neutral:
+                settings.pop(key)
         return {"name": self.name, "workflow": self.workflow, "fidelity": fidelity, "settings": settings}
 
     def canonical_sha256(self, fidelity: str) -> str:
