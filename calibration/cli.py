@@ -117,6 +117,8 @@ def registry() -> dict[str, Command]:
 def _global_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--version", action="version", version=f"nanoimpact {__version__}")
     add_verbosity(parser)
+    # a subcommand's own -v/-q (zero where it has none, or where it parses its own options)
+    parser.set_defaults(sub_verbose=0, sub_quiet=0)
     parser.add_argument("--data", metavar="DIR", help=f"user data folder (scenes/, params/, md/, calibration/ as "
                         f"in inputs/), searched before the shipped data and where calibrated sets are written; "
                         f"default ${data.ENV_VAR}")
@@ -157,8 +159,7 @@ def _split_globals(argv: list[str]) -> tuple[list[str], list[str]]:
 
 
 def _apply_globals(args: argparse.Namespace) -> None:
-    setup_logging(getattr(args, "verbose", 0) + getattr(args, "sub_verbose", 0)
-                  - getattr(args, "quiet", 0) - getattr(args, "sub_quiet", 0))
+    setup_logging(args.verbose + args.sub_verbose - args.quiet - args.sub_quiet)
     if args.data is not None:
         if not Path(args.data).expanduser().is_dir():
             raise InputError("--data", args.data, "must be an existing folder (the user data folder)")
