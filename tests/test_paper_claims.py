@@ -152,6 +152,56 @@ def test_wet_claim_without_an_impact_outlasting_t_a_is_not_evaluable_and_says_wh
     assert c["values"]["t_a_flip_s"] == 31e-6
 
 
+# ------------------------------------------------------------------------------ the t_a band's edge
+def test_the_t_a_band_edge_is_bisected_to_the_closed_form_crossing_of_a_monotone_impact_time():
+    """t(eps) = t_a (eps_c / eps)^0.1 falls through t_a at eps_c exactly."""
+    from continuum.paper.run import WET_DRY_REL_TOL, WET_EPS, t_a_band_edge
+
+    t_a, eps_c = 25e-6, 3.7e-4
+    edge = t_a_band_edge(lambda e: t_a * (eps_c / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)
+    assert edge["eps"] == pytest.approx(eps_c, rel=1e-6) and edge["eps"] <= eps_c
+    assert 0 < edge["rel_tol"] < 1e-6 * eps_c + 2 * WET_DRY_REL_TOL
+    # a crossing below the scan's first point is bracketed by the escape velocity's own bracket
+    low = t_a_band_edge(lambda e: t_a * (3e-9 / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)
+    assert low["eps"] == pytest.approx(3e-9, rel=1e-6)
+
+
+def test_an_impact_time_that_crosses_t_a_twice_gives_no_band_edge_and_the_wet_claim_says_why():
+    """Dry impacts long near the escape velocity, short, long again around eps = 0.1 (a second band: the
+    impact time not monotone in the speed), then short: a bisection between the scan's ends would pick either
+    crossing, so no edge is reported and the claim is not evaluable with the reason."""
+    from continuum.paper.run import WET_DRY_REL_TOL, WET_EPS, t_a_band_edge
+
+    t_a = 25e-6
+
+    def bumpy(e):
+        return 30e-6 if e < 1e-5 or 0.03 < e < 0.3 else 20e-6
+
+    edge = t_a_band_edge(bumpy, t_a, WET_EPS, WET_DRY_REL_TOL)
+    assert edge["eps"] is None and "not monotone" in edge["reason"] and "3 times" in edge["reason"]
+    assert t_a_band_edge(lambda e: 30e-6, t_a, WET_EPS, WET_DRY_REL_TOL)["eps"] is None      # long to the end
+    turning = t_a_band_edge(lambda e: 30e-6 if e > 1e-3 else 20e-6, t_a, WET_EPS, WET_DRY_REL_TOL)
+    assert turning["eps"] is None and "not monotone" in turning["reason"]
+    w = _wet(1e-3, 1.0105e-3, 1.01e-3)
+    w["wet_silica"]["t_a_band_edge"] = edge
+    c = {c["name"]: c for c in wet_checks.evaluate_wet("t", w, {})}["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]
+    assert c["state"] == NOT_EVALUABLE and "not monotone" in c["reason"]
+
+
+# ------------------------------------------------------------------------------ samples
+def test_an_uncertainty_rows_sigma_does_not_move_the_sigma3_claim_off_3_nm():
+    """The calibration's rows sample sigma around rough_silica's 6 nm; the sigma = 3 nm claim stays at 3 nm
+    (the row's other keys still apply), while the 6 nm drops take the row's sigma."""
+    from continuum.paper.cases import sigma_case
+    from continuum.paper.samples import _resolved
+
+    row = {"surfaces.roughness.sigma": 6.5e-9, "surfaces.roughness.summit_radius": 0.23e-6}
+    s3 = _resolved(sigma_case(3.0), "paper", row, "fast", 1).scene.surfaces.roughness
+    assert s3.sigma == pytest.approx(3e-9) and s3.summit_radius == pytest.approx(0.23e-6)
+    s6 = _resolved(sigma_case(6.0), "paper", row, "fast", 1).scene.surfaces.roughness
+    assert s6.sigma == pytest.approx(6.5e-9)
+
+
 # ------------------------------------------------------------------------------ one physical case
 def test_a_sam_that_adheres_more_than_bare_silica_fails_the_sam_claims():
     """The paper set with the OTS work of adhesion raised above bare silica's (0.3 > 0.12 J/m^2): OTS's adhesive

@@ -169,20 +169,54 @@ def _nucleation_time(scene) -> float | None:
 
 def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -> tuple[list[float], dict | None]:
     """Speeds inside the band above the escape velocity where dry impacts rebound after more than t_a: the band's
-    upper end (dry duration = t_a) bisected in ln(v - upper), then BAND_POINTS speeds spread geometrically in it.
-    Returns (speeds, {'speed', 'rel_tol'} of the edge); ([], None) when no dry impact that rebounds lasts t_a (or
-    without menisci)."""
+    upper end (dry duration = t_a) found by `t_a_band_edge` on the dry law's impact time, then BAND_POINTS speeds
+    spread geometrically in it. Returns (speeds, edge); edge is `t_a_band_edge`'s dict, with 'speed' added when
+    the edge was found; ([], None) when no dry impact that rebounds lasts t_a (or without menisci)."""
     if t_a is None or runs[upper]["stuck"] or runs[upper]["duration"] < t_a:
         return [], None
-    lo, hi = math.log(WET_DRY_REL_TOL), math.log(2.0)        # ln eps: long at lo, short at hi
-    for _ in range(30):
-        mid = 0.5 * (lo + hi)
-        v = upper * (1.0 + math.exp(mid))
+
+    def duration(eps: float) -> float:
+        v = upper * (1.0 + eps)
         runs.setdefault(v, _outcome(dry, mass, g, v, rtol))
-        lo, hi = (mid, hi) if runs[v]["duration"] >= t_a else (lo, mid)
-    eps = np.geomspace(WET_DRY_REL_TOL, math.exp(lo), BAND_POINTS)
-    edge = {"speed": upper * (1.0 + math.exp(lo)), "rel_tol": math.exp(hi) - math.exp(lo) + WET_DRY_REL_TOL}
-    return [upper * (1.0 + e) for e in eps], edge
+        return math.inf if runs[v]["stuck"] else runs[v]["duration"]
+
+    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL)
+    if edge.get("eps") is None:
+        return [], edge
+    edge["speed"] = upper * (1.0 + edge["eps"])
+    return [upper * (1.0 + e) for e in np.geomspace(WET_DRY_REL_TOL, edge["eps"], BAND_POINTS)], edge
+
+
+def t_a_band_edge(duration: Callable[[float], float], t_a: float, scan: tuple, eps_floor: float,
+                  ln_width: float = 2e-8) -> dict:
+    """Where the dry impact time falls through t_a above the escape velocity: eps of v = v_esc (1 + eps).
+
+    `duration(eps)` is the dry impact time (inf where it sticks), known to be >= t_a at eps = 0. The scan speeds
+    (eps values `scan`) bracket the crossing first; only a scan whose impacts outlast t_a up to one point and no
+    further (one crossing, from long to short) is bisected, in ln eps, to `ln_width` (below the scan's first
+    point the bracket's lower end is `eps_floor`, the escape velocity's own relative bracket). A scan that
+    crosses t_a more than once (the impact time is not monotone in the speed there), that starts short and turns
+    long, or that outlasts t_a to its fastest speed gives no edge: {'eps': None, 'reason': ...}. Returns {'eps',
+    'rel_tol' (the bracket's width in eps plus eps_floor), 'scan': [[eps, outlasts], ...]}."""
+    grid = sorted(scan)
+    long = [duration(e) >= t_a for e in grid]
+    record = [[e, bool(x)] for e, x in zip(grid, long)]
+    crossings = sum(a != b for a, b in zip(long, long[1:]))
+    if crossings > 1 or (crossings == 1 and not long[0]):
+        where = ", ".join(f"{e:.3g}" for (e, a), (_, b) in zip(record, record[1:]) if a != b)
+        return {"eps": None, "scan": record,
+                "reason": f"the dry impact time crosses t_a {crossings} times in the scan (near eps = {where}): "
+                          "not monotone in the speed, so no single band edge"}
+    if all(long):
+        return {"eps": None, "scan": record,
+                "reason": f"dry impacts outlast t_a up to the scan's fastest speed, v_esc (1 + {grid[-1]:.3g})"}
+    n_long = sum(long)
+    lo = math.log(grid[n_long - 1]) if n_long else math.log(eps_floor)        # long at lo, short at hi
+    hi = math.log(grid[n_long])
+    while hi - lo > ln_width:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if duration(math.exp(mid)) >= t_a else (lo, mid)
+    return {"eps": math.exp(lo), "rel_tol": math.exp(hi) - math.exp(lo) + eps_floor, "scan": record}
 
 
 def fig4_curves(set_name: str, fidelity: str | None) -> dict:

@@ -56,14 +56,15 @@ def _end_rebounds(s: str, si: dict) -> dict:
     v_wet = (si["escape_wet"] or {}).get("escape_velocity")
     values = {"dry_rebounding_impacts_outlasting_t_a": len(outlast),
               "of_which_stick_with_menisci": sum(p["wet"]["stuck"] for p in outlast),
-              "v_ta_m_per_s": edge["speed"] if edge else None, "escape_velocity_dry_m_per_s": v_dry,
+              "v_ta_m_per_s": (edge or {}).get("speed"), "escape_velocity_dry_m_per_s": v_dry,
               "escape_velocity_wet_m_per_s": v_wet, **_t_a_values(si)}
-    tol = WET_REL_TOL + WET_DRY_REL_TOL + (edge["rel_tol"] if edge else 0.0)
-    if edge is None or not (v_dry and v_wet):
+    tol = WET_REL_TOL + WET_DRY_REL_TOL + (edge.get("rel_tol") or 0.0 if edge else 0.0)
+    if edge is None or edge.get("speed") is None or not (v_dry and v_wet):
         flip = si.get("longest_dry_rebound_s")
         why = ("no dry impact that rebounds lasts t_a (the longest, at the escape velocity's bracket, lasts "
                f"{flip if flip is not None else float('nan'):.4g} s): the claim has no subject at this t_a"
-               if edge is None else "no wet or dry escape velocity")
+               if edge is None else f"no band edge: {edge['reason']}" if edge.get("speed") is None
+               else "no wet or dry escape velocity")
         return over_samples(not_evaluable(name, s, REPRODUCTION, thr, units, why, values, tol), [], NOMINAL_ONLY)
     width = edge["speed"] / v_dry - 1.0
     captured = (v_wet - v_dry) / (edge["speed"] - v_dry)
