@@ -86,6 +86,24 @@ def test_silica_that_never_sticks_or_sticks_at_once_fails_the_decay_claim():
     assert _states(_bundle(silica=_seq([])))[sc.NAMES[2]] == FAIL
 
 
+def test_a_claim_that_holds_nominally_but_not_on_its_seeds_names_them_and_reports_its_stick_probability():
+    """The sigma = 3 nm claim: the averaged law sticks, 2 of 4 seeds rebound. The claim fails over the samples,
+    names the two seeds with their margins, and reports the stick probability 3 of 5 with its Wilson interval
+    (closed form: p = 0.6, n = 5 -> 0.231-0.882)."""
+    nominal = _bundle()
+    seeds = [dict(_bundle(sigma3=_seq([0.2 * i], stuck=False) if i else _seq([])), label=f"seed {k}", seed=True)
+             for k, i in ((1, 1), (2, 0), (3, 2), (4, 0))]
+    claims = {c["name"]: c for c in sc.judged_over_samples("t", nominal, seeds)}
+    c = claims["fig7_sigma3_sticks_at_first_impact"]
+    assert c["state"] == FAIL and c["holds_fraction"] == pytest.approx(0.6)
+    assert [f["label"] for f in c["failing_samples"]] == ["seed 1", "seed 3"]
+    assert c["failing_samples"][1]["margin"] == pytest.approx(1e-3 - 0.4)
+    assert "fails on seed 1 (margin -0.199), seed 3 (margin -0.399)" in c["reason"]
+    p = c["bands"]["stuck_at_first_impact"]
+    assert (p["k"], p["n"]) == (3, 5) and p["wilson95"] == pytest.approx([0.2307, 0.8824], abs=1e-4)
+    assert "failing_samples" not in claims["fig4_ots_loop_smaller_than_silica"]
+
+
 # ------------------------------------------------------------------------------ sweep claims (nominal runs)
 def _impact(sigma, rebounds, status="stuck"):
     return {"scene": {"si": {"release_height": H0, "surfaces": {"roughness": {"sigma": sigma}}}}, "status": status,

@@ -143,6 +143,14 @@ def set_claims(set_name: str, collected: dict) -> list[dict]:
     return sorted(out, key=lambda c: c["kind"] != VERIFICATION)
 
 
+def _band_text(key: str, b: dict) -> str:
+    """A band (min-max, median) or a proportion (k of n, Wilson 95 % interval) as one phrase."""
+    if "fraction" in b:
+        lo, hi = b["wilson95"]
+        return f"{key} {b['k']} of {b['n']} (95 % {lo:.2f}-{hi:.2f})"
+    return f"{key} {_fmt(b['min'])}-{_fmt(b['max'])} (median {_fmt(b['median'])}, n {b['n']})"
+
+
 def claim_tables(set_checks: list[dict]) -> list[str]:
     """summary.md's two tables: verification checks, then reproduction claims with their sample fractions."""
     ver = [c for c in set_checks if c["kind"] == VERIFICATION]
@@ -157,8 +165,7 @@ def claim_tables(set_checks: list[dict]) -> list[str]:
               "| bands |", "|---|---|---|---|---|---|---|---|---|"]
     for c in rep:
         src = c.get("sampled", {})
-        bands = "; ".join(f"{k} {_fmt(b['min'])}-{_fmt(b['max'])} (median {_fmt(b['median'])}, n {b['n']})"
-                          for k, b in (c.get("bands") or {}).items() if b)
+        bands = "; ".join(_band_text(k, b) for k, b in (c.get("bands") or {}).items() if b)
         lines.append(f"| `{c['name']}` | {c['state']} | {_fmt(c.get('holds_fraction'), '.3g')} | {c.get('samples')} "
                      f"({src.get('seeds', 0)}, {src.get('uncertainty', 0)}) | {_fmt(c['margin'])} | "
                      f"{_fmt(c['tolerance'])} | {c['units']} | {c.get('reason', '')} | {bands} |")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from .samples import ESCAPE_REL_TOL, SAMPLE_MAX_BOUNCES
-from .verdict import NOT_EVALUABLE, REPRODUCTION, band, entry, not_evaluable, over_samples
+from .verdict import FAIL, NOT_EVALUABLE, REPRODUCTION, band, entry, not_evaluable, over_samples, proportion
 
 #: "Sticks" means no rebound above this fraction of the release height h0 (the paper notes).
 STICK_FRACTION = 1e-3
@@ -146,7 +146,17 @@ def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> li
                    "seeds": 0 if name in FULL_ONLY else len(seeds)}
         if name in FULL_ONLY and seeds:
             sources["seeds_note"] = "not judged on discrete seeds (needs the averaged law's escape search or loop)"
-        out.append(over_samples(nom[name], used, sources, _bands(name, [nominal] + samples)))
+        e = over_samples(nom[name], used, sources, _bands(name, [nominal] + samples))
+        failing = [{"label": b["label"], "margin": p[name]["margin"], **({"reason": p[name]["reason"]}
+                                                                          if p[name].get("reason") else {})}
+                   for p, b in zip(per, samples) if p[name]["state"] == FAIL
+                   and not (name in FULL_ONLY and b.get("seed"))]
+        if failing:
+            e["failing_samples"] = failing
+            if e["state"] == FAIL and nom[name]["state"] != FAIL:
+                e["reason"] += "; fails on " + ", ".join(
+                    f["label"] + (f" (margin {f['margin']:.3g})" if f["margin"] is not None else "") for f in failing)
+        out.append(e)
     return out
 
 
@@ -159,7 +169,9 @@ def _bands(name: str, bundles: list[dict]) -> dict | None:
     if name == NAMES[2]:
         return {"rebounds_silica": band(len(rebounds(b["silica"])) for b in ok)}
     if name == NAMES[3]:
-        return {"first_rebound_over_h0": band(b["sigma3"]["rebound_over_h0"][0] for b in ok)}
+        return {"first_rebound_over_h0": band(b["sigma3"]["rebound_over_h0"][0] for b in ok),
+                "stuck_at_first_impact": proportion(b["sigma3"]["rebound_over_h0"][0] <= STICK_FRACTION
+                                                    for b in ok)}
     if name == NAMES[0]:
         return {"loop_ratio": band(b["loop"]["ots"] / b["loop"]["silica"] for b in ok if "loop" in b)}
     return None

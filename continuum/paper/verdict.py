@@ -101,3 +101,16 @@ def band(values) -> dict | None:
         return None
     mid = v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
     return {"min": v[0], "median": mid, "max": v[-1], "n": len(v)}
+
+
+def proportion(flags) -> dict | None:
+    """How often an outcome occurred over samples: k of n, the fraction, and its Wilson score 95 % interval
+    (Wilson, J. Am. Stat. Assoc. 22 (1927) 209), which stays inside [0, 1] for a handful of samples."""
+    f = [bool(x) for x in flags]
+    n, k = len(f), sum(f)
+    if n == 0:
+        return None
+    z, p = 1.959964, k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return {"fraction": p, "k": k, "n": n, "wilson95": [max(0.0, centre - half), min(1.0, centre + half)]}
