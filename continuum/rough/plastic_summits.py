@@ -1,0 +1,404 @@
+"""Adhesive elastic-plastic summits (Thornton & Ning 1998 on each summit), one by one and averaged (GW).
+
+What it is
+----------
+A summit is a sphere of tip radius beta with the summits' contact modulus E* and the pair's work of adhesion w,
+pressed by its approach delta against a flat (displacement control, as under a roller or a punch). Above its
+limiting contact pressure p_y (`continuum.limiting_pressure`) it follows the Thornton-Ning adhesive
+elastic-plastic law of `continuum.reference.thornton_ning` (the same law as the smooth sphere's
+`continuum.laws.plastic_sphere`):
+
+* elastic loading is JKR on beta up to the yield approach delta_y (centre pressure = p_y);
+* plastic loading is the line F = F_y + pi p_y beta (delta - delta_y);
+* unloading and elastic reloading follow JKR about the flattened radius
+  R_p = 4E*a*^3 / (3 (F* + sqrt(8 pi w E* a*^3))), shifted by the residual indentation delta_p, so that the
+  branch passes through the deepest state (delta_max, F*);
+* the summit lets go at the fold of that branch, delta = delta_p - delta_c(R_p) (displacement control), and
+  meets the flattened summit again at delta = delta_p.
+
+A summit's plastic state is a function of one number, its deepest approach delta_max (`PlasticSummitLaw.
+flattening`): each summit carries (R_p, delta_p) into later contacts. With p_y = inf no summit yields and every
+function is the elastic JKR summit's, evaluated by the same closed forms (`continuum.reference.jkr`).
+
+Energy of a summit (exact, from the closed forms): stored U = the JKR energy of its current branch from that
+branch's touch point (`jkr.energy_from_approach`); plastic work W_p(delta_max) = U_beta(a_y) + F_y D +
+pi p_y beta D^2/2 - U_Rp(a*), D = delta_max - delta_y (work done along the loading path less what the new
+branch stores); hysteresis at release = U_Rp at the fold (the Fuller-Tabor loop of the R_p branch).
+
+Mean field (Greenwood & Williamson 1966): summit heights z are Gaussian (rms sigma_s, density n, truncated at
+z_max). A summit of height z under a flat at separation d has delta = z - d; its plastic state depends only on the
+deepest separation ever reached, d_p (delta_max = z - d_p), and whether it is attached in the present contact on
+the deepest separation of this contact, d_c (>= d_p), and on d (monotonic approach, then monotonic retreat: the
+driver ends a contact at its first turn while attached). With u = z - d_p:
+
+    attached  <=>  u - delta_p(u) >= d_c - d_p     (met in this contact)
+              and  u - delta_p(u) + delta_c(R_p(u)) > d - d_p     (not yet let go),
+
+both left sides increasing in u (tested), so the attached summits are u > u_a(d, d_c, d_p), and
+
+    p = n int_{u_a}^{z_max - d_p} F(u) phi(d_p + u) du,   E = n int U phi du,   W_p = n int W_p(u) phi du.
+
+The integrals are Gauss-Legendre panels (8 nodes) in u, geometric from u_a (first width a tenth of the adhesive
+length scale, at most sigma/4), the first panel in t with u = u_a + t^2 (the JKR force has a square-root
+behaviour at the fold), split at delta_y. They run in NumPy: the summit states are not tabulated, so these
+surfaces are for flat-punch contact (`PlasticGWPunch`) and for the checks, not for the rough roller's footprint
+tables.
+
+Plasticity index (Greenwood & Williamson 1966): psi = (E*/H) sqrt(sigma_s/beta); psi < 0.6 the summits stay
+elastic under any practical load, psi > 1 most touching summits yield (`continuum.regimes.plasticity_index`).
+
+Sources: C. Thornton & Z. Ning, Powder Technol. 99 (1998) 154-162; J. A. Greenwood & J. B. P. Williamson,
+Proc. R. Soc. Lond. A 295 (1966) 300; K. L. Johnson, K. Kendall & A. D. Roberts, Proc. R. Soc. Lond. A 324
+(1971) 301; K. N. G. Fuller & D. Tabor, Proc. R. Soc. Lond. A 345 (1975) 327. Why Thornton-Ning and not
+Mesarovic-Johnson or Kogut-Etsion: `continuum.reference.thornton_ning`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..laws.base import ContactLaw
+from ..reference import jkr
+from ..reference import thornton_ning as tn
+
+__all__ = ["PlasticSummitLaw", "PlasticGWSurface", "PlasticGWPunch", "PlasticSummitsPunch"]
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+_SQRT2PI = math.sqrt(2.0 * math.pi)
+
+
+@dataclass(frozen=True)
+class PlasticSummitLaw:
+    """One summit's Thornton-Ning law: tip radius beta (m), work of adhesion w > 0 (J/m^2), contact modulus E* (Pa),
+    limiting contact pressure p_y (Pa; math.inf: elastic JKR). Functions are vectorised over summits."""
+
+    radius: float
+    work_of_adhesion: float
+    e_star: float
+    limiting_pressure: float
+    yield_radius: float = field(init=False)
+    yield_force: float = field(init=False)
+    yield_approach: float = field(init=False)
+    plastic_slope: float = field(init=False)
+
+    def __post_init__(self):
+        if not self.work_of_adhesion > 0.0:
+            raise ValueError(f"work_of_adhesion = {self.work_of_adhesion!r}: the adhesive plastic summit needs w > 0")
+        p = (self.radius, self.work_of_adhesion, self.e_star)
+        if math.isinf(self.limiting_pressure):
+            a_y, f_y, d_y = math.inf, math.inf, math.inf
+        else:
+            tn.check_limiting_pressure(self.limiting_pressure, *p)
+            a_y = float(tn.yield_radius(self.limiting_pressure, *p))
+            f_y, d_y = float(jkr.force_from_radius(a_y, *p)), float(jkr.approach_from_radius(a_y, *p))
+        set_ = object.__setattr__
+        set_(self, "yield_radius", a_y)
+        set_(self, "yield_force", f_y)
+        set_(self, "yield_approach", d_y)
+        set_(self, "plastic_slope", math.pi * self.limiting_pressure * self.radius)
+
+    def flattening(self, delta_max):
+        """(R_p, delta_p) (m) of the elastic branch after the deepest approach delta_max (m): (beta, 0) unyielded."""
+        dm = np.asarray(delta_max, float)
+        over = np.maximum(dm - self.yield_approach, 0.0) if math.isfinite(self.yield_approach) else np.zeros_like(dm)
+        yielded = over > 0.0
+        w, e, beta = self.work_of_adhesion, self.e_star, self.radius
+        a = np.sqrt(self.yield_radius**2 + beta * over) if yielded.any() else np.ones_like(dm)
+        f = self.yield_force + self.plastic_slope * over if yielded.any() else np.zeros_like(dm)
+        r_p = np.where(yielded, 4.0 * e * a**3 / (3.0 * (f + np.sqrt(8.0 * math.pi * w * e * a**3))), beta)
+        d_p = np.where(yielded, dm - np.asarray(jkr.approach_from_radius(a, r_p, w, e), float), 0.0)
+        return r_p, d_p
+
+    def release_stretch(self, r_p):
+        """delta_c(R_p) (m): the branch lets go at delta = delta_p - delta_c (displacement control)."""
+        return np.asarray(jkr.critical_approach(r_p, self.work_of_adhesion, self.e_star), float)
+
+    def branch(self, delta, delta_max):
+        """(force N, stored energy J) of attached summits at approach delta (m), deepest approach delta_max (m,
+        >= delta; the plastic line where delta = delta_max > delta_y)."""
+        r_p, d_p = self.flattening(delta_max)
+        # attached summits lie at or above the fold; the clamp only absorbs round-off at the release boundary
+        e = np.maximum(np.asarray(delta, float) - d_p, -self.release_stretch(r_p))
+        w, es = self.work_of_adhesion, self.e_star
+        a = np.asarray(jkr.radius_from_approach(e, r_p, w, es), float)
+        return (np.asarray(jkr.force_from_radius(a, r_p, w, es), float),
+                np.asarray(jkr.energy_from_radius(a, r_p, w, es), float))
+
+    def plastic_work(self, delta_max):
+        """W_p (J): the work a summit loaded to delta_max absorbed plastically (0 unyielded)."""
+        dm = np.asarray(delta_max, float)
+        if not math.isfinite(self.yield_approach):
+            return np.zeros_like(dm)
+        d = np.maximum(dm - self.yield_approach, 0.0)
+        p = (self.radius, self.work_of_adhesion, self.e_star)
+        work = float(jkr.energy_from_radius(self.yield_radius, *p)) + self.yield_force * d + 0.5 * self.plastic_slope * d * d
+        _, stored = self.branch(np.maximum(dm, self.yield_approach), np.maximum(dm, self.yield_approach))
+        return np.where(d > 0.0, work - stored, 0.0)
+
+    def loop_energy(self, delta_max):
+        """Energy (J) a summit with deepest approach delta_max loses when it lets go (the R_p branch's loop)."""
+        r_p, _ = self.flattening(delta_max)
+        return np.asarray(jkr.energy_from_approach(-self.release_stretch(r_p), r_p, self.work_of_adhesion,
+                                                   self.e_star), float)
+
+    def describe(self) -> dict:
+        return {"name": "thornton_ning_summit", "radius": self.radius, "work_of_adhesion": self.work_of_adhesion,
+                "e_star": self.e_star, "limiting_pressure": self.limiting_pressure,
+                "yield_radius": self.yield_radius, "yield_force": self.yield_force,
+                "yield_approach": self.yield_approach, "plastic_slope": self.plastic_slope,
+                "source": "Thornton & Ning (1998) per summit: JKR to yield, plastic line pi p_y beta, JKR unloading "
+                          "about R_p shifted by delta_p; Fuller-Tabor release at the fold"}
+
+
+class PlasticGWSurface:
+    """GW mean field of `PlasticSummitLaw` summits: Gaussian heights of rms sigma (m), density n (1/m^2), truncated
+    at z_max sigma (the tallest summit, the datum of `PlasticGWPunch`). Values per unit nominal area, functions of
+    the separation d, this contact's deepest separation d_c and the deepest ever d_p (m; d_p <= d_c)."""
+
+    def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float):
+        if not math.isfinite(z_max):
+            raise ValueError("PlasticGWSurface needs a finite truncation z_max (units of sigma): the tallest summit")
+        self.law, self.sigma, self.density = law, float(sigma), float(density)
+        self.z_top = float(z_max) * self.sigma
+        self.delta_c = float(law.release_stretch(law.radius))
+        self._first = 0.1 * max(self.delta_c, 1e-3 * self.sigma)
+
+    # ------------------------------------------------------------------ summit sets
+    def recovery(self, u):
+        """g(u) = u - delta_p(u): a summit of deepest approach u (m) is met again at separation d_p + g(u)."""
+        u = np.asarray(u, float)
+        return u - self.law.flattening(u)[1]
+
+    def hold(self, u):
+        """h(u) = g(u) + delta_c(R_p(u)): a summit of deepest approach u lets go at separation d_p + h(u)."""
+        u = np.asarray(u, float)
+        r_p, d_p = self.law.flattening(u)
+        return u - d_p + self.law.release_stretch(r_p)
+
+    def _inverse(self, fn, value, offset):
+        """The u (m) with fn(u) = value, fn(u) = u + offset up to delta_y and increasing beyond."""
+        d_y = self.law.yield_approach
+        if value - offset <= d_y:
+            return value - offset
+        hi = max(2.0 * (value - offset), d_y + self.sigma)
+        while float(fn(hi)) < value:
+            hi *= 2.0
+        return brentq(lambda u: float(fn(u)) - value, d_y, hi, xtol=1e-15 * hi, rtol=1e-14)
+
+    def bounds(self, d, d_c, d_p):
+        """(u_met, u_held): summits met in this contact are u >= u_met, those not yet let go u > u_held (m)."""
+        u_met = self._inverse(self.recovery, d_c - d_p, 0.0) if math.isfinite(d_c) else math.inf
+        return u_met, self._inverse(self.hold, d - d_p, self.delta_c) if math.isfinite(d) else math.inf
+
+    # ------------------------------------------------------------------ quadrature
+    def _nodes(self, lo, hi):
+        """Gauss-Legendre nodes and weights on [lo, hi] (m): geometric panels from lo, the first in u = lo + t^2,
+        split at delta_y."""
+        if not hi > lo:
+            return np.empty(0), np.empty(0)
+        t1 = math.sqrt(min(self._first, hi - lo))
+        t = 0.5 * t1 * (_GL_X + 1.0)
+        xs, ws = [lo + t * t], [0.5 * t1 * _GL_W * 2.0 * t]
+        edges, x, width = [], lo + t1 * t1, self._first
+        while x < hi:
+            edges.append(x)
+            width = min(1.5 * width, 0.25 * self.sigma)
+            x += width
+        edges.append(hi)
+        d_y = self.law.yield_approach
+        edges = np.unique(np.concatenate([edges, [d_y] if edges[0] < d_y < hi else []]))
+        a, b = edges[:-1, None], edges[1:, None]
+        xs.append((0.5 * (a + b) + 0.5 * (b - a) * _GL_X).ravel())
+        ws.append((0.5 * (b - a) * _GL_W).ravel())
+        return np.concatenate(xs), np.concatenate(ws)
+
+    def _weight(self, u, w, d_p):
+        z = (d_p + u) / self.sigma
+        return self.density * w * np.exp(-0.5 * z * z) / (_SQRT2PI * self.sigma)
+
+    def state(self, d, d_c, d_p):
+        """(pressure Pa (+ compressive), stored energy J/m^2, contact density 1/m^2) at separation d (m)."""
+        u_met, u_held = self.bounds(d, d_c, d_p)
+        u, w = self._nodes(max(u_met, u_held, 0.0), self.z_top - d_p)
+        if u.size == 0:
+            return 0.0, 0.0, 0.0
+        f, en = self.law.branch(u - (d - d_p), u)
+        q = self._weight(u, w, d_p)
+        return float(q @ f), float(q @ en), float(q.sum())
+
+    def plastic_work(self, d_p):
+        """Plastic work (J/m^2) of all summits after the deepest separation d_p (m)."""
+        u, w = self._nodes(max(self.law.yield_approach, 0.0), self.z_top - d_p)
+        return float(self._weight(u, w, d_p) @ self.law.plastic_work(u)) if u.size else 0.0
+
+    def released(self, d, d_c, d_p):
+        """Hysteresis (J/m^2) of the summits met in this contact that have let go at separation d (m)."""
+        u_met, u_held = self.bounds(d, d_c, d_p)
+        lo = max(u_met, 0.0)
+        u, w = self._nodes(lo, min(max(u_held, lo), self.z_top - d_p))
+        return float(self._weight(u, w, d_p) @ self.law.loop_energy(u)) if u.size else 0.0
+
+    def plasticity_index(self, hardness: float) -> float:
+        """Greenwood-Williamson psi = (E*/H) sqrt(sigma/beta) of these summits (hardness H in Pa)."""
+        return self.law.e_star / hardness * math.sqrt(self.sigma / self.law.radius)
+
+
+class PlasticGWPunch(ContactLaw):
+    """Rigid flat of nominal area A (m^2) on a `PlasticGWSurface`; gap = d - z_max (m) above the tallest summit.
+
+    The deepest separation ever, d_p, outlives a contact (`reset` keeps it, `forget_history` clears it), so a
+    second impact meets flattened summits. Losses from the law's own terms: plastic work W_p(d_p) and the loops
+    of the summits that let go."""
+
+    name = "plastic_gw_punch"
+    has_history = True
+    bound_is_final = True   # the driver ends a contact at its first turn while attached (one approach, one retreat)
+
+    def __init__(self, surface: PlasticGWSurface, area: float):
+        self.surface, self.area = surface, float(area)
+        self.forget_history()
+
+    def forget_history(self) -> None:
+        self._d_p = self.surface.z_top          # no summit met yet
+        self.impacts = 0
+        self.reset()
+
+    def reset(self) -> None:
+        self._d_c = math.inf
+        self._w0 = self.surface.plastic_work(self._d_p)
+
+    def _trial(self, gap):
+        d = self.surface.z_top + gap
+        return d, min(self._d_c, d), min(self._d_p, d)
+
+    def force(self, gap):
+        return self.area * self.surface.state(*self._trial(gap))[0]
+
+    def stiffness(self, gap):
+        h = 1e-7 * self.surface.sigma
+        return (self.force(gap - h) - self.force(gap + h)) / (2.0 * h)
+
+    def stored_energy(self, gap):
+        return self.area * self.surface.state(*self._trial(gap))[1]
+
+    def dissipated(self, gap):
+        d, d_c, d_p = self._trial(gap)
+        s = self.surface
+        return self.area * (s.plastic_work(d_p) - self._w0 + s.released(d, d_c, d_p))
+
+    def release_gap(self):
+        s = self.surface
+        u_top = s.z_top - self._d_p
+        fn = s.hold if math.isfinite(self._d_c) else s.recovery
+        return self._d_p + float(fn(u_top)) - s.z_top
+
+    def on_release(self):
+        s = self.surface
+        return self.area * (s.plastic_work(self._d_p) - self._w0 + s.released(math.inf, self._d_c, self._d_p))
+
+    def accept(self, gap):
+        d, self._d_c, self._d_p = self._trial(gap)
+
+    def length_scale(self, mass, speed):
+        return max(0.1 * self.surface.sigma, self.surface.delta_c)
+
+    def diagnostics(self):
+        return {"deepest_separation": self._d_p, "plastic_work": self.area * self.surface.plastic_work(self._d_p)}
+
+    def describe(self):
+        s = self.surface
+        return {"name": self.name, "area": self.area, "sigma": s.sigma, "density": s.density, "z_top": s.z_top,
+                "summit_law": s.law.describe(), "source": "Greenwood & Williamson (1966) mean field of Thornton & "
+                "Ning (1998) summits, history (d, d_c, d_p)"}
+
+
+class PlasticSummitsPunch(ContactLaw):
+    """Rigid flat on discrete `PlasticSummitLaw` summits of heights z (m); gap = d - max(z) (m).
+
+    Each summit carries its deepest approach (hence R_p and delta_p) into later contacts; `forget_history` returns
+    them to virgin summits. A summit is met at delta = delta_p (its force jumps onto the JKR curve of R_p there, at
+    no cost in energy) and lets go at the fold delta_p - delta_c(R_p), booking that branch's loop."""
+
+    name = "plastic_summits_punch"
+    has_history = True
+    bound_is_final = True
+
+    def __init__(self, law: PlasticSummitLaw, heights):
+        self.law = law
+        self.heights = np.asarray(heights, float)
+        self.z_top = float(np.max(self.heights))
+        self.forget_history()
+
+    def forget_history(self) -> None:
+        self.delta_max = np.zeros_like(self.heights)      # 0 < delta_y: virgin summits
+        self.reset()
+
+    def reset(self) -> None:
+        self._attached = np.zeros(self.heights.size, bool)
+        self._met = np.zeros(self.heights.size, bool)
+        self._w0 = float(np.sum(self.law.plastic_work(self.delta_max)))
+        self._loops = 0.0
+
+    def _trial(self, gap):
+        """(delta, attached, deepest approach, loops of the summits letting go now) at gap (m)."""
+        delta = self.heights - self.z_top - gap
+        r_p, d_p = self.law.flattening(self.delta_max)
+        release = d_p - self.law.release_stretch(r_p)
+        attached = (delta >= d_p) | (self._attached & (delta > release))
+        lost = self._attached & ~attached
+        dm = np.where(attached, np.maximum(self.delta_max, delta), self.delta_max)
+        loops = float(np.sum(self.law.loop_energy(self.delta_max[lost]))) if lost.any() else 0.0
+        return delta, attached, dm, loops
+
+    def _values(self, gap):
+        delta, att, dm, loops = self._trial(gap)
+        if not att.any():
+            return 0.0, 0.0, dm, loops
+        f, en = self.law.branch(delta[att], dm[att])
+        return float(np.sum(f)), float(np.sum(en)), dm, loops
+
+    def force(self, gap):
+        return self._values(gap)[0]
+
+    def stiffness(self, gap):
+        h = 1e-9 * self.law.radius
+        return (self.force(gap - h) - self.force(gap + h)) / (2.0 * h)
+
+    def stored_energy(self, gap):
+        return self._values(gap)[1]
+
+    def dissipated(self, gap):
+        _, _, dm, loops = self._values(gap)
+        return float(np.sum(self.law.plastic_work(dm))) - self._w0 + self._loops + loops
+
+    def release_gap(self):
+        r_p, d_p = self.law.flattening(self.delta_max)
+        release = self.heights - d_p + self.law.release_stretch(r_p) - self.z_top
+        met = self._met if self._met.any() else np.ones_like(self._met)
+        return float(np.max(release[met]))
+
+    def on_release(self):
+        held = self._attached
+        return (float(np.sum(self.law.plastic_work(self.delta_max))) - self._w0 + self._loops
+                + float(np.sum(self.law.loop_energy(self.delta_max[held]))))
+
+    def accept(self, gap):
+        _, att, dm, loops = self._trial(gap)
+        self._loops += loops
+        self._attached, self.delta_max = att, dm
+        self._met |= att
+
+    def length_scale(self, mass, speed):
+        return float(self.law.release_stretch(self.law.radius))
+
+    def diagnostics(self):
+        r_p, d_p = self.law.flattening(self.delta_max)
+        return {"summits_yielded": int(np.sum(self.delta_max > self.law.yield_approach)),
+                "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
+
+    def describe(self):
+        return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
+                "source": "Thornton & Ning (1998) on each summit, each carrying its flattening"}

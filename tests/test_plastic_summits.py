@@ -1,0 +1,174 @@
+"""Adhesive elastic-plastic summits (continuum.rough.plastic_summits) against closed forms and their own limits.
+
+References independent of the module's sums: the JKR closed forms (`continuum.reference.jkr`), the Thornton-Ning
+closed-form impact of one sphere (`continuum.reference.thornton_ning.impact`: a quadratic for the maximum approach,
+the JKR energy integrals), scipy's adaptive quadrature of the GW integral, the tabulated elastic GW surface
+(`GWBranchSurface` with JKR summits), and the driver's energy audit (the motion integrated at rtol 1e-9 against
+the losses the law books from its own terms).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from continuum.driver import DriverSettings, simulate
+from continuum.reference import jkr
+from continuum.reference import thornton_ning as tn
+from continuum.rough.branch_laws import make_summit_law
+from continuum.rough.gw_branches import GWBranchSurface
+from continuum.rough.plastic_summits import PlasticGWPunch, PlasticGWSurface, PlasticSummitLaw, PlasticSummitsPunch
+from continuum.rough.summits import SummitStatistics
+
+BETA, W, E = 1e-6, 0.1, 1e11            # summit tip radius (m), work of adhesion (J/m^2), contact modulus (Pa)
+P_Y = 3e9                                # limiting contact pressure (Pa): yield approach ~2.2 nm
+SIGMA, DENSITY, ZMAX = 5e-9, 1e13, 4.0   # summit heights rms (m), summits per m^2, truncation (sigma)
+AREA, MASS, SPEED = 1e-8, 1e-9, 0.05     # punch: nominal area (m^2), mass (kg), impact speed (m/s)
+SETTINGS = DriverSettings(rtol=1e-9, max_bounces=1)
+
+
+def _punch(p_y):
+    return PlasticGWPunch(PlasticGWSurface(PlasticSummitLaw(BETA, W, E, p_y), SIGMA, DENSITY, ZMAX), AREA)
+
+
+# ----------------------------------------------------------------------------- (a) p_y -> inf is elastic JKR
+def test_infinite_limiting_pressure_is_the_jkr_summit():
+    law = PlasticSummitLaw(BETA, W, E, math.inf)
+    dc = float(jkr.critical_approach(BETA, W, E))
+    delta = np.linspace(-dc, 20 * dc, 301)
+    f, u = law.branch(delta, np.maximum(delta, 30 * dc))
+    pc = 1.5 * math.pi * W * BETA
+    # the same closed form reached through the contact radius: round-off apart
+    np.testing.assert_allclose(f, jkr.force_from_approach(delta, BETA, W, E), rtol=1e-12, atol=1e-12 * pc)
+    np.testing.assert_allclose(u, jkr.energy_from_approach(delta, BETA, W, E), rtol=1e-12, atol=1e-12 * dc * pc)
+    np.testing.assert_array_equal(law.plastic_work(delta), 0.0)
+    np.testing.assert_allclose(law.loop_energy(delta), jkr.loop_area(BETA, W, E), rtol=1e-12)
+    # a finite p_y that the summit never reaches gives the same numbers bit for bit
+    high = PlasticSummitLaw(BETA, W, E, 0.5 * E)
+    assert high.yield_approach > delta[-1]
+    np.testing.assert_array_equal(high.branch(delta, delta)[0], law.branch(delta, delta)[0])
+
+
+def test_elastic_mean_field_is_the_gw_jkr_surface():
+    """p_y = inf: the mean field equals the tabulated elastic GW surface (threshold zeta = d_c for JKR summits)
+    within that surface's table error, and adaptive quadrature of the JKR closed form to 1e-7."""
+    surf = PlasticGWSurface(PlasticSummitLaw(BETA, W, E, math.inf), SIGMA, DENSITY, ZMAX)
+    stats = SummitStatistics(SIGMA, DENSITY, BETA)
+    elastic = GWBranchSurface(stats, make_summit_law("jkr", BETA, W, E, delta_max=10 * SIGMA), z_max=ZMAX)
+    scale = DENSITY * 1.5 * math.pi * W * BETA
+    for depth, back in ((1.0, 0.0), (2.5, 0.0), (2.5, 0.5), (3.0, 1.2)):
+        d_c = surf.z_top - depth * SIGMA
+        d = d_c + back * SIGMA
+        p, energy, _ = surf.state(d, d_c, d_c)
+        assert abs(p - float(elastic.pressure(d, d_c))) < 2e-5 * max(abs(p), scale)
+        assert abs(energy - float(elastic.energy(d, d_c))) < 2e-5 * max(abs(energy), scale * SIGMA)
+        # independent: quad over summit heights of the JKR closed form (attached: met, z >= d_c, and above the fold)
+        dc = float(jkr.critical_approach(BETA, W, E))
+
+        def f(z):
+            return float(jkr.force_from_approach(z - d, BETA, W, E)) * math.exp(-0.5 * (z / SIGMA) ** 2)
+
+        lo = max(d_c, d - dc)
+        ref, _ = integrate.quad(f, lo, surf.z_top, epsabs=0, epsrel=1e-11, limit=400)
+        ref *= DENSITY / (math.sqrt(2 * math.pi) * SIGMA)
+        assert abs(p - ref) < 1e-7 * max(abs(ref), scale * 1e-3)
+
+
+# ----------------------------------------------------------------------------- (b) one summit = Thornton-Ning
+@pytest.mark.parametrize("speed", [3.0, 10.0, 30.0])
+def test_one_summit_is_the_thornton_ning_sphere(speed):
+    """A summit loaded to delta* by an impact of a sphere of the summit's radius: flattened radius, residual
+    indentation, force at the maximum, plastic loss and unloading loop are Thornton-Ning's closed forms."""
+    rho = 2330.0
+    ref = tn.impact(speed, BETA, W, E, rho, P_Y)
+    assert ref.yielded[0]
+    law = PlasticSummitLaw(BETA, W, E, P_Y)
+    d_star = law.yield_approach + (ref.max_force[0] - law.yield_force) / law.plastic_slope
+    r_p, d_p = law.flattening(d_star)
+    assert r_p == pytest.approx(ref.plastic_radius[0], rel=1e-11)
+    assert d_p == pytest.approx(ref.plastic_approach[0], rel=1e-9)
+    f, stored = law.branch(d_star, d_star)
+    assert f == pytest.approx(ref.max_force[0], rel=1e-11)
+    assert law.plastic_work(d_star) == pytest.approx(ref.plastic_loss[0], rel=1e-9)
+    assert law.loop_energy(d_star) == pytest.approx(ref.adhesive_loss[0], rel=1e-9)
+    # loading: the force on the plastic line, F_y + pi p_y beta (delta - delta_y) (Thornton & Ning eq. for F_p)
+    a_y = float(tn.yield_radius(P_Y, BETA, W, E))
+    delta = law.yield_approach + np.linspace(0.0, 1.0, 7) * (d_star - law.yield_approach)
+    line = float(jkr.force_from_radius(a_y, BETA, W, E)) + math.pi * P_Y * BETA * (delta - law.yield_approach)
+    np.testing.assert_allclose(law.branch(delta, delta)[0], line, rtol=1e-10)
+    # unloading: JKR of R_p shifted by delta_p, through (delta*, F*), letting go at delta_p - delta_c(R_p)
+    back = np.linspace(d_p - float(jkr.critical_approach(r_p, W, E)), d_star, 9)
+    np.testing.assert_allclose(law.branch(back, d_star)[0], jkr.force_from_approach(back - d_p, r_p, W, E), rtol=1e-12)
+
+
+def test_summit_sets_are_one_interval_in_height():
+    """The mean field's attached summits are one interval because g(u) = u - delta_p and h = g + delta_c(R_p)
+    increase with the deepest approach u."""
+    surf = PlasticGWSurface(PlasticSummitLaw(BETA, W, E, P_Y), SIGMA, DENSITY, ZMAX)
+    u = np.linspace(0.0, 10 * SIGMA, 2001)
+    assert np.all(np.diff(surf.recovery(u)) > 0.0)
+    assert np.all(np.diff(surf.hold(u)) > 0.0)
+
+
+# ----------------------------------------------------------------------------- (c), (d) impacts with the audit
+def test_plastic_summits_dissipate_more_and_the_audit_closes():
+    runs = {}
+    for p_y in (math.inf, P_Y):
+        punch = _punch(p_y)
+        run = simulate(punch, MASS, 0.0, impact_velocity=SPEED, settings=SETTINGS)
+        assert run.status == "escaped"
+        b = run.bounces[0]
+        plastic = punch.diagnostics()["plastic_work"]
+        # the motion's loss is the booked plastic work plus the loops of the summits that let go
+        assert run.audit["max_relative_error"] < 1e-6
+        assert b.energy_lost == pytest.approx(b.energy_booked, rel=1e-5)
+        runs[p_y] = (b.energy_lost, plastic)
+    (lost_el, w_el), (lost_pl, w_pl) = runs[math.inf], runs[P_Y]
+    assert w_el == 0.0 and w_pl > 0.0
+    assert lost_pl > 2.0 * lost_el
+    assert lost_pl > w_pl
+
+
+def test_second_impact_meets_the_flattened_summits():
+    punch = _punch(P_Y)
+    first = simulate(punch, MASS, 0.0, impact_velocity=SPEED, settings=SETTINGS)
+    w1 = punch.diagnostics()["plastic_work"]
+    punch.reset()                       # a new contact on the same spot: the flattening stays
+    second = simulate(punch, MASS, 0.0, impact_velocity=SPEED, settings=SETTINGS)
+    w2 = punch.diagnostics()["plastic_work"]
+    lost1, lost2 = first.bounces[0].energy_lost, second.bounces[0].energy_lost
+    assert second.audit["max_relative_error"] < 1e-6
+    assert lost2 < 0.5 * lost1
+    assert lost2 == pytest.approx(second.bounces[0].energy_booked, rel=1e-5)
+    assert w2 - w1 < 0.5 * w1           # little new plastic work: the summits are already flattened
+    punch.forget_history()              # a fresh spot: the first impact again
+    again = simulate(punch, MASS, 0.0, impact_velocity=SPEED, settings=SETTINGS)
+    assert again.bounces[0].energy_lost == pytest.approx(lost1, rel=1e-9)
+
+
+def test_discrete_summits_carry_their_flattening():
+    rng = np.random.default_rng(1)
+    heights = rng.normal(0.0, SIGMA, 40)
+    lost, yielded = {}, {}
+    for p_y in (math.inf, P_Y):
+        punch = PlasticSummitsPunch(PlasticSummitLaw(BETA, W, E, p_y), heights)
+        for k in range(2):
+            run = simulate(punch, 1e-11, 0.0, impact_velocity=0.1, settings=SETTINGS)
+            b = run.bounces[0]
+            assert run.audit["max_relative_error"] < 1e-6
+            assert b.energy_lost == pytest.approx(b.energy_booked, rel=1e-4)
+            lost[p_y, k] = b.energy_lost
+            yielded[p_y] = punch.diagnostics()["summits_yielded"]
+            punch.reset()
+    assert yielded[math.inf] == 0 and yielded[P_Y] > 0
+    assert lost[math.inf, 1] == pytest.approx(lost[math.inf, 0], rel=1e-9)    # elastic: no memory
+    assert lost[P_Y, 0] > 2.0 * lost[math.inf, 0]
+    assert lost[P_Y, 1] < 0.5 * lost[P_Y, 0]
+
+
+def test_limiting_pressure_below_the_adhesive_stress_is_refused():
+    p_a = float(tn.adhesive_stress_scale(BETA, W, E))
+    with pytest.raises(Exception, match="limiting_pressure"):
+        PlasticSummitLaw(BETA, W, E, 0.5 * p_a)
