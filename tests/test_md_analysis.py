@@ -274,11 +274,22 @@ def test_force_integration_starts_at_the_zero_force_point_of_a_grid_reaching_int
 
 
 def test_registry_average_carries_the_spread_between_registries():
-    from md.analysis import registry_average
+    """The spread of n registries enters with the Student-t factor of n - 1 degrees of freedom at 68.27 %: the
+    t quantiles checked here against the closed forms of t with 1 dof (Cauchy: tan(pi (p - 1/2))) and 2 dof
+    (x / sqrt(2 + x^2) = 2p - 1), p = (1 + erf(1/sqrt 2)) / 2."""
+    from md.analysis import registry_average, student_t_factor
+    p = 0.5 * (1.0 + math.erf(1.0 / math.sqrt(2.0)))
+    t1, t2 = math.tan(math.pi * (p - 0.5)), math.sqrt(2.0 * (2 * p - 1) ** 2 / (1.0 - (2 * p - 1) ** 2))
+    assert student_t_factor(2) == rel(t1, 1e-9) and student_t_factor(3) == rel(t2, 1e-9)
+    assert t1 == pytest.approx(1.84, abs=0.005) and t2 == pytest.approx(1.32, abs=0.005)
+    with pytest.raises(ValueError, match="two samples"):
+        student_t_factor(1)
     one = registry_average([[1.0, 2.0]], [[0.1, 0.2]])
     assert np.allclose(one["mean"], [1, 2]) and np.allclose(one["stderr"], [0.1, 0.2])
     three = registry_average([1.0, 2.0, 3.0], [0.01, 0.01, 0.01])       # spread dominates
-    assert three["mean"] == 2.0 and three["stderr"] == rel(1.0 / math.sqrt(3), 1e-12)
+    assert three["mean"] == 2.0 and three["stderr"] == rel(t2 / math.sqrt(3), 1e-9)
+    two = registry_average([1.0, 2.0], [0.01, 0.01])
+    assert two["stderr"] == rel(t1 * math.sqrt(0.5) / math.sqrt(2), 1e-9) and two["t_factor"] == rel(t1, 1e-9)
     agree = registry_average([2.0, 2.0, 2.0], [0.3, 0.3, 0.3])          # agreement by chance: statistics remain
     assert agree["stderr"] == rel(0.3 / math.sqrt(3), 1e-12) and agree["registry_spread"] == 0.0
 
@@ -785,3 +796,119 @@ def test_dispersion_tail_work_reaches_hamaker_for_a_solid_half_space_beyond_the_
     expected = hamaker / (12.0 * np.pi) * (D**-2 - (D + depth) ** -2)
     assert w == pytest.approx(expected, rel=1e-5)
     assert 0.0 < dispersion_tail_work(z, c6, 0.0, n, 2.0 * D, area) < w   # a longer cutoff leaves less beyond it
+
+
+# ------------------------------------------------------------------ chained windows, window length, grid, T dS
+
+def test_correlated_window_errors_follow_the_lag1_covariance():
+    """sqrt(g^T C g) with C_kl = rho^|k-l| e_k e_l, against the sum written out: grid 0, 1, 3 A (trapezoid weights
+    0.5, 1.5, 1), errors 1, 2, 3: g e = (0.5, 3, 3), so var = 18.25 + 2 rho (1.5 + 9) + 2 rho^2 1.5."""
+    from md.analysis import force_integration_work
+    d, e = np.array([0.0, 1.0, 3.0]), np.array([1.0, 2.0, 3.0])
+    for rho in (0.0, 0.5, 0.9):
+        r = force_integration_work(d, np.zeros(3), e, 1.0, correlation=rho)
+        var = 18.25 + 2 * rho * 10.5 + 2 * rho ** 2 * 1.5
+        assert r["stderr"] == rel(math.sqrt(var) * KCALMOL_PER_A2_TO_J_PER_M2, 1e-6)
+    with pytest.raises(ValueError, match="correlation"):
+        force_integration_work(d, np.zeros(3), e, 1.0, correlation=1.0)
+
+
+def test_chain_correlation_recovers_the_replicates_lag1_and_the_stderr_that_covers_their_scatter():
+    """Replicate chains whose window errors are AR(1) along the chain (rho = 0.7, unit stderrs): the pooled estimate
+    from 4 chains x 300 windows is 0.7 within 0.08, and independent errors give ~0. On 3000 such chains of 20
+    windows the scatter of W is what the lag-1 covariance propagates (within 8 %), while independent propagation
+    understates it more than 1.8-fold."""
+    from md.analysis import chain_correlation, force_integration_work
+    rng = np.random.default_rng(3)
+
+    def ar1(n_chains, n, rho):
+        z = rng.normal(size=(n_chains, n))
+        x = np.empty_like(z)
+        x[:, 0] = z[:, 0]
+        for k in range(1, n):
+            x[:, k] = rho * x[:, k - 1] + math.sqrt(1 - rho * rho) * z[:, k]
+        return x
+
+    curve = -np.sin(np.linspace(0, np.pi, 300))
+    e = np.ones((4, 300))
+    assert chain_correlation(curve + ar1(4, 300, 0.7), e) == pytest.approx(0.7, abs=0.08)
+    assert chain_correlation(curve + rng.normal(size=(4, 300)), e) < 0.08
+    assert chain_correlation(curve[None, :20], np.ones((1, 20))) == 0.0          # one chain: nothing to compare
+    d = np.linspace(0.0, 10.0, 20)
+    f0 = -np.sin(np.linspace(0, np.pi, 20)) - 0.1
+    ws = [force_integration_work(d, f0 + x, np.ones(20), 1.0, from_zero_crossing=False)["value"]
+          for x in ar1(3000, 20, 0.7)]
+    corr = force_integration_work(d, f0, np.ones(20), 1.0, from_zero_crossing=False, correlation=0.7)["stderr"]
+    indep = force_integration_work(d, f0, np.ones(20), 1.0, from_zero_crossing=False)["stderr"]
+    assert np.std(ws) == rel(corr, 0.08) and np.std(ws) > 1.8 * indep
+
+
+def _two_registry_curve(d):
+    """A flat-slab-like curve (repulsive below 0, a well, back to 0) on d (A), kcal/mol/A."""
+    return 40.0 * np.exp(-2.0 * (d + 0.5)) - 30.0 * np.exp(-((d - 1.0) / 1.2) ** 2) - 10.0 * np.exp(-d - 0.5)
+
+
+def test_window_length_check_fails_on_a_drift_that_a_tolerance_holding_the_registry_spread_passes():
+    """Two registries that differ by a registry offset (their W_F 10 % apart) with small within-window stderrs;
+    the second half of every window is more attractive than the first by 3 statistical stderrs. The check from the
+    statistical stderrs flags it; the tolerance that held the registries' spread (2 x 2 x max(stat, Student-t spread
+    of the registries' W)) passes it. Negative control: halves that differ only by their own noise pass in about 95
+    % of 400 seeded draws (2 sigma)."""
+    from md.analysis import force_integration_work, registry_average, window_length_check
+    d = np.concatenate([-np.linspace(1.5, 0.25, 6), 0.2 + 8.0 * (np.arange(14) / 13) ** 2])
+    area, stat = 500.0, np.full(d.size, 0.3)
+    base = _two_registry_curve(d)
+    regs = np.array([base * 0.95, base * 1.05])                                  # registry dependence
+    w_reg = [force_integration_work(d, f, stat, area)["value"] for f in regs]
+    avg = registry_average(w_reg, [force_integration_work(d, f, stat, area)["stderr"] for f in regs])
+    old_tol = 2.0 * 2.0 * max(force_integration_work(d, regs.mean(0), registry_average(regs, np.broadcast_to(
+        stat, regs.shape))["stderr"], area)["stderr"], avg["stderr"])
+    drift = 3.0 * stat * np.sqrt(2.0) * (base < 0)                              # attractive windows drift
+    first, second = regs.mean(0) + 0.5 * drift, regs.mean(0) - 0.5 * drift
+    chk = window_length_check(d, first, second, stat / math.sqrt(2.0), area)
+    assert not chk["converged"] and abs(chk["difference_J_m2"]) <= old_tol      # old tolerance: passes the drift
+    rng = np.random.default_rng(11)
+    ok = [window_length_check(d, base + rng.normal(0, 0.3 * math.sqrt(2), d.size),
+                              base + rng.normal(0, 0.3 * math.sqrt(2), d.size), stat, area)["converged"]
+          for _ in range(400)]
+    assert 0.90 <= np.mean(ok) <= 0.99
+
+
+def test_grid_error_bounds_a_rupture_between_two_windows_that_the_quadrature_difference_misses():
+    """A step curve: repulsive at -1 A, -F0 from the zero crossing to a rupture at r, 0 beyond; windows at
+    -1, 0, 1, 2, 4, 6 A, so the rupture falls in the interval 2-4 A wherever r lies there. The true work (the
+    linear repulsive piece, then F0 to r) differs from the trapezoid by up to F0 x 1 A; the interval bound
+    1/2 |df| dd = F0 x 1 A covers it for every r, the trapezoid-PCHIP difference does not, and 2-4 A is flagged
+    for refinement. Negative control: a dense smooth 9-3 curve flags nothing and keeps its small grid error."""
+    from md.analysis import force_integration_work
+    f0, area = 10.0, 100.0
+    d = np.array([-1.0, 0.0, 1.0, 2.0, 4.0, 6.0])
+    f = np.array([f0, -f0, -f0, -f0, 0.0, 0.0])
+    r0 = force_integration_work(d, f, np.full(6, 0.1), area)
+    start = r0["zero_force_separation_A"]
+    assert start == pytest.approx(-0.5)
+    for rupture in (2.02, 3.0, 3.98):
+        exact = (f0 * (0.0 - start) / 2 + f0 * (rupture - 0.0)) * KCALMOL_PER_A2_TO_J_PER_M2 / area
+        err = abs(r0["value"] - exact)
+        assert err <= r0["discretisation_error"] * (1 + 1e-9)
+    worst = 0.98 * f0 * KCALMOL_PER_A2_TO_J_PER_M2 / area
+    assert r0["quadrature_difference"] < 0.5 * worst                          # PCHIP follows the trapezoid
+    assert r0["grid_bound_max"] == rel(f0 * 1.0 * KCALMOL_PER_A2_TO_J_PER_M2 / area, 1e-12)
+    assert r0["refine_intervals_A"] == [[2.0, 4.0]] or [2.0, 4.0] in r0["refine_intervals_A"]
+    W, z0 = 0.06, 2.5
+    dd = np.concatenate([-np.linspace(0.8, 0.1, 8), 20.0 * (np.arange(300) / 299) ** 2])
+    smooth = force_integration_work(dd, _lj93_window_curve(W, z0, area, dd), np.full(dd.size, 0.5), area)
+    assert smooth["refine_intervals_A"] == [] and smooth["discretisation_error"] < 0.02 * smooth["value"]
+
+
+def test_entropic_term_compares_energy_and_free_energy_of_the_same_registry():
+    """dE/A of registry 0 only (its zero-load contact leg), W_F of three registries: T dS is registry 0's
+    dE - dF (0.292 - 0.256 = 0.036), not dE against the registries' mean W_F (0.292 - 0.197 = 0.095)."""
+    from md.analysis import entropic_term
+    r = entropic_term({0: (0.292, 0.002)}, {0: (0.256, 0.01), 1: (0.124, 0.01), 2: (0.21, 0.01)})
+    assert r["registries"] == [0] and r["per_registry"][0][0] == pytest.approx(0.036)
+    assert r["per_registry"][0][1] == rel(math.hypot(0.002, 0.01), 1e-12) and r["mean"] == pytest.approx(0.036)
+    both = entropic_term({0: (0.3, 0.0), 1: (0.2, 0.0)}, {0: (0.25, 0.01), 1: (0.18, 0.01)})
+    assert both["registries"] == [0, 1] and both["mean"] == pytest.approx(0.035)
+    with pytest.raises(ValueError, match="no registry"):
+        entropic_term({1: (0.3, 0.0)}, {0: (0.25, 0.01)})

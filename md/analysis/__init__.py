@@ -6,7 +6,8 @@ maps).  Every conversion factor comes from :mod:`md.units`.
 
 One analysis per module: :mod:`~md.analysis.stats`, :mod:`~md.analysis.adhesion`, :mod:`~md.analysis.contact_angle`,
 :mod:`~md.analysis.surface_tension`, :mod:`~md.analysis.pulloff`,
-:mod:`~md.analysis.free_energy` (W_SL by thermodynamic integration); the unit factors in :mod:`~md.analysis.common`.
+:mod:`~md.analysis.free_energy` (W_SL by thermodynamic integration), :mod:`~md.analysis.layer_modulus` (a SAM's
+confined modulus from a flat-slab compression branch); the unit factors in :mod:`~md.analysis.common`.
 
 Sources (details and measured accuracies: ``docs/md-analysis.md``):
 
@@ -27,7 +28,10 @@ Sources (details and measured accuracies: ``docs/md-analysis.md``):
 :class:`ContactAngle` needs MDAnalysis (the ``md`` extra); everything else needs numpy and scipy only.
 """
 from md.analysis.adhesion import (force_integration_work, registry_average, registry_consistency, traction_peak,
-                                  flat_slab_range, lj_tail_between, MAUGIS_LJ93, energy_separation_work, work_from_energy_curve)
+                                  flat_slab_range, lj_tail_between, MAUGIS_LJ93, energy_separation_work, work_from_energy_curve,
+                                  chain_correlation, window_length_check, entropic_term, grid_interval_bounds,
+                                  hysteresis)
+from md.analysis.layer_modulus import confined_layer_modulus, sam_layer_thickness_A, young_from_confined
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
                                        block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
@@ -38,13 +42,15 @@ from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_o
                                      film_lower_dividing_plane)
 from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
 from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
-                               detect_equilibration, timeseries_stats)
+                               detect_equilibration, timeseries_stats, student_t_factor)
 from md.analysis.surface_tension import surface_tension, lj_tail_correction, density_profile, slab_density
 
 __all__ = [
     "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M",
     "block_average", "block_analysis", "blocking_stderr", "statistical_inefficiency", "detect_equilibration",
-    "timeseries_stats",
+    "timeseries_stats", "student_t_factor",
+    "chain_correlation", "window_length_check", "entropic_term", "grid_interval_bounds", "hysteresis",
+    "confined_layer_modulus", "sam_layer_thickness_A", "young_from_confined",
     "force_integration_work", "registry_average", "registry_consistency", "traction_peak", "flat_slab_range",
     "lj_tail_between",
     "MAUGIS_LJ93",

@@ -9,7 +9,7 @@ import numpy as np
 
 from md import units as _units
 
-from md.analysis.stats import block_average, timeseries_stats
+from md.analysis.stats import block_average, student_t_factor, timeseries_stats
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, refined_min
 
 
@@ -66,8 +66,39 @@ def _trapezoid_from(d: np.ndarray, f: np.ndarray, j: int | None) -> tuple[float,
     return -area, start
 
 
+#: an interval whose force change exceeds this fraction of the peak attraction is flagged for refinement (a
+#: choice: one interval then carries a jump of the order of the well depth, as a rupture between two windows does)
+REFINE_FRACTION = 0.5
+
+
+def grid_interval_bounds(separation_A, force, start_A: float, refine_fraction: float = REFINE_FRACTION) -> dict:
+    """Grid error bound of the trapezoid rule, interval by interval, over the integrated range [start, d[-1]].
+
+    For a force monotone between two neighbouring windows the true integral over the interval lies between the
+    two rectangles f_k dd and f_{k+1} dd, so the trapezoid (their mean) is within b_k = 1/2 |f_{k+1} - f_k| dd of
+    it, whatever the shape in between (a step -- a rupture -- anywhere inside the interval included). The first
+    interval is cut at ``start_A`` (the force there is interpolated). Returns ``bounds_kcal_mol`` (b_k per
+    interval of the sorted grid, 0 outside the range), ``detachment_max_kcal_mol`` (the largest b_k from the most
+    attractive window outwards: where the force returns to zero), ``refine_A`` ([d_k, d_k+1] where
+    |f_{k+1} - f_k| > ``refine_fraction`` x the peak attraction |min f|) and ``refine`` (bool per interval)."""
+    d = np.asarray(separation_A, float).ravel()
+    f = np.asarray(force, float).ravel()
+    lo = np.maximum(d[:-1], float(start_A))
+    width = np.clip(d[1:] - lo, 0.0, None)
+    f_lo = np.where(d[:-1] < lo, np.interp(lo, d, f), f[:-1])
+    jump = np.abs(f[1:] - f_lo)
+    bounds = 0.5 * jump * width
+    i_min = int(np.argmin(f))
+    detach = bounds[i_min:] if i_min < bounds.size else bounds[:0]
+    peak = max(-float(f.min()), 0.0)
+    refine = (width > 0) & (jump > refine_fraction * peak) if peak > 0 else np.zeros(bounds.size, bool)
+    return {"bounds_kcal_mol": bounds, "detachment_max_kcal_mol": float(detach.max()) if detach.size else 0.0,
+            "refine_A": [[float(d[k]), float(d[k + 1])] for k in np.flatnonzero(refine)], "refine": refine}
+
+
 def force_integration_work(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA,
-                           area_A2: float, from_zero_crossing: bool = True) -> dict:
+                           area_A2: float, from_zero_crossing: bool = True, correlation: float = 0.0,
+                           refine_fraction: float = REFINE_FRACTION) -> dict:
     """Free energy of separation by thermodynamic integration of the mean force over separation (J/m^2).
 
     W_F = -(1/A) integral <F_z> dd from the bottom of the adhesive well to the last window, with ``mean_force``
@@ -79,11 +110,22 @@ def force_integration_work(separation_A, mean_force_kcal_per_molA, force_stderr_
     misses part of the well (a lower bound); ``from_zero_crossing=False`` always integrates the whole grid.
 
     ``value`` uses the trapezoid rule and ``stderr`` propagates the windows' statistical errors through it
-    (linearised: the start point moves with the forces, at zero force). ``value_pchip`` integrates the
-    shape-preserving cubic (PCHIP, Fritsch & Carlson, SIAM J. Numer. Anal. 17 (1980) 238) over the same range;
-    ``discretisation_error`` = |trapezoid - PCHIP| estimates what the window grid misses (two quadratures of
-    different order agree when the grid resolves the force curve). ``pmf_J_per_m2``: the PMF at each window
-    relative to the well's bottom; ``cumulative_J_per_m2``: -integral from the first window.
+    (linearised: the start point moves with the forces, at zero force). Windows that form a chain (each started
+    from its neighbour's last state) share slow modes, so their errors are positively correlated: ``correlation``
+    rho gives them the lag-1 (AR(1)) covariance C_kl = rho^|k-l| e_k e_l in separation order, and the stderr is
+    sqrt(g^T C g) with g the rule's weights (propagation of correlated inputs, JCGM 100:2008, the GUM, section
+    5.2; rho = 0: independent windows; :func:`chain_correlation` estimates rho from replicate chains).
+
+    ``value_pchip`` integrates the shape-preserving cubic (PCHIP, Fritsch & Carlson, SIAM J. Numer. Anal. 17
+    (1980) 238) over the same range. Two quadratures of different order agree when the grid resolves the curve,
+    and both interpolate monotonically across a step, so |trapezoid - PCHIP| cannot see where in a wide interval
+    the force jumped (a rupture). Each interval's own bound does: if the force is monotone between two windows,
+    the true area lies between the two rectangles, so the trapezoid is within 1/2 |df| dd of it
+    (:func:`grid_interval_bounds`). ``discretisation_error`` = max(|trapezoid - PCHIP|, the largest interval
+    bound over the detachment region, from the most attractive window outwards); ``refine_intervals`` lists the
+    intervals whose force change exceeds ``refine_fraction`` of the peak attraction (windows to add there).
+    ``pmf_J_per_m2``: the PMF at each window relative to the well's bottom; ``cumulative_J_per_m2``: -integral
+    from the first window.
     """
     from scipy.interpolate import PchipInterpolator
 
@@ -110,15 +152,23 @@ def force_integration_work(separation_A, mean_force_kcal_per_molA, force_stderr_
         fp[k] += h
         fm[k] -= h
         grad[k] = (_trapezoid_from(d, fp, j)[0] - _trapezoid_from(d, fm, j)[0]) / (2 * h)
-    err = float(np.sqrt(np.sum((grad * e) ** 2))) * conv
+    if not 0.0 <= correlation < 1.0:
+        raise ValueError(f"correlation = {correlation}: must lie in [0, 1)")
+    lag = np.abs(np.subtract.outer(np.arange(f.size), np.arange(f.size)))
+    ge = grad * e
+    err = math.sqrt(max(float(ge @ (float(correlation) ** lag) @ ge), 0.0)) * conv
     trap = w_kcal * conv
     pchip = -float(PchipInterpolator(d, f).integrate(start, d[-1])) * conv if d.size >= 3 else trap
+    grid = grid_interval_bounds(d, f, start, refine_fraction)
+    grid_max = float(grid["detachment_max_kcal_mol"]) * conv
     cumulative = -np.concatenate([[0.0], np.cumsum(0.5 * np.diff(d) * (f[1:] + f[:-1]))]) * conv
     # PMF relative to the well's bottom: cumulative minus its (interpolated) value at the start
     # (the trapezoid value at the crossing, where f = 0; the first window without a crossing)
     c_start = float(cumulative[j]) - 0.5 * (start - d[j]) * f[j] * conv if j is not None else 0.0
-    return {"value": trap, "stderr": err, "value_pchip": pchip, "discretisation_error": abs(trap - pchip),
-            "units": "J/m^2", "separation_A": d, "cumulative_J_per_m2": cumulative,
+    return {"value": trap, "stderr": err, "value_pchip": pchip, "discretisation_error": max(abs(trap - pchip), grid_max),
+            "quadrature_difference": abs(trap - pchip), "grid_bound_max": grid_max,
+            "interval_bounds_J_per_m2": grid["bounds_kcal_mol"] * conv, "refine_intervals_A": grid["refine_A"],
+            "correlation": float(correlation), "units": "J/m^2", "separation_A": d, "cumulative_J_per_m2": cumulative,
             "pmf_J_per_m2": cumulative - c_start, "repulsive_end": j is not None,
             "zero_force_separation_A": start if j is not None else float("nan"), "start_A": start}
 
@@ -135,10 +185,13 @@ def registry_average(values, stderrs) -> dict:
     ``values``, ``stderrs``: shape (n_registries,) for one quantity or (n_registries, n_points) for a curve.
     The registries sample the lateral offset of two crystalline faces; an incommensurate contact averages over
     all of them, so the mean over registries is the estimate and their spread is part of its error:
-    ``stderr = max(std over registries / sqrt(n), sqrt(sum stderr^2) / n)`` -- the first is the random-effects
-    error (it carries the registries' own statistical noise too), the second guards it when two or three
-    registries agree by chance. One registry: its own stderr.
-    Returns ``mean``, ``stderr``, ``stderr_statistical``, ``registry_spread`` (std, ddof 1) and ``n``.
+    ``stderr = max(t std over registries / sqrt(n), sqrt(sum stderr^2) / n)`` -- the first is the random-effects
+    error (it carries the registries' own statistical noise too), scaled by the Student-t factor of n - 1 degrees
+    of freedom (:func:`md.analysis.stats.student_t_factor`: 1.84 for two registries, 1.32 for three) so that it is
+    a one-sigma half-width although the spread of so few is itself uncertain; the second guards it when two or
+    three registries agree by chance. One registry: its own stderr.
+    Returns ``mean``, ``stderr``, ``stderr_statistical`` (the registries' own stderrs only), ``registry_spread``
+    (std, ddof 1), ``t_factor`` and ``n``.
     """
     scalar = np.ndim(values) == 1
     v = np.asarray(values, float).reshape(len(values), -1)
@@ -147,10 +200,11 @@ def registry_average(values, stderrs) -> dict:
     mean = v.mean(axis=0)
     stat = np.sqrt(np.sum(e ** 2, axis=0)) / n
     spread = v.std(axis=0, ddof=1) if n >= 2 else np.zeros_like(mean)
-    err = np.maximum(spread / math.sqrt(n), stat)
+    t = student_t_factor(n) if n >= 2 else 1.0
+    err = np.maximum(t * spread / math.sqrt(n), stat)
     pick = (lambda a: float(a[0])) if scalar else (lambda a: a)
     return {"mean": pick(mean), "stderr": pick(err), "stderr_statistical": pick(stat),
-            "registry_spread": pick(spread), "n": int(n)}
+            "registry_spread": pick(spread), "t_factor": t, "n": int(n)}
 
 
 def registry_consistency(values, stderrs, p_min: float = 0.01) -> dict:
@@ -182,6 +236,85 @@ def registry_consistency(values, stderrs, p_min: float = 0.01) -> dict:
         chi2 = np.sum(w * (v - m) ** 2, axis=0)
     p = chi2_dist.sf(chi2, n - 1)
     return {"chi2_per_dof": chi2 / (n - 1), "p": p, "inconsistent": p < p_min, "dof": n - 1}
+
+
+def chain_correlation(values, stderrs) -> float:
+    """Lag-1 correlation rho of the window errors along a chain, from replicate chains (registries) of one curve.
+
+    ``values``, ``stderrs``: shape (n_registries, n_windows) in separation order. Each chain's deviation from the
+    mean over chains, in units of its own stderr, z_rk = (v_rk - m_k) / e_rk, is its error at window k (up to the
+    mean's share); in a chain whose windows share slow modes neighbouring z's have the same sign. rho = sum z_rk
+    z_r,k+1 / sum z_rk^2, pooled over chains and pairs of neighbours (the lag-1 autocorrelation estimate, Box,
+    Jenkins & Reinsel, *Time Series Analysis*, 4th ed., eq. 2.1.12), clipped to [0, 0.95]: a negative estimate
+    from few chains is taken as independence, and 0.95 keeps the AR(1) covariance of
+    :func:`force_integration_work` well conditioned. A registry-dependent force that one chain keeps along the
+    curve counts as correlation too (conservative). Fewer than two chains or three windows: 0."""
+    v = np.asarray(values, float)
+    e = np.asarray(stderrs, float)
+    if v.ndim != 2 or v.shape != e.shape:
+        raise ValueError(f"values and stderrs must both have shape (registries, windows); got {v.shape}, {e.shape}")
+    if v.shape[0] < 2 or v.shape[1] < 3:
+        return 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.where(e > 0, (v - v.mean(axis=0)) / e, 0.0)
+    den = float(np.sum(z * z))
+    if not den > 0:
+        return 0.0
+    return float(np.clip(np.sum(z[:, 1:] * z[:, :-1]) / den, 0.0, 0.95))
+
+
+def window_length_check(separation_A, first_half_force, second_half_force, statistical_stderr, area_A2: float,
+                        correlation: float = 0.0, n_sigma: float = 2.0) -> dict:
+    """Have the windows run long enough for their mean force to settle? W from the first half of every window's
+    samples against W from the second half, over the same grid (each from its zero-force point).
+
+    ``first_half_force``, ``second_half_force``: the mean force of each half per window (kcal/mol/A, averaged over
+    the registries in the same way as the whole); ``statistical_stderr``: the whole window's stderr from its
+    samples alone (within-registry statistics, :func:`registry_average`'s ``stderr_statistical``). A half has
+    sqrt 2 of it, so W of a half has sqrt 2 of the whole's error sigma_W, and the difference of two independent
+    halves 2 sigma_W. The registries' spread must stay out of this tolerance: a registry's offset is in both of
+    its halves and cancels in their difference, so a tolerance that held it would pass drifts it has nothing to
+    do with. ``converged`` when |difference| <= ``n_sigma`` x its stderr. Returns both halves' W, the
+    difference, its stderr and ``converged``."""
+    e = np.asarray(statistical_stderr, float) * math.sqrt(2.0)
+    w1 = force_integration_work(separation_A, first_half_force, e, area_A2, correlation=correlation)
+    w2 = force_integration_work(separation_A, second_half_force, e, area_A2, correlation=correlation)
+    diff = w2["value"] - w1["value"]
+    err = math.hypot(w1["stderr"], w2["stderr"])
+    return {"first_half_J_m2": w1["value"], "second_half_J_m2": w2["value"], "difference_J_m2": diff,
+            "difference_stderr_J_m2": err, "n_sigma": float(n_sigma), "converged": bool(abs(diff) <= n_sigma * err)}
+
+
+def entropic_term(energy_work: dict, free_energy_work: dict) -> dict:
+    """T dS / A = (dE - dF) / A of each registry that has both works (J/m^2).
+
+    ``energy_work``, ``free_energy_work``: {registry: (value, stderr)} -- dE/A from a zero-load contact leg and
+    W_F by force integration of that registry's own chain. dE and dF must describe the same contact: the
+    difference of one registry's energy and another registry's (or the registries' average) free energy holds
+    their registry dependence, not the entropy (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.,
+    section 17.2, for dF = dE - T dS at the interface). Returns ``per_registry`` {registry: (value, stderr)},
+    ``registries`` (sorted) and, with several, their ``mean`` and ``stderr`` (:func:`registry_average`);
+    with one, its value and stderr. No common registry: ValueError."""
+    common = sorted(set(energy_work) & set(free_energy_work))
+    if not common:
+        raise ValueError(f"no registry has both dE (registries {sorted(energy_work)}) and dF "
+                         f"(registries {sorted(free_energy_work)})")
+    per = {r: (float(energy_work[r][0]) - float(free_energy_work[r][0]),
+               math.hypot(float(energy_work[r][1] or 0.0), float(free_energy_work[r][1] or 0.0))) for r in common}
+    avg = registry_average([per[r][0] for r in common], [per[r][1] for r in common])
+    return {"per_registry": per, "registries": common, "mean": avg["mean"], "stderr": avg["stderr"]}
+
+
+def hysteresis(w_out: float, stderr_out: float, w_back: float, stderr_back: float) -> dict:
+    """Out-and-back works of one path (J/m^2): the hysteresis W_out - W_back with its stderr, and the estimate of
+    the reversible work as their mean, stderr 1/2 sqrt(e_out^2 + e_back^2) (the two chains' statistical errors
+    taken as independent), with half the hysteresis as a systematic error. A forward non-equilibrium work exceeds
+    the free energy and a reverse one falls short of it (second law), so the mean brackets it to first order in
+    the dissipation (Crooks, Phys. Rev. E 61 (2000) 2361: for a dissipation symmetric in the two directions)."""
+    h = float(w_out - w_back)
+    e = float(np.hypot(stderr_out, stderr_back))
+    return {"value": 0.5 * float(w_out + w_back), "stderr": 0.5 * e, "hysteresis": h, "hysteresis_stderr": e,
+            "systematic": 0.5 * abs(h)}
 
 
 def traction_peak(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA, area_A2: float) -> dict:

@@ -7,7 +7,8 @@ import math
 
 import numpy as np
 
-
+#: probability inside one standard deviation of a normal distribution, erf(1/sqrt 2): the level a "stderr" states
+ONE_SIGMA_LEVEL = math.erf(1.0 / math.sqrt(2.0))
 
 
 # ---------------------------------------------------------------------------------------- block errors
@@ -187,3 +188,22 @@ def blocking_stderr(x, min_blocks: int = BLOCKING_MIN_BLOCKS) -> float:
     levels = block_analysis(x, min_blocks=min_blocks)
     errs = levels["stderr"][levels["n_blocks"] >= min_blocks]
     return float(errs.max()) if errs.size else 0.0
+
+
+# ------------------------------------------------------------------------------------- few samples
+
+def student_t_factor(n_samples: int, level: float = ONE_SIGMA_LEVEL) -> float:
+    """Student-t coverage factor for the mean of ``n_samples`` independent samples whose stderr is estimated from
+    their own spread (std / sqrt n, n - 1 degrees of freedom): the half-width of the ``level`` interval is
+    t * stderr, t = the (1 + level)/2 quantile of Student's t with n - 1 degrees of freedom (JCGM 100:2008, the GUM,
+    annex G.3-G.4). At the one-sigma level (68.27 %) t = 1.84 for two samples and 1.32 for three; it tends to 1 for
+    many. A "stderr" multiplied by it is the one-sigma-equivalent half-width that a normal error would have.
+    One sample or none: no spread to estimate from (ValueError)."""
+    from scipy.stats import t as student_t
+
+    n = int(n_samples)
+    if n < 2:
+        raise ValueError(f"n_samples = {n_samples}: a spread needs at least two samples")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level = {level}: must lie in (0, 1)")
+    return float(student_t.ppf(0.5 * (1.0 + level), n - 1))
