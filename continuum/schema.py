@@ -78,7 +78,8 @@ FIELDS: tuple[Field, ...] = (
           "sphere's limiting contact pressure 2.8 Y (as surfaces.body.yield_strength); rough and line contact warn "
           "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
     Field("surfaces.substrate.hardness", float, "Pa", "Indentation hardness of the substrate (and its summits): a "
-          "smooth sphere's limiting contact pressure; the plasticity index of rough contact (optional).", None,
+          "smooth sphere's limiting contact pressure; the summits' limiting pressure in the plasticity index of rough "
+          "contact (physics.plasticity; optional).", None,
           low=1e6, high=1e12),
     Field("surfaces.sam.coverage", str, "", "Self-assembled monolayer: 'none', or 'both' (both surfaces covered; "
           "the SAM-SAM work of adhesion replaces surfaces.work_of_adhesion).", "none", choices=("none", "both")),
@@ -179,7 +180,9 @@ FIELDS: tuple[Field, ...] = (
     Field("physics.plasticity", str, "", "Smooth sphere: the Thornton-Ning (1998) adhesive elastic-plastic law "
           "(JKR to yield, then a limiting contact pressure from the softer partner's hardness or 2.8 x yield "
           "strength; the flattening is carried into later impacts). 'auto': on when the first impact is faster "
-          "than the yield velocity, off (recorded) when no yield key is given. Summits stay elastic.", "auto",
+          "than the yield velocity, off (recorded) when no yield key is given. Rough contact: 'auto' records the "
+          "summits' plasticity index psi = (E*/p_y) sqrt(sigma/beta) and whether they yield (psi >= 0.6, Greenwood "
+          "& Williamson 1966); the rough roller runs elastic summits.", "auto",
           choices=("auto", "on", "off")),
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",

@@ -172,3 +172,26 @@ def test_limiting_pressure_below_the_adhesive_stress_is_refused():
     p_a = float(tn.adhesive_stress_scale(BETA, W, E))
     with pytest.raises(Exception, match="limiting_pressure"):
         PlasticSummitLaw(BETA, W, E, 0.5 * p_a)
+
+
+# ----------------------------------------------------------------------------- (e) auto by the plasticity index
+@pytest.mark.parametrize("hardness,yields", [(8.3e9, False), (0.25e9, True)])
+def test_auto_decides_summit_plasticity_by_the_plasticity_index(hardness, yields):
+    """The paper's silica set with silicon's hardness (Knoop 850 kg/mm^2 = 8.3 GPa, K. E. Petersen, Proc. IEEE 70
+    (1982) 420): psi well below 0.6, elastic summits; a soft metal's hardness (0.25 GPa): psi > 1. psi is recorded
+    beside the decision and is Greenwood-Williamson's (E*/H) sqrt(sigma/beta)."""
+    from pathlib import Path
+
+    from continuum.model.decisions import plasticity_decision
+    from continuum.model.regime import summit_e_star
+    from continuum.scene import resolve_scene
+
+    scene = resolve_scene(Path(__file__).resolve().parents[1] / "inputs" / "scenes" / "rough_silica.toml",
+                          overrides={"surfaces.substrate.hardness": hardness}).scene
+    rec = plasticity_decision(scene, "jkr", 0.1).record()
+    rough = scene.surfaces.roughness
+    psi = summit_e_star(scene) / hardness * math.sqrt(rough.sigma / rough.summit_radius)
+    assert rec["plasticity_index"] == pytest.approx(psi, rel=1e-12)
+    assert rec["decided_by"] == "plasticity_index" and rec["summits_yield"] is yields
+    assert (psi > 1.0) if yields else (psi < 0.6)
+    assert rec["used"] is False and ("elastic summits only" in rec["why"]) is yields

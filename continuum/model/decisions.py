@@ -375,12 +375,21 @@ class PlasticityDecision:
     impact_speed: float | None = None
     partners: tuple = ()
     """Each partner with a yield key: `continuum.limiting_pressure.PartnerLimit`."""
+    plasticity_index: float | None = None
+    """Rough contact: the summits' Greenwood-Williamson psi = (E*/p_y) sqrt(sigma/beta) (`summit_plasticity`)."""
+    summits_yield: bool | None = None
+    """Rough contact: what 'auto' decides from psi (True: plastic summits matter), whether or not they run."""
 
     def record(self) -> dict:
         rec: dict = {}
         if self.partners:
             rec["partners"] = [{"key": p.key, "value": p.value, "limiting_pressure": p.limiting_pressure}
                                for p in self.partners]
+        if self.plasticity_index is not None:
+            rec.update(plasticity_index=self.plasticity_index, summits_yield=self.summits_yield,
+                       limiting_pressure=self.limiting_pressure, from_key=self.from_key,
+                       thresholds={"elastic_below": PSI_ELASTIC, "plastic_above": PSI_PLASTIC},
+                       source="Greenwood & Williamson, Proc. R. Soc. Lond. A 295 (1966) 300")
         if self.yield_velocity is not None:
             rec.update(limiting_pressure=self.limiting_pressure, from_key=self.from_key,
                        yield_velocity=self.yield_velocity, impact_speed=self.impact_speed,
@@ -398,6 +407,38 @@ def _yield_values(scene: Scene) -> dict:
     return out
 
 
+#: Greenwood & Williamson (1966): psi below 0.6 the summits stay elastic under any practical load; above 1 most
+#: touching summits yield. 'auto' counts plastic summits as mattering from psi = PSI_ELASTIC on.
+PSI_ELASTIC, PSI_PLASTIC = 0.6, 1.0
+
+
+def summit_plasticity(scene: Scene) -> PlasticityDecision:
+    """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
+    with the summits' E* (`summit_e_star`) and the softer partner's limiting pressure p_y (H, or 2.8 Y) decides.
+
+    The rough roller's footprint tables are built on elastic summit laws: plastic summits exist as a law
+    (`continuum.rough.plastic_summits`: mean field and discrete, under a flat punch), not in the roller, so the
+    roller runs elastic summits and the record says so, with psi and what 'auto' would include."""
+    from ..limiting_pressure import partner_limits, softer_partner
+
+    limits = tuple(partner_limits(_yield_values(scene)))
+    soft = softer_partner(list(limits))
+    if soft is None:
+        return PlasticityDecision(False, "yield_strength", "no yield key (surfaces.body or surfaces.substrate "
+                                  "yield_strength or hardness): the summits are elastic")
+    rough = scene.surfaces.roughness
+    psi = summit_e_star(scene) / soft.limiting_pressure * math.sqrt(rough.sigma / rough.summit_radius)
+    yields = psi >= PSI_ELASTIC
+    state = ("most summits yield" if psi > PSI_PLASTIC else "some summits yield") if yields else "summits stay elastic"
+    why = (f"auto: plasticity index psi = {psi:.3g} " + (">=" if yields else "<") + f" {PSI_ELASTIC} "
+           f"(limiting contact pressure {soft.limiting_pressure:.3g} Pa from {soft.key}): {state}")
+    if yields:
+        why += ("; the rough roller's footprint carries elastic summits only (Thornton-Ning summits: "
+                "continuum.rough.plastic_summits, flat punch): this run is elastic and overestimates the rebound")
+    return PlasticityDecision(False, "plasticity_index", why, limiting_pressure=soft.limiting_pressure,
+                              from_key=soft.key, partners=limits, plasticity_index=psi, summits_yield=yields)
+
+
 def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> PlasticityDecision:
     """Elastic-plastic smooth sphere or not, for the adhesion law that runs (`adhesion`) and the first impact's
     `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key."""
@@ -407,10 +448,11 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> Plasticity
     choice = scene.physics.plasticity
     if choice == "off":
         return PlasticityDecision(False, "scene", "physics.plasticity = 'off' set in the scene")
-    if scene.contact == "rough" or scene.body.shape != "sphere":
-        return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; summits and "
-                                  "rollers stay elastic (the plasticity index and yield warnings say where they "
-                                  "would yield)")
+    if scene.contact == "rough":
+        return summit_plasticity(scene)
+    if scene.body.shape != "sphere":
+        return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; a smooth "
+                                  "roller stays elastic (the line-contact yield warning says where it would yield)")
     limits = tuple(partner_limits(_yield_values(scene)))
     soft = softer_partner(list(limits))
     if soft is None:
