@@ -25,7 +25,31 @@ from typing import Any, Callable, Iterable, Mapping
 
 from .mdset import _delete_nested, _get_nested, _set_nested, write_parameter_set
 
-__all__ = ["Revert", "ClaimWhy", "reverts", "revert_table", "explain_claims", "attribute_claims"]
+__all__ = ["Revert", "ClaimWhy", "reverts", "revert_table", "explain_claims", "attribute_claims", "acceptance",
+           "PHYSICAL_DIRECTION"]
+
+#: Fig 4's loop claim, probed over its declared choices when it fails (continuum.paper.loop_probe).
+LOOP_CLAIM = "fig4_ots_loop_smaller_than_silica"
+_W_SI, _W_OTS = "surfaces.work_of_adhesion", "surfaces.sam.work_of_adhesion"
+_Z_SI, _Z_OTS = "surfaces.interaction_range", "surfaces.sam.interaction_range"
+#: Silica stickier than OTS: the margin of a claim that bare silica adheres more than OTS rises with silica's
+#: work of adhesion and falls with OTS's; a longer range z0 at the same work lowers the summits' Tabor parameter
+#: and with it their hysteresis (Greenwood, Proc. R. Soc. A 453 (1997) 1277), so it acts the other way.
+_SILICA_OVER_OTS = {_W_SI: +1, _W_OTS: -1, _Z_SI: -1, _Z_OTS: +1}
+#: Bridges pull harder with a larger surface tension and a smaller contact angle (F = 4 pi R gamma cos theta).
+_BRIDGES = {"menisci.surface_tension": +1, "surfaces.body.contact_angle": -1, "surfaces.substrate.contact_angle": -1}
+#: The sign of d(margin)/d(value) physics predicts for a claim and a measured scene key (claims and keys not
+#: listed have no declared direction, so a failure through them is not accepted).
+PHYSICAL_DIRECTION = {
+    "fig4_ots_loop_smaller_than_silica": _SILICA_OVER_OTS,
+    "fig5a_ots_outbounces_silica": _SILICA_OVER_OTS,
+    "fig8b_ots_lower_escape_velocity": _SILICA_OVER_OTS,
+    "fig8b_ots_impact_shorter_at_the_same_low_velocity": _SILICA_OVER_OTS,
+    "fig5a_silica_impacts_weaken_until_it_sticks": {_W_SI: +1, _Z_SI: -1},
+    "fig7_sigma3_sticks_at_first_impact": {_W_SI: +1, _Z_SI: -1},
+    "fig8a_menisci_raise_the_escape_velocity": _BRIDGES,
+    "fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a": _BRIDGES,
+}
 
 
 @dataclass(frozen=True)
@@ -64,7 +88,8 @@ class ClaimWhy:
     """Why one claim fails with the calibrated set.
 
     `cause`: 'base fails too' (not the calibration's doing), 'single' (`restored_by` lists each revert that
-    alone makes the claim hold again), 'several' (no single revert restores it) or 'not run' (`text` says why).
+    alone makes the claim hold again), 'several' (no single revert restores it), 'samples' (it holds on the
+    set's own runs and fails over the uncertainty samples or seeds) or 'not run' (`text` says why).
     """
 
     claim: str
@@ -141,6 +166,10 @@ def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],
         if c["pass"]:
             continue
         name = c["name"]
+        if c.get("nominal_state") == "pass":
+            out.append(ClaimWhy(name, "samples", (), f"holds on the set's own runs and fails over its samples "
+                                f"({c.get('reason', 'holds_fraction below the criterion')})"))
+            continue
         if name not in base_pass:
             out.append(ClaimWhy(name, "not run", (), "the base set's cases did not evaluate this claim"))
             continue
@@ -167,12 +196,14 @@ def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],
 
 def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]], paper_checks: Iterable[Mapping],
                      set_name: str, base_name: str, out: str | Path, *, executor=None,
-                     progress: Callable[[str], None] | None = None) -> dict:
+                     progress: Callable[[str], None] | None = None, set_path: str | None = None) -> dict:
     """Run the reverts a failing claim needs and explain every claim that fails with `set_name`.
 
     `table` is the calibrated set as written, `rows` its value rows, `paper_checks` the claims of the paper step
     (with `set_name` and `base_name` among their sets). Revert sets go to OUT/sets/, their paper cases to
-    OUT/paper/ (no figures). Returns {"reverts": [...], "claims": [ClaimWhy.to_dict()...], "ran": bool}."""
+    OUT/paper/ (no figures). Returns {"reverts": [...], "claims": [ClaimWhy.to_dict()...], "ran": bool,
+    "acceptance": `acceptance`'s entries, "choices": {claim: probe}}: with `set_path` (the set's file), Fig 4's
+    loop claim that fails is probed over its declared choices (continuum.paper.loop_probe)."""
     from continuum.paper.report import make_paper
 
     checks = list(paper_checks)
@@ -195,5 +226,57 @@ def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]]
         for c in record["checks"]:
             by_revert.setdefault(c["set"], []).append(c)
     whys = explain_claims(cal, base, by_revert, groups)
+    choices = {}
+    if set_path is not None and any(c["name"] == LOOP_CLAIM and not c["pass"] for c in cal):
+        from continuum.paper.loop_probe import fig4_choice_probe
+
+        choices[LOOP_CLAIM] = fig4_choice_probe(str(set_path))
     return {"reverts": [g.to_dict() for g in groups], "claims": [w.to_dict() for w in whys],
-            "ran": bool(by_revert)}
+            "ran": bool(by_revert), "acceptance": acceptance(cal, whys, groups), "choices": choices}
+
+
+def _direction(claim: str, g: Revert) -> tuple[bool | None, str]:
+    """Whether putting group `g` back restoring `claim` is the direction physics predicts: the margin is higher
+    at the base value, so d(margin)/d(value) has the sign of (base - calibrated); PHYSICAL_DIRECTION says which
+    sign physics predicts. (None, why) where no key of the group has a declared direction or a base value."""
+    declared = PHYSICAL_DIRECTION.get(claim, {})
+    for key, cal, base in zip(g.keys, g.calibrated, g.base):
+        if key not in declared or not isinstance(cal, (int, float)) or not isinstance(base, (int, float)):
+            continue
+        seen = 1 if base > cal else -1
+        word = "raises" if declared[key] > 0 else "lowers"
+        moved = "lower" if cal < base else "higher"
+        text = (f"the measured `{key}` = {cal:.4g} is {moved} than the base {base:.4g}, and a larger value {word} "
+                f"the claim's margin")
+        return seen == declared[key], text
+    return None, f"no declared physical direction for {g.label} on this claim"
+
+
+def acceptance(calibrated: Iterable[Mapping], whys: Iterable[ClaimWhy | Mapping],
+               groups: Iterable[Revert]) -> list[dict]:
+    """Per claim that fails with the calibrated set: accepted when it fails through measured values only, i.e. one
+    MD value put back alone restores it (cause 'single') and the direction is the one physics predicts
+    (`_direction`); otherwise not accepted, with the reason. Each entry carries the claim's holds_fraction and
+    sample count. Pure."""
+    by = {c["name"]: c for c in calibrated}
+    groups = {g.label: g for g in groups}
+    out = []
+    for w in whys:
+        w = w.to_dict() if isinstance(w, ClaimWhy) else dict(w)
+        c = by.get(w["claim"], {})
+        entry = {"claim": w["claim"], "accepted": False, "holds_fraction": c.get("holds_fraction"),
+                 "samples": c.get("samples"), "cause": w["cause"]}
+        if w["cause"] != "single":
+            entry["why"] = {"base fails too": "fails with the base set too: not a measured value's doing",
+                            "several": "no single measured value put back restores it",
+                            "samples": "holds on the set's own runs: the spread over its samples fails it",
+                            }.get(w["cause"], w["text"])
+        else:
+            verdicts = [(_direction(w["claim"], groups[label]), label) for label in w["restored_by"] if label in groups]
+            physical = [(text, label) for (ok, text), label in verdicts if ok]
+            entry["accepted"] = bool(physical)
+            entry["why"] = ("; ".join(f"{label}: {text}" for text, label in physical) if physical else
+                            "; ".join(f"{label}: {text}" + ("" if ok is None else ", the opposite of what it did")
+                                      for (ok, text), label in verdicts) or "the restoring group is unknown")
+        out.append(entry)
+    return out

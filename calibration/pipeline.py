@@ -9,7 +9,10 @@ Steps (each timed in the report):
    inputs/params/<name>.toml (or --params-out), every value with its MD run hash in [meta].
 3. The paper's dry, wet and SAM cases for the base set, the recipe's `compare_sets` (default: the literature
    `silicon` set) and the new set
-   (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper.
+   (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper. The sampled
+   claims are judged on the paper command's discrete-summit seeds and, for the new set, on the Latin-hypercube
+   rows of step 4 (the same draws), so a calibrated claim's holds_fraction covers the calibration's own
+   uncertainty.
    3b. Claim attribution (calibration.attribution): when a claim holds with the base set and fails with the new
    one, each group of MD values is put back to the base values alone and the paper's cases run again (no
    figures), into OUT/attribution; the claims that hold again name the value that broke them.
@@ -557,18 +560,23 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         # 3. the paper's cases
         t = time.perf_counter()
         from continuum.paper.report import make_paper
+        from continuum.paper.samples import DEFAULT_SEEDS
 
         sets = [cal.base, *[s for s in paper_sets if s != cal.base], str(set_path)]
-        paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None)   # the user's executor
+        keys, samples = sample_inputs(table["meta"].get("calibration", {}), cal.uncertainty.ranges,
+                                      cal.uncertainty.samples, cal.uncertainty.seed)
+        # the new set's claims judged over the calibration's own Latin-hypercube rows and the discrete seeds
+        paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None,   # the user's executor
+                           seeds=DEFAULT_SEEDS, uncertainty=paper_uncertainty(cal.uncertainty, samples, set_path))
         timings["paper_s"] = time.perf_counter() - t
         # 3b. why a claim that holds with the base set fails with the new one: each MD value put back alone
         t = time.perf_counter()
         attribution = attribute_claims(table, rows, paper["checks"], Path(set_path).stem, Path(cal.base).stem,
-                                       out / "attribution", executor=ex, progress=progress)
+                                       out / "attribution", executor=ex, progress=progress, set_path=str(set_path))
         timings["attribution_s"] = time.perf_counter() - t
         # 4. uncertainty
         t = time.perf_counter()
-        keys, sample_out = _run_uncertainty(ex, cal.uncertainty, table, set_path)
+        sample_out = _run_uncertainty(ex, cal.uncertainty, samples, set_path)
         timings["uncertainty_s"] = time.perf_counter() - t
     finally:
         ex.close()
@@ -633,15 +641,21 @@ def _write_set(cal: CalibrationRecipe, results: dict, md_fidelity: str, machine:
     return table, rows, set_path
 
 
-def _run_uncertainty(ex, unc: Uncertainty, table: dict, set_path: Path) -> tuple[list, list]:
-    """The Latin-hypercube samples of the set's uncertain inputs, each run on `ex`; a sample whose job failed
-    (a crash, a lost worker) is counted and reported like a refused one. Returns (sampled keys, outcomes)."""
-    keys, samples = sample_inputs(table["meta"].get("calibration", {}), unc.ranges, unc.samples, unc.seed)
+def paper_uncertainty(unc: Uncertainty, samples: list[dict], set_path: Path) -> dict[str, list[dict]]:
+    """The rows the paper run judges the new set's sampled claims on: each Latin-hypercube sample (`samples`,
+    :func:`sample_inputs`) with the recipe's scene overrides, the same rows the uncertainty bands run
+    ({set name: [overrides, ...]}, continuum.paper.report.make_paper's `uncertainty`)."""
+    return {Path(set_path).stem: [{**unc.overrides, **smp} for smp in samples]}
+
+
+def _run_uncertainty(ex, unc: Uncertainty, samples: list[dict], set_path: Path) -> list:
+    """The Latin-hypercube `samples` of the set's uncertain inputs, each run on `ex`; a sample whose job failed
+    (a crash, a lost worker) is counted and reported like a refused one. Returns the outcomes."""
     sample_out = [None] * len(samples)
     tasks = [(unc.scene, str(set_path), {**unc.overrides, **smp}, unc.max_bounces) for smp in samples]
     for i, s in ex.map(uncertainty_sample, tasks, on_error="collect"):
         sample_out[i] = {"overrides": tasks[i][2], "error": s.reason} if isinstance(s, Failure) else s
-    return keys, sample_out
+    return sample_out
 
 
 def _bands(sample_out: list, keys: list, unc: Uncertainty, table: dict) -> dict:

@@ -193,6 +193,32 @@ def _chosen_lines(meta: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+def _acceptance_text(a: Mapping[str, Any], probe: Mapping[str, Any] | None) -> str:
+    """One claim's acceptance line: accepted or not, over how many samples it holds, why; Fig 4's loop claim
+    with what its declared choices do to the loop ratio (continuum.paper.loop_probe)."""
+    frac = a.get("holds_fraction")
+    held = (f"holds on {frac:.2f} of {a.get('samples')} samples" if frac is not None
+            else f"{a.get('samples')} samples, none decided")
+    text = f"**Acceptance:** {'accepted' if a['accepted'] else 'not accepted'} ({held}): {a['why']}."
+    if probe:
+        stiff, scan = probe.get("stiff_layer"), probe["summit_radius_scan"]
+        parts = [f"loop ratio {probe['loop_ratio']:.3g} as declared"]
+        if stiff:
+            parts.append(f"{stiff['loop_ratio']:.3g} with the SAM layer as stiff as its substrate "
+                         f"({stiff['layer_modulus_Pa']:.3g} Pa instead of the declared {stiff['declared_layer_modulus_Pa']:.3g})")
+        cross = probe.get("crossing_m")
+        parts.append(f"over summit radii {scan['radius_m'][0] * 1e6:.2g}-{scan['radius_m'][-1] * 1e6:.2g} um (declared "
+                     f"{probe['declared_summit_radius_m'] * 1e6:.2g}) it runs {scan['loop_ratio'][0]:.3g} to "
+                     f"{scan['loop_ratio'][-1]:.3g}" + (f", passing 1 between {cross[0] * 1e6:.2g} and "
+                                                        f"{cross[1] * 1e6:.2g} um" if cross else ", never passing 1"))
+        decides = [w for w, on in (("the compliant layer", stiff and stiff["loop_ratio"] < 1),
+                                   ("the summit radius", cross)) if on]
+        text += (" Declared choices: " + "; ".join(parts) + ". " +
+                 (f"It is decided by {' and '.join(decides)} (declared, not measured)." if decides else
+                  "Neither declared choice alone restores it."))
+    return text
+
+
 def report_markdown(rec: CalibrationReport) -> str:
     cal, t, m = rec.calibration, rec.timings, rec.machine
     lines = [f"# Calibration `{cal.name}` (base `{cal.base}`)", "", *_chosen_lines(rec.set_meta),
@@ -235,9 +261,17 @@ def report_markdown(rec: CalibrationReport) -> str:
         lines += [f"**Where it does not** ({len(differ)}), and why: each MD value put back to the base set's "
                   "value alone, the paper's cases run again, and the claims that hold again name it "
                   "(`attribution/`):", ""]
+        att = rec.claim_attribution or {}
+        accept = {a["claim"]: a for a in att.get("acceptance", [])}
         lines += [f"- `{c['name']}`: needs {c['threshold']}; got {json.dumps(c['values'], default=str)[:300]}"
                   + (f". **Why:** {why[c['name']]['text']}." if c["name"] in why else "")
+                  + (" " + _acceptance_text(accept[c["name"]], (att.get("choices") or {}).get(c["name"]))
+                     if c["name"] in accept else "")
                   for c in differ]
+        n_acc = sum(a["accepted"] for a in accept.values())
+        lines += ["", f"**Accepted failures:** {n_acc} of {len(differ)} (a failure is accepted when one measured value "
+                      "put back alone restores the claim and the measured value moved it the way physics predicts, "
+                      "`calibration.attribution.PHYSICAL_DIRECTION`)."]
     b = rec.bands
     lines += ["", "## Uncertainty", "",
               f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "

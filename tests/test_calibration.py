@@ -394,6 +394,10 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     assert len(report.md_sources) == 7 and len(report.rows) == 8
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
+    # the new set's sampled claims are judged over the recipe's own Latin-hypercube rows and the discrete seeds
+    sampled = {c["set"]: c["sampled"] for c in report.paper_checks if c["name"] == "fig5a_ots_outbounces_silica"}
+    assert sampled["calibrated_smoke"]["uncertainty"] == 2 and sampled["paper"]["uncertainty"] == 0
+    assert sampled["calibrated_smoke"]["seeds"] == sampled["paper"]["seeds"] > 0
     assert len(report.used) + len(report.not_used) == 8
     # every claim that fails with the new set is explained (the attribution's revert runs are on Dask too)
     failing = {c["name"] for c in report.claims() if not c["pass"]}

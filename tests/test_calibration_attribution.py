@@ -130,3 +130,72 @@ def test_no_revert_runs_when_every_failing_claim_fails_with_the_base_set_too(tmp
     assert not got["ran"] and not (tmp_path / "attribution").exists()
     assert got["claims"] == [{"claim": "a", "cause": "base fails too", "restored_by": [],
                               "text": "fails with the base set too: not caused by the calibrated values"}]
+
+
+# ------------------------------------------------------------------------------ acceptance
+def _named(set_name, states):
+    return [{"name": n, "set": set_name, "pass": ok, "holds_fraction": 1.0 if ok else 0.25, "samples": 4}
+            for n, ok in states.items()]
+
+
+ESC = "fig8b_ots_lower_escape_velocity"
+
+
+def test_a_failure_restored_by_one_measured_value_is_accepted_only_in_the_physical_direction():
+    """OTS's escape velocity below silica's needs silica stickier: a measured W_silica below the base (0.2 ->
+    0.12 read backwards) that breaks it is physical; the same claim restored by putting back a W_silica measured
+    *above* the base would mean a stickier silica broke it, which physics does not predict."""
+    from calibration.attribution import acceptance
+
+    lower = [_row("surfaces.work_of_adhesion", "adhesion_silica", "work_of_adhesion_free_energy", 0.08, 0.12)]
+    higher = [_row("surfaces.work_of_adhesion", "adhesion_silica", "work_of_adhesion_free_energy", 0.2, 0.12)]
+    for rows, accepted in ((lower, True), (higher, False)):
+        groups = reverts(rows, "cal")
+        why = explain_claims(_named("cal", {ESC: False}), _named("paper", {ESC: True}),
+                             {groups[0].set_name: _named(groups[0].set_name, {ESC: True})}, groups)
+        (a,) = acceptance(_named("cal", {ESC: False}), why, groups)
+        assert a["accepted"] is accepted and a["holds_fraction"] == 0.25 and a["samples"] == 4
+        assert "surfaces.work_of_adhesion" in a["why"] and ("opposite" in a["why"]) is (not accepted)
+
+
+def test_failures_through_several_values_the_base_set_or_the_samples_are_not_accepted():
+    from calibration.attribution import acceptance
+
+    groups = reverts(ROWS, "cal")
+    cal = _named("cal", {"a": False, "b": False, "c": False})
+    cal[2]["nominal_state"] = "pass"                               # holds on its own runs, not over its samples
+    why = explain_claims(cal, _named("paper", {"a": True, "b": False, "c": True}),
+                         {g.set_name: _named(g.set_name, {"a": False, "b": False, "c": False}) for g in groups}, groups)
+    causes = {w.claim: w.cause for w in why}
+    assert causes == {"a": "several", "b": "base fails too", "c": "samples"}
+    acc = {a["claim"]: a for a in acceptance(cal, why, groups)}
+    assert not any(a["accepted"] for a in acc.values())
+    assert "no single measured value" in acc["a"]["why"] and "base set too" in acc["b"]["why"]
+
+
+def test_the_report_says_per_claim_whether_it_is_accepted_with_its_sample_fraction_and_figure_4s_choices():
+    from calibration.report import _acceptance_text
+
+    a = {"claim": "fig4_ots_loop_smaller_than_silica", "accepted": False, "holds_fraction": 0.0, "samples": 17,
+         "cause": "several", "why": "no single measured value put back restores it"}
+    probe = {"loop_ratio": 6.36, "declared_summit_radius_m": 2e-7,
+             "stiff_layer": {"layer_modulus_Pa": 1.69e11, "declared_layer_modulus_Pa": 1e9, "loop_ratio": 2e-4},
+             "summit_radius_scan": {"radius_m": [5e-8, 5e-7, 8e-7, 2e-6], "loop_ratio": [108, 1.07, 0.58, 0.26]},
+             "crossing_m": [5e-7, 8e-7]}
+    text = _acceptance_text(a, probe)
+    assert text.startswith("**Acceptance:** not accepted (holds on 0.00 of 17 samples)")
+    assert "0.0002 with the SAM layer as stiff as its substrate" in text and "between 0.5 and 0.8 um" in text
+    assert "decided by the compliant layer and the summit radius" in text
+
+
+def test_a_compliant_sam_layer_raises_the_ots_loop():
+    """Fig 4's probe, physics: a softer coated summit (lower E*) has a larger adhesive hysteresis (JKR: ~ E*^(-2/3),
+    Maugis 2000), so the declared 1 GPa layer gives OTS a larger loop than a layer as stiff as its substrate, and a
+    larger summit radius raises bare silica's Tabor parameter and loop, lowering the ratio."""
+    from continuum.paper.loop_probe import loop_area, loop_ratio
+
+    soft = loop_area("rough_ots.toml", "calibrated", {})
+    stiff = loop_area("rough_ots.toml", "calibrated", {"surfaces.sam.layer_modulus": 1.69e11})
+    assert soft > 10 * stiff
+    small, large = ({"surfaces.roughness.summit_radius": r} for r in (0.1e-6, 1e-6))
+    assert loop_ratio("calibrated", large, large) < loop_ratio("calibrated", small, small)

@@ -63,3 +63,20 @@ def test_paper_output_has_figures_data_summary_and_case_results(paper_run):
     assert "Parameter set `paper`" in summary and "Verification (" in summary and "Reproduction (" in summary
     result = json.loads((out / "cases" / "rough_silica" / "paper" / "result.json").read_text())
     assert result["schema_version"] == "2.0" and result["n_bounces"] >= 2
+
+
+def test_the_calibration_judges_its_new_sets_claims_on_its_own_latin_hypercube_rows():
+    """`nanoimpact calibrate` hands the paper run the very rows its uncertainty bands run: each Latin-hypercube
+    draw of the set's measured values (and the recipe's ranges) with the recipe's scene overrides, under the
+    new set's name."""
+    from pathlib import Path
+
+    from calibration.pipeline import load_calibration, paper_uncertainty, sample_inputs
+
+    cal = load_calibration(Path(__file__).resolve().parents[1] / "inputs" / "calibration" / "quick.toml")
+    measured = {"surfaces.work_of_adhesion": {"value": 0.196, "stderr": 0.039}}
+    keys, samples = sample_inputs(measured, cal.uncertainty.ranges, cal.uncertainty.samples, cal.uncertainty.seed)
+    rows = paper_uncertainty(cal.uncertainty, samples, Path("/x/calibrated.toml"))
+    assert list(rows) == ["calibrated"] and len(rows["calibrated"]) == cal.uncertainty.samples
+    for row, drawn in zip(rows["calibrated"], samples):
+        assert row == {**cal.uncertainty.overrides, **drawn} and set(keys) <= set(row)

@@ -78,7 +78,7 @@ def over_samples(nominal: dict, sample_states: list[str], sources: dict, bands: 
     undecided = len(states) - decided
     fraction = held / decided if decided else None
     out = dict(nominal, holds_fraction=fraction, samples=len(states), samples_undecided=undecided,
-               sampled=sources)
+               sampled=sources, nominal_state=nominal["state"])
     if bands:
         out["bands"] = bands
     if nominal["state"] != PASS:            # the set's own model decides first; the samples test robustness
