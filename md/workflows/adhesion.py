@@ -272,9 +272,11 @@ class _AdhesionAnalysis:
         self.dsep = self.d_A.mean(axis=0)
         avg = A.registry_average(self.f_m, self.f_e)
         self.fbar, self.ebar = np.asarray(avg["mean"]), np.asarray(avg["stderr"])
+        self.estat = np.asarray(avg["stderr_statistical"])
         self._tail_forces()
         self._free_energy()
         self._flat_slab_law()
+        self._layer_modulus()
         self._window_checks()
         self.tail_det.update(tail_energy_last_window_kcal=self.u_tail_last)
         self.details["dispersion_tail"] = self.tail_det
@@ -301,27 +303,28 @@ class _AdhesionAnalysis:
                         self.u_tail_last = float(np.mean(tw["energy"]))
 
     def _free_energy(self) -> None:
-        """W_F by force integration from the zero-force point (trapezoid; PCHIP and the grid error beside it), per
-        registry and from each half of the windows' samples; T dS = dE - dF."""
+        """W_F by force integration from the zero-force point (trapezoid; PCHIP and the grid error beside it) with
+        the chained windows' errors correlated (lag-1 from the replicate chains), per registry (each chain an
+        independent sample of the whole integral: their Student-t spread bounds the error from below); T dS = dE -
+        dF of registry 0, the registry the contact leg's energy belongs to."""
         dsep, ebar, area, conv, w = self.dsep, self.ebar, self.area, self.conv, self.w
         self.f_tot = f_tot = self.fbar + self.f_tail
-        self.ti_cut = A.force_integration_work(dsep, self.fbar, ebar, area)
-        self.ti = ti = A.force_integration_work(dsep, f_tot, ebar, area)
+        self.rho = rho = A.chain_correlation(self.f_m, self.f_e)
+        self.ti_cut = A.force_integration_work(dsep, self.fbar, ebar, area, correlation=rho)
+        self.ti = ti = A.force_integration_work(dsep, f_tot, ebar, area, correlation=rho)
         self.wf_val = wf = ti["value"] - self.u_tail_last * conv
         self.wf_pchip = ti["value_pchip"] - self.u_tail_last * conv
         wf_err, self.wf_disc = ti["stderr"], ti["discretisation_error"]
-        # window length: W_F from each window's first half against its second half (the same grid, tail and
-        # registries); windows long enough for their decorrelation give the same W within the errors
-        self.w_half = [A.force_integration_work(dsep, np.nanmean(h, axis=0) + self.f_tail, ebar * math.sqrt(2.0),
-                                                area)["value"] - self.u_tail_last * conv for h in self.halves]
-        per_reg = [A.force_integration_work(self.d_A[r], self.f_m[r], self.f_e[r], area) for r in range(self.n_reg)]
-        self.w_reg = np.array([p["value"] for p in per_reg])
+        per_reg = [A.force_integration_work(self.d_A[r], self.f_m[r] + self.f_tail, self.f_e[r], area,
+                                            correlation=rho) for r in range(self.n_reg)]
+        self.w_reg = np.array([p["value"] - self.u_tail_last * conv for p in per_reg])
+        self.w_reg_err = np.array([p["stderr"] for p in per_reg])
         if self.n_reg >= 2:
-            reg_avg = A.registry_average(self.w_reg, [p["stderr"] for p in per_reg])
-            wf_err = max(wf_err, reg_avg["stderr"])
+            wf_err = max(wf_err, A.registry_average(self.w_reg, self.w_reg_err)["stderr"])
         self.wf_err = wf_err
         w_e = w["value"] + self.w_tail_static
-        self.tds = w_e - wf
+        self.tds_rec = A.entropic_term({0: (w_e, w["stderr"])}, {0: (self.w_reg[0], self.w_reg_err[0])})
+        self.tds, self.tds_err = self.tds_rec["per_registry"][0]
         self.repulsive = bool(ti["repulsive_end"])
         q, tail_on, n_reg = self.q, self.tail_on, self.n_reg
         q["work_of_adhesion_free_energy"] = quantity_record(
@@ -330,8 +333,10 @@ class _AdhesionAnalysis:
                                                                    "included" if tail_on else "") + ")",
             discretisation_error=self.wf_disc, value_pchip=self.wf_pchip, repulsive_end=self.repulsive,
             registry_spread=float(np.std(self.w_reg, ddof=1)) if n_reg >= 2 else 0.0, registries=n_reg)
-        q["entropic_term_TdS"] = quantity_record(self.tds, math.hypot(w["stderr"], wf_err), "J/m^2",
-                                    kind="T dS / A = (dE - dF) / A", discretisation_error=self.wf_disc)
+        q["entropic_term_TdS"] = quantity_record(self.tds, self.tds_err, "J/m^2",
+                                    kind="T dS / A = (dE - dF) / A of registry 0: dE/A from the zero-load contact "
+                                         "leg (registry 0) and W_F of registry 0's own chain",
+                                    discretisation_error=self.wf_disc, registry=0)
         if tail_on:
             q["dispersion_tail_work"] = quantity_record(wf - self.ti_cut["value"], None, "J/m^2",
                                            kind="static dispersion beyond the cutoff for TraPPE pairs, in W_F: "
@@ -370,6 +375,32 @@ class _AdhesionAnalysis:
             zsig["lj93_fit"] = {"error": str(exc)}
         self.details["flat_slab_law"] = zsig
 
+    def _layer_modulus(self) -> None:
+        """The SAM layers' confined modulus from the compression branch (windows pressed into the contact, below the
+        zero crossing) of the mean-force curve with its tail (:func:`md.analysis.confined_layer_modulus`); the
+        thickness is the builder's (chain length and tilt) of every SAM between the backs. Pairs without a SAM:
+        nothing."""
+        try:
+            t, n_layers = A.sam_layer_thickness_A(self.info)
+        except ValueError:
+            return
+        try:
+            lm = A.confined_layer_modulus(self.dsep, self.f_tot, self.ebar, self.area, t)
+        except ValueError as exc:
+            self.notes.append(f"SAM layer modulus not measured: {exc}")
+            self.details["sam_layer_modulus"] = {"error": str(exc)}
+            return
+        self.q["sam_layer_modulus"] = quantity_record(
+            lm["modulus_Pa"], lm["stderr_Pa"], "Pa",
+            kind=f"confined (uniaxial-strain) modulus of the SAM layer{'s' if n_layers > 1 else ''} between the "
+                 f"backs: -t d sigma / d d over the {lm['windows']} repulsive windows pressed into the contact, "
+                 f"t = {t:.1f} A ({n_layers} SAM{'s' if n_layers > 1 else ''}, the builder's thickness); the "
+                 "slabs' and the interface's compliance counted as the layers'",
+            thickness_m=U.angstrom_to_m(t), layers=n_layers, windows=lm["windows"], strain_max=lm["strain_max"])
+        self.details["sam_layer_modulus"] = lm
+        if lm["note"]:
+            self.notes.append(f"SAM layer modulus: {lm['note']}.")
+
     def _window_checks(self) -> None:
         """Windows with few independent samples, registries that disagree beyond their stderrs, the window-length
         check (W_F from the halves), and the per-window record."""
@@ -392,16 +423,27 @@ class _AdhesionAnalysis:
             "registry_work_J_m2": self.w_reg.tolist(), "registry_offsets_A": self.info["registry_offsets_A"],
             "zero_force_separation_A": self.ti["zero_force_separation_A"], "repulsive_end": self.repulsive,
             "windows_with_few_samples": self.short, "cutoff_only_work_J_m2": self.ti_cut["value"],
-            "registry_chi2_per_dof": cons["chi2_per_dof"].tolist(), "registries_disagree": disagree}
-        # the halves' errors are sqrt(2) of the whole's, so their difference has stderr 2 x the whole's
-        self.half_diff, self.half_err = self.w_half[1] - self.w_half[0], 2.0 * self.wf_err
+            "registry_chi2_per_dof": cons["chi2_per_dof"].tolist(), "registries_disagree": disagree,
+            "statistical_stderr_kcal_mol_A": self.estat.tolist(), "chain_correlation_lag1": self.rho,
+            "registry_work_stderr_J_m2": self.w_reg_err.tolist(),
+            "t_factor": A.student_t_factor(self.n_reg) if self.n_reg >= 2 else 1.0,
+            "interval_grid_bound_J_m2": self.ti["interval_bounds_J_per_m2"].tolist(),
+            "refine_intervals_A": self.ti["refine_intervals_A"], "grid_bound_max_J_m2": self.ti["grid_bound_max"],
+            "quadrature_difference_J_m2": self.ti["quadrature_difference"]}
+        # tolerance from the windows' within-registry statistical stderrs only: a registry's offset cancels in the
+        # difference of its halves, so the registries' spread must not widen it
+        first, second = (np.nanmean(h, axis=0) + self.f_tail for h in self.halves)
+        wl = A.window_length_check(self.dsep, first, second, self.estat, self.area, correlation=self.rho)
+        self.w_half = [wl["first_half_J_m2"] - self.u_tail_last * self.conv,
+                       wl["second_half_J_m2"] - self.u_tail_last * self.conv]
+        self.half_diff, self.half_err, self.half_ok = wl["difference_J_m2"], wl["difference_stderr_J_m2"], wl["converged"]
         self.details["window_length_check"] = {
             "first_half_J_m2": self.w_half[0], "second_half_J_m2": self.w_half[1], "whole_J_m2": self.wf_val,
-            "difference_J_m2": self.half_diff, "difference_stderr_J_m2": self.half_err,
-            "converged": bool(abs(self.half_diff) <= 2.0 * self.half_err),
+            "difference_J_m2": self.half_diff, "difference_stderr_J_m2": self.half_err, "converged": self.half_ok,
             "what": "W_F from the first and the second half of every window's equilibrated samples (after the detected "
                     "start, as W_F itself; same grid, tail, registries): a drift between them means the windows are "
-                    "too short for the force to settle"}
+                    "too short for the force to settle. Tolerance: 2 x the difference's stderr from the windows' "
+                    "within-registry statistical stderrs (the registries' spread cancels in the difference)"}
 
     def _pmf_notes(self) -> list[str]:
         dsep, wf, wf_err, n_reg, s = self.dsep, self.wf_val, self.wf_err, self.n_reg, self.s
@@ -411,8 +453,17 @@ class _AdhesionAnalysis:
             f"{'y' if n_reg == 1 else 'ies'} ({dsep[0]:+.2f} to {dsep[-1]:.2f} A from the contact leg's mean back "
             f"height {self.zc:.2f} A; chains: each window continues from its neighbour): dF/A = {wf:.4f} +/- "
             f"{wf_err:.4f} J/m^2 (trapezoid from the zero-force point {self.ti['zero_force_separation_A']:+.2f} A; "
-            f"PCHIP gives {self.wf_pchip:.4f}, grid error about {self.wf_disc:.4f}); T dS/A = {self.tds:.4f} J/m^2. "
-            f"The stderr is statistical (and the registries' spread); the discretisation error is given beside it."]
+            f"PCHIP gives {self.wf_pchip:.4f}, grid error {self.wf_disc:.4f}: the larger of the two quadratures' "
+            f"difference and the largest interval bound 1/2 |df| dd over the detachment region); T dS/A of registry "
+            f"0 (its contact leg's dE against its own chain's W_F) = {self.tds:.4f} +/- {self.tds_err:.4f} J/m^2. "
+            f"The stderr is statistical with the chained windows' errors correlated (lag-1 rho = {self.rho:.2f} from "
+            f"the replicate chains), and at least the registries' spread of W_F times the Student-t factor of "
+            f"{n_reg} registries; the discretisation error is given beside it."]
+        if self.ti["refine_intervals_A"]:
+            notes.append("windows too sparse: between " + ", ".join(f"{a:+.2f} and {b:+.2f} A" for a, b in
+                                                                     self.ti["refine_intervals_A"])
+                         + " the mean force changes by more than half the peak attraction in one interval (a "
+                           "rupture the grid does not resolve); add windows there.")
         if not self.repulsive:
             notes.append("NO REPULSIVE END: no window before the most attractive one has a repulsive mean force, so "
                          "the bottom of the adhesive well lies inside the innermost window and W_F is a lower bound: "
@@ -422,7 +473,7 @@ class _AdhesionAnalysis:
                          f"(lengthen pmf_sample_steps).")
         notes.append(f"window length: W_F from the first half of every window {w_half[0]:.4f}, from the second half "
                      f"{w_half[1]:.4f} J/m^2 (difference {half_diff:+.4f} +/- {half_err:.4f}: "
-                     + ("within 2 stderr" if abs(half_diff) <= 2.0 * half_err else
+                     + ("within 2 stderr" if self.half_ok else
                         "MORE THAN 2 STDERR: the windows are too short for the mean force to settle; lengthen "
                         "pmf_sample_steps") + ").")
         if self.tail_on:
