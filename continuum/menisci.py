@@ -84,6 +84,11 @@ NUCLEATION_BARRIER_40 = 7.8e-20
 NUCLEATION_TIME_299K = 4.2e-3
 NUCLEATION_REFERENCE_RH = 0.4
 NUCLEATION_REFERENCE_T = 299.0
+#: One water molecule's diameter d_w = n_w^(-1/3) (m, 0.31 nm): the default smallest Kelvin radius a smooth
+#: sphere's bridge is given (``menisci.min_kelvin_radius``). The Kelvin and Laplace equations describe a
+#: continuum liquid; Israelachvili (2011, §17.7) finds them holding down to menisci of a few molecular
+#: diameters, so a meniscus narrower than one molecule is not modelled as a bridge.
+WATER_MOLECULE_DIAMETER = WATER_NUMBER_DENSITY ** (-1.0 / 3.0)
 
 
 def kelvin_radius(relative_humidity: float, temperature: float, surface_tension: float,

@@ -469,17 +469,19 @@ def _check_plasticity(si: dict, sam, origin: str) -> None:
 
 
 def _check_menisci(si: dict, sam, origin: str) -> None:
-    """Menisci need mean-field rough contact, 0 < RH < 1 and both faces' water contact angles."""
+    """Menisci need mean-field rough contact or a smooth sphere, 0 < RH < 1 and both faces' water contact angles."""
     mode = si["surfaces.roughness.mode"]
     menisci = si["physics.menisci"]
     rh = si["environment.relative_humidity"]
+    sphere = si["contact"] == "smooth" and si["body.shape"] == "sphere"
     if menisci == "on":
-        if si["contact"] != "rough" or mode not in ("mean_field", "auto"):
-            raise SceneError("physics.menisci", "on", "menisci are modelled for mean-field rough contact only "
-                             "(contact = 'rough', surfaces.roughness.mode = 'mean_field' or 'auto')", origin)
+        if not sphere and (si["contact"] != "rough" or mode not in ("mean_field", "auto")):
+            raise SceneError("physics.menisci", "on", "menisci are modelled for mean-field rough contact "
+                             "(contact = 'rough', surfaces.roughness.mode = 'mean_field' or 'auto') and the smooth "
+                             "sphere (contact = 'smooth', body.shape = 'sphere')", origin)
         if rh <= 0.0:
             raise SceneError("environment.relative_humidity", rh, "must be > 0 when physics.menisci = 'on'", origin)
-    if menisci != "off" and si["contact"] == "rough" and rh > 0.0:
+    if menisci != "off" and (si["contact"] == "rough" or sphere) and rh > 0.0:
         if rh >= 1.0:
             raise SceneError("environment.relative_humidity", rh, "must be < 1 for menisci (the Kelvin radius "
                              "diverges at saturation); set physics.menisci = 'off' to ignore humidity", origin)

@@ -191,9 +191,11 @@ FIELDS: tuple[Field, ...] = (
           "under them (eqs 16-17, FFT influence coefficients), treat the substrate below the summits as rigid, or "
           "'auto': on unless its estimated deflection across the footprint is below 1e-3 sigma.",
           "auto", choices=("auto", "on", "off")),
-    Field("physics.menisci", str, "", "Rough contact: capillary bridges at summits after the condensation time "
-          "(section 'menisci'). 'auto': left out when dry, hydrophobic (cos t1 + cos t2 <= 0), or when no contact "
-          "of the dry run lasts the condensation time.", "auto", choices=("auto", "on", "off")),
+    Field("physics.menisci", str, "", "Capillary bridges after the condensation time (section 'menisci'): at "
+          "the summits of mean-field rough contact, or one bridge at a smooth sphere's contact. 'auto': left out "
+          "when dry, hydrophobic (cos t1 + cos t2 <= 0), for a sphere when the Kelvin radius is below "
+          "menisci.min_kelvin_radius, or when no contact of the dry run lasts the condensation time.", "auto",
+          choices=("auto", "on", "off")),
     # --- menisci -------------------------------------------------------------------------
     Field("menisci.condensation_time", float, "s", "t_a: contact time before the first bridges form "
           "(25 us, the paper's value from Riedo et al. 2002). Used when condensation_model = 'fixed'.", 25e-6,
@@ -212,6 +214,9 @@ FIELDS: tuple[Field, ...] = (
           "SPC/E water 0.0636).", 0.072, low=1e-3, high=1.0),
     Field("menisci.molar_volume", float, "m^3/mol", "Molar volume of the liquid (Kelvin radius; water 1.807e-5).",
           1.807e-5, low=1e-6, high=1e-3),
+    Field("menisci.min_kelvin_radius", float, "m", "Smooth sphere: no bridge condenses where the Kelvin radius is "
+          "below this (a meniscus narrower than a molecule is no continuum liquid). Not set: one water molecule, "
+          "n_w^(-1/3) = 0.31 nm.", None, low=1e-11, high=1e-8),
     # --- numerics ------------------------------------------------------------------------
     Field("numerics.fidelity", str, "", "Preset for tolerances (and later grid and table sizes).", "standard",
           choices=("fast", "standard", "reference")),

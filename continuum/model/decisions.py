@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 from .. import menisci as men
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
-from .regime import Regime, meniscus_parameters, summit_e_star
+from .regime import Regime, kelvin_radius_cutoff, meniscus_parameters, summit_e_star
 
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
 TABOR_JKR, TABOR_DMT = 5.0, 0.1
@@ -240,9 +240,11 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
     rh = env.relative_humidity
     if choice == "off":
         return MenisciDecision("off", "scene", "physics.menisci = 'off' set in the scene", rh)
-    if scene.contact != "rough":
-        return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact only", rh)
-    if surf.roughness.mode != "mean_field":
+    sphere = scene.contact == "smooth" and scene.body.shape == "sphere"
+    if scene.contact != "rough" and not sphere:
+        return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact and the smooth "
+                               "sphere only", rh)
+    if not sphere and surf.roughness.mode != "mean_field":
         return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact only (surfaces."
                                f"roughness.mode = '{surf.roughness.mode}')", rh)
     if rh <= 0.0:
@@ -253,6 +255,11 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
     if wet <= 0.0:
         return MenisciDecision("off", "contact_angles", f"hydrophobic: cos t1 + cos t2 = {wet:.3g} <= 0, no bridge pulls",
                                rh, **numbers)
+    if sphere:
+        r_k, cutoff, source = kelvin_radius_cutoff(scene)
+        if r_k < cutoff:
+            return MenisciDecision("off", "kelvin_radius", f"Kelvin radius {r_k:.3g} m < {cutoff:.3g} m ({source}): "
+                                   "no continuum meniscus condenses", rh, **numbers)
     if choice == "on":
         return MenisciDecision("on", "scene", "physics.menisci = 'on' set in the scene", rh, **numbers)
     return MenisciDecision("after_dry_run", "longest_contact_time",

@@ -93,3 +93,12 @@ def with_menisci(dry: ContactLaw, scene: Scene, stats, parameters: dict) -> Cont
     bridges = MeniscusBridges(stats, dry.z_top, body.radius, body.length, p["bridge_pull_off"], p["kelvin_gap"],
                               p["condensation_time"], p["growth_length"])
     return WetRoughRoller(dry, bridges, p)
+
+
+def with_sphere_meniscus(dry: ContactLaw, wet: ContactLaw, parameters: dict) -> ContactLaw:
+    """`dry` (a smooth-sphere law) plus one capillary bridge at its contact with the meniscus `parameters`; `wet`:
+    the sphere's law for solids touching inside the bridge (`dry` itself for the additive choice)."""
+    from ..laws.sphere_meniscus import SphereBridge, WetSphere
+    p = parameters
+    bridge = SphereBridge(p["bridge_pull_off"], p["kelvin_gap"], p["condensation_time"], p["growth_length"])
+    return WetSphere(dry, wet, bridge, p)

@@ -139,25 +139,43 @@ def condensation_time(scene: Scene) -> tuple[float, str]:
     return t_a, "nucleation (Szoszkiewicz & Riedo 2005)"
 
 
+def kelvin_radius_cutoff(scene: Scene) -> tuple[float, float, str]:
+    """(r_K m, the smallest r_K a smooth sphere's bridge is given m, its source) at the scene's humidity."""
+    env, m = scene.environment, scene.menisci
+    r_k = men.kelvin_radius(env.relative_humidity, env.temperature, m.surface_tension, m.molar_volume)
+    if m.min_kelvin_radius is not None:
+        return r_k, m.min_kelvin_radius, "menisci.min_kelvin_radius"
+    return r_k, men.WATER_MOLECULE_DIAMETER, "one water molecule, n_w^(-1/3)"
+
+
 def meniscus_parameters(scene: Scene) -> dict:
-    """Kelvin radius and gap, bridge pull, t_a and growth length for the scene (SI), with their sources."""
+    """Kelvin radius and gap, bridge pull, t_a and growth length for the scene (SI), with their sources: at the
+    summits (radius beta) of rough contact, or at a smooth sphere's contact (its radius R)."""
     surf, env, m = scene.surfaces, scene.environment, scene.menisci
     t1, t2 = surf.contact_angles
     rh, temp = env.relative_humidity, env.temperature
     r_k = men.kelvin_radius(rh, temp, m.surface_tension, m.molar_volume)
     d_k = men.kelvin_gap(r_k, t1, t2)
-    beta = surf.roughness.summit_radius
+    smooth = scene.contact == "smooth"
+    beta = scene.body.radius if smooth else surf.roughness.summit_radius
     t_a, t_src = condensation_time(scene)
     h1 = m.growth_length if m.growth_length is not None else men.default_growth_length(rh)
     w = surf.interface_work_of_adhesion
-    return {"kelvin_radius": r_k, "kelvin_gap": d_k, "kelvin_gap_over_summit_radius": d_k / beta,
-            "bridge_pull_off": men.bridge_pull_off(beta, m.surface_tension, t1, t2),
-            "solid_adhesion": m.solid_adhesion,
-            "work_of_adhesion_wet": men.wet_work_of_adhesion(w, m.surface_tension, t1, t2),
-            "solid_pull": men.solid_pull_inside_bridge(beta, w, m.surface_tension, t1, t2, m.solid_adhesion),
-            "condensation_time": t_a, "condensation_time_source": t_src, "growth_length": h1,
-            "growth_length_source": "menisci.growth_length" if m.growth_length is not None
-            else "1/(n_w^(1/3) ln(1/RH)) (one molecule's cross-section)",
-            "surface_tension": m.surface_tension, "force_law": "constant Kelvin radius, F0 (1 - g/D_K), "
-            "rupture at D_K (docs/model.md, Menisci)", "bridges_see": "rigid geometry (half-space deflection left "
-            "out of the bridges' gaps)"}
+    out = {"kelvin_radius": r_k, "kelvin_gap": d_k, "kelvin_gap_over_summit_radius": d_k / beta,
+           "bridge_pull_off": men.bridge_pull_off(beta, m.surface_tension, t1, t2),
+           "solid_adhesion": m.solid_adhesion,
+           "work_of_adhesion_wet": men.wet_work_of_adhesion(w, m.surface_tension, t1, t2),
+           "solid_pull": men.solid_pull_inside_bridge(beta, w, m.surface_tension, t1, t2, m.solid_adhesion),
+           "condensation_time": t_a, "condensation_time_source": t_src, "growth_length": h1,
+           "growth_length_source": "menisci.growth_length" if m.growth_length is not None
+           else "1/(n_w^(1/3) ln(1/RH)) (one molecule's cross-section)",
+           "surface_tension": m.surface_tension, "force_law": "constant Kelvin radius, F0 (1 - g/D_K), "
+           "rupture at D_K (docs/model.md, Menisci)", "bridges_see": "rigid geometry (half-space deflection left "
+           "out of the bridges' gaps)"}
+    if smooth:
+        _, cutoff, source = kelvin_radius_cutoff(scene)
+        out.pop("kelvin_gap_over_summit_radius")
+        out.update({"bridge_radius": beta, "kelvin_radius_over_radius": r_k / beta, "min_kelvin_radius": cutoff,
+                    "min_kelvin_radius_source": source, "bridges_see": "the sphere's rigid approach (one bridge at "
+                    "its contact, continuum.laws.sphere_meniscus)"})
+    return out

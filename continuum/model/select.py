@@ -137,6 +137,31 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     return law, record
 
 
+def _wet_solids_record(scene: Scene, plastic: bool) -> dict:
+    """How a smooth sphere's solids adhere inside its bridge (menisci.solid_adhesion): 'wet', at the work of
+    adhesion under the liquid max(W_wet, 0) (continuum.menisci.wet_work_of_adhesion), their law rebuilt at it;
+    'additive', the dry law unchanged. The summits' DMT solid pull is not used: the sphere's own law carries it."""
+    from .. import menisci as men
+    surf, m = scene.surfaces, scene.menisci
+    t1, t2 = surf.contact_angles
+    w = surf.interface_work_of_adhesion
+    w_wet = max(men.wet_work_of_adhesion(w, m.surface_tension, t1, t2), 0.0)
+    if m.solid_adhesion == "wet" and plastic:
+        raise SceneError("menisci.solid_adhesion", "wet", "the wet solid adhesion rebuilds the sphere's law when "
+                         "the bridge condenses, which would drop the Thornton-Ning flattening: set "
+                         "menisci.solid_adhesion = 'additive' or physics.plasticity = 'off'", "scene")
+    return {"solid_pull": 0.0, "solid_work_of_adhesion": w_wet if m.solid_adhesion == "wet" else w}
+
+
+def _with_work_of_adhesion(scene: Scene, w: float) -> Scene:
+    """`scene` with the contacting pair's work of adhesion `w` (J/m^2): the SAM's when both sides carry one."""
+    from dataclasses import replace
+    surf = scene.surfaces
+    if surf.sam is not None:
+        return replace(scene, surfaces=replace(surf, sam=replace(surf.sam, work_of_adhesion=w)))
+    return replace(scene, surfaces=replace(surf, work_of_adhesion=w))
+
+
 def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None) -> tuple[ContactLaw, dict]:
     """The contact law for `scene` and a record of what runs, what is left out, and why.
 
@@ -171,6 +196,18 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
     plastic = plasticity_decision(scene, adhesion.law, first_impact_speed)
     law, why = factory.smooth_law(scene, adhesion.law, first_impact_speed,
                                   plastic.limiting_pressure if plastic.used else None)
+    if menisci is not None:
+        m_rec = {**m_rec, "used": menisci}
+    if menisci if menisci is not None else m.choice == "on":
+        params = {**meniscus_parameters(scene), **_wet_solids_record(scene, plastic.used)}
+        wet = law
+        if params["solid_adhesion"] == "wet":
+            wet_scene = _with_work_of_adhesion(scene, params["solid_work_of_adhesion"])
+            wet, _ = factory.smooth_law(wet_scene, adhesion.law if params["solid_work_of_adhesion"] > 0 else "none",
+                                        first_impact_speed)
+        m_rec.update(params)
+        law = factory.with_sphere_meniscus(law, wet, params)
+        why += "; one capillary bridge at the contact (continuum.laws.sphere_meniscus)"
     a_rec = adhesion.record()
     if not adhesion.used and scene.surfaces.interface_work_of_adhesion > 0 and scene.physics.adhesion_law == "none":
         a_rec = {**a_rec, "why": "adhesion_law = 'none' (work_of_adhesion ignored)"}
