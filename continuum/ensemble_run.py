@@ -28,6 +28,13 @@ from .scene import ResolvedScene, Scene
 
 log = logging.getLogger(__name__)
 
+#: Relative bracket width of a member's escape velocity: the paper's sampled claims bisect theirs to the same
+#: width (continuum.paper.samples.ESCAPE_REL_TOL); result.json -> ensemble -> escape_velocity states it beside
+#: the members' spread.
+ESCAPE_REL_TOL = 1e-3
+#: Halvings or doublings of the first-impact speed tried to bracket a member's escape velocity (a factor 2^40).
+MAX_ESCAPE_BRACKET_STEPS = 40
+
 
 def with_realisation(scene: Scene, mode: str, seed: int | None = None) -> Scene:
     """`scene` with surfaces.roughness.mode (and seed) replaced."""
@@ -107,14 +114,13 @@ def _release(scene: Scene, z_top: float) -> float | None:
     return scene.release_height
 
 
-def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
-    """One realisation (seed) of `scene` run to the end; module-level so that executors can pickle it."""
+def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any, tuple[float, float] | None]:
+    """(the member's scene, its discrete law, its patch offset on the map or None) for realisation `seed`."""
     from .model import factory
     from .rough.gw import SummitStatistics
 
-    start = time.perf_counter()
     member = with_realisation(scene, "discrete", seed)
-    rough, n = member.surfaces.roughness, member.numerics
+    rough = member.surfaces.roughness
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
     offset = summits = None
     if plan.field is not None:
@@ -122,6 +128,35 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
         summits = patch_summits(plan.field, offset, plan.footprint_half_width, member.body.length)
     law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
                                   plan.footprint_half_width, plan.summit_law, summits)
+    return member, law, offset
+
+
+def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:
+    """The realisation's escape velocity (m/s): the first-impact speed `speed` halved until the body sticks or
+    doubled until it rebounds (at most MAX_ESCAPE_BRACKET_STEPS times), then bisected to `rel_tol`
+    (`continuum.escape.escape_velocity`, single impacts on virgin summits); {'escape_velocity': None, 'reason'}
+    where no bracket is found (summits without adhesion never hold the body)."""
+    from .escape import escape_velocity, single_impact
+
+    mass, g, rtol = member.body.mass, member.environment.gravity, member.numerics.rtol
+    v, lo, hi = speed, None, None
+    for _ in range(MAX_ESCAPE_BRACKET_STEPS):
+        if single_impact(law, mass, g, v, rtol).stuck:
+            lo, v = v, 2.0 * v
+        else:
+            hi, v = v, 0.5 * v
+        if lo is not None and hi is not None:
+            return {**escape_velocity(law, mass, g, lo, hi, rel_tol=rel_tol, rtol=rtol), "rel_tol": rel_tol}
+    return {"escape_velocity": None, "reason": f"no bracket within {MAX_ESCAPE_BRACKET_STEPS} halvings or "
+                                               f"doublings of {speed:.3g} m/s"}
+
+
+def run_member(scene: Scene, seed: int, plan: MemberPlan, escape_rel_tol: float | None = None) -> MemberOutcome:
+    """One realisation (seed) of `scene` run to the end, and with `escape_rel_tol` its escape velocity bisected to
+    that relative width; module-level so that executors can pickle it."""
+    start = time.perf_counter()
+    member, law, offset = member_law(scene, seed, plan)
+    n = member.numerics
     release = _release(member, float(law.z_top))
     if release is not None and release <= 0.0:
         raise ValueError(f"member seed {seed}: the release height lies below the realisation's tallest summit")
@@ -131,21 +166,26 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan) -> MemberOutcome:
     run = simulate(law, member.body.mass, member.environment.gravity, release_height=release,
                    impact_velocity=member.impact_velocity, settings=settings)
     heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)
+    contacts = int(law.diagnostics()["max_contacts"])
+    escape = member_escape(law, member, plan.speed, escape_rel_tol) if escape_rel_tol is not None else None
     return MemberOutcome(seed=int(seed), status=run.status, rebound_heights=heights, release_height=release,
-                         max_contacts=int(law.diagnostics()["max_contacts"]), wall_s=time.perf_counter() - start,
-                         energy_error=float(run.audit["max_relative_error"]), patch_offset=offset)
+                         max_contacts=contacts, wall_s=time.perf_counter() - start,
+                         energy_error=float(run.audit["max_relative_error"]), patch_offset=offset, escape=escape)
 
 
 def _member_job(job: tuple) -> MemberOutcome:
-    scene, seed, plan = job
-    return run_member(scene, seed, plan)
+    scene, seed, plan, escape_rel_tol = job
+    return run_member(scene, seed, plan, escape_rel_tol)
 
 
 def run_ensemble(scene: Scene | ResolvedScene, members: int | None = None, seed: int | None = None,
-                 executor: Any = None, workers: int | None = None) -> EnsembleResult:
+                 executor: Any = None, workers: int | None = None, escape: bool | None = None,
+                 escape_rel_tol: float = ESCAPE_REL_TOL) -> EnsembleResult:
     """Run `members` discrete realisations of the rough `scene` (default surfaces.roughness.members) with seeds
     derived from `seed` (default surfaces.roughness.seed). `executor`: None or a name ('local', 'processes',
-    'dask'; None is 'local') opened and closed here with `workers`, or an open `nanoimpact.executors` executor."""
+    'dask'; None is 'local') opened and closed here with `workers`, or an open `nanoimpact.executors` executor.
+    `escape` (default surfaces.roughness.escape_velocities): also bisect each member's escape velocity to
+    `escape_rel_tol` (`member_escape`)."""
     from nanoimpact.executors import executor as make_executor
 
     from .model.regime import first_impact_speed
@@ -159,7 +199,9 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | None = None, seed:
     seeds = member_seeds(master, members)
     field = summit_field(scene) if isinstance(scene, ResolvedScene) else None
     plan = replace(member_plan(sc, first_impact_speed(sc)), field=field)
-    jobs = [(sc, s, plan) for s in seeds]
+    escape = bool(rough.escape_velocities) if escape is None else bool(escape)
+    tol = float(escape_rel_tol) if escape else None
+    jobs = [(sc, s, plan, tol) for s in seeds]
     start = time.perf_counter()
     own = executor is None or isinstance(executor, str)
     if own and (executor or "local") != "local":
@@ -177,4 +219,4 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | None = None, seed:
     wall = time.perf_counter() - start
     log.info("ensemble of %d members (master seed %d) on %s: %.2f s", members, master, where, wall)
     return EnsembleResult(master_seed=master, outcomes=tuple(outcomes), executor=where, wall_s=wall,
-                          source=source_record(field, plan, sc.body.length))
+                          source=source_record(field, plan, sc.body.length), escape_rel_tol=tol)

@@ -49,7 +49,13 @@ def force_vs_time(trace: dict, bounces: list[dict], ax=None, max_impacts: int = 
 
 def ensemble_spread(ensemble: dict, ax=None):
     """An ensemble's members: first rebound height / h0 against the member's number of rebounds (one dot per
-    member, jittered sideways), with the mean-field run's point and the stick probabilities in the legend."""
+    member, jittered sideways), with the mean-field run's point and the stick probabilities in the legend. Where
+    the ensemble has escape velocities (and no `ax` is given), a second panel shows their distribution
+    (`escape_velocity_spread`)."""
+    escape = ensemble.get("escape_velocity") or {}
+    if ax is None and escape.get("m_per_s"):
+        ax, right = Figure(figsize=(11, 3.5)).subplots(1, 2, gridspec_kw={"width_ratios": (3, 2), "wspace": 0.3})
+        escape_velocity_spread(ensemble, right)
     ax = ax or Figure(figsize=(7, 3.5)).subplots()
     runs = ensemble["member_runs"]
     h0 = ensemble.get("release_height_m") or 1.0
@@ -65,6 +71,26 @@ def ensemble_spread(ensemble: dict, ax=None):
         ax.plot([mf["rebounds"]], [mf["first_rebound_m"] / h0], "*", ms=12, color="C3", label="mean field")
     ax.set_xlabel("rebounds before the run ended")
     ax.set_ylabel("first rebound / release height" if ensemble.get("release_height_m") else "first rebound (m)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return ax
+
+
+def escape_velocity_spread(ensemble: dict, ax=None):
+    """The members' escape velocities (mm/s) as an empirical distribution (fraction of members whose escape
+    velocity is at most v), with the 5-95 % band and the median of result.json -> ensemble -> escape_velocity."""
+    ax = ax or Figure(figsize=(5, 3.5)).subplots()
+    rec = ensemble["escape_velocity"]
+    v = np.sort([m["escape"]["escape_velocity"] for m in ensemble["member_runs"]
+                 if (m.get("escape") or {}).get("escape_velocity") is not None]) * 1e3
+    q = rec["m_per_s"]
+    ax.step(v, np.arange(1, v.size + 1) / v.size, where="post", color="C0",
+            label=f"{v.size} members (bracket {rec['rel_tol']:.0e} relative)")
+    ax.axvspan(q["p5"] * 1e3, q["p95"] * 1e3, color="C0", alpha=0.15, label="5-95 %")
+    ax.axvline(q["p50"] * 1e3, color="C3", lw=1, label="median")
+    ax.set_xlabel("escape velocity (mm/s)")
+    ax.set_ylabel("fraction of members")
+    ax.set_ylim(0.0, 1.02)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     return ax

@@ -124,6 +124,10 @@ FIELDS: tuple[Field, ...] = (
           "the master seed its members' seeds are derived from (numpy SeedSequence).", 0, low=0, high=2**63 - 1),
     Field("surfaces.roughness.members", int, "1", "Realisations in an ensemble (mode 'ensemble', or 'auto' where "
           "it runs one).", 64, low=2, high=100000),
+    Field("surfaces.roughness.escape_velocities", bool, "", "Of an ensemble, also bisect each member's escape "
+          "velocity (the smallest first-impact speed from which it rebounds, continuum.escape) and report their "
+          "percentiles in result.json -> ensemble -> escape_velocity; each member then runs a dozen or more single "
+          "impacts besides its drop.", False),
     Field("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography reads: "
           "NanoScope .di, Gwyddion .gwy, Nanosurf .nid, Asylum .ibw, matrix text, .npy); a relative path is looked "
           "up beside the scene file, then in the data folders. Its summit statistics fill sigma, summit_density and "

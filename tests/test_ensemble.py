@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from continuum import EnsembleResult, run_scene
-from continuum.ensemble_run import member_plan, run_ensemble, run_member
+from continuum.ensemble_run import member_law, member_plan, run_ensemble, run_member
 from continuum.model.decisions import ENSEMBLE_BELOW_CONTACTS, realisation_decision
 from continuum.model.regime import first_impact_speed, regime_of
 from continuum.rough.ensemble import MemberOutcome, member_seeds
@@ -183,16 +183,7 @@ def test_the_shipped_scene_at_auto_runs_an_ensemble_of_rigid_members_with_the_ca
 
 
 def _member_law(scene, seed):
-    from continuum.ensemble_run import with_realisation
-    from continuum.model import factory
-    from continuum.rough.gw import SummitStatistics
-
-    plan = member_plan(scene, first_impact_speed(scene))
-    scene = with_realisation(scene, "discrete", seed)
-    rough = scene.surfaces.roughness
-    stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
-    return factory.discrete_roller(scene, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
-                                   plan.footprint_half_width, plan.summit_law)
+    return member_law(scene, seed, member_plan(scene, first_impact_speed(scene)))[1]
 
 
 def test_tabulated_first_approach_forces_are_the_summit_sums_at_each_depth():
@@ -262,3 +253,58 @@ def test_members_of_a_scene_with_a_height_map_are_patches_of_its_summits():
     ny = math.ceil(scene.body.length / field.size[1])
     assert rec["patches"]["tiles"][1] == ny and rec["patches"]["tiled"] is True
     assert len({tuple(m["patch_offset_m"]) for m in rec["member_runs"]}) == 2
+
+
+@pytest.mark.parametrize("law", ["jkr", "maugis_dugdale"])
+def test_members_on_a_process_pool_are_bit_for_bit_the_serial_members(law):
+    """A member's outcome depends on its seed only: run on two forked workers (which inherit the parent's compiled
+    kernel and summit law) it is the serial run's, every rebound height to the last bit."""
+    scene = _scene(**{"numerics.max_bounces": 5, "physics.adhesion_law": law})
+    serial = run_ensemble(scene, members=5, seed=9, executor="local")
+    pooled = run_ensemble(scene, members=5, seed=9, executor="processes", workers=2)
+    assert pooled.executor.startswith("processes")
+    assert pooled.seeds == serial.seeds
+    for a, b in zip(serial.outcomes, pooled.outcomes):
+        assert (a.seed, a.status, a.rebound_heights, a.max_contacts, a.energy_error) == \
+            (b.seed, b.status, b.rebound_heights, b.max_contacts, b.energy_error)
+
+
+def test_escape_velocities_are_asked_for_by_the_scene_and_their_percentiles_bracket_the_members():
+    """Each member's escape velocity is bisected to the asked relative width: its lower end sticks and its upper
+    end rebounds when the member's summits are drawn again (virgin), and the ensemble's percentiles are ordered
+    and lie between the members' smallest and largest values."""
+    from continuum.escape import single_impact
+
+    scene = _scene(**{"numerics.max_bounces": 2, "surfaces.roughness.escape_velocities": True})
+    ens = run_ensemble(scene, members=4, seed=2, escape_rel_tol=0.05)
+    rec = ens.to_record()["escape_velocity"]
+    assert rec["requested"] is True and rec["rel_tol"] == 0.05 and rec["members_with_value"] == 4
+    values = ens.escape_velocities()
+    q = [rec["m_per_s"][f"p{p}"] for p in (5, 25, 50, 75, 95)]
+    assert all(a <= b for a, b in zip(q, q[1:]))
+    assert values.min() <= q[0] and q[-1] <= values.max()
+    assert rec["m_per_s"]["min"] == values.min() and rec["m_per_s"]["max"] == values.max()
+    for o in ens.outcomes[:2]:
+        lo, hi = o.escape["lower"], o.escape["upper"]
+        assert lo < o.escape["escape_velocity"] < hi and hi / lo - 1.0 <= 0.05
+        law = _member_law(scene, o.seed)
+        assert single_impact(law, scene.body.mass, scene.environment.gravity, lo, scene.numerics.rtol).stuck
+        assert not single_impact(law, scene.body.mass, scene.environment.gravity, hi, scene.numerics.rtol).stuck
+    back = EnsembleResult.from_record(ens.to_record(), scene.release_height)
+    assert back.escape_rel_tol == 0.05 and np.array_equal(back.escape_velocities(), values)
+
+
+def test_without_the_scene_key_the_ensemble_says_no_escape_velocities_were_asked_for():
+    ens = run_ensemble(_scene(**{"numerics.max_bounces": 1}), members=2, seed=2)
+    rec = ens.to_record()["escape_velocity"]
+    assert rec["requested"] is False and "surfaces.roughness.escape_velocities" in rec["why"]
+    assert all(o.escape is None for o in ens.outcomes) and np.isnan(ens.escape_velocities()).all()
+
+
+def test_the_ensemble_figure_shows_the_escape_velocity_spread():
+    from continuum import plots
+
+    scene = _scene(**{"numerics.max_bounces": 1})
+    with_escape = run_ensemble(scene, members=3, seed=2, escape=True, escape_rel_tol=0.1).to_record()
+    assert len(plots.ensemble_spread(with_escape).figure.axes) == 2
+    assert len(plots.ensemble_spread(run_ensemble(scene, members=2, seed=2).to_record()).figure.axes) == 1

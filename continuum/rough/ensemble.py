@@ -21,7 +21,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-#: Percentiles reported for the rebound count and the first rebound height.
+#: Percentiles reported for the rebound count, the first rebound height and the escape velocity.
 PERCENTILES = (5, 25, 50, 75, 95)
 #: numpy's percentile method for them ('linear': interpolated between order statistics, numpy's default).
 PERCENTILE_METHOD = "linear"
@@ -94,6 +94,9 @@ class MemberOutcome:
     """The run's energy audit: largest error of its energy books against the first impact's kinetic energy."""
     patch_offset: tuple[float, float] | None = None
     """Where a map-patch member's strip starts on the map (m); None for a draw from the statistics."""
+    escape: Mapping[str, Any] | None = None
+    """The member's escape velocity where the ensemble was asked for it (`continuum.escape.escape_velocity`:
+    escape_velocity, lower, upper (m/s), runs), or {"escape_velocity": None, "reason": ...}; None: not asked."""
 
     @property
     def stuck(self) -> bool:
@@ -118,7 +121,8 @@ class MemberOutcome:
         return {"seed": self.seed, "status": self.status, "rebounds": self.rebounds,
                 "rebound_heights": list(self.rebound_heights), "max_contacts": self.max_contacts,
                 "energy_error": self.energy_error, "wall_s": self.wall_s,
-                **({"patch_offset_m": list(self.patch_offset)} if self.patch_offset is not None else {})}
+                **({"patch_offset_m": list(self.patch_offset)} if self.patch_offset is not None else {}),
+                **({"escape": dict(self.escape)} if self.escape is not None else {})}
 
     @classmethod
     def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "MemberOutcome":
@@ -126,7 +130,8 @@ class MemberOutcome:
                    rebound_heights=tuple(float(h) for h in rec["rebound_heights"]), release_height=release_height,
                    max_contacts=int(rec["max_contacts"]), wall_s=float(rec["wall_s"]),
                    energy_error=float(rec["energy_error"]),
-                   patch_offset=tuple(rec["patch_offset_m"]) if "patch_offset_m" in rec else None)
+                   patch_offset=tuple(rec["patch_offset_m"]) if "patch_offset_m" in rec else None,
+                   escape=rec.get("escape"))
 
 
 def _percentiles(values: Sequence[float]) -> dict[str, float]:
@@ -152,6 +157,8 @@ class EnsembleResult:
     source: Mapping[str, Any] = field(default_factory=lambda: {"source": "statistics"})
     """What the members realise: {"source": "statistics"} (draws from sigma, summit_density, summit_radius) or
     {"source": "map_patches", ...} (patches of the scene's height map, with the map and its tiling)."""
+    escape_rel_tol: float | None = None
+    """Relative bracket width of each member's escape velocity; None where the scene did not ask for them."""
 
     @property
     def members(self) -> int:
@@ -198,8 +205,7 @@ class EnsembleResult:
                               for s in sorted({o.status for o in self.outcomes})},
             "max_contacts": _percentiles([o.max_contacts for o in self.outcomes]),
             "energy_audit_max_relative_error": max(o.energy_error for o in self.outcomes),
-            "escape_velocity": {"requested": False,
-                                "why": "no scene key asks for an escape-velocity distribution"},
+            "escape_velocity": self.escape_record(),
             "executor": self.executor, "wall_s": self.wall_s,
             "member_runs": [o.to_record() for o in self.outcomes]}
         if h0:
@@ -209,9 +215,33 @@ class EnsembleResult:
             rec["mean_field"] = dict(mean_field)
         return rec
 
+    def escape_velocities(self) -> np.ndarray:
+        """The members' escape velocities (m/s), in member order, NaN where a member has none."""
+        return np.array([(o.escape or {}).get("escape_velocity") or math.nan for o in self.outcomes], float)
+
+    def escape_record(self) -> dict:
+        """result.json -> ensemble -> escape_velocity: percentiles over the members' escape velocities (each the
+        geometric middle of its bisection bracket), or why there are none."""
+        if self.escape_rel_tol is None:
+            return {"requested": False, "why": "surfaces.roughness.escape_velocities is false (the default): "
+                                               "set it true for each member's escape velocity"}
+        v = self.escape_velocities()
+        found = v[np.isfinite(v)]
+        rec: dict = {"requested": True, "rel_tol": self.escape_rel_tol, "members_with_value": int(found.size),
+                     "rule": "each member's smallest first-impact speed from which it rebounds: bracketed by "
+                             "halving/doubling the first-impact speed, bisected (continuum.escape.escape_velocity)",
+                     "without_value": {str(o.seed): (o.escape or {}).get("reason", "not run")
+                                       for o, x in zip(self.outcomes, v) if not math.isfinite(x)}}
+        if found.size:
+            rec["m_per_s"] = {**_percentiles(found), "mean": float(np.mean(found)), "std": float(np.std(found)),
+                              "min": float(np.min(found)), "max": float(np.max(found))}
+        return rec
+
     @classmethod
     def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "EnsembleResult":
         outcomes = tuple(MemberOutcome.from_record(m, release_height) for m in rec["member_runs"])
         source = {k: rec[k] for k in ("source", "patches") if k in rec} or {"source": "statistics"}
+        escape = rec.get("escape_velocity") or {}
         return cls(master_seed=int(rec["master_seed"]), outcomes=outcomes, executor=str(rec["executor"]),
-                   wall_s=float(rec["wall_s"]), source=source)
+                   wall_s=float(rec["wall_s"]), source=source,
+                   escape_rel_tol=escape.get("rel_tol") if escape.get("requested") else None)
