@@ -195,3 +195,57 @@ def test_auto_decides_summit_plasticity_by_the_plasticity_index(hardness, yields
     assert rec["decided_by"] == "plasticity_index" and rec["summits_yield"] is yields
     assert (psi > 1.0) if yields else (psi < 0.6)
     assert rec["used"] is False and ("elastic summits only" in rec["why"]) is yields
+
+
+# ----------------------------------------------------------------------------- rigid roller on plastic summits
+R_ROLLER, L_ROLLER, M_ROLLER, V_ROLLER = 1e-3, 1e-3, 1e-8, 0.01
+
+
+def _roller(p_y):
+    from continuum.rough.plastic_summits import PlasticGWRoller
+    return PlasticGWRoller(PlasticSummitLaw(BETA, W, E, p_y), SIGMA, DENSITY, ZMAX, R_ROLLER, L_ROLLER)
+
+
+@pytest.mark.parametrize("h,h_c,h_p", [(-3e-9, -3e-9, -3e-9), (-1e-9, -3e-9, -3e-9), (-1e-9, -2e-9, -4e-9),
+                                       (-0.5e-9, -2e-9, -4e-9)])
+def test_roller_footprint_is_the_mean_field_integrated_across_the_footprint(h, h_c, h_p):
+    """The footprint kernel K(z) against the per-area mean field integrated over x by adaptive quadrature, with the
+    separations d + x^2/2R (attached summits end where z_max - d_p(x) = u_a)."""
+    from continuum.rough.plastic_summits import RollerFootprint
+    law = PlasticSummitLaw(BETA, W, E, P_Y)
+    area = PlasticGWSurface(law, SIGMA, DENSITY, ZMAX)
+    foot = RollerFootprint(law, SIGMA, DENSITY, ZMAX, R_ROLLER, L_ROLLER)
+    top = area.z_top
+    shift = lambda x: x * x / (2.0 * R_ROLLER)                                       # noqa: E731
+    u_a = max(*area.bounds(top + h, top + h_c, top + h_p), 0.0)
+    x_end = math.sqrt(2.0 * R_ROLLER * (-h_p - u_a))
+    for n, what in enumerate(("pressure", "energy")):
+        ref, _ = integrate.quad(lambda x: area.state(top + h + shift(x), top + h_c + shift(x), top + h_p + shift(x))[n],
+                                0.0, x_end, epsabs=0, epsrel=1e-12, limit=400)
+        got = foot.state(top + h, top + h_c, top + h_p)[n]
+        assert got == pytest.approx(2.0 * L_ROLLER * ref, rel=1e-6), what
+
+
+def test_elastic_roller_is_the_rigid_gw_jkr_roller():
+    """p_y = inf: the restitution and loss of the project's rigid roller on tabulated GW/JKR summits."""
+    from continuum.laws.rough_rigid import RigidRoughRoller
+    from continuum.rough.gw import GWJKRSurface
+    ours = simulate(_roller(math.inf), M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS).bounces[0]
+    theirs = RigidRoughRoller(GWJKRSurface(SummitStatistics(SIGMA, DENSITY, BETA), W, E, z_max=ZMAX), R_ROLLER, L_ROLLER)
+    ref = simulate(theirs, M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS).bounces[0]
+    assert ours.restitution == pytest.approx(ref.restitution, abs=1e-7)
+    assert ours.energy_lost == pytest.approx(ref.energy_lost, rel=1e-5)
+    assert ours.max_penetration == pytest.approx(ref.max_penetration, rel=1e-6)
+
+
+def test_plastic_roller_dissipates_more_and_remembers_the_spot():
+    elastic = simulate(_roller(math.inf), M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS)
+    roller = _roller(P_Y)
+    first = simulate(roller, M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS)
+    roller.reset()
+    second = simulate(roller, M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS)
+    for run in (elastic, first, second):
+        assert run.audit["max_relative_error"] < 1e-6
+        assert run.bounces[0].energy_lost == pytest.approx(run.bounces[0].energy_booked, rel=1e-5)
+    lost = [r.bounces[0].energy_lost for r in (elastic, first, second)]
+    assert lost[1] > 2.0 * lost[0] and lost[2] < 0.5 * lost[1]

@@ -64,7 +64,8 @@ from ..laws.base import ContactLaw
 from ..reference import jkr
 from ..reference import thornton_ning as tn
 
-__all__ = ["PlasticSummitLaw", "PlasticGWSurface", "PlasticGWPunch", "PlasticSummitsPunch"]
+__all__ = ["PlasticSummitLaw", "PlasticGWSurface", "RollerFootprint", "PlasticGWPunch", "PlasticGWRoller",
+           "PlasticSummitsPunch"]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _SQRT2PI = math.sqrt(2.0 * math.pi)
@@ -194,28 +195,45 @@ class PlasticGWSurface:
         return u_met, self._inverse(self.hold, d - d_p, self.delta_c) if math.isfinite(d) else math.inf
 
     # ------------------------------------------------------------------ quadrature
+    #: the weight has a square-root end at the top of the summits (a footprint's edge): last panel in u = hi - t^2
+    _root_at_top = False
+
     def _nodes(self, lo, hi):
-        """Gauss-Legendre nodes and weights on [lo, hi] (m): geometric panels from lo, the first in u = lo + t^2,
-        split at delta_y."""
+        """Gauss-Legendre nodes and weights on [lo, hi] (m): geometric panels from lo (split at delta_y), the first in
+        u = lo + t^2 (and with `_root_at_top` the last in u = hi - t^2)."""
         if not hi > lo:
             return np.empty(0), np.empty(0)
-        t1 = math.sqrt(min(self._first, hi - lo))
-        t = 0.5 * t1 * (_GL_X + 1.0)
-        xs, ws = [lo + t * t], [0.5 * t1 * _GL_W * 2.0 * t]
-        edges, x, width = [], lo + t1 * t1, self._first
+        edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
         while x < hi:
             edges.append(x)
             width = min(1.5 * width, 0.25 * self.sigma)
             x += width
         edges.append(hi)
         d_y = self.law.yield_approach
-        edges = np.unique(np.concatenate([edges, [d_y] if edges[0] < d_y < hi else []]))
-        a, b = edges[:-1, None], edges[1:, None]
+        edges = np.unique(np.concatenate([edges, [d_y] if lo < d_y < hi else []]))
+        if self._root_at_top:
+            # the last panel at least as wide as its neighbour: the plain panels keep their distance from the
+            # square-root end, so the sums change smoothly when an edge appears as hi grows
+            while edges.size > 3 and hi - edges[-2] < edges[-2] - edges[-3]:
+                edges = np.delete(edges, -2)
+            if edges.size == 2:
+                edges = np.array([lo, 0.5 * (lo + hi), hi])
+        xs, ws = [], []
+        for start, end, sign in ((edges[0], edges[1], 1.0), (hi, edges[-2], -1.0)):
+            if sign < 0.0 and not (self._root_at_top and edges.size > 2):
+                break
+            t1 = math.sqrt(abs(end - start))
+            t = 0.5 * t1 * (_GL_X + 1.0)
+            xs.append(start + sign * t * t)
+            ws.append(0.5 * t1 * _GL_W * 2.0 * t)
+        inner = edges[1:-1] if self._root_at_top and edges.size > 2 else edges[1:]
+        a, b = inner[:-1, None], inner[1:, None]
         xs.append((0.5 * (a + b) + 0.5 * (b - a) * _GL_X).ravel())
         ws.append((0.5 * (b - a) * _GL_W).ravel())
         return np.concatenate(xs), np.concatenate(ws)
 
     def _weight(self, u, w, d_p):
+        """Quadrature weights times the summits per unit height at z = d_p + u (per unit nominal area: n phi(z))."""
         z = (d_p + u) / self.sigma
         return self.density * w * np.exp(-0.5 * z * z) / (_SQRT2PI * self.sigma)
 
@@ -244,6 +262,38 @@ class PlasticGWSurface:
     def plasticity_index(self, hardness: float) -> float:
         """Greenwood-Williamson psi = (E*/H) sqrt(sigma/beta) of these summits (hardness H in Pa)."""
         return self.law.e_star / hardness * math.sqrt(self.sigma / self.law.radius)
+
+
+class RollerFootprint(PlasticGWSurface):
+    """The same summits under a rigid roller of radius R and length l (m): values per roller (N, J), not per area.
+
+    Under the roller the separation is d(x) = d + x^2/2R across the footprint, and so are d_c(x) and d_p(x): the
+    differences d - d_p and d_c - d_p, hence the summit sets u > u_a and each summit's state as a function of
+    u = z - d_p(x), are the same at every x. Only the number of summits at height z = d_p(x) + u changes, so the
+    footprint integral l int dx n int du (...) phi(d_p(x) + u) is the mean field's with phi(z) replaced by
+
+        K(z) = l int dx phi(z + x^2/2R) [z + x^2/2R <= z_max] = l sqrt(2R) int_0^{sqrt(z_max - z)} 2 phi(z + t^2) dt
+
+    (x^2 = 2R t^2), evaluated by 24-node Gauss-Legendre in t; z, d, d_c, d_p are the values on the roller's axis.
+    K falls to 0 as sqrt(z_max - z) at the top summit, so the last panel in u is taken in u = u_top - t^2.
+    The roller is rigid and the substrate below the summits too (no half-space deflection), as in
+    `continuum.laws.rough_rigid`, and it stays on the spot it flattened (repeated bounces, no rolling)."""
+
+    def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float, radius: float,
+                 length: float):
+        super().__init__(law, sigma, density, z_max)
+        self.roller_radius, self.length = float(radius), float(length)
+        self._tx, self._tw = np.polynomial.legendre.leggauss(24)
+
+    _root_at_top = True
+
+    def _weight(self, u, w, d_p):
+        z = d_p + u
+        top = np.sqrt(np.maximum(self.z_top - z, 0.0))
+        t = 0.5 * top[:, None] * (self._tx + 1.0)
+        y = (z[:, None] + t * t) / self.sigma
+        k = (0.5 * top * (np.exp(-0.5 * y * y) @ self._tw)) * 2.0 / (_SQRT2PI * self.sigma)
+        return self.density * w * self.length * math.sqrt(2.0 * self.roller_radius) * k
 
 
 class PlasticGWPunch(ContactLaw):
@@ -402,3 +452,20 @@ class PlasticSummitsPunch(ContactLaw):
     def describe(self):
         return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
                 "source": "Thornton & Ning (1998) on each summit, each carrying its flattening"}
+
+
+class PlasticGWRoller(PlasticGWPunch):
+    """Rigid roller of radius R and length l (m) on the mean field of plastic summits over a rigid substrate
+    (`RollerFootprint`); gap = d - z_max on the roller's axis. Same history and losses as `PlasticGWPunch`."""
+
+    name = "rough_roller_gw_plastic_rigid"
+
+    def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float, radius: float,
+                 length: float):
+        super().__init__(RollerFootprint(law, sigma, density, z_max, radius, length), 1.0)
+
+    def describe(self):
+        s = self.surface
+        return {**super().describe(), "name": self.name, "roller_radius": s.roller_radius, "length": s.length,
+                "source": "Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) summits under a rigid "
+                          "roller over a rigid substrate, history (h, h_c, h_p) on its axis"}
