@@ -135,6 +135,23 @@ def test_sigma_and_velocity_sweep_claims_hold_and_each_can_fail():
     assert _dry_states(good_i, close)["fig8a_escape_velocity_falls_as_sigma_rises"] == NOT_EVALUABLE
 
 
+def test_the_escape_velocitys_fall_with_sigma_is_judged_on_every_sample_that_searched_it():
+    """Two uncertainty rows carry each sigma's escape velocity; one has it rise from 6 to 10 nm: the claim holds on
+    2 of 3 and fails over the samples; a discrete seed (no escape search) is not counted."""
+    good_i = {"sigma_3nm": _impact(3e-9, []), "rough_silica": _impact(6e-9, [0.3])}
+    good_s = {"a": _sweep(3e-9, [3e-6, 2e-6], 2e-3), "b": _sweep(6e-9, [3e-6, 2e-6], 1e-3)}
+    falls = {"escape_sigma": {3e-9: {"escape_velocity": 2e-3}, 6e-9: {"escape_velocity": 1e-3},
+                              10e-9: {"escape_velocity": 0.8e-3}}}
+    rises = {"escape_sigma": {3e-9: {"escape_velocity": 2e-3}, 6e-9: {"escape_velocity": 1e-3},
+                              10e-9: {"escape_velocity": 1.2e-3}}}
+    name = "fig8a_escape_velocity_falls_as_sigma_rises"
+    one = {c["name"]: c for c in checks.reproduce_dry("t", good_i, good_s, [falls, {"seed": True}])}[name]
+    assert one["state"] == PASS and one["sampled"]["uncertainty"] == 1 and one["samples"] == 2
+    two = {c["name"]: c for c in checks.reproduce_dry("t", good_i, good_s, [falls, rises])}[name]
+    assert two["state"] == FAIL and two["holds_fraction"] == pytest.approx(2 / 3)
+    assert two["bands"]["escape_velocity_m_per_s_at_10nm"]["max"] == pytest.approx(1.2e-3)
+
+
 def _wet(v_dry, v_wet, v_ta, t_a=25e-6):
     pts = [{"v_impact": v_dry * 1.001, "dry": {"stuck": False, "duration": 30e-6, "restitution": 0.1},
             "wet": {"stuck": True, "duration": None, "restitution": 0.0}}]
@@ -202,7 +219,8 @@ def test_an_impact_time_that_crosses_t_a_twice_gives_no_band_edge_and_the_wet_cl
     assert turning["eps"] is None and "not monotone" in turning["reason"]
     w = _wet(1e-3, 1.0105e-3, 1.01e-3)
     w["wet_silica"]["t_a_band_edge"] = edge
-    c = {c["name"]: c for c in wet_checks.evaluate_wet("t", w, {})}["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]
+    claims = {c["name"]: c for c in wet_checks.evaluate_wet("t", w, {})}
+    c = claims["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]
     assert c["state"] == NOT_EVALUABLE and "not monotone" in c["reason"]
 
 

@@ -20,6 +20,8 @@ RUN_RTOL = 1e-6
 NAMES = ("fig4_ots_loop_smaller_than_silica", "fig5a_ots_outbounces_silica",
          "fig5a_silica_impacts_weaken_until_it_sticks", "fig7_sigma3_sticks_at_first_impact",
          "fig8b_ots_lower_escape_velocity", "fig8b_ots_impact_shorter_at_the_same_low_velocity")
+#: Failing samples a claim's reason names (checks.json -> failing_samples lists them all).
+NAMED_FAILURES = 8
 #: Claims that need the averaged-law runs of a bundle (escape velocities, loops): not judged on seeds.
 FULL_ONLY = {"fig4_ots_loop_smaller_than_silica", "fig8b_ots_lower_escape_velocity",
              "fig8b_ots_impact_shorter_at_the_same_low_velocity"}
@@ -155,7 +157,9 @@ def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> li
             e["failing_samples"] = failing
             if e["state"] == FAIL and nom[name]["state"] != FAIL:
                 e["reason"] += "; fails on " + ", ".join(
-                    f["label"] + (f" (margin {f['margin']:.3g})" if f["margin"] is not None else "") for f in failing)
+                    f["label"] + (f" (margin {f['margin']:.3g})" if f["margin"] is not None else "")
+                    for f in failing[:NAMED_FAILURES]) + (f" and {len(failing) - NAMED_FAILURES} more (failing_samples)"
+                                                          if len(failing) > NAMED_FAILURES else "")
         out.append(e)
     return out
 

@@ -2,8 +2,9 @@
 
 A *bundle* is what the sampled reproduction claims read (``claims.bundle_claims``): the 100 nm drops of
 rough silica and OTS-covered silica (sigma = 6 nm, at most ``SAMPLE_MAX_BOUNCES`` impacts), the first
-impact at sigma = 3 nm, both escape velocities (adaptive bracket, bisection to ``ESCAPE_REL_TOL``), both
-impact times at 1.2 times silica's escape velocity, and (averaged summits only) both adhesive loops.
+impact at sigma = 3 nm and, with averaged summits only, both escape velocities (adaptive bracket,
+bisection to ``ESCAPE_REL_TOL``), bare silica's at each of Fig 8a's sigmas, both impact times at 1.2
+times silica's escape velocity, and both adhesive loops.
 Every run is on a rigid substrate (the half-space deflection under this roller is femtometres).
 
 Samples of a parameter set:
@@ -24,7 +25,7 @@ from ..escape import escape_velocity, single_impact
 from ..impact import first_impact_speed, run_impact
 from ..model import select_law
 from ..scene import SceneError, resolve_scene
-from .cases import RIGID, Case, sigma_case
+from .cases import FIG8_SIGMAS_NM, RIGID, Case, sigma_case
 
 #: Impacts per sampled drop: the sampled claims read at most this many ("sticks within 20 impacts").
 SAMPLE_MAX_BOUNCES = 20
@@ -156,6 +157,7 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
     if not full:
         return out
     out["escape"] = {k: escape_search(law, m, g, v0, rtol) for k, (law, m, g, rtol, v0) in laws.items()}
+    out["escape_sigma"] = _escape_over_sigma(params, overrides, fidelity, out["escape"]["silica"])
     v_si = out["escape"]["silica"].get("escape_velocity")
     if v_si:
         v = 1.2 * v_si
@@ -165,6 +167,22 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
     from .figures import characteristic
 
     out["loop"] = {k: characteristic(law.surface)["loop_area"] for k, (law, *_) in laws.items()}
+    return out
+
+
+def _escape_over_sigma(params, overrides, fidelity, at_6nm: dict) -> dict[float, dict]:
+    """Bare silica's escape velocity at each of Fig 8a's sigmas (averaged summits), {sigma (m): escape_search};
+    6 nm is the bundle's own silica search."""
+    out = {}
+    for s in FIG8_SIGMAS_NM:
+        case = sigma_case(s)
+        if case.name == "rough_silica":
+            out[s * 1e-9] = at_6nm
+            continue
+        resolved = _resolved(case, params, overrides, fidelity, 1)
+        sc, v0 = resolved.scene, first_impact_speed(resolved)
+        out[s * 1e-9] = escape_search(select_law(sc, v0)[0], sc.body.mass, sc.environment.gravity, v0,
+                                      sc.numerics.rtol)
     return out
 
 

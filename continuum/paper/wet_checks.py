@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from .checks import NOMINAL_ONLY, rebounds
+from .checks import nominal_only, rebounds
 from .run import WET_DRY_REL_TOL, WET_REL_TOL
 from .sampled_claims import RUN_RTOL
 from .verdict import FAIL, REPRODUCTION, VERIFICATION, entry, not_evaluable, over_samples
@@ -36,8 +36,10 @@ def _raise_escape(s: str, si: dict) -> dict:
     tol = WET_REL_TOL + WET_DRY_REL_TOL
     if not (v_dry and v_wet):
         why = (si["escape_dry"] or {}).get("reason") or (si["escape_wet"] or {}).get("reason") or "no escape velocity"
-        return over_samples(not_evaluable(name, s, REPRODUCTION, thr, units, why, values, tol), [], NOMINAL_ONLY)
-    return over_samples(entry(name, s, REPRODUCTION, values, thr, v_wet / v_dry - 1.0, tol, units), [], NOMINAL_ONLY)
+        return over_samples(not_evaluable(name, s, REPRODUCTION, thr, units, why, values, tol), [],
+                            nominal_only(name))
+    return over_samples(entry(name, s, REPRODUCTION, values, thr, v_wet / v_dry - 1.0, tol, units), [],
+                        nominal_only(name))
 
 
 def _end_rebounds(s: str, si: dict) -> dict:
@@ -65,12 +67,13 @@ def _end_rebounds(s: str, si: dict) -> dict:
                f"{flip if flip is not None else float('nan'):.4g} s): the claim has no subject at this t_a"
                if edge is None else f"no band edge: {edge['reason']}" if edge.get("speed") is None
                else "no wet or dry escape velocity")
-        return over_samples(not_evaluable(name, s, REPRODUCTION, thr, units, why, values, tol), [], NOMINAL_ONLY)
+        return over_samples(not_evaluable(name, s, REPRODUCTION, thr, units, why, values, tol), [],
+                            nominal_only(name))
     width = edge["speed"] / v_dry - 1.0
     captured = (v_wet - v_dry) / (edge["speed"] - v_dry)
     values.update(captured_fraction_of_band=captured, band_width_relative=width)
     return over_samples(entry(name, s, REPRODUCTION, values, thr, captured - (1.0 - BAND_EDGE), tol / width, units),
-                        [], NOMINAL_ONLY)
+                        [], nominal_only(name))
 
 
 def _unchanged(s: str, si: dict) -> dict:
