@@ -55,7 +55,9 @@ CONDITIONAL_KEYS: dict[str, dict[str, tuple[str, Any]]] = {
 #: {key: neutral value}. At that value the key stays out of the run's identity (`Recipe.canonical`), because the
 #: run it describes is the same run; any other value enters the hash. A protocol option added to a workflow is
 #: registered here with the value that reproduces the runs already committed.
-NEUTRAL_KEYS: dict[str, dict[str, Any]] = {}
+NEUTRAL_KEYS: dict[str, dict[str, Any]] = {
+    "adhesion": {"registry_sampling": "rank1", "registry_contact_steps": 0, "sam_anneal_steps": 0,
+                 "pmf_return": False, "pmf_extra_windows_A": ()}}
 
 
 class RecipeError(InputError):
@@ -180,6 +182,28 @@ FIELDS: tuple[Field, ...] = (
     Field("lateral_registries", "fidelity", int, "1", "Adhesion PMF: lateral offsets of the upper slab (a "
           "rank-1 lattice over one surface cell, the first at zero); each has its own chain of windows; the "
           "force curves are averaged and their spread enters the error.", 1, low=1, high=16, workflows=_ADH),
+    Field("registry_sampling", "fidelity", str, "", "Adhesion PMF: how the lateral offsets are chosen. 'rank1' = "
+          "the rank-1 lattice over the rectangular surface cell (k/n, {k g/n}); on the centred (111) cell some of its "
+          "offsets are lattice translations of the slab (n = 2: the centring vector), which repeat registry 0 and "
+          "are named in the notes. 'primitive' = quasi-random offsets (R2 sequence) over the primitive cell of the "
+          "slab's own lateral lattice (found from the built slabs' heavy atoms), lattice translations and offsets "
+          "closer than 1 A to another excluded.", "rank1", choices=("rank1", "primitive"), workflows=_ADH),
+    Field("registry_contact_steps", "fidelity", int, "steps", "Adhesion PMF: steps of a zero-load contact leg of "
+          "its own for every registry after the first (upper back rigid and free along z, as the contact leg), "
+          "started from the contact leg's last state moved to the registry's offset; its window chain starts from "
+          "it. 0 = the chain starts from the contact leg's last state directly (bare silica: lowered in "
+          "minimisation steps).", 0, low=0, high=100_000_000, workflows=_ADH),
+    Field("sam_anneal_steps", "fidelity", int, "steps", "Adhesion: steps of NVT at temperature_K of the two slabs "
+          "apart (separation_A, backs held) before the contact is formed; its energy and mean chain tilt series "
+          "are tested for a remaining linear drift. 0 = the slabs go from the builder into the contact leg.", 0,
+          low=0, high=100_000_000, workflows=_ADH),
+    Field("pmf_return", "fidelity", bool, "", "Adhesion PMF: after the outward chain reaches separation_A, a "
+          "return chain through the same windows back into compression (each from its outer neighbour's last "
+          "state); W_F out and back, their hysteresis, and W_F = their mean with half the hysteresis as a "
+          "systematic error.", False, workflows=_ADH),
+    Field("pmf_extra_windows_A", "fidelity", list, "A", "Adhesion PMF: separations from contact inserted into the "
+          "outward grid (e.g. over the force peak); each strictly between 0 and separation_A and apart from the "
+          "grid's own windows.", (), low=0.0, high=60.0, workflows=_ADH, item=float),
     Field("pmf_equilibrate_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window discarded.", 1000,
           low=0, high=100_000_000, workflows=_ADH),
     Field("pmf_sample_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window sampled.", 5000, low=1,
@@ -333,13 +357,21 @@ class Recipe:
             if settings.get(when) != value:
                 settings.pop(key, None)
         for key, neutral in NEUTRAL_KEYS.get(self.workflow, {}).items():
-            if key in settings and settings[key] == neutral:
+            if key in settings and _is_neutral(settings[key], neutral):
                 settings.pop(key)
         return {"name": self.name, "workflow": self.workflow, "fidelity": fidelity, "settings": settings}
 
     def canonical_sha256(self, fidelity: str) -> str:
         text = json.dumps(self.canonical(fidelity), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _is_neutral(value: Any, neutral: Any) -> bool:
+    """``value`` equals the neutral value; a list and a tuple with the same items are equal (a list key read from
+    TOML is a list, its default a tuple)."""
+    if isinstance(value, (list, tuple)) and isinstance(neutral, (list, tuple)):
+        return list(value) == list(neutral)
+    return value == neutral
 
 
 def parse_recipe(table: Mapping[str, Any], *, name: str = "recipe", origin: str = "", path: Path | None = None,
@@ -426,6 +458,8 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
                               f"window; allowed <= {MAX_COMPRESS_STEP_A:g} A (each window moves the slab rigidly "
                               f"from its neighbour: 4 A at once overlapped OTS chains and LAMMPS lost bond atoms); "
                               f"use pmf_compress_windows >= {need} or a smaller pmf_compress_A", origin)
+    if wf == "adhesion":
+        _check_extra_windows(system, fid, p, origin)
     if wf == "pulloff":
         speeds = fid["retract_speeds_m_s"]
         if len(speeds) > 1 and fname != "production":
@@ -435,6 +469,22 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
             raise RecipeError(f"{p}.retract_speeds_m_s", speeds, "speeds must be distinct", origin)
     if wf == "contact_angle" and system["surface"] == "ots" and fid["nx"] < 2:
         raise RecipeError(f"{p}.nx", fid["nx"], "must be >= 2", origin)
+
+
+def _check_extra_windows(system: Mapping[str, Any], fid: Mapping[str, Any], p: str, origin: str) -> None:
+    """Extra PMF windows lie strictly inside the outward grid and at least 0.05 A from its windows and each other
+    (two windows at one separation would be one window sampled twice)."""
+    extra = sorted(fid["pmf_extra_windows_A"])
+    sep, n = system["separation_A"], fid["pmf_windows"]
+    grid = [sep * (k / (n - 1)) ** 2 for k in range(n)]
+    for k, d in enumerate(extra):
+        if not 0.0 < d < sep:
+            raise RecipeError(f"{p}.pmf_extra_windows_A", list(extra), f"{d:g} must lie strictly between 0 and "
+                              f"separation_A = {sep:g} A", origin)
+        near = min(abs(d - g) for g in grid + extra[:k] + extra[k + 1:])
+        if near < 0.05:
+            raise RecipeError(f"{p}.pmf_extra_windows_A", list(extra), f"{d:g} A lies within 0.05 A of another "
+                              f"window (grid {', '.join(f'{g:.2f}' for g in grid)} A)", origin)
 
 
 def load_recipe(spec: str | Path) -> Recipe:

@@ -28,6 +28,8 @@ from md.system.lammps_data import read_atoms, write_data
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.topology import System
 
+from md.workflows import adhesion_protocol as P
+from md.workflows.adhesion_registries import degenerate_registries, primitive_offsets, surface_lattice
 from md.workflows.common import (common_define, derived_seed, ENERGY_NOT_FREE_ENERGY, equilibrate_stage,
                                  figure_writer, forcefield_of, fresh_from_data, intersect_ids, minimize_lines,
                                  quantity_record, restart_header_lines, round_up, Settings, silica_face_of,
@@ -83,8 +85,7 @@ class Adhesion(Workflow):
         """Nominal separations from contact (A): the compressed chain (negative, innermost first) and the outward
         chain (0 first, quadratically spaced to separation_A)."""
         s = self.typed(s)
-        n = int(s.pmf_windows)
-        out = s.separation_A * (np.arange(n) / (n - 1)) ** 2
+        out = outward_grid(s)
         m = int(s.pmf_compress_windows)
         inward = -s.pmf_compress_A * np.arange(m, 0, -1) / m if m else np.zeros(0)
         return np.concatenate([inward, out])
@@ -94,8 +95,8 @@ class Adhesion(Workflow):
         """(leg-name suffix, nominal separation, suffix of the leg it continues from) in run order: the contact
         window, the inward chain, the outward chain."""
         s = cls.typed(s)
-        n, m = int(s.pmf_windows), int(s.pmf_compress_windows)
-        out = s.separation_A * (np.arange(n) / (n - 1)) ** 2
+        out = outward_grid(s)
+        n, m = len(out), int(s.pmf_compress_windows)
         rows = [("o00", 0.0, None)]
         prev = "o00"
         for k in range(1, m + 1):
@@ -107,13 +108,33 @@ class Adhesion(Workflow):
             prev = f"o{k:02d}"
         return rows
 
+    @classmethod
+    def return_chain(cls, s) -> list[tuple[str, float, str, str]]:
+        """With ``pmf_return``: (suffix, nominal separation, suffix it continues from, the outward window it
+        repeats) in run order, from the outermost outward window back through the outward grid (``bKK`` repeats
+        ``oKK``) and into compression (``cKK`` repeats ``iKK``); empty without it."""
+        s = cls.typed(s)
+        if not s.pmf_return:
+            return []
+        out = outward_grid(s)
+        n, m = len(out), int(s.pmf_compress_windows)
+        rows, prev = [], f"o{n - 1:02d}"
+        for k in range(n - 2, -1, -1):
+            rows.append((f"b{k:02d}", float(out[k]), prev, f"o{k:02d}"))
+            prev = f"b{k:02d}"
+        for k in range(1, m + 1):
+            rows.append((f"c{k:02d}", -s.pmf_compress_A * k / m, prev, f"i{k:02d}"))
+            prev = f"c{k:02d}"
+        return rows
+
     def plan(self, s, run_dir):
         s = self.typed(s)
         legs = _AdhesionLegs(self, s, run_dir)
+        anneal = [legs.anneal()] if s.sam_anneal_steps > 0 else []
         contact = legs.contact()
         windows = legs.windows(contact) if s.free_energy == "pmf" else []
         seed = int(s.seed)
-        return Plan(legs=[contact, legs.separated()] + windows, timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
+        return Plan(legs=anneal + [contact, legs.separated()] + windows, timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
                     seeds={"structure_lower": seed, "structure_upper": seed + 10, "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed},
                     forcefield_files=self.forcefield_files(s), system_info=legs.info())
@@ -158,6 +179,7 @@ class _AdhesionAnalysis:
 
     def run(self) -> Analysis:
         self._prepare()
+        self._protocol_legs()
         if self.s.free_energy != "pmf":
             self.notes.append("free energy not estimated at this fidelity (free_energy = 'none'); the quick and "
                               "production recipes integrate the mean force over separation to measure T dS.")
@@ -250,6 +272,19 @@ class _AdhesionAnalysis:
         ax.set_title(f"W = {w['value']:.3f} ± {w['stderr']:.3f} J/m² (energy)")
         ax.legend()
 
+    def _protocol_legs(self) -> None:
+        """The optional legs (md.workflows.adhesion_protocol): the SAM anneal, each registry's own contact, and a
+        note on registries that repeat another."""
+        names = {leg.name for leg in self.ctx.plan.legs}
+        if "anneal" in names:
+            det, notes, curves = P.anneal_record(self.ctx, self.dt)
+            self.details["anneal"], self.notes, self.curves = det, self.notes + notes, {**self.curves, **curves}
+        if any(n.startswith("contact_r") for n in names):
+            self.details["registry_contacts"] = P.registry_contacts_record(
+                self.ctx, self.ctx.samples("separated")["pe"], self.area, self.zc, self.w_tail_static)
+        if self.s.free_energy == "pmf":
+            self.notes += P.degenerate_note(self.info)
+
     # ---- per window
     def _single_window(self, r: int, k: int, suf: str) -> None:
         """Window ``suf`` of registry ``r``: measured separation, mean force with its stderr, statistical
@@ -278,6 +313,8 @@ class _AdhesionAnalysis:
         self._flat_slab_law()
         self._layer_modulus()
         self._window_checks()
+        if self.s.pmf_return:
+            P.return_path(self, self.wf.return_chain(self.s))
         self.tail_det.update(tail_energy_last_window_kcal=self.u_tail_last)
         self.details["dispersion_tail"] = self.tail_det
         pmf = self.ti["pmf_J_per_m2"]
@@ -521,6 +558,10 @@ class _AdhesionLegs:
             self.groups["tailset"] = np.arange(system.n_atoms)
         self.contact_dir = run_dir / "legs" / "contact"
         self.registries: list[tuple[float, float]] = []
+        self.lattice = np.zeros((2, 2))
+        self.axes = _chain_axes(system) if s.sam_anneal_steps > 0 else np.zeros((0, 2), int)
+        if len(self.axes):
+            self.groups["chain_axes"] = np.unique(self.axes)
         si = s.sample_interval
         self.base = dict(define=None, restart_head=restart_header_lines(s),
                          columns={"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_back": "v_zback"},
@@ -552,10 +593,31 @@ class _AdhesionLegs:
         si = self.s.sample_interval
         return Frames("tailset", round_up(steps_of(sample_steps, si) / per_leg, si)) if on else None
 
+    def anneal(self) -> Leg:
+        """``sam_anneal_steps`` of NVT with the slabs ``separation_A`` apart and both backs held, from the minimised
+        build with fresh velocities: each surface relaxes alone (SAM chains tilt collectively, silanols reorient)
+        before the contact is formed. Frames of the chains' head Si and CH3 give the mean tilt."""
+        s, si = self.s, self.s.sample_interval
+
+        def fresh(leg_dir: Path) -> list[str]:
+            return fresh_from_data(self.ff, self.data, s, self.groups) + self.setup_groups() + \
+                [f"displace_atoms upper move 0.0 0.0 {s.separation_A:.6f} units box"]
+        steps = steps_of(s.sam_anneal_steps, si)
+        velocity = (f"velocity mobile create {s.temperature_K:g} {derived_seed(s.seed, 3, 5)} mom yes rot no "
+                    f"dist gaussian",)
+        frames = Frames("chain_axes", round_up(steps / ANNEAL_FRAMES, si)) if len(self.axes) else None
+        return Leg(name="anneal", fresh=fresh, prepare=lambda d: minimize_lines(s),
+                   stages=[Stage("anneal", steps, velocity)], frames=frames,
+                   info={"chain_axes": self.axes.tolist()}, **{**self.base, "define": self.define(False, 5)})
+
     def contact(self) -> Leg:
         s = self.s
+        annealed = s.sam_anneal_steps > 0
 
         def fresh_contact(leg_dir: Path) -> list[str]:
+            if annealed:        # the annealed pair, the upper slab moved back down by separation_A
+                return self.from_leg(self.run_dir / "legs" / "anneal", steps_of(s.sam_anneal_steps, s.sample_interval),
+                                     (0.0, 0.0, -s.separation_A))(leg_dir)
             return fresh_from_data(self.ff, self.data, s, self.groups) + self.setup_groups()
         return Leg(name="contact", fresh=fresh_contact,
                    prepare=lambda d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"]
@@ -595,12 +657,23 @@ class _AdhesionLegs:
                             Stage("sample", steps_of(s.pmf_sample_steps, s.sample_interval)))
         total = sum(st.steps for st in stages)
         cell = (float(system.cell[0]) / s.nx, float(system.cell[1]) / s.ny)
-        self.registries = _registry_offsets(int(s.lateral_registries), cell)
+        low, up = self.groups["lower"], self.groups["upper"]
+        self.lattice = surface_lattice([(system.positions[g], system.types[g]) for g in (low, up)],
+                                       system.cell[:2], cell)
+        n_reg = int(s.lateral_registries)
+        self.registries = (primitive_offsets(n_reg, self.lattice) if s.registry_sampling == "primitive"
+                           else _registry_offsets(n_reg, cell))
         legs, nominal, salt = [], {}, 10
         for r, (dx, dy) in enumerate(self.registries):
+            start = None
+            if r > 0 and s.registry_contact_steps > 0:
+                legs.append(self.registry_contact(r, (dx, dy), contact))
+                start = legs[-1]
             for suffix, d_nom, prev in self.wf.chains(s):
                 prepare = lambda _d: ["reset_timestep 0"]
-                if prev is None and r > 0 and _lifts_registries(s):
+                if prev is None and start is not None:      # from the registry's own zero-load contact
+                    fresh = self.from_leg(self.run_dir / "legs" / start.name, start.total_steps, (0.0, 0.0, d_nom))
+                elif prev is None and r > 0 and _lifts_registries(s):
                     fresh = self.from_leg(self.contact_dir, contact.total_steps, (dx, dy, d_nom + REGISTRY_LIFT_A))
                     prepare = lambda _d: registry_approach_lines(s)
                 elif prev is None:
@@ -612,10 +685,40 @@ class _AdhesionLegs:
                 legs.append(Leg(name=f"pmf_r{r}_{suffix}", fresh=fresh, prepare=prepare, stages=stages,
                                 frames=self.frames(s.pmf_sample_steps, TAIL_FRAMES_WINDOW, self.tail and r == 0),
                                 info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
-                                      "continues": f"pmf_r{r}_{prev}" if prev else "contact"},
+                                      "continues": f"pmf_r{r}_{prev}" if prev else
+                                      (start.name if start is not None else "contact")},
                                 **{**self.base, "define": self.define(False, salt)}))
                 salt += 1
+            for suffix, d_nom, prev, repeats in self.wf.return_chain(s):
+                legs.append(Leg(name=f"pmf_r{r}_{suffix}", prepare=lambda _d: ["reset_timestep 0"], stages=stages,
+                                fresh=self.from_leg(self.run_dir / "legs" / f"pmf_r{r}_{prev}", total,
+                                                    (0.0, 0.0, d_nom - nominal[prev])),
+                                info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
+                                      "continues": f"pmf_r{r}_{prev}", "repeats": f"pmf_r{r}_{repeats}"},
+                                **{**self.base, "define": self.define(False, salt)}))
+                nominal[suffix] = d_nom
+                salt += 1
         return legs
+
+    def registry_contact(self, r: int, offset: tuple[float, float], contact: Leg) -> Leg:
+        """Registry r's own zero-load contact (``registry_contact_steps``): the contact leg's last state moved to
+        the offset (bare silica: lifted first and lowered back in minimisation steps), minimised with the backs
+        held, then NVT with the upper back one rigid body free along z (as the contact leg), fresh velocities for
+        the first fifth (not sampled)."""
+        s, si = self.s, self.s.sample_interval
+        lift = REGISTRY_LIFT_A if _lifts_registries(s) else 0.0
+        approach = registry_approach_lines(s) if lift else minimize_lines(s)
+        steps = steps_of(s.registry_contact_steps, si)
+        warm = round_up(steps / 5, si)
+        velocity = (f"velocity mobile create {s.temperature_K:g} {derived_seed(s.seed, 3, 20 + r)} mom yes rot no "
+                    f"dist gaussian",)
+        return Leg(name=f"contact_r{r}", fresh=self.from_leg(self.contact_dir, contact.total_steps,
+                                                             (offset[0], offset[1], lift)),
+                   prepare=lambda _d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"] + approach
+                   + ["unfix back_min", _BACK_RIGID, "reset_timestep 0"],
+                   stages=stage_list(Stage("equilibrate", warm, velocity, sampled=False),
+                                     Stage("sample", max(steps - warm, si))),
+                   info={"registry": r, "offset_A": list(offset)}, **{**self.base, "define": self.define(True, 40 + r)})
 
     def info(self) -> dict:
         s, system, groups = self.s, self.system, self.groups
@@ -624,7 +727,34 @@ class _AdhesionLegs:
                 "n_lower": int(len(groups["lower"])), "n_upper": int(len(groups["upper"])),
                 "lower": system_summary(self.lower), "upper": system_summary(self.upper),
                 "dispersion_tail": s.dispersion_tail, "tail_applies": bool(self.tail), "tail_study": bool(self.study),
-                "registry_offsets_A": [list(o) for o in self.registries]}
+                "registry_offsets_A": [list(o) for o in self.registries],
+                "registry_sampling": s.registry_sampling, "surface_lattice_A": self.lattice.tolist(),
+                "degenerate_registries": degenerate_registries(self.registries, self.lattice)
+                if len(self.registries) else []}
+
+
+#: frames of the chain axes stored over the anneal (its mean tilt series)
+ANNEAL_FRAMES = 50
+
+
+def outward_grid(s: Settings) -> np.ndarray:
+    """Nominal separations (A) of the outward windows: ``pmf_windows`` quadratically spaced from contact to
+    separation_A (dense near contact), with ``pmf_extra_windows_A`` inserted (e.g. over the force peak)."""
+    n = int(s.pmf_windows)
+    out = s.separation_A * (np.arange(n) / (n - 1)) ** 2
+    extra = np.asarray(s.pmf_extra_windows_A, float)
+    return np.sort(np.concatenate([out, extra])) if extra.size else out
+
+
+def _chain_axes(system: System) -> np.ndarray:
+    """(head Si, CH3) atom indices of every grafted chain (one molecule id each): the chain axis whose angle to
+    the surface normal is the chain's tilt."""
+    rows = []
+    for i in np.flatnonzero(system.types == "CH3"):
+        head = np.flatnonzero((system.mol_ids == system.mol_ids[i]) & (system.types == "SIH"))
+        if len(head):
+            rows.append((int(head[0]), int(i)))
+    return np.array(rows, int).reshape(-1, 2)
 
 
 def _tail_applies(s: Settings, system: System) -> bool:
