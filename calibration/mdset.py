@@ -28,6 +28,14 @@ against the rigid holder's travel: it absorbs the asperity's compliance and over
 note says so. The pull-off results are otherwise a validation: F / (2 pi R) (DMT, the limit an MD-scale asperity is
 in) is compared with W_F in [meta.validation].
 
+SAM layer modulus: the confined (uniaxial-strain) modulus M of the SAMs between the adhesion_ots slabs, from the
+compression branch of the same flat-slab curve (md.analysis.confined_layer_modulus: the repulsive windows pressed
+into the contact, t = both SAMs' builder thickness). A result that predates the quantity has it derived here from
+its committed windows (details.pmf_windows, system) with the same function, and the origin says so. The scene key is
+Young's modulus of an isotropic layer, so E = M (1 + nu)(1 - 2 nu) / (1 - nu) with the set's layer Poisson ratio
+(surfaces.sam.layer_poisson_ratio, itself a declared choice); a modulus from fewer than three repulsive windows
+(a line without a check of its linearity) is not used.
+
 A value outside the scene schema's range, or not finite, or a contact angle the analysis could not
 measure (0 deg: a film, 180 deg: no contact yet -- what smoke runs give) is not used: the base set's
 value is kept for that key, and [meta.rejected] and the report name the MD run and the value.
@@ -39,6 +47,8 @@ import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from continuum.origins import check_origins
 from continuum.scene import SceneError, check_value, find_params, flatten
@@ -93,6 +103,7 @@ MAPPING: tuple[Source, ...] = (
     Source("surfaces.sam.interaction_range", "adhesion_ots", ("interaction_range_z0",),
            fallback=Source("surfaces.sam.interaction_range", "pulloff_ots", ("interaction_range_z0",),
                            note=_PULLOFF_Z0)),
+    Source("surfaces.sam.layer_modulus", "adhesion_ots", ("sam_layer_modulus",)),
 )
 
 #: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
@@ -259,6 +270,54 @@ def _effective_source(src: Source, results: dict) -> Source:
     return src
 
 
+def _with_derived(res: dict | None, source: Source) -> dict | None:
+    """The result with ``sam_layer_modulus`` derived from its committed windows where the source asks for it and
+    the run predates the quantity (md.analysis.confined_layer_modulus on details.pmf_windows: the mean force with
+    its dispersion tail, the registry-averaged stderrs, both SAMs' builder thickness); the record says
+    ``derived_from_windows``. A result without windows, or whose compression branch gives no modulus, is returned
+    as it is (the key then has none of its quantities)."""
+    if res is None or "sam_layer_modulus" not in source.quantities or \
+            "sam_layer_modulus" in (res.get("quantities") or {}):
+        return res
+    from md.analysis import confined_layer_modulus, sam_layer_thickness_A
+
+    win, system = (res.get("details") or {}).get("pmf_windows"), res.get("system") or {}
+    try:
+        t, layers = sam_layer_thickness_A(system)
+        force = np.add(win["mean_force_kcal_mol_A"], win.get("tail_force_kcal_mol_A") or 0.0)
+        lm = confined_layer_modulus(win["separation_A"], force, win["stderr_kcal_mol_A"], system["area_A2"], t)
+    except (KeyError, TypeError, ValueError):
+        return res
+    q = {"value": lm["modulus_Pa"], "stderr": lm["stderr_Pa"], "units": "Pa", "windows": lm["windows"],
+         "layers": layers, "thickness_m": t * 1e-10, "strain_max": lm["strain_max"], "derived_from_windows": True}
+    return {**res, "quantities": {**res["quantities"], "sam_layer_modulus": q}}
+
+
+def _to_scene_units(key: str, value: float, stderr, table: dict):
+    """(value, stderr, note) in the scene key's meaning: the SAMs' confined modulus M becomes the layer's Young's
+    modulus E = M (1 + nu)(1 - 2 nu) / (1 - nu) with the set's layer Poisson ratio; other keys as they are."""
+    if key != "surfaces.sam.layer_modulus":
+        return value, stderr, ""
+    from md.analysis import young_from_confined
+
+    nu = _get_nested(table, "surfaces.sam.layer_poisson_ratio")
+    nu = FIELD_BY_PATH["surfaces.sam.layer_poisson_ratio"].default if nu is None else float(nu)
+    factor = young_from_confined(1.0, nu)
+    return value * factor, None if stderr is None else stderr * factor, (
+        f"confined modulus M = {value / 1e9:.3g} GPa converted to Young's modulus with the set's layer Poisson "
+        f"ratio nu = {nu:g} (E = M (1 + nu)(1 - 2 nu) / (1 - nu) = {factor:.3f} M)")
+
+
+def _implausible(key: str, qname: str, result: dict) -> str | None:
+    """Why an MD value that is within the schema's range is still not used: a layer modulus from fewer than three
+    repulsive windows rests on a line whose linearity nothing checks."""
+    if qname == "sam_layer_modulus":
+        n = (result.get("quantities", {}).get(qname) or {}).get("windows")
+        if n is not None and n < 3:
+            return f"only {n} repulsive windows: the compression branch's linearity is unchecked"
+    return None
+
+
 def build_parameter_set(results: dict[str, dict], base: str, name: str, *, description: str = "",
                         mapping=MAPPING, extra_meta: dict | None = None) -> tuple[dict, list[dict]]:
     """The set as a TOML-ready dict and one row per mapped key (used / rejected / missing).
@@ -274,7 +333,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
     water_mismatch = water_model_mismatch(results)
     for src in mapping:
         src = _effective_source(src, results)
-        res = results.get(src.recipe)
+        res = _with_derived(results.get(src.recipe), src)
         row = {"key": src.key, "recipe": src.recipe, "base_value": _get_nested(table, src.key)}
         rows.append(row)
         if res is None:
@@ -286,10 +345,11 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "why": picked[1]}
             continue
         qname, value, stderr, units = picked
+        value, stderr, converted = _to_scene_units(src.key, value, stderr, table)
         row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
                    fidelity=res.get("fidelity"))
         why = (water_mismatch if water_mismatch and src.recipe in WATER_RECIPES
-               else _rejection(src.key, value, qname, res))
+               else _rejection(src.key, value, qname, res) or _implausible(src.key, qname, res))
         if why:
             row.update(status="rejected", why=why)
             rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "quantity": qname,
@@ -298,6 +358,8 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
         row["status"] = "used"
         _set_nested(table, src.key, value)
         calib[src.key] = _calibration_entry(src, res, qname, value, stderr, units)
+        if converted:
+            calib[src.key]["conversion"] = converted
         origin[src.key] = _md_origin(src, res, calib[src.key])
     out_meta = {"description": description or f"MD-calibrated set '{name}' on base '{Path(base).stem}'",
                 "base": Path(base).stem, "origin": origin, "calibration": calib}
@@ -338,6 +400,14 @@ def _calibration_entry(src: Source, res: dict, qname: str, value: float, stderr,
         _angle_flags(entry, src, res, qname)
     if qname == "interaction_range_z0":
         _z0_details(entry, src, qs)
+    if qname == "sam_layer_modulus":
+        lm = qs[qname]
+        entry["confined_modulus"] = {"value": lm.get("value"), "stderr": lm.get("stderr"), "units": "Pa",
+                                     "windows": lm.get("windows"), "layers": lm.get("layers"),
+                                     "strain_max": lm.get("strain_max")}
+        if lm.get("derived_from_windows"):
+            entry["note"] = ("derived from the run's committed windows (details.pmf_windows; the result predates the "
+                             "quantity) with md.analysis.confined_layer_modulus")
     if qname == "work_of_adhesion_free_energy":
         entry["stderr_statistical"] = qs[qname].get("stderr")
         entry["discretisation_error"] = qs[qname].get("discretisation_error")
@@ -388,6 +458,11 @@ def _md_origin(src: Source, res: dict, entry: dict) -> dict:
             "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
                                             "incl. the window grid's discretisation error",
             "contact_angle_upper_bound": "the water wets: uniform on [0, the run's upper bound]",
+            "sam_layer_modulus": "Young's modulus of the SAM layer from the confined modulus of the compression "
+                                 "branch of the flat-slab force curve, converted with the set's layer Poisson "
+                                 "ratio" + ("; derived from the run's committed windows"
+                                           if (res.get("quantities", {}).get("sam_layer_modulus") or {}).get(
+                                               "derived_from_windows") else ""),
             "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
                                      if src.recipe.startswith("adhesion") else
                                      "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
@@ -402,9 +477,8 @@ def _md_origin(src: Source, res: dict, entry: dict) -> dict:
 
 
 def pulloff_validation(results: dict[str, dict]) -> dict:
-    """F / (2 pi R) of each pull-off (DMT: an MD-scale asperity is far in the DMT limit, Tabor mu ~ 0.06)
-    against the flat-slab W_F of the same surfaces: the ratio and the difference in units of the combined
-    stderr. Validation only: nothing here enters the set."""
+    """F / (2 pi R) of each pull-off (DMT) against the flat-slab W_F of the same surfaces: the ratio and the
+    difference in units of the combined stderr. Validation only: nothing here enters the set."""
     out = {}
     for pull, adh in VALIDATION:
         rp, ra = results.get(pull), results.get(adh)
@@ -424,6 +498,7 @@ def pulloff_validation(results: dict[str, dict]) -> dict:
                      "adhesion_recipe": adh, "residual_drag_N": drag.get("value"),
                      "note": "pull-off F / (2 pi R) (DMT) against the flat-slab work of adhesion; validation only"}
     return out
+
 
 
 # ----------------------------------------------------------------------------- TOML writing
