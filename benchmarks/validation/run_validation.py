@@ -28,8 +28,9 @@ from nanoimpact.errors import InputError
 from nanoimpact.fileio import atomic_save_figure, atomic_write_json
 
 try:  # the page is written by the sibling module; both run as a script or as a package member
-    from . import validation_page
+    from . import pull_off_humidity, validation_page
 except ImportError:
+    import pull_off_humidity
     import validation_page
 
 HERE = Path(__file__).resolve().parent
@@ -251,6 +252,41 @@ def capillary_case(name, ds):
 
 
 # ------------------------------------------------------------------------------------------------
+# AFM pull-off against humidity (Jones et al. 2002)
+# ------------------------------------------------------------------------------------------------
+def humidity_case(name, ds):
+    """Pull-off of the afm_tip_humidity scene at the printed tip radius over the printed RH range, as a band over
+    the contact angle and work of adhesion ranges, for each menisci.solid_adhesion choice."""
+    rows = {r["quantity"]: r for r in read_csv(HERE / ds["file"])}
+    lo, hi = float(rows["relative_humidity_low"]["value"]), float(rows["relative_humidity_high"]["value"])
+    rhs = [float(x) for x in np.round(np.arange(lo, hi + 1e-9, 0.05), 2)]
+    radius = float(rows["tip_radius"]["value"])
+    bands = ds["bands"]
+    curves = {}
+    for choice in ds["choices"]["solid_adhesion"]:
+        runs = [pull_off_humidity.pull_off_curve(
+            "afm_tip_humidity", rhs, {"body.radius": radius, "surfaces.body.contact_angle": theta,
+                                      "surfaces.substrate.contact_angle": theta, "surfaces.work_of_adhesion": w,
+                                      "menisci.solid_adhesion": choice, "menisci.surface_tension":
+                                      ds["liquid"]["surface_tension"]})
+                for theta in bands["contact_angle"] for w in bands["work_of_adhesion"]]
+        forces = np.array([[r["pull_off_force"] for r in run] for run in runs])
+        bridged = [all(run[i]["bridge"] for run in runs) for i in range(len(rhs))]
+        wet = forces[:, bridged]
+        curves[choice] = {"low": forces.min(axis=0).tolist(), "high": forces.max(axis=0).tolist(),
+                          "bridged": bridged, "band_with_bridge": [float(wet.min()), float(wet.max())]
+                          if wet.size else None, "band_dry": [float(forces[:, 0].min()), float(forces[:, 0].max())],
+                          "laws": sorted({r["law"] for run in runs for r in run})}
+    first = next((rh for rh, b in zip(rhs, curves[ds["choices"]["solid_adhesion"][0]]["bridged"]) if b), None)
+    row = rows["pull_off_force_small_contacts"]
+    return {"case": name, "relative_humidity": rhs, "tip_radius": radius, "curves": curves,
+            "kelvin_radius": [r["kelvin_radius"] for r in runs[0]], "min_kelvin_radius": runs[0][0]["min_kelvin_radius"],
+            "measured": float(row["value"]), "where": row["where_in_source"], "how": row["how_obtained"],
+            "reading": row["reading"], "first_bridged_rh": first, "contact_angle_band": bands["contact_angle"],
+            "work_of_adhesion_band": bands["work_of_adhesion"], "surface_tension": ds["liquid"]["surface_tension"]}
+
+
+# ------------------------------------------------------------------------------------------------
 # Figures
 # ------------------------------------------------------------------------------------------------
 def figure_capture(res):
@@ -313,6 +349,21 @@ def figure_capillary(res):
     return fig
 
 
+def figure_humidity(res):
+    fig = Figure(figsize=(6.4, 4.6))
+    ax = fig.subplots()
+    rh = np.asarray(res["relative_humidity"]) * 100
+    for (choice, c), col in zip(res["curves"].items(), ("tab:blue", "tab:red")):
+        ax.fill_between(rh, np.asarray(c["low"]) * 1e9, np.asarray(c["high"]) * 1e9, color=col, alpha=0.3,
+                        step="mid", label=f"model, solid adhesion '{choice}' (angle, w band)")
+    ax.hlines(res["measured"] * 1e9, rh[0], rh[-1], colors="k", linestyles="--",
+              label="Jones et al. 2002: ~20 nN at R ~ 20 nm, humidity not stated (printed)")
+    ax.set(xlabel="relative humidity (%)", ylabel="pull-off force (nN)", ylim=(0, None),
+           title=f"Silicon tip, R = {res['tip_radius'] * 1e9:g} nm, on hydrophilic silicon")
+    ax.legend(fontsize=7)
+    return fig
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--no-simulator", action="store_true", help="closed forms only")
@@ -323,8 +374,10 @@ def main(argv=None):
     simulate = not args.no_simulator
     results = {"capture": capture_case("arffman2015", datasets["arffman2015"], simulate),
                "restitution": restitution_case("wall1990", datasets["wall1990"], simulate),
-               "capillary": capillary_case("delrio2007", datasets["delrio2007"])}
-    makers = {"capture": figure_capture, "restitution": figure_restitution, "capillary": figure_capillary}
+               "capillary": capillary_case("delrio2007", datasets["delrio2007"]),
+               "humidity": humidity_case("jones2002", datasets["jones2002"])}
+    makers = {"capture": figure_capture, "restitution": figure_restitution, "capillary": figure_capillary,
+              "humidity": figure_humidity}
     for key, res in results.items():
         atomic_write_json(FIGURES / f"validation_{key}.json", res)
         atomic_save_figure(makers[key](res), FIGURES / f"validation_{key}.png", dpi=120)
