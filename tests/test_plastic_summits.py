@@ -1,4 +1,5 @@
-"""Adhesive elastic-plastic summits (continuum.rough.plastic_summits) against closed forms and their own limits.
+"""Adhesive elastic-plastic summits (continuum.rough.plastic_summits, continuum.laws.plastic_rough) against closed
+forms and their own limits.
 
 References independent of the module's sums: the JKR closed forms (`continuum.reference.jkr`), the Thornton-Ning
 closed-form impact of one sphere (`continuum.reference.thornton_ning.impact`: a quadratic for the maximum approach,
@@ -19,7 +20,8 @@ from continuum.reference import jkr
 from continuum.reference import thornton_ning as tn
 from continuum.rough.branch_laws import make_summit_law
 from continuum.rough.gw_branches import GWBranchSurface
-from continuum.rough.plastic_summits import PlasticGWPunch, PlasticGWSurface, PlasticSummitLaw, PlasticSummitsPunch
+from continuum.laws.plastic_rough import PlasticGWPunch, PlasticGWRoller, PlasticSummitsPunch
+from continuum.rough.plastic_summits import PlasticGWSurface, PlasticSummitLaw, RollerFootprint
 from continuum.rough.summits import SummitStatistics
 
 BETA, W, E = 1e-6, 0.1, 1e11            # summit tip radius (m), work of adhesion (J/m^2), contact modulus (Pa)
@@ -194,7 +196,33 @@ def test_auto_decides_summit_plasticity_by_the_plasticity_index(hardness, yields
     assert rec["plasticity_index"] == pytest.approx(psi, rel=1e-12)
     assert rec["decided_by"] == "plasticity_index" and rec["summits_yield"] is yields
     assert (psi > 1.0) if yields else (psi < 0.6)
-    assert rec["used"] is False and ("elastic summits only" in rec["why"]) is yields
+    assert rec["used"] is yields     # JKR summits over a rigid substrate: the plastic mean field can run
+    blocked = plasticity_decision(scene, "jkr", 0.1, half_space=True).record()
+    assert blocked["used"] is False and blocked["summits_yield"] is yields
+    assert ("half-space grid roller carries elastic summits only" in blocked["why"]) is yields
+
+
+def test_rough_scene_runs_plastic_summits_where_they_yield():
+    """The paper's silica roller with a soft hardness: the plastic roller runs (recorded) and its first impact loses
+    more of the impact energy than the elastic summits' (silicon's hardness) do."""
+    from pathlib import Path
+
+    from continuum.impact import run_impact
+    from continuum.scene import resolve_scene
+
+    path = Path(__file__).resolve().parents[1] / "inputs" / "scenes" / "rough_silica.toml"
+    out = {}
+    for hardness in (8.3e9, 0.25e9):
+        result, _ = run_impact(resolve_scene(path, overrides={"surfaces.substrate.hardness": hardness,
+                                                              "surfaces.roughness.mode": "mean_field",
+                                                              "numerics.max_bounces": 1}))
+        assert result["energy_audit"]["max_relative_error"] < 1e-5
+        out[hardness] = result
+    elastic, plastic = out[8.3e9], out[0.25e9]
+    assert elastic["models"]["contact_law"]["name"] == "rough_roller_gw_jkr_rigid"
+    assert plastic["models"]["contact_law"]["name"] == "rough_roller_gw_plastic_rigid"
+    assert plastic["models"]["plasticity"]["used"] and plastic["models"]["plasticity"]["plasticity_index"] > 1.0
+    assert plastic["bounces"][0]["energy_booked"] > 2.0 * elastic["bounces"][0]["energy_booked"]
 
 
 # ----------------------------------------------------------------------------- rigid roller on plastic summits
@@ -202,7 +230,6 @@ R_ROLLER, L_ROLLER, M_ROLLER, V_ROLLER = 1e-3, 1e-3, 1e-8, 0.01
 
 
 def _roller(p_y):
-    from continuum.rough.plastic_summits import PlasticGWRoller
     return PlasticGWRoller(PlasticSummitLaw(BETA, W, E, p_y), SIGMA, DENSITY, ZMAX, R_ROLLER, L_ROLLER)
 
 
@@ -211,7 +238,6 @@ def _roller(p_y):
 def test_roller_footprint_is_the_mean_field_integrated_across_the_footprint(h, h_c, h_p):
     """The footprint kernel K(z) against the per-area mean field integrated over x by adaptive quadrature, with the
     separations d + x^2/2R (attached summits end where z_max - d_p(x) = u_a)."""
-    from continuum.rough.plastic_summits import RollerFootprint
     law = PlasticSummitLaw(BETA, W, E, P_Y)
     area = PlasticGWSurface(law, SIGMA, DENSITY, ZMAX)
     foot = RollerFootprint(law, SIGMA, DENSITY, ZMAX, R_ROLLER, L_ROLLER)
@@ -231,7 +257,8 @@ def test_elastic_roller_is_the_rigid_gw_jkr_roller():
     from continuum.laws.rough_rigid import RigidRoughRoller
     from continuum.rough.gw import GWJKRSurface
     ours = simulate(_roller(math.inf), M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS).bounces[0]
-    theirs = RigidRoughRoller(GWJKRSurface(SummitStatistics(SIGMA, DENSITY, BETA), W, E, z_max=ZMAX), R_ROLLER, L_ROLLER)
+    surface = GWJKRSurface(SummitStatistics(SIGMA, DENSITY, BETA), W, E, z_max=ZMAX)
+    theirs = RigidRoughRoller(surface, R_ROLLER, L_ROLLER)
     ref = simulate(theirs, M_ROLLER, 0.0, impact_velocity=V_ROLLER, settings=SETTINGS).bounces[0]
     assert ours.restitution == pytest.approx(ref.restitution, abs=1e-7)
     assert ours.energy_lost == pytest.approx(ref.energy_lost, rel=1e-5)

@@ -369,9 +369,10 @@ def realisation_decision(scene: Scene, regime: Regime) -> RealisationDecision:
 # ----------------------------------------------------------------------------- plasticity (smooth sphere)
 @dataclass(frozen=True)
 class PlasticityDecision:
-    """Whether a smooth sphere runs the Thornton-Ning adhesive elastic-plastic law, and the numbers that decided
-    it: the softer partner's limiting contact pressure (Pa, `continuum.limiting_pressure`) and the yield velocity
-    (m/s, `continuum.reference.thornton_ning.yield_velocity`) against the first impact's speed (m/s)."""
+    """Whether a smooth sphere (or the summits of rough contact, `summit_plasticity`) runs the Thornton-Ning adhesive
+    elastic-plastic law, and the numbers that decided it: the softer partner's limiting contact pressure (Pa,
+    `continuum.limiting_pressure`) and the yield velocity (m/s, `continuum.reference.thornton_ning.yield_velocity`)
+    against the first impact's speed (m/s), or the summits' plasticity index."""
 
     used: bool
     decided_by: str
@@ -419,14 +420,20 @@ def _yield_values(scene: Scene) -> dict:
 PSI_ELASTIC, PSI_PLASTIC = 0.6, 1.0
 
 
-def summit_plasticity(scene: Scene) -> PlasticityDecision:
+def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = False,
+                      menisci: bool = False) -> PlasticityDecision:
     """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
     with the summits' E* (`summit_e_star`) and the softer partner's limiting pressure p_y (H, or 2.8 Y) decides.
 
-    The rough roller's footprint tables are built on elastic summit laws: plastic summits exist as a law
-    (`continuum.rough.plastic_summits`: mean field and discrete, under a flat punch), not in the roller, so the
-    roller runs elastic summits and the record says so, with psi and what 'auto' would include."""
+    Where they yield, the mean field of Thornton-Ning summits under a rigid roller runs
+    (`continuum.laws.plastic_rough.PlasticGWRoller`); it is built on JKR summits over a rigid substrate without
+    bridges, so under another summit law (`adhesion`), the half-space grid, discrete summits or menisci the summits
+    stay elastic and the record says why. A p_y below the summits' adhesive stress scale (they would yield on
+    snap-in, outside Thornton-Ning) is refused naming its key."""
+    from nanoimpact.errors import InputError
+
     from ..limiting_pressure import partner_limits, softer_partner
+    from ..reference import thornton_ning as tn
 
     limits = tuple(partner_limits(_yield_values(scene)))
     soft = softer_partner(list(limits))
@@ -434,21 +441,37 @@ def summit_plasticity(scene: Scene) -> PlasticityDecision:
         return PlasticityDecision(False, "yield_strength", "no yield key (surfaces.body or surfaces.substrate "
                                   "yield_strength or hardness): the summits are elastic")
     rough = scene.surfaces.roughness
-    psi = summit_e_star(scene) / soft.limiting_pressure * math.sqrt(rough.sigma / rough.summit_radius)
+    e_s = summit_e_star(scene)
+    psi = e_s / soft.limiting_pressure * math.sqrt(rough.sigma / rough.summit_radius)
     yields = psi >= PSI_ELASTIC
     state = ("most summits yield" if psi > PSI_PLASTIC else "some summits yield") if yields else "summits stay elastic"
     why = (f"auto: plasticity index psi = {psi:.3g} " + (">=" if yields else "<") + f" {PSI_ELASTIC} "
            f"(limiting contact pressure {soft.limiting_pressure:.3g} Pa from {soft.key}): {state}")
-    if yields:
-        why += ("; the rough roller's footprint carries elastic summits only (Thornton-Ning summits: "
-                "continuum.rough.plastic_summits, flat punch): this run is elastic and overestimates the rebound")
-    return PlasticityDecision(False, "plasticity_index", why, limiting_pressure=soft.limiting_pressure,
+    blockers = [text for cond, text in (
+        (adhesion != "jkr", f"the summit law is '{adhesion}' (Thornton-Ning summits are JKR summits)"),
+        (half_space, "the half-space grid roller carries elastic summits only"),
+        (rough.mode == "discrete", "discrete summits under the roller are elastic"),
+        (menisci, "the bridges' law wraps elastic summits")) if cond]
+    used = yields and not blockers
+    if used:
+        w = scene.surfaces.interface_work_of_adhesion
+        p_a = float(tn.adhesive_stress_scale(rough.summit_radius, w, e_s))
+        if soft.limiting_pressure <= p_a:
+            raise InputError(soft.key, soft.value, f"gives a limiting contact pressure of {soft.limiting_pressure:.4g} "
+                             f"Pa, below the summits' adhesive stress scale E* a0/(pi beta) = {p_a:.4g} Pa (they "
+                             "would yield on snap-in, outside the Thornton-Ning law)")
+        why += ": Thornton-Ning summits, rigid roller on their GW mean field"
+    elif yields:
+        why += "; " + "; ".join(blockers) + ": this run is elastic and overestimates the rebound"
+    return PlasticityDecision(used, "plasticity_index", why, limiting_pressure=soft.limiting_pressure,
                               from_key=soft.key, partners=limits, plasticity_index=psi, summits_yield=yields)
 
 
-def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> PlasticityDecision:
+def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space: bool = False,
+                        menisci: bool = False) -> PlasticityDecision:
     """Elastic-plastic smooth sphere or not, for the adhesion law that runs (`adhesion`) and the first impact's
-    `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key."""
+    `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key. Rough
+    contact: `summit_plasticity` (with the half-space and menisci decisions)."""
     from ..limiting_pressure import partner_limits, softer_partner
     from ..reference import thornton_ning as tn
 
@@ -456,7 +479,7 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float) -> Plasticity
     if choice == "off":
         return PlasticityDecision(False, "scene", "physics.plasticity = 'off' set in the scene")
     if scene.contact == "rough":
-        return summit_plasticity(scene)
+        return summit_plasticity(scene, adhesion, half_space, menisci)
     if scene.body.shape != "sphere":
         return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; a smooth "
                                   "roller stays elastic (the line-contact yield warning says where it would yield)")

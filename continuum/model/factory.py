@@ -65,6 +65,17 @@ def rigid_roller(surface, radius: float, length: float, resolution: str = "stand
     return RigidRoughRoller(surface, radius, length, resolution=resolution)
 
 
+def plastic_rigid_roller(scene: Scene, summit_e_star: float, limiting_pressure: float, z_max: float) -> ContactLaw:
+    """Rigid roller on the GW mean field of Thornton-Ning summits over a rigid substrate (summits of the scene's
+    roughness, the summits' E*, limiting contact pressure p_y in Pa, truncation z_max in units of sigma)."""
+    from ..laws.plastic_rough import PlasticGWRoller
+    from ..rough.plastic_summits import PlasticSummitLaw
+    rough, body = scene.surfaces.roughness, scene.body
+    law = PlasticSummitLaw(rough.summit_radius, scene.surfaces.interface_work_of_adhesion, summit_e_star,
+                           limiting_pressure)
+    return PlasticGWRoller(law, rough.sigma, rough.summit_density, z_max, body.radius, body.length)
+
+
 def grid_roller(surface, scene: Scene) -> ContactLaw:
     """Averaged rough roller on the elastic half-space (grid of scene.numerics.grid_points cells)."""
     from ..laws.rough_roller import RoughRoller

@@ -178,12 +178,18 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         hs = half_space_decision(scene, regime)
         wet = menisci if menisci is not None else (m.choice == "on")
         law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, estimate=estimate, regime=regime)
+        plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet)
+        if plastic.used:
+            law = factory.plastic_rigid_roller(scene, regime.e_star, plastic.limiting_pressure,
+                                               record["datum"]["z_max"])
+            record["table"] = {"used": False, "why": "plastic summits: the mean field is summed state by state "
+                               "(continuum.rough.plastic_summits), no footprint tables"}
         models["estimate"] = rec.estimate_record(estimate)
         models["contact_law"] = {**law.describe(), **record,
                                  "why": "contact = 'rough': GW summits on a grid under the roller"}
         models["adhesion"] = {"used": adhesion.used, **adhesion.record()}
         models["half_space"] = hs.record()
-        models["plasticity"] = plasticity_decision(scene, adhesion.law, first_impact_speed).record()
+        models["plasticity"] = plastic.record()
         if menisci is not None:
             m_rec = {**m_rec, "used": menisci}
         if wet:

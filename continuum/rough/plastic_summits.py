@@ -41,8 +41,8 @@ both left sides increasing in u (tested), so the attached summits are u > u_a(d,
 The integrals are Gauss-Legendre panels (8 nodes) in u, geometric from u_a (first width a tenth of the adhesive
 length scale, at most sigma/4), the first panel in t with u = u_a + t^2 (the JKR force has a square-root
 behaviour at the fold), split at delta_y. They run in NumPy: the summit states are not tabulated, so these
-surfaces are for flat-punch contact (`PlasticGWPunch`) and for the checks, not for the rough roller's footprint
-tables.
+surfaces are evaluated state by state (a few hundred nodes), with no tables; the contact laws that use them are in
+`continuum.laws.plastic_rough` (flat punch, rigid roller, discrete summits).
 
 Plasticity index (Greenwood & Williamson 1966): psi = (E*/H) sqrt(sigma_s/beta); psi < 0.6 the summits stay
 elastic under any practical load, psi > 1 most touching summits yield (`continuum.regimes.plasticity_index`).
@@ -60,12 +60,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from ..laws.base import ContactLaw
 from ..reference import jkr
 from ..reference import thornton_ning as tn
 
-__all__ = ["PlasticSummitLaw", "PlasticGWSurface", "RollerFootprint", "PlasticGWPunch", "PlasticGWRoller",
-           "PlasticSummitsPunch"]
+__all__ = ["PlasticSummitLaw", "PlasticGWSurface", "RollerFootprint"]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _SQRT2PI = math.sqrt(2.0 * math.pi)
@@ -135,7 +133,8 @@ class PlasticSummitLaw:
             return np.zeros_like(dm)
         d = np.maximum(dm - self.yield_approach, 0.0)
         p = (self.radius, self.work_of_adhesion, self.e_star)
-        work = float(jkr.energy_from_radius(self.yield_radius, *p)) + self.yield_force * d + 0.5 * self.plastic_slope * d * d
+        work = (float(jkr.energy_from_radius(self.yield_radius, *p)) + self.yield_force * d
+                + 0.5 * self.plastic_slope * d * d)
         _, stored = self.branch(np.maximum(dm, self.yield_approach), np.maximum(dm, self.yield_approach))
         return np.where(d > 0.0, work - stored, 0.0)
 
@@ -294,178 +293,3 @@ class RollerFootprint(PlasticGWSurface):
         y = (z[:, None] + t * t) / self.sigma
         k = (0.5 * top * (np.exp(-0.5 * y * y) @ self._tw)) * 2.0 / (_SQRT2PI * self.sigma)
         return self.density * w * self.length * math.sqrt(2.0 * self.roller_radius) * k
-
-
-class PlasticGWPunch(ContactLaw):
-    """Rigid flat of nominal area A (m^2) on a `PlasticGWSurface`; gap = d - z_max (m) above the tallest summit.
-
-    The deepest separation ever, d_p, outlives a contact (`reset` keeps it, `forget_history` clears it), so a
-    second impact meets flattened summits. Losses from the law's own terms: plastic work W_p(d_p) and the loops
-    of the summits that let go."""
-
-    name = "plastic_gw_punch"
-    has_history = True
-    bound_is_final = True   # the driver ends a contact at its first turn while attached (one approach, one retreat)
-
-    def __init__(self, surface: PlasticGWSurface, area: float):
-        self.surface, self.area = surface, float(area)
-        self.forget_history()
-
-    def forget_history(self) -> None:
-        self._d_p = self.surface.z_top          # no summit met yet
-        self.impacts = 0
-        self.reset()
-
-    def reset(self) -> None:
-        self._d_c = math.inf
-        self._w0 = self.surface.plastic_work(self._d_p)
-
-    def _trial(self, gap):
-        d = self.surface.z_top + gap
-        return d, min(self._d_c, d), min(self._d_p, d)
-
-    def force(self, gap):
-        return self.area * self.surface.state(*self._trial(gap))[0]
-
-    def stiffness(self, gap):
-        h = 1e-7 * self.surface.sigma
-        return (self.force(gap - h) - self.force(gap + h)) / (2.0 * h)
-
-    def stored_energy(self, gap):
-        return self.area * self.surface.state(*self._trial(gap))[1]
-
-    def dissipated(self, gap):
-        d, d_c, d_p = self._trial(gap)
-        s = self.surface
-        return self.area * (s.plastic_work(d_p) - self._w0 + s.released(d, d_c, d_p))
-
-    def release_gap(self):
-        s = self.surface
-        u_top = s.z_top - self._d_p
-        fn = s.hold if math.isfinite(self._d_c) else s.recovery
-        return self._d_p + float(fn(u_top)) - s.z_top
-
-    def on_release(self):
-        s = self.surface
-        return self.area * (s.plastic_work(self._d_p) - self._w0 + s.released(math.inf, self._d_c, self._d_p))
-
-    def accept(self, gap):
-        d, self._d_c, self._d_p = self._trial(gap)
-
-    def length_scale(self, mass, speed):
-        return max(0.1 * self.surface.sigma, self.surface.delta_c)
-
-    def diagnostics(self):
-        return {"deepest_separation": self._d_p, "plastic_work": self.area * self.surface.plastic_work(self._d_p)}
-
-    def describe(self):
-        s = self.surface
-        return {"name": self.name, "area": self.area, "sigma": s.sigma, "density": s.density, "z_top": s.z_top,
-                "summit_law": s.law.describe(), "source": "Greenwood & Williamson (1966) mean field of Thornton & "
-                "Ning (1998) summits, history (d, d_c, d_p)"}
-
-
-class PlasticSummitsPunch(ContactLaw):
-    """Rigid flat on discrete `PlasticSummitLaw` summits of heights z (m); gap = d - max(z) (m).
-
-    Each summit carries its deepest approach (hence R_p and delta_p) into later contacts; `forget_history` returns
-    them to virgin summits. A summit is met at delta = delta_p (its force jumps onto the JKR curve of R_p there, at
-    no cost in energy) and lets go at the fold delta_p - delta_c(R_p), booking that branch's loop."""
-
-    name = "plastic_summits_punch"
-    has_history = True
-    bound_is_final = True
-
-    def __init__(self, law: PlasticSummitLaw, heights):
-        self.law = law
-        self.heights = np.asarray(heights, float)
-        self.z_top = float(np.max(self.heights))
-        self.forget_history()
-
-    def forget_history(self) -> None:
-        self.delta_max = np.zeros_like(self.heights)      # 0 < delta_y: virgin summits
-        self.reset()
-
-    def reset(self) -> None:
-        self._attached = np.zeros(self.heights.size, bool)
-        self._met = np.zeros(self.heights.size, bool)
-        self._w0 = float(np.sum(self.law.plastic_work(self.delta_max)))
-        self._loops = 0.0
-
-    def _trial(self, gap):
-        """(delta, attached, deepest approach, loops of the summits letting go now) at gap (m)."""
-        delta = self.heights - self.z_top - gap
-        r_p, d_p = self.law.flattening(self.delta_max)
-        release = d_p - self.law.release_stretch(r_p)
-        attached = (delta >= d_p) | (self._attached & (delta > release))
-        lost = self._attached & ~attached
-        dm = np.where(attached, np.maximum(self.delta_max, delta), self.delta_max)
-        loops = float(np.sum(self.law.loop_energy(self.delta_max[lost]))) if lost.any() else 0.0
-        return delta, attached, dm, loops
-
-    def _values(self, gap):
-        delta, att, dm, loops = self._trial(gap)
-        if not att.any():
-            return 0.0, 0.0, dm, loops
-        f, en = self.law.branch(delta[att], dm[att])
-        return float(np.sum(f)), float(np.sum(en)), dm, loops
-
-    def force(self, gap):
-        return self._values(gap)[0]
-
-    def stiffness(self, gap):
-        h = 1e-9 * self.law.radius
-        return (self.force(gap - h) - self.force(gap + h)) / (2.0 * h)
-
-    def stored_energy(self, gap):
-        return self._values(gap)[1]
-
-    def dissipated(self, gap):
-        _, _, dm, loops = self._values(gap)
-        return float(np.sum(self.law.plastic_work(dm))) - self._w0 + self._loops + loops
-
-    def release_gap(self):
-        r_p, d_p = self.law.flattening(self.delta_max)
-        release = self.heights - d_p + self.law.release_stretch(r_p) - self.z_top
-        met = self._met if self._met.any() else np.ones_like(self._met)
-        return float(np.max(release[met]))
-
-    def on_release(self):
-        held = self._attached
-        return (float(np.sum(self.law.plastic_work(self.delta_max))) - self._w0 + self._loops
-                + float(np.sum(self.law.loop_energy(self.delta_max[held]))))
-
-    def accept(self, gap):
-        _, att, dm, loops = self._trial(gap)
-        self._loops += loops
-        self._attached, self.delta_max = att, dm
-        self._met |= att
-
-    def length_scale(self, mass, speed):
-        return float(self.law.release_stretch(self.law.radius))
-
-    def diagnostics(self):
-        r_p, d_p = self.law.flattening(self.delta_max)
-        return {"summits_yielded": int(np.sum(self.delta_max > self.law.yield_approach)),
-                "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
-
-    def describe(self):
-        return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
-                "source": "Thornton & Ning (1998) on each summit, each carrying its flattening"}
-
-
-class PlasticGWRoller(PlasticGWPunch):
-    """Rigid roller of radius R and length l (m) on the mean field of plastic summits over a rigid substrate
-    (`RollerFootprint`); gap = d - z_max on the roller's axis. Same history and losses as `PlasticGWPunch`."""
-
-    name = "rough_roller_gw_plastic_rigid"
-
-    def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float, radius: float,
-                 length: float):
-        super().__init__(RollerFootprint(law, sigma, density, z_max, radius, length), 1.0)
-
-    def describe(self):
-        s = self.surface
-        return {**super().describe(), "name": self.name, "roller_radius": s.roller_radius, "length": s.length,
-                "source": "Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) summits under a rigid "
-                          "roller over a rigid substrate, history (h, h_c, h_p) on its axis"}

@@ -1,0 +1,200 @@
+"""Contact laws of adhesive elastic-plastic summits (`continuum.rough.plastic_summits`): a rigid flat punch and a rigid
+roller on their GW mean field, and a flat punch on discrete summits, each carrying the summits' flattening from one
+contact to the next.
+
+History: the mean-field laws keep the deepest separation ever reached, d_p (the summits' flattening), and this
+contact's deepest, d_c; the discrete law keeps each summit's deepest approach. The driver ends a contact at its
+first turn while attached (`bound_is_final`), so a contact is one approach and one retreat, which (d, d_c, d_p)
+describe exactly. Losses come from the laws' own terms (plastic work, the loops of the summits that let go), so the
+driver's energy audit tests the motion against them.
+
+Sources: C. Thornton & Z. Ning, Powder Technol. 99 (1998) 154-162; J. A. Greenwood & J. B. P. Williamson, Proc. R.
+Soc. Lond. A 295 (1966) 300.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..rough.plastic_summits import PlasticGWSurface, PlasticSummitLaw, RollerFootprint
+from .base import ContactLaw
+
+__all__ = ["PlasticGWPunch", "PlasticGWRoller", "PlasticSummitsPunch"]
+
+
+class PlasticGWPunch(ContactLaw):
+    """Rigid flat of nominal area A (m^2) on a `PlasticGWSurface`; gap = d - z_max (m) above the tallest summit.
+
+    The deepest separation ever, d_p, outlives a contact (`reset` keeps it, `forget_history` clears it), so a
+    second impact meets flattened summits. Losses from the law's own terms: plastic work W_p(d_p) and the loops
+    of the summits that let go."""
+
+    name = "plastic_gw_punch"
+    has_history = True
+    bound_is_final = True   # the driver ends a contact at its first turn while attached (one approach, one retreat)
+
+    def __init__(self, surface: PlasticGWSurface, area: float):
+        self.surface, self.area = surface, float(area)
+        #: tallest summit above the summits' mean plane (m) and their height rms (m), as the rough rollers give them
+        self.z_top, self.sigma = surface.z_top, surface.sigma
+        self.forget_history()
+
+    def forget_history(self) -> None:
+        self._d_p = self.surface.z_top          # no summit met yet
+        self.impacts = 0
+        self.reset()
+
+    def reset(self) -> None:
+        self._d_c = math.inf
+        self._w0 = self.surface.plastic_work(self._d_p)
+
+    def _trial(self, gap):
+        d = self.surface.z_top + gap
+        return d, min(self._d_c, d), min(self._d_p, d)
+
+    def force(self, gap):
+        return self.area * self.surface.state(*self._trial(gap))[0]
+
+    def stiffness(self, gap):
+        h = 1e-7 * self.surface.sigma
+        return (self.force(gap - h) - self.force(gap + h)) / (2.0 * h)
+
+    def stored_energy(self, gap):
+        return self.area * self.surface.state(*self._trial(gap))[1]
+
+    def dissipated(self, gap):
+        d, d_c, d_p = self._trial(gap)
+        s = self.surface
+        return self.area * (s.plastic_work(d_p) - self._w0 + s.released(d, d_c, d_p))
+
+    def release_gap(self):
+        s = self.surface
+        u_top = s.z_top - self._d_p
+        fn = s.hold if math.isfinite(self._d_c) else s.recovery
+        return self._d_p + float(fn(u_top)) - s.z_top
+
+    def on_release(self):
+        s = self.surface
+        return self.area * (s.plastic_work(self._d_p) - self._w0 + s.released(math.inf, self._d_c, self._d_p))
+
+    def accept(self, gap):
+        d, self._d_c, self._d_p = self._trial(gap)
+
+    def length_scale(self, mass, speed):
+        return max(0.1 * self.surface.sigma, self.surface.delta_c)
+
+    def diagnostics(self):
+        return {"deepest_separation": self._d_p, "plastic_work": self.area * self.surface.plastic_work(self._d_p)}
+
+    def describe(self):
+        s = self.surface
+        return {"name": self.name, "area": self.area, "sigma": s.sigma, "density": s.density, "z_top": s.z_top,
+                "summit_law": s.law.describe(), "source": "Greenwood & Williamson (1966) mean field of Thornton & "
+                "Ning (1998) summits, history (d, d_c, d_p)"}
+
+
+class PlasticGWRoller(PlasticGWPunch):
+    """Rigid roller of radius R and length l (m) on the mean field of plastic summits over a rigid substrate
+    (`RollerFootprint`); gap = d - z_max on the roller's axis. Same history and losses as `PlasticGWPunch`."""
+
+    name = "rough_roller_gw_plastic_rigid"
+
+    def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float, radius: float,
+                 length: float):
+        super().__init__(RollerFootprint(law, sigma, density, z_max, radius, length), 1.0)
+
+    def describe(self):
+        s = self.surface
+        return {**super().describe(), "name": self.name, "roller_radius": s.roller_radius, "length": s.length,
+                "source": "Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) summits under a rigid "
+                          "roller over a rigid substrate, history (h, h_c, h_p) on its axis"}
+
+
+class PlasticSummitsPunch(ContactLaw):
+    """Rigid flat on discrete `PlasticSummitLaw` summits of heights z (m); gap = d - max(z) (m).
+
+    Each summit carries its deepest approach (hence R_p and delta_p) into later contacts; `forget_history` returns
+    them to virgin summits. A summit is met at delta = delta_p (its force jumps onto the JKR curve of R_p there, at
+    no cost in energy) and lets go at the fold delta_p - delta_c(R_p), booking that branch's loop."""
+
+    name = "plastic_summits_punch"
+    has_history = True
+    bound_is_final = True
+
+    def __init__(self, law: PlasticSummitLaw, heights):
+        self.law = law
+        self.heights = np.asarray(heights, float)
+        self.z_top = float(np.max(self.heights))
+        self.forget_history()
+
+    def forget_history(self) -> None:
+        self.delta_max = np.zeros_like(self.heights)      # 0 < delta_y: virgin summits
+        self.reset()
+
+    def reset(self) -> None:
+        self._attached = np.zeros(self.heights.size, bool)
+        self._met = np.zeros(self.heights.size, bool)
+        self._w0 = float(np.sum(self.law.plastic_work(self.delta_max)))
+        self._loops = 0.0
+
+    def _trial(self, gap):
+        """(delta, attached, deepest approach, loops of the summits letting go now) at gap (m)."""
+        delta = self.heights - self.z_top - gap
+        r_p, d_p = self.law.flattening(self.delta_max)
+        release = d_p - self.law.release_stretch(r_p)
+        attached = (delta >= d_p) | (self._attached & (delta > release))
+        lost = self._attached & ~attached
+        dm = np.where(attached, np.maximum(self.delta_max, delta), self.delta_max)
+        loops = float(np.sum(self.law.loop_energy(self.delta_max[lost]))) if lost.any() else 0.0
+        return delta, attached, dm, loops
+
+    def _values(self, gap):
+        delta, att, dm, loops = self._trial(gap)
+        if not att.any():
+            return 0.0, 0.0, dm, loops
+        f, en = self.law.branch(delta[att], dm[att])
+        return float(np.sum(f)), float(np.sum(en)), dm, loops
+
+    def force(self, gap):
+        return self._values(gap)[0]
+
+    def stiffness(self, gap):
+        h = 1e-9 * self.law.radius
+        return (self.force(gap - h) - self.force(gap + h)) / (2.0 * h)
+
+    def stored_energy(self, gap):
+        return self._values(gap)[1]
+
+    def dissipated(self, gap):
+        _, _, dm, loops = self._values(gap)
+        return float(np.sum(self.law.plastic_work(dm))) - self._w0 + self._loops + loops
+
+    def release_gap(self):
+        r_p, d_p = self.law.flattening(self.delta_max)
+        release = self.heights - d_p + self.law.release_stretch(r_p) - self.z_top
+        met = self._met if self._met.any() else np.ones_like(self._met)
+        return float(np.max(release[met]))
+
+    def on_release(self):
+        held = self._attached
+        return (float(np.sum(self.law.plastic_work(self.delta_max))) - self._w0 + self._loops
+                + float(np.sum(self.law.loop_energy(self.delta_max[held]))))
+
+    def accept(self, gap):
+        _, att, dm, loops = self._trial(gap)
+        self._loops += loops
+        self._attached, self.delta_max = att, dm
+        self._met |= att
+
+    def length_scale(self, mass, speed):
+        return float(self.law.release_stretch(self.law.radius))
+
+    def diagnostics(self):
+        r_p, d_p = self.law.flattening(self.delta_max)
+        return {"summits_yielded": int(np.sum(self.delta_max > self.law.yield_approach)),
+                "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
+
+    def describe(self):
+        return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
+                "source": "Thornton & Ning (1998) on each summit, each carrying its flattening"}
