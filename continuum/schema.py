@@ -184,9 +184,10 @@ FIELDS: tuple[Field, ...] = (
     Field("physics.plasticity", str, "", "Smooth sphere: the Thornton-Ning (1998) adhesive elastic-plastic law "
           "(JKR to yield, then a limiting contact pressure from the softer partner's hardness or 2.8 x yield "
           "strength; the flattening is carried into later impacts). 'auto': on when the first impact is faster "
-          "than the yield velocity, off (recorded) when no yield key is given. Rough contact: 'auto' records the "
-          "summits' plasticity index psi = (E*/p_y) sqrt(sigma/beta) and whether they yield (psi >= 0.6, Greenwood "
-          "& Williamson 1966); the rough roller runs elastic summits.", "auto",
+          "than the yield velocity, off (recorded) when no yield key is given. Rough contact: 'auto' runs Thornton-Ning "
+          "summits where their plasticity index psi = (E*/p_y) sqrt(sigma/beta) >= 0.6 (Greenwood & Williamson "
+          "1966) and the mean field of JKR summits over a rigid substrate runs without bridges (else elastic "
+          "summits, recorded with psi).", "auto",
           choices=("auto", "on", "off")),
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",
