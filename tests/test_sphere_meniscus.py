@@ -132,3 +132,35 @@ def test_wet_solids_with_plasticity_are_refused_naming_the_key():
     table["physics"]["plasticity"] = "on"
     with pytest.raises(SceneError, match="menisci.solid_adhesion"):
         _models(table)
+
+
+def test_pull_off_without_a_bridge_is_jkrs_load_controlled_1p5_pi_r_w():
+    from continuum.laws.jkr import JKRSphere
+    w = 0.1
+    res = pull_off(JKRSphere(RADIUS, w, 80e9), None)
+    assert res["pull_off_force"] == pytest.approx(1.5 * math.pi * RADIUS * w, rel=1e-6)
+
+
+def test_auto_sphere_meniscus_left_out_when_no_contact_lasts_t_a():
+    """Default t_a = 25 us against a nanosecond impact: the dry run is the wet run, recorded with its numbers."""
+    result = run_scene(_scene(menisci_choice="auto", t_a=25e-6))
+    men = result.record["models"]["menisci"]
+    assert men["used"] is False and men["decided_by"] == "longest_contact_time"
+    assert men["longest_contact_s"] < men["condensation_time_s"] == 25e-6
+
+
+def test_humidity_sweep_steps_from_the_dry_to_the_bridged_pull_off():
+    """benchmarks/validation/pull_off_humidity.py: below the cutoff the dry DMT pull-off 2 pi R dgamma, above it
+    (W_wet < 0 for the silicon set) the bridge's F0 = 4 pi R gamma cos 20 deg."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks" / "validation"))
+    try:
+        import pull_off_humidity as sweep
+    finally:
+        sys.path.pop(0)
+    rows = sweep.pull_off_curve("afm_tip_humidity", [0.1, 0.5])
+    assert [r["bridge"] for r in rows] == [False, True]
+    assert rows[0]["pull_off_force"] == pytest.approx(2.0 * math.pi * RADIUS * 0.063, rel=1e-4)
+    assert rows[1]["pull_off_force"] == pytest.approx(4.0 * math.pi * RADIUS * GAMMA * math.cos(math.radians(20.0)),
+                                                      rel=1e-4)
