@@ -57,7 +57,8 @@ def result_warnings(scene, law, bounces) -> list[str]:
         psi = regimes.plasticity_index(e_s, surf.hardness, surf.roughness.sigma, surf.roughness.summit_radius)
         if psi > 1.0:
             out.append(f"plasticity index psi = {psi:.3g} > 1: most summits yield (Greenwood & Williamson 1966); "
-                       "the elastic JKR summits overstate the rebound")
+                       + ("they run the Thornton-Ning elastic-plastic law (models.plasticity)"
+                          if diag.get("plastic_summits") else "the elastic JKR summits overstate the rebound"))
         elif psi > 0.6 and math.isfinite(psi):
             out.append(f"plasticity index psi = {psi:.3g} between 0.6 and 1: some summits yield")
     return out

@@ -85,7 +85,12 @@ class PlasticGWPunch(ContactLaw):
         return max(0.1 * self.surface.sigma, self.surface.delta_c)
 
     def diagnostics(self):
-        return {"deepest_separation": self._d_p, "plastic_work": self.area * self.surface.plastic_work(self._d_p)}
+        """The deepest state reached (first contact's maximum approach, where the most summits hold): its summits in
+        contact and nominal pressure on the axis, the plastic work so far, and that the summits are plastic."""
+        s, d = self.surface, self._d_p
+        contacts = self.area * s.state(d, d, d)[2] if d < s.z_top else 0.0
+        return {"deepest_separation": d, "plastic_work": self.area * s.plastic_work(d), "max_contacts": contacts,
+                "max_nominal_pressure": s.axis_state(d, d, d)[0] if d < s.z_top else 0.0, "plastic_summits": True}
 
     def describe(self):
         s = self.surface

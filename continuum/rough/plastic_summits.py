@@ -246,6 +246,16 @@ class PlasticGWSurface:
         q = self._weight(u, w, d_p)
         return float(q @ f), float(q @ en), float(q.sum())
 
+    def axis_state(self, d, d_c, d_p):
+        """(pressure Pa, contacts 1/m^2) per unit nominal area at separation d (m): `state` with the Gaussian density
+        whatever this surface's weight (a footprint's: its nominal pressure on the axis)."""
+        u_met, u_held = self.bounds(d, d_c, d_p)
+        u, w = self._nodes(max(u_met, u_held, 0.0), self.z_top - d_p)
+        if u.size == 0:
+            return 0.0, 0.0
+        q = PlasticGWSurface._weight(self, u, w, d_p)
+        return float(q @ self.law.branch(u - (d - d_p), u)[0]), float(q.sum())
+
     def plastic_work(self, d_p):
         """Plastic work (J/m^2) of all summits after the deepest separation d_p (m)."""
         u, w = self._nodes(max(self.law.yield_approach, 0.0), self.z_top - d_p)
