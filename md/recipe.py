@@ -56,6 +56,7 @@ CONDITIONAL_KEYS: dict[str, dict[str, tuple[str, Any]]] = {
 #: run it describes is the same run; any other value enters the hash. A protocol option added to a workflow is
 #: registered here with the value that reproduces the runs already committed.
 NEUTRAL_KEYS: dict[str, dict[str, Any]] = {
+    "pulloff": {"flat_thermostat": "mobile", "tip_positions": 1},
     "adhesion": {"registry_sampling": "rank1", "registry_contact_steps": 0, "sam_anneal_steps": 0,
                  "pmf_return": False, "pmf_extra_windows_A": ()}}
 
@@ -230,7 +231,8 @@ FIELDS: tuple[Field, ...] = (
     Field("retract_distance_A", "fidelity", float, "A", "Pull-off: holder travel away from the flat (beyond "
           "the cutoff so the curve returns to zero).", REQUIRED, low=0.5, high=200.0, workflows=_PULL),
     Field("retract_speeds_m_s", "fidelity", list, "m/s", "Pull-off: holder speeds on retraction; more than one "
-          "(a rate scan, extrapolated to low rate) only at production.", REQUIRED, low=0.01, high=2000.0,
+          "(a rate scan, extrapolated to low rate from three or more) only at production, two at any fidelity "
+          "with tip_positions > 1.", REQUIRED, low=0.01, high=2000.0,
           workflows=_PULL, item=float),
     Field("retract_repeats", "fidelity", int, "1", "Pull-off: independent retractions per speed, each from the "
           "held contact with fresh velocities and hold_steps more of holding; the pull-off force is their mean, "
@@ -240,6 +242,20 @@ FIELDS: tuple[Field, ...] = (
           "'none': the asperity runs NVE (only the flat is thermostatted); 'lab': the old lab-frame thermostat "
           "on every mobile atom (drags the asperity: ~gamma M v).", "comoving",
           choices=("comoving", "none", "lab"), workflows=_PULL),
+    Field("flat_thermostat", "fidelity", str, "", "Pull-off: which of the flat's mobile atoms are thermostatted "
+          "(in the lab frame). 'mobile': all of them, the OTS flat's SAM included, whose chain ends the tip drags "
+          "along (Langevin friction m gamma v on every chain end that follows the tip, transmitted into the "
+          "measured force); 'silica': only the flat's silica (Si, O, silanol H; the SAM, head groups included, "
+          "runs NVE and exchanges heat through its bonds), so nothing the tip moves is thermostatted in the lab "
+          "frame. With 'silica' (or tip_positions > 1) the thermostat force on the flat is measured as the tip's "
+          "(Newton for the flat's mobile atoms) and reported.", "mobile", choices=("mobile", "silica"),
+          workflows=_PULL),
+    Field("tip_positions", "fidelity", int, "1", "Pull-off: lateral positions of the tip over the flat (the first "
+          "at zero offset, the rest quasi-random, R2 sequence, over the primitive cell of the flat's surface "
+          "lattice, lattice translations excluded); each has its own approach and hold (its own contact) and its "
+          "own retractions at every speed, so the spread over positions includes the geometric variance. With "
+          "more than one, up to two retraction speeds are allowed below production.", 1, low=1, high=16,
+          workflows=_PULL),
     # ---------------------------------------------------------------- fidelity: contact angle
     Field("substrate_equilibrate_steps", "fidelity", int, "steps", "Contact angle: NVT steps of the substrate "
           "alone (minimised with nothing held, then its deep Si and bridging O held) before the droplet is "
@@ -462,9 +478,14 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
         _check_extra_windows(system, fid, p, origin)
     if wf == "pulloff":
         speeds = fid["retract_speeds_m_s"]
-        if len(speeds) > 1 and fname != "production":
+        allowed = 2 if fid["tip_positions"] > 1 else 1
+        if len(speeds) > allowed and fname != "production":
             raise RecipeError(f"{p}.retract_speeds_m_s", speeds,
-                              "a rate scan (more than one speed) is run only at production; give one speed", origin)
+                              f"a rate scan (more than one speed) is run only at production; give one speed (two "
+                              f"with tip_positions > 1)", origin)
+        if fid["flat_thermostat"] == "silica" and fid["tip_thermostat"] == "lab":
+            raise RecipeError(f"{p}.flat_thermostat", fid["flat_thermostat"], "'silica' needs tip_thermostat "
+                              "'comoving' or 'none' ('lab' thermostats every mobile atom together)", origin)
         if len(set(speeds)) != len(speeds):
             raise RecipeError(f"{p}.retract_speeds_m_s", speeds, "speeds must be distinct", origin)
     if wf == "contact_angle" and system["surface"] == "ots" and fid["nx"] < 2:

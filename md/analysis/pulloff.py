@@ -249,28 +249,45 @@ def rate_extrapolation(rates, forces, target_rate: float = 1.0, forces_stderr=No
 
 # ------------------------------------------------------------------ surface-element integration (SEI)
 
-def tip_height_map(xy, z, box_xy, bin_A: float) -> dict:
-    """The asperity's height map on a lateral grid: in each bin of a ``bin_A`` grid over the periodic box
-    ``box_xy`` (Lx, Ly), the height of the bin's lowest atom (the surface that faces a flat below a downward tip)
-    above the lowest atom of all, the apex. Bins that hold no atom take the height of the nearest bin that does
-    (scipy's Euclidean distance transform): a grid finer than the atomic spacing would otherwise open holes in
-    the surface that are not there. Same units in and out (A by the workflow's convention).
+def tip_height_map(xy, z, box_xy, bin_A: float, reach_A: float = 0.0) -> dict:
+    """The asperity's height map on a lateral grid of ``bin_A`` over the periodic box ``box_xy`` (Lx, Ly): the
+    height above the apex (the lowest atom of all) of the surface that faces a flat below a downward tip.
+
+    ``reach_A`` = 0: each bin's lowest atom. A bin finer than the outermost atoms' spacing then sees the
+    subsurface atoms between them, and the map has holes that a flat face does not have. ``reach_A`` > 0: each
+    bin centre takes the lowest atom within that lateral distance (periodic). With ``reach_A`` at least the
+    covering radius of the outermost sites (the largest distance from any point to its nearest site: a / sqrt 3
+    on a hexagonal lattice of spacing a) a flat face of the crystal maps to one height at any grid spacing, so the
+    flat-slab law applies unchanged to it; the price is that every protrusion is widened by up to ``reach_A``.
+    Bins that still see no atom take the height of the nearest bin that does (scipy's distance transform).
 
     Returns ``heights`` (nbx, nby), ``cell_area`` (area of one bin), ``bins`` (nbx, nby), ``filled`` (the number
-    of empty bins filled) and ``apex_z``."""
+    of empty bins filled) and ``apex_z``. Same length units in and out."""
     from scipy.ndimage import distance_transform_edt
+    from scipy.spatial import cKDTree
 
     p = np.asarray(xy, float).reshape(-1, 2)
     zz = np.asarray(z, float).ravel()
     lx, ly = (float(v) for v in box_xy)
-    if not (bin_A > 0 and lx > 0 and ly > 0) or p.shape[0] != zz.size or zz.size == 0:
-        raise ValueError("tip_height_map needs atoms (xy, z of equal length), a positive box and bin_A > 0")
+    if not (bin_A > 0 and lx > 0 and ly > 0 and reach_A >= 0) or p.shape[0] != zz.size or zz.size == 0:
+        raise ValueError("tip_height_map needs atoms (xy, z of equal length), a positive box, bin_A > 0 and "
+                         "reach_A >= 0")
     nbx, nby = max(1, int(round(lx / bin_A))), max(1, int(round(ly / bin_A)))
-    ix = np.floor(np.mod(p[:, 0], lx) / lx * nbx).astype(int) % nbx
-    iy = np.floor(np.mod(p[:, 1], ly) / ly * nby).astype(int) % nby
     low = np.full((nbx, nby), np.inf)
-    np.minimum.at(low, (ix, iy), zz)
+    wrapped = np.mod(p, [lx, ly])
+    if reach_A > 0:
+        cx, cy = np.meshgrid((np.arange(nbx) + 0.5) * lx / nbx, (np.arange(nby) + 0.5) * ly / nby, indexing="ij")
+        tree = cKDTree(np.minimum(wrapped, np.nextafter([lx, ly], 0)), boxsize=[lx, ly])
+        for k, idx in enumerate(tree.query_ball_point(np.column_stack([cx.ravel(), cy.ravel()]), reach_A)):
+            if idx:
+                low.flat[k] = zz[idx].min()
+    else:
+        ix = np.floor(wrapped[:, 0] / lx * nbx).astype(int) % nbx
+        iy = np.floor(wrapped[:, 1] / ly * nby).astype(int) % nby
+        np.minimum.at(low, (ix, iy), zz)
     empty = ~np.isfinite(low)
+    if empty.all():
+        raise ValueError("tip_height_map: no bin sees an atom")
     if empty.any():
         _, (jx, jy) = distance_transform_edt(empty, return_indices=True)
         low = low[jx, jy]
@@ -339,8 +356,8 @@ def surface_element_pull_off(heights, cell_area: float, traction, d_range, n_gri
 def tabor_parameter(radius_m: float, work_J_m2: float, e_star_Pa: float, z0_m: float) -> dict:
     """Tabor's parameter mu = (R W^2 / (E*^2 z0^3))^(1/3) (Tabor, J. Colloid Interface Sci. 58 (1977) 2) and
     Maugis' lambda = 2 sigma0 (R / (pi W K^2))^(1/3), K = 4 E*/3, with the LJ 9-3 peak traction
-    sigma0 = 1.026 W / z0 (Maugis, J. Colloid Interface Sci. 150 (1992) 243; lambda = 1.157 mu). Small (< 0.1) is the DMT limit,
-    pull-off 2 pi R W; large (> 5) JKR, 1.5 pi R W."""
+    sigma0 = 1.026 W / z0 (Maugis, J. Colloid Interface Sci. 150 (1992) 243; lambda = 1.157 mu). Small (< 0.1)
+    is the DMT limit, pull-off 2 pi R W; large (> 5) JKR, 1.5 pi R W."""
     R, W, E, z0 = (float(v) for v in (radius_m, work_J_m2, e_star_Pa, z0_m))
     if min(R, W, E, z0) <= 0:
         raise ValueError("tabor_parameter needs positive R, W, E* and z0")
@@ -348,3 +365,10 @@ def tabor_parameter(radius_m: float, work_J_m2: float, e_star_Pa: float, z0_m: f
     sigma0 = 16.0 / (9.0 * math.sqrt(3.0)) * W / z0
     lam = 2.0 * sigma0 * (R / (math.pi * W * (4.0 * E / 3.0) ** 2)) ** (1.0 / 3.0)
     return {"mu": float(mu), "lambda": float(lam), "sigma0_Pa": float(sigma0)}
+
+
+#: E* = E / (2 (1 - nu^2)) of silica on silica (Pa): fused silica E = 72 GPa, nu = 0.17 (Bansal & Doremus,
+#: Handbook of Glass Properties, Academic Press 1986). A declared choice for Tabor's parameter of the MD pull-off:
+#: the MD asperity is IFF beta-cristobalite, whose moduli are not measured here; mu scales as E*^(-2/3), so
+#: +-30 % in E* moves mu by about +-20 %, not across the DMT/JKR boundary.
+SILICA_E_STAR_PA = 72.0e9 / (2.0 * (1.0 - 0.17 ** 2))

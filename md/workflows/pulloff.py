@@ -10,17 +10,24 @@ pulloff
     plus the holder's travel). :func:`md.analysis.pull_off_analysis` gives the maximum tensile force, a 9-3 z0
     (validation only: it absorbs the asperity's compliance) and Delta gamma_eff = F/(1.5 pi R) (JKR) and
     F/(2 pi R) (DMT, the limit at MD scale). At production a rate scan branches several retractions from the same
-    held contact and extrapolates (:func:`md.analysis.rate_extrapolation`).
+    held contact and extrapolates (:func:`md.analysis.rate_extrapolation`) from three or more speeds.
+    ``tip_positions`` > 1 repeats approach, hold and retractions at several lateral offsets of the tip over the
+    flat (each its own held contact: the spread then includes the geometric variance); ``flat_thermostat``
+    'silica' leaves the flat's SAM out of the lab-frame thermostat and measures the flat-side thermostat force.
+    The prediction to compare with is :func:`md.analysis.pulloff.surface_element_pull_off` (the flat-slab traction
+    law integrated over the asperity's height map).
 """
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from md import analysis as A
+from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
 from md import units as U
 from md.build import flip_upside_down, graft_dome, place_on, silica_asperity
 from md.system.atoms import as_system
@@ -42,8 +49,10 @@ class PullOff(Workflow):
     thermal motion, a temp/com bias; the flat has its own thermostat): a lab-frame Langevin thermostat drags an
     asperity moving at v with gamma M v, which at tens of m/s dwarfs a pull-off force of a fraction of a nN. The
     residual drag on the asperity is measured from the holder's reaction and reported; ``retract_repeats``
-    independent retractions per speed give the pull-off force a spread; the OTS asperity carries >= 4 chains per
-    nm^2 of projected cap. ``version`` (2) enters the run hash."""
+    independent retractions per speed give the pull-off force a spread (from one held contact: "same contact");
+    ``tip_positions`` gives each position its own contact; the OTS asperity carries >= 4 chains per nm^2 of
+    projected cap. ``version`` (2) enters the run hash; the options at their neutral values
+    (:data:`md.recipe.NEUTRAL_KEYS`) run the same plan as without them."""
     name = "pulloff"
     version = 2
     yields = {"pull_off_force": "N", "separation_at_max_tension": "m", "interaction_range_z0": "m",
@@ -75,78 +84,32 @@ class PullOff(Workflow):
         system = as_system(place_on(flat, flip_upside_down(asp), gap=s.initial_gap_A,
                                     vacuum=s.retract_distance_A + 15.0))
         info.update(asperity=system_summary(asp), flat=system_summary(flat), box_A=system.cell.tolist())
+        if s.tip_positions > 1:
+            info["tip_offsets_A"] = tip_offsets(s.tip_positions, (system.cell[0] / nx, system.cell[1] / ny))
         return system, info
 
     def plan(self, s, run_dir):
         s = self.typed(s)
         ff = forcefield_of(self.forcefield_files(s))
         system, info = self.build(s)
-        data = run_dir / "system.data"
-        write_data(system, ff, data)
         groups = {"flat": system.group("substrate"), "tip": system.group("adsorbate"),
                   "flat_fixed": intersect_ids(system, "frozen", "substrate"),
                   "holder_rigid": intersect_ids(system, "frozen", "adsorbate")}
+        if s.flat_thermostat == "silica" and s.surface == "ots":
+            groups["flat_sam"] = intersect_ids(system, "sam", "substrate")
         tip_mobile = np.setdiff1d(groups["tip"], groups["holder_rigid"])
         n = system.n_atoms
-        dt = s.timestep_fs
-        si = s.sample_interval
         seed = int(s.seed)
-        v_app = U.m_per_s_to_angstrom_per_fs(s.approach_speed_m_s)
-        n_app = round_up(s.approach_distance_A / (v_app * dt), si)
-        columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_holder": "v_zh", "tip_zmin": "v_tipmin",
-                   "flat_zmax": "v_flatmax", "f_holder": "f_hold_holder[3]", "p_tip": "v_ptip"}
-
-        def define(salt: int):
-            def d(step: int) -> list[str]:
-                return common_define(s, "mobile") + [
-                    "neigh_modify exclude group flat_fixed flat_fixed",
-                    "neigh_modify exclude group holder_rigid holder_rigid",
-                    "fix hold_flat flat_fixed setforce 0.0 0.0 0.0",
-                    "fix hold_holder holder_rigid setforce 0.0 0.0 0.0",
-                    "fix move_holder holder_rigid nve",
-                    "compute gg tip group/group flat kspace yes",
-                    "variable zh equal xcm(holder_rigid,z)", "variable tipmin equal bound(tip,zmin)",
-                    "variable flatmax equal bound(flat,zmax)",
-                    "variable ptip equal mass(tip_mobile)*vcm(tip_mobile,z)"] + \
-                    _pulloff_thermostat(s, step, salt)
-            return d
-
-        def fresh(leg_dir: Path) -> list[str]:
-            return fresh_from_data(ff, data, s, groups) + [
-                "group held union flat_fixed holder_rigid", "group mobile subtract all held",
-                "group flat_mobile subtract flat flat_fixed", "group tip_mobile subtract tip holder_rigid"]
-
-        vz = lambda v: f"velocity holder_rigid set 0.0 0.0 {v:.10g} units box"
-        approach = Leg(
-            name="approach", fresh=fresh, define=define(0), prepare=lambda d: minimize_lines(s, d / "minimized.data"),
-            restart_head=restart_header_lines(s),
-            stages=stage_list(equilibrate_stage(s, "mobile", 1, (vz(0.0),)), Stage("approach", n_app, (vz(-v_app),)),
-                           Stage("hold", steps_of(s.hold_steps, s.sample_interval), (vz(0.0),))),
-            columns=columns, sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
-            info={"v_approach_A_fs": v_app})
-        legs = [approach]
-        approach_dir = run_dir / "legs" / "approach"
-        repeats = int(s.retract_repeats)
-        t = s.temperature_K
-        for k, v in enumerate(s.retract_speeds_m_s):
-            v_ret = U.m_per_s_to_angstrom_per_fs(v)
-            n_ret = round_up(s.retract_distance_A / (v_ret * dt), si)
-            for j in range(repeats):
-                def fresh_retract(leg_dir: Path, _total=approach.total_steps) -> list[str]:
-                    return restart_header_lines(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
-                stages = [Stage("retract", n_ret, (vz(v_ret),))]
-                if repeats > 1:     # independent pulls: fresh velocities, then hold_steps more in contact
-                    stages = stage_list(Stage("rehold", steps_of(s.hold_steps, s.sample_interval), (
-                        f"velocity mobile create {t:g} {derived_seed(seed, 7, k, j)} mom yes rot no dist gaussian",
-                        vz(0.0)), sampled=False)) + stages
-                legs.append(Leg(name=f"retract_{k}" + (f"_{j}" if j else ""), fresh=fresh_retract,
-                                define=define(100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
-                                restart_head=restart_header_lines(s), stages=stages, columns=columns, sample_interval=si,
-                                chunk_steps=s.chunk_steps, n_atoms=n,
-                                info={"speed_m_s": v, "v_A_fs": v_ret, "repeat": j}))
+        legs: list[Leg] = []
+        for p, offset in enumerate(info.get("tip_offsets_A", [(0.0, 0.0)])):
+            data = run_dir / ("system.data" if p == 0 else f"system_p{p}.data")
+            write_data(system if p == 0 else _shift_tip(system, offset), ff, data)
+            legs += _position_legs(s, ff, data, groups, n, p, run_dir)
         info.update(n_flat=int(len(groups["flat"])), n_tip=int(len(groups["tip"])),
                     tip_mobile_mass_g_mol=float(system.masses[tip_mobile].sum()), tip_thermostat=s.tip_thermostat)
-        return Plan(legs=legs, timestep_fs=dt, n_atoms=n,
+        if _measures_flat(s):
+            info.update(flat_thermostat=s.flat_thermostat, n_flat_sam=int(len(groups.get("flat_sam", ()))))
+        return Plan(legs=legs, timestep_fs=s.timestep_fs, n_atoms=n,
                     seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed, **({"sam_asperity": seed + 30} if s.surface == "ots" else {})},
                     forcefield_files=self.forcefield_files(s), system_info=info)
@@ -174,31 +137,37 @@ class _PullOffAnalysis:
     def _prepare(self) -> None:
         ctx = self.ctx
         self.R_m = U.angstrom_to_m(self.s.asperity_radius_A)
-        ids, _, pos = read_atoms(ctx.leg_dir("approach") / "minimized.data")
+        self.origin: dict[int, tuple[float, float]] = {}
         n_flat = self.info["n_flat"]
-        # ids 1..n_flat are the flat (place_on puts the substrate first)
-        flat_top = pos[:n_flat, 2].max()
-        tip_bottom = pos[n_flat:, 2].min()
-        self.s0 = tip_bottom - flat_top
-        app = ctx.samples("approach", False)
-        # the holder's height at the minimised start: it does not move before the approach stage, so the first
-        # sample of the equilibration has it exactly
-        self.zh0 = float(app["z_holder"][0])
+        for p in range(len(self.info.get("tip_offsets_A", [0]))):
+            name = leg_name("approach", p)
+            ids, _, pos = read_atoms(ctx.leg_dir(name) / "minimized.data")
+            # ids 1..n_flat are the flat (place_on puts the substrate first)
+            s0 = pos[n_flat:, 2].min() - pos[:n_flat, 2].max()
+            # the holder's height at the minimised start: it does not move before the approach stage, so the first
+            # sample of the equilibration has it exactly
+            self.origin[p] = (float(s0), float(ctx.samples(name, False)["z_holder"][0]))
+        self.s0, self.zh0 = self.origin[0]
         self.dt = ctx.plan.timestep_fs
         self.curves, self.figures, self.pulls = {}, {}, []
         self.smooth = None
 
-    def sep(self, d) -> np.ndarray:
-        """The rigid-holder separation (A) of the samples ``d``."""
-        return self.s0 + (d["z_holder"] - self.zh0)
+    def sep(self, d, position: int = 0) -> np.ndarray:
+        """The rigid-holder separation (A) of the samples ``d`` of tip position ``position``."""
+        s0, zh0 = self.origin[position]
+        return s0 + (d["z_holder"] - zh0)
 
     def _single_retraction(self, leg) -> None:
         d = self.ctx.samples(leg)
         n = len(d["step"])
         self.smooth = smooth = max(5, (n // 25) | 1) if n >= 15 else None
-        r = A.pull_off_analysis(self.sep(d), d["fz"], smooth=smooth, radius_m=self.R_m)
+        p = int(leg.info.get("position", 0))
+        r = A.pull_off_analysis(self.sep(d, p), d["fz"], smooth=smooth, radius_m=self.R_m)
         r["local_noise"] = _local_noise(r, smooth)
         r["drag"] = _residual_drag(d, self.dt)
+        if "f_flat" in d:
+            r["flat_drag"] = _residual_drag(d, self.dt, side="flat")
+        r["position"] = p
         self.pulls.append((leg.info["speed_m_s"], leg.info.get("repeat", 0), leg.name, r))
         self.curves[f"pulloff_curve_{leg.name}"] = (
             ["separation_m", "force_N", "force_smoothed_N"],
@@ -211,20 +180,14 @@ class _PullOffAnalysis:
                                                           U.angstrom_to_m(self.sep(d_app)),
                                                           U.kcal_per_mol_A_to_N(d_app["fz"])]))
         self.speeds = speeds = sorted({v for v, *_ in self.pulls})
-        self.per_speed = []
-        for v in speeds:
-            rs = [r for vv, _, _, r in self.pulls if vv == v]
-            fs = np.array([r["max_tensile_force"] for r in rs])
-            if len(rs) >= 2:
-                f_err, how = float(fs.std(ddof=1) / math.sqrt(len(rs))), f"spread of {len(rs)} pulls"
-            else:
-                f_err, how = rs[0]["local_noise"], "force noise of one curve near its maximum"
-            self.per_speed.append({"speed_m_s": float(v), "force": float(fs.mean()), "stderr": f_err, "how": how,
-                                   "forces": fs.tolist(), "results": rs})
+        self.per_speed = [_speed_summary(float(v), [r for vv, _, _, r in self.pulls if vv == v]) for v in speeds]
         q = self._quantities()
         notes = self._notes(q)
         details = self._details()
-        if len(speeds) >= 2:
+        if len(speeds) == 2 and len(self.origin) >= 2:
+            details["speed_difference"] = _paired_speed_difference(self.per_speed)
+            notes.append(_speed_difference_note(details["speed_difference"]))
+        if len(speeds) >= 3:
             ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in self.per_speed]),
                                        target_rate=float(min(speeds)) / 10.0, temperature_K=self.s.temperature_K)
             q["pull_off_force_extrapolated"] = quantity_record(ext["F0"], ext["stderr"], "N",
@@ -251,24 +214,34 @@ class _PullOffAnalysis:
         self.gamma_lab = gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(
             self.info["tip_mobile_mass_g_mol"] * v_slow / self.s.thermostat_damping_fs)
         err = lambda x: x / (2 * math.pi * R_m) if x else None
-        return {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"],
-                                                  repeats=len(slow["results"]),
-                                                  kind=f"maximum tensile force on retraction (mean of "
-                                                       f"{len(slow['results'])}; stderr: {slow['how']})"),
+        extra = {"positions": slow["positions"]} if slow["positions"] > 1 else {}
+        q = {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"],
+                                                  repeats=len(slow["results"]), **extra,
+                                                  kind=f"maximum tensile force on retraction ({slow['what']}; "
+                                                       f"stderr: {slow['how']})"),
                 "separation_at_max_tension": quantity_record(best["separation_at_max"], None, "m"),
                 "interaction_range_z0": z0q,
                 "work_of_adhesion_eff_jkr": quantity_record(F / (1.5 * math.pi * R_m),
                                                             f_err / (1.5 * math.pi * R_m) if f_err else None,
                                                             "J/m^2", kind="F / (1.5 pi R)"),
                 "work_of_adhesion_eff_dmt": quantity_record(F / (2 * math.pi * R_m), err(f_err), "J/m^2",
-                                               kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit: a "
-                                                    "nanometre asperity has a small Tabor parameter)"),
+                                               kind="F / (2 pi R): compare with the flat-slab W_F (DMT limit; "
+                                                    "Tabor's parameter in the notes)"),
                 "residual_drag_force": quantity_record(float(U.kcal_per_mol_A_to_N(drag.mean())),
                                           float(U.kcal_per_mol_A_to_N(math.sqrt(np.sum(drag_err ** 2)) / len(drag))),
                                           "N", kind="mean thermostat force on the moving asperity along the pulling "
                                                     "axis on retraction (holder reaction - interaction + momentum "
                                                     "change)",
                                           lab_frame_drag_N=float(U.kcal_per_mol_A_to_N(-gamma_lab)))}
+        flat = [r["flat_drag"] for r in slow["results"] if "flat_drag" in r]
+        if flat:
+            q["flat_thermostat_force"] = quantity_record(
+                float(U.kcal_per_mol_A_to_N(np.mean([f["value"] for f in flat]))),
+                float(U.kcal_per_mol_A_to_N(math.sqrt(sum(f["stderr"] ** 2 for f in flat)) / len(flat))), "N",
+                kind=f"mean force of the flat's thermostat ('{self.s.flat_thermostat}') on the flat's mobile atoms "
+                     "along the pulling axis on retraction (holder-of-the-flat reaction + interaction + momentum "
+                     "change); it reaches the asperity through the interface")
+        return q
 
     def _notes(self, q: dict) -> list[str]:
         s, slow, F, R_m = self.s, self.per_speed[0], self.F, self.R_m
@@ -276,8 +249,7 @@ class _PullOffAnalysis:
                  f"start ({self.s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
                  f"flat's deformation); force = compute group/group (asperity body vs flat, kspace yes), "
                  f"positive = repulsive.",
-                 f"pull-off force: mean of {len(slow['results'])} retraction(s) at {slow['speed_m_s']:g} m/s; "
-                 f"stderr: {slow['how']}.",
+                 f"pull-off force at {slow['speed_m_s']:g} m/s: {slow['what']}; stderr: {slow['how']}.",
                  f"thermostat on the asperity: '{s.tip_thermostat}'"
                  + {"comoving": " (its thermal motion only: compute temp/com bias, so no drag on its motion; the flat "
                                 "has its own thermostat)",
@@ -287,9 +259,10 @@ class _PullOffAnalysis:
                  + f"; residual drag measured {q['residual_drag_force']['value'] * 1e9:+.3f} nN against "
                    f"{-self.gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
                    f"(gamma M v) would apply.",
-                 f"validation, not calibration: at MD scale (R = {s.asperity_radius_A:g} A) the contact is "
-                 f"DMT-like (a small Tabor parameter), so F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the "
-                 f"number to compare with the flat-slab work of adhesion W_F (the calibration report does).",
+                 _flat_thermostat_note(s, q.get("flat_thermostat_force")),
+                 f"validation, not calibration: F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the number "
+                 f"to compare with the flat-slab work of adhesion W_F (the calibration report does); "
+                 + _tabor_note(R_m, F / (2 * math.pi * R_m), q["interaction_range_z0"]["value"], s.surface),
                  f"R = {s.asperity_radius_A:g} A (the requested radius of the carved, faceted dome)."]
         if s.surface == "ots":
             g = self.info.get("asperity_sam", {})
@@ -303,8 +276,18 @@ class _PullOffAnalysis:
 
     def _details(self) -> dict:
         return {"per_speed": [{"speed_m_s": p["speed_m_s"], "max_tensile_force_N": p["force"],
-                               "stderr_N": p["stderr"], "forces_N": p["forces"]} for p in self.per_speed],
-                "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j,
+                               "stderr_N": p["stderr"], "forces_N": p["forces"], "stderr_how": p["how"],
+                               "positions": p["positions"], **({"t_factor": p["t_factor"],
+                                                               "stderr_plain_N": p["stderr_plain"]}
+                                                              if p["positions"] > 1 else {})}
+                              for p in self.per_speed],
+                "per_position": [dict(pp, speed_m_s=p["speed_m_s"]) for p in self.per_speed
+                                 for pp in p["per_position"]],
+                "tip_offsets_A": self.info.get("tip_offsets_A", [[0.0, 0.0]]),
+                "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j, "position": r["position"],
+                           "contact": leg_name("approach", r["position"]),
+                           "same_contact_as": [n2 for _, _, n2, r2 in self.pulls
+                                               if r2["position"] == r["position"] and n2 != name],
                            "max_tensile_force_N": r["max_tensile_force"],
                            "separation_at_max_m": r["separation_at_max"], "z0_m": r["z0"],
                            "z0_stderr_m": r["z0_stderr"], "z0_zero_to_min_m": r["z0_zero_to_min"],
@@ -312,6 +295,9 @@ class _PullOffAnalysis:
                            "local_noise_N": r["local_noise"],
                            "residual_drag_N": float(U.kcal_per_mol_A_to_N(r["drag"]["value"])),
                            "residual_drag_stderr_N": float(U.kcal_per_mol_A_to_N(r["drag"]["stderr"])),
+                           **({"flat_thermostat_force_N": float(U.kcal_per_mol_A_to_N(r["flat_drag"]["value"])),
+                               "flat_thermostat_force_stderr_N": float(U.kcal_per_mol_A_to_N(
+                                   r["flat_drag"]["stderr"]))} if "flat_drag" in r else {}),
                            "traction_fit": {k: v for k, v in r["traction_fit"].items()
                                             if isinstance(v, (int, float, str, dict))}}
                           for v, j, name, r in self.pulls],
@@ -333,6 +319,203 @@ class _PullOffAnalysis:
         ax.legend(fontsize=7)
 
 
+def leg_name(base: str, position: int) -> str:
+    """The name of a leg at tip position ``position``: position 0 keeps the plain name (``approach``,
+    ``retract_0``), the others carry ``_p<k>`` (``approach_p1``, ``retract_p1_0``)."""
+    if position == 0:
+        return base
+    head, _, tail = base.partition("_")
+    return f"{head}_p{position}" + (f"_{tail}" if tail else "")
+
+
+def _measures_flat(s: Settings) -> bool:
+    """Whether the flat's thermostat force is sampled (columns f_flat, p_flat): with the silica-only flat
+    thermostat or several tip positions."""
+    return s.flat_thermostat != "mobile" or int(s.tip_positions) > 1
+
+
+def tip_offsets(n: int, cell: tuple[float, float]) -> list[tuple[float, float]]:
+    """``n`` lateral offsets (A) of the tip over the flat: the first zero, the others the R2 quasi-random sequence
+    (Roberts 2018: k (1/phi2, 1/phi2^2) mod 1, phi2 the plastic number) over the fundamental domain [0, 1) x
+    [0, 1/2) of the flat's rectangular surface cell ``cell``. That cell is centred on the cristobalite faces
+    (its (1/2, 1/2) point is a lattice translation), so the half cell is the primitive cell and no offset but the
+    first is a lattice translation (or a copy of another)."""
+    phi2 = 1.324717957244746
+    a = np.array([1.0 / phi2, 1.0 / phi2 ** 2])
+    k = np.arange(int(n))[:, None]
+    frac = np.mod(k * a, 1.0) * np.array([1.0, 0.5])
+    return [(round(float(u * cell[0]), 6), round(float(v * cell[1]), 6)) for u, v in frac]
+
+
+def _shift_tip(system: System, offset) -> System:
+    """The system with the tip (asperity and holder, group 'adsorbate') moved laterally by ``offset`` (A); the
+    data writer wraps it into the periodic box."""
+    pos = system.positions.copy()
+    pos[system.group("adsorbate"), :2] += np.asarray(offset, float)
+    return replace(system, positions=pos)
+
+
+def _columns(s: Settings) -> dict[str, str]:
+    columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_holder": "v_zh", "tip_zmin": "v_tipmin",
+               "flat_zmax": "v_flatmax", "f_holder": "f_hold_holder[3]", "p_tip": "v_ptip"}
+    if _measures_flat(s):
+        columns.update(f_flat="f_hold_flat[3]", p_flat="v_pflat")
+    return columns
+
+
+def _define(s: Settings, salt: int):
+    """The per-(re)start commands of every pull-off leg: holds, the group/group force, sampled variables and the
+    thermostats (``salt`` varies the Langevin seeds between legs)."""
+    def d(step: int) -> list[str]:
+        return common_define(s, "mobile") + [
+            "neigh_modify exclude group flat_fixed flat_fixed",
+            "neigh_modify exclude group holder_rigid holder_rigid",
+            "fix hold_flat flat_fixed setforce 0.0 0.0 0.0",
+            "fix hold_holder holder_rigid setforce 0.0 0.0 0.0",
+            "fix move_holder holder_rigid nve",
+            "compute gg tip group/group flat kspace yes",
+            "variable zh equal xcm(holder_rigid,z)", "variable tipmin equal bound(tip,zmin)",
+            "variable flatmax equal bound(flat,zmax)",
+            "variable ptip equal mass(tip_mobile)*vcm(tip_mobile,z)"] + \
+            (["variable pflat equal mass(flat_mobile)*vcm(flat_mobile,z)"] if _measures_flat(s) else []) + \
+            _pulloff_thermostat(s, step, salt)
+    return d
+
+
+def _position_legs(s: Settings, ff, data: Path, groups: Mapping[str, Any], n: int, p: int,
+                   run_dir: Path) -> list[Leg]:
+    """The legs of tip position ``p``: its approach (equilibrate, approach, hold: its own contact) and, from the
+    restart at the end of its hold, ``retract_repeats`` retractions per speed. Position 0 has the seeds and salts
+    of a single-position run; the others shift them."""
+    dt, si, seed, t = s.timestep_fs, s.sample_interval, int(s.seed), s.temperature_K
+    v_app = U.m_per_s_to_angstrom_per_fs(s.approach_speed_m_s)
+    n_app = round_up(s.approach_distance_A / (v_app * dt), si)
+    columns = _columns(s)
+    base = 1000 * p
+    extra = ["group flat_silica subtract flat_mobile flat_sam"] if "flat_sam" in groups else []
+
+    def fresh(leg_dir: Path) -> list[str]:
+        return fresh_from_data(ff, data, s, groups) + [
+            "group held union flat_fixed holder_rigid", "group mobile subtract all held",
+            "group flat_mobile subtract flat flat_fixed", "group tip_mobile subtract tip holder_rigid"] + extra
+
+    vz = lambda v: f"velocity holder_rigid set 0.0 0.0 {v:.10g} units box"
+    approach = Leg(
+        name=leg_name("approach", p), fresh=fresh, define=_define(s, base),
+        prepare=lambda d: minimize_lines(s, d / "minimized.data"), restart_head=restart_header_lines(s),
+        stages=stage_list(equilibrate_stage(s, "mobile", 1 + base, (vz(0.0),)),
+                          Stage("approach", n_app, (vz(-v_app),)),
+                          Stage("hold", steps_of(s.hold_steps, s.sample_interval), (vz(0.0),))),
+        columns=columns, sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
+        info={"v_approach_A_fs": v_app, **({"position": p} if s.tip_positions > 1 else {})})
+    legs = [approach]
+    approach_dir = run_dir / "legs" / approach.name
+    repeats = int(s.retract_repeats)
+    for k, v in enumerate(s.retract_speeds_m_s):
+        v_ret = U.m_per_s_to_angstrom_per_fs(v)
+        n_ret = round_up(s.retract_distance_A / (v_ret * dt), si)
+        for j in range(repeats):
+            def fresh_retract(leg_dir: Path, _total=approach.total_steps) -> list[str]:
+                return restart_header_lines(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
+            stages = [Stage("retract", n_ret, (vz(v_ret),))]
+            if repeats > 1:     # independent pulls: fresh velocities, then hold_steps more in contact
+                vseed = derived_seed(seed, 7, k, j) if p == 0 else derived_seed(seed, 7, k, j, p)
+                stages = stage_list(Stage("rehold", steps_of(s.hold_steps, s.sample_interval), (
+                    f"velocity mobile create {t:g} {vseed} mom yes rot no dist gaussian",
+                    vz(0.0)), sampled=False)) + stages
+            legs.append(Leg(name=leg_name(f"retract_{k}" + (f"_{j}" if j else ""), p), fresh=fresh_retract,
+                            define=_define(s, base + 100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
+                            restart_head=restart_header_lines(s), stages=stages, columns=columns,
+                            sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
+                            info={"speed_m_s": v, "v_A_fs": v_ret, "repeat": j,
+                                  **({"position": p} if s.tip_positions > 1 else {})}))
+    return legs
+
+
+def _student_t(n: int) -> float:
+    """Student-t factor of the one-sigma (68.27 %) interval of a mean of ``n`` samples whose stderr comes from
+    their own spread (n - 1 degrees of freedom; JCGM 100:2008, annex G): 1.84 for 2, 1.32 for 3, -> 1."""
+    from scipy.stats import t as student_t
+    return float(student_t.ppf(0.5 * (1.0 + math.erf(1.0 / math.sqrt(2.0))), int(n) - 1))
+
+
+def _speed_summary(v: float, rs: list[dict]) -> dict[str, Any]:
+    """The pull-off force at one speed from its pulls ``rs``: the mean over tip positions of each position's
+    mean. Over >= 2 positions (independent contacts) its stderr is the positions' spread / sqrt(n) times the
+    Student-t factor (one-sigma-equivalent); with one position and several pulls, the pulls' spread, marked
+    "same contact" (they branch from one held contact: no geometric variance in it); one pull, the force noise."""
+    pos = sorted({r["position"] for r in rs})
+    per = [{"position": p, "max_tensile_force_N": float(np.mean([r["max_tensile_force"] for r in rs
+                                                                 if r["position"] == p])),
+            "pulls": sum(r["position"] == p for r in rs)} for p in pos]
+    fs = np.array([r["max_tensile_force"] for r in rs])
+    fp = np.array([x["max_tensile_force_N"] for x in per])
+    out = {"speed_m_s": v, "force": float(fp.mean()), "forces": fs.tolist(), "results": rs, "positions": len(pos),
+           "per_position": per}
+    if len(pos) >= 2:
+        plain = float(fp.std(ddof=1) / math.sqrt(len(pos)))
+        t = _student_t(len(pos))
+        out.update(stderr=t * plain, stderr_plain=plain, t_factor=t,
+                   what=f"mean over {len(pos)} tip positions, each its own held contact",
+                   how=f"spread of the {len(pos)} positions / sqrt(n) x Student t = {t:.2f} ({len(pos) - 1} dof)")
+    elif len(rs) >= 2:
+        out.update(stderr=float(fs.std(ddof=1) / math.sqrt(len(rs))), what=f"mean of {len(rs)}",
+                   how=f"spread of {len(rs)} pulls, same contact (all branch from one held contact at one lateral "
+                       f"position: the geometric variance is not in it)")
+    else:
+        out.update(stderr=rs[0]["local_noise"], what="one pull", how="force noise of one curve near its maximum")
+    return out
+
+
+def _paired_speed_difference(per_speed: list[dict]) -> dict[str, Any]:
+    """F(fast) - F(slow) per tip position (both speeds pull from the same held contact: a paired difference),
+    its mean and the Student-t stderr over positions."""
+    slow, fast = ({x["position"]: x["max_tensile_force_N"] for x in p["per_position"]} for p in per_speed)
+    common = sorted(set(slow) & set(fast))
+    dF = np.array([fast[p] - slow[p] for p in common])
+    out = {"speeds_m_s": [per_speed[0]["speed_m_s"], per_speed[1]["speed_m_s"]], "positions": common,
+           "difference_N": dF.tolist(), "mean_N": float(dF.mean())}
+    if dF.size >= 2:
+        out["stderr_N"] = _student_t(dF.size) * float(dF.std(ddof=1) / math.sqrt(dF.size))
+    return out
+
+
+def _speed_difference_note(d: Mapping[str, Any]) -> str:
+    e = d.get("stderr_N")
+    return (f"speed dependence: F({d['speeds_m_s'][1]:g} m/s) - F({d['speeds_m_s'][0]:g} m/s) = "
+            f"{d['mean_N'] * 1e9:+.3f}" + (f" +- {e * 1e9:.3f}" if e is not None else "") +
+            f" nN (paired per position over {len(d['positions'])} positions; the two speeds of one position pull "
+            "from the same held contact).")
+
+
+def _flat_thermostat_note(s: Settings, q: Mapping[str, Any] | None) -> str:
+    what = {"mobile": "every mobile atom of the flat, in the lab frame (on an OTS flat its SAM too, whose chain "
+                      "ends the tip drags along)",
+            "silica": "the flat's silica only (the SAM of an OTS flat runs NVE: nothing the tip drags is "
+                      "thermostatted in the lab frame)"}[s.flat_thermostat]
+    out = f"thermostat on the flat ('{s.flat_thermostat}'): {what}"
+    if q is not None:
+        e = q["stderr"]
+        out += (f"; its force on the flat measured {q['value'] * 1e9:+.3f}"
+                + (f" +- {e * 1e9:.3f}" if e is not None else "") + " nN")
+    return out + "."
+
+
+def _tabor_note(R_m: float, w_eff: float, z0_m: float, surface: str) -> str:
+    """Tabor's parameter of this run from its own numbers: R, W = F/(2 pi R), the retraction curve's z0 (it
+    absorbs the asperity's compliance, so it overstates z0 and understates mu) and E* of silica on silica
+    (:data:`md.analysis.pulloff.SILICA_E_STAR_PA`)."""
+    if not (w_eff > 0 and z0_m and np.isfinite(z0_m) and z0_m > 0):
+        return "Tabor's parameter not computed (no positive W or z0)."
+    t = tabor_parameter(R_m, w_eff, SILICA_E_STAR_PA, z0_m)
+    out = (f"Tabor mu = {t['mu']:.3f} (Maugis lambda = {t['lambda']:.3f}) from R, F / (2 pi R), the fitted z0 and "
+           f"E* = {SILICA_E_STAR_PA / 1e9:.1f} GPa of silica on silica: mu < 0.1 is the DMT limit (pull-off 2 pi R "
+           "W), near 1 the Maugis-Dugdale transition (about 1.9 pi R W at lambda 0.2)")
+    if surface == "ots":
+        out += "; the OTS layers are far more compliant than silica, so the coated contact's mu is larger"
+    return out + "."
+
+
 def _thermostat_fix(name: str, group: str, settings: Settings, step: int, salt: int) -> list[str]:
     """A named thermostat fix on ``group`` (Langevin + nve, or Nose-Hoover nvt)."""
     t = settings.temperature_K
@@ -344,14 +527,19 @@ def _thermostat_fix(name: str, group: str, settings: Settings, step: int, salt: 
 
 
 def _pulloff_thermostat(s: Settings, step: int, salt: int) -> list[str]:
-    """The pull-off thermostats (recipe ``tip_thermostat``): the flat's mobile atoms always; the asperity's mobile
+    """The pull-off thermostats (recipe ``tip_thermostat``, ``flat_thermostat``): the flat's mobile atoms (or only
+    its silica, the SAM then NVE); the asperity's mobile
     atoms in its own frame ('comoving': a temp/com bias, so drag and noise act on the thermal velocities only and
     sum to zero over the asperity), not at all ('none': NVE), or together with the
     flat in the lab frame ('lab')."""
     mode = s.tip_thermostat
     if mode == "lab":
         return thermostat_lines("mobile", s, step, salt)
-    cmds = _thermostat_fix("thermo_flat", "flat_mobile", s, step, 2 * salt)
+    if s.flat_thermostat == "silica" and s.surface == "ots":
+        cmds = _thermostat_fix("thermo_flat", "flat_silica", s, step, 2 * salt) + \
+            ["fix integrate_flat_sam flat_sam nve"]
+    else:
+        cmds = _thermostat_fix("thermo_flat", "flat_mobile", s, step, 2 * salt)
     if mode == "comoving":
         cmds += ["compute tip_com tip_mobile temp/com"] + \
             _thermostat_fix("thermo_tip", "tip_mobile", s, step, 2 * salt + 1) + ["fix_modify thermo_tip temp tip_com"]
@@ -372,18 +560,26 @@ def _local_noise(r: Mapping[str, Any], smooth: int | None) -> float | None:
     return float(np.std(resid[lo:hi]))
 
 
-def _residual_drag(d: Mapping[str, np.ndarray], dt_fs: float, block: int = 10) -> dict[str, float]:
-    """Mean thermostat force on the moving asperity's mobile atoms along z over a retraction (kcal/mol/A).
+def _residual_drag(d: Mapping[str, np.ndarray], dt_fs: float, block: int = 10,
+                   side: str = "tip") -> dict[str, float]:
+    """Mean thermostat force on the moving asperity's mobile atoms (``side`` 'tip') or on the flat's mobile atoms
+    ('flat') along z over a retraction (kcal/mol/A).
 
     Newton for the asperity: dP/dt = F_thermostat + F_flat->asperity + F_holder->asperity, and the holder's
     setforce reports f_holder = F_asperity->holder + F_flat->holder; with F_gg = compute group/group of the whole
     upper body (asperity + holder) against the flat, F_thermostat = dP/dt + f_holder - F_gg. Per block of
     ``block`` samples: the time average of f_holder - F_gg (trapezoid) plus the block's momentum change over its
     duration -- the momentum term cancels the asperity's vibrations, which would otherwise swamp the mean. The value
-    is the mean over blocks (= the whole leg's), the stderr from the blocks' statistical inefficiency."""
-    x = np.asarray(d["f_holder"], float) - np.asarray(d["fz"], float)
+    is the mean over blocks (= the whole leg's), the stderr from the blocks' statistical inefficiency.
+    The flat by the same bookkeeping: the fixed bottom's setforce reports f_flat = F_mobile->fixed +
+    F_asperity->fixed, the whole flat feels -F_gg, so F_thermostat,flat = dP_flat/dt + F_gg + f_flat."""
+    if side == "flat":
+        x = np.asarray(d["f_flat"], float) + np.asarray(d["fz"], float)
+        p = np.asarray(d["p_flat"], float)
+    else:
+        x = np.asarray(d["f_holder"], float) - np.asarray(d["fz"], float)
+        p = np.asarray(d["p_tip"], float)
     t = np.asarray(d["step"], float) * dt_fs
-    p = np.asarray(d["p_tip"], float)
     if x.size < 3:
         return {"value": float("nan"), "stderr": float("nan")}
     edges = np.arange(0, x.size, block)
