@@ -230,7 +230,10 @@ def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]]
     if set_path is not None and any(c["name"] == LOOP_CLAIM and not c["pass"] for c in cal):
         from continuum.paper.loop_probe import fig4_choice_probe
 
-        choices[LOOP_CLAIM] = fig4_choice_probe(str(set_path))
+        origin = (table.get("meta") or {}).get("origin") or {}
+        choices[LOOP_CLAIM] = dict(fig4_choice_probe(str(set_path)), origins={
+            k: (origin.get(k) or {}).get("kind", "origin not given")
+            for k in ("surfaces.sam.layer_modulus", "surfaces.roughness.summit_radius")})
     return {"reverts": [g.to_dict() for g in groups], "claims": [w.to_dict() for w in whys],
             "ran": bool(by_revert), "acceptance": acceptance(cal, whys, groups), "choices": choices}
 

@@ -483,9 +483,13 @@ def uncertainty_sample(task: tuple) -> dict:
     from continuum.model import select_law
     from continuum.scene import SceneError, resolve_scene
 
+    from continuum.paper.samples import row_for_scene
+
     try:
+        # a SAM's values describe nothing on a scene without one (row_for_scene): left out and said so
+        used, left_out = row_for_scene(scene, params, {}, overrides)
         # the sample reads the mean-field trajectory: an ensemble that 'auto' would add goes unread
-        resolved = resolve_scene(scene, params=params, overrides={"surfaces.roughness.mode": "mean_field", **overrides,
+        resolved = resolve_scene(scene, params=params, overrides={"surfaces.roughness.mode": "mean_field", **used,
                                                                   "numerics.max_bounces": max_bounces},
                                  override_label="uncertainty sample")
         result, _ = run_impact(resolved)
@@ -508,7 +512,7 @@ def uncertainty_sample(task: tuple) -> dict:
         esc_error = str(exc)
     return {"overrides": overrides, "rebounds_over_h0": [r / h0 for r in reb[:3]],
             "rebound_count": sum(r > 1e-3 * h0 for r in reb), "escape_velocity": esc,
-            **({"escape_error": esc_error} if esc_error else {})}
+            **({"escape_error": esc_error} if esc_error else {}), **({"left_out": left_out} if left_out else {})}
 
 
 def _md_wall(result: dict) -> float:
@@ -669,6 +673,7 @@ def _bands(sample_out: list, keys: list, unc: Uncertainty, table: dict) -> dict:
             "max_bounces": unc.max_bounces,
             "rebound_count_capped": sum(s["rebound_count"] >= unc.max_bounces for s in ran),
             "samples": len(sample_out), "failed_samples": len(sample_out) - len(ran),
+            "left_out": sorted({k for s in ran for k in s.get("left_out", ())}),
             "truncated": truncation(table["meta"].get("calibration", {})),
             "seed": unc.seed, "scene": unc.scene}
 

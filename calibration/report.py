@@ -193,6 +193,9 @@ def _chosen_lines(meta: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+LAYER, RADIUS = "surfaces.sam.layer_modulus", "surfaces.roughness.summit_radius"
+
+
 def _acceptance_text(a: Mapping[str, Any], probe: Mapping[str, Any] | None) -> str:
     """One claim's acceptance line: accepted or not, over how many samples it holds, why; Fig 4's loop claim
     with what its declared choices do to the loop ratio (continuum.paper.loop_probe)."""
@@ -202,20 +205,24 @@ def _acceptance_text(a: Mapping[str, Any], probe: Mapping[str, Any] | None) -> s
     text = f"**Acceptance:** {'accepted' if a['accepted'] else 'not accepted'} ({held}): {a['why']}."
     if probe:
         stiff, scan = probe.get("stiff_layer"), probe["summit_radius_scan"]
-        parts = [f"loop ratio {probe['loop_ratio']:.3g} as declared"]
+        kind = probe.get("origins") or {}
+        parts = [f"loop ratio {probe['loop_ratio']:.3g} with the set's values"]
         if stiff:
             parts.append(f"{stiff['loop_ratio']:.3g} with the SAM layer as stiff as its substrate "
-                         f"({stiff['layer_modulus_Pa']:.3g} Pa instead of the declared {stiff['declared_layer_modulus_Pa']:.3g})")
+                         f"({stiff['layer_modulus_Pa']:.3g} Pa instead of the set's "
+                         f"{stiff['set_layer_modulus_Pa']:.3g}, {kind.get(LAYER, 'origin not given')})")
         cross = probe.get("crossing_m")
-        parts.append(f"over summit radii {scan['radius_m'][0] * 1e6:.2g}-{scan['radius_m'][-1] * 1e6:.2g} um (declared "
-                     f"{probe['declared_summit_radius_m'] * 1e6:.2g}) it runs {scan['loop_ratio'][0]:.3g} to "
+        parts.append(f"over summit radii {scan['radius_m'][0] * 1e6:.2g}-{scan['radius_m'][-1] * 1e6:.2g} um (the "
+                     f"set's {probe['set_summit_radius_m'] * 1e6:.2g}, {kind.get(RADIUS, 'origin not given')}) "
+                     f"it runs {scan['loop_ratio'][0]:.3g} to "
                      f"{scan['loop_ratio'][-1]:.3g}" + (f", passing 1 between {cross[0] * 1e6:.2g} and "
                                                         f"{cross[1] * 1e6:.2g} um" if cross else ", never passing 1"))
-        decides = [w for w, on in (("the compliant layer", stiff and stiff["loop_ratio"] < 1),
-                                   ("the summit radius", cross)) if on]
-        text += (" Declared choices: " + "; ".join(parts) + ". " +
-                 (f"It is decided by {' and '.join(decides)} (declared, not measured)." if decides else
-                  "Neither declared choice alone restores it."))
+        decides = [f"{w} ({kind.get(k, 'origin not given')})" for w, k, on in
+                   (("the compliant layer", LAYER, stiff and stiff["loop_ratio"] < 1), ("the summit radius", RADIUS,
+                                                                                         cross)) if on]
+        text += (" Probed: " + "; ".join(parts) + ". " +
+                 (f"It is decided by {' and '.join(decides)}." if decides else
+                  "Neither the layer nor the summit radius alone restores it."))
     return text
 
 
@@ -275,7 +282,9 @@ def report_markdown(rec: CalibrationReport) -> str:
     b = rec.bands
     lines += ["", "## Uncertainty", "",
               f"{b['samples']} Latin-hypercube samples (seed {b['seed']}) of `{b['scene']}`; inputs covered: "
-              f"{', '.join(b['covers'])}; failed samples: {b['failed_samples']}.", "",
+              f"{', '.join(b['covers'])}; failed samples: {b['failed_samples']}."
+              + (f" Left out on this scene, which has no SAM: {', '.join(b['left_out'])}." if b.get("left_out")
+                 else ""), "",
               "| output | median | 5 % | 95 % | n |", "|---|---|---|---|---|"]
     trunc = b.get("truncated") or {}
     for key in ("first_rebound_over_h0", "rebound_count", "escape_velocity_m_per_s"):

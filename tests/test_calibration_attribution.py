@@ -178,14 +178,15 @@ def test_the_report_says_per_claim_whether_it_is_accepted_with_its_sample_fracti
 
     a = {"claim": "fig4_ots_loop_smaller_than_silica", "accepted": False, "holds_fraction": 0.0, "samples": 17,
          "cause": "several", "why": "no single measured value put back restores it"}
-    probe = {"loop_ratio": 6.36, "declared_summit_radius_m": 2e-7,
-             "stiff_layer": {"layer_modulus_Pa": 1.69e11, "declared_layer_modulus_Pa": 1e9, "loop_ratio": 2e-4},
+    probe = {"loop_ratio": 6.36, "set_summit_radius_m": 2e-7,
+             "stiff_layer": {"layer_modulus_Pa": 1.69e11, "set_layer_modulus_Pa": 1e9, "loop_ratio": 2e-4},
              "summit_radius_scan": {"radius_m": [5e-8, 5e-7, 8e-7, 2e-6], "loop_ratio": [108, 1.07, 0.58, 0.26]},
-             "crossing_m": [5e-7, 8e-7]}
+             "crossing_m": [5e-7, 8e-7],
+             "origins": {"surfaces.sam.layer_modulus": "md", "surfaces.roughness.summit_radius": "chosen"}}
     text = _acceptance_text(a, probe)
     assert text.startswith("**Acceptance:** not accepted (holds on 0.00 of 17 samples)")
     assert "0.0002 with the SAM layer as stiff as its substrate" in text and "between 0.5 and 0.8 um" in text
-    assert "decided by the compliant layer and the summit radius" in text
+    assert "decided by the compliant layer (md) and the summit radius (chosen)" in text
 
 
 def test_a_compliant_sam_layer_raises_the_ots_loop():

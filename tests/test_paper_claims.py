@@ -215,6 +215,8 @@ def test_an_impact_time_that_crosses_t_a_twice_gives_no_band_edge_and_the_wet_cl
     edge = t_a_band_edge(bumpy, t_a, WET_EPS, WET_DRY_REL_TOL)
     assert edge["eps"] is None and "not monotone" in edge["reason"] and "3 times" in edge["reason"]
     assert t_a_band_edge(lambda e: 30e-6, t_a, WET_EPS, WET_DRY_REL_TOL)["eps"] is None      # long to the end
+    far = t_a_band_edge(lambda e: t_a * (50.0 / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)  # past the scan's 2
+    assert far["eps"] == pytest.approx(50.0, rel=1e-6) and far["scan"][-1][0] > 50.0
     turning = t_a_band_edge(lambda e: 30e-6 if e > 1e-3 else 20e-6, t_a, WET_EPS, WET_DRY_REL_TOL)
     assert turning["eps"] is None and "not monotone" in turning["reason"]
     w = _wet(1e-3, 1.0105e-3, 1.01e-3)
@@ -236,6 +238,22 @@ def test_an_uncertainty_rows_sigma_does_not_move_the_sigma3_claim_off_3_nm():
     assert s3.sigma == pytest.approx(3e-9) and s3.summit_radius == pytest.approx(0.23e-6)
     s6 = _resolved(sigma_case(6.0), "paper", row, "fast", 1).scene.surfaces.roughness
     assert s6.sigma == pytest.approx(6.5e-9)
+
+
+def test_a_rows_sam_values_are_left_out_on_bare_silica_and_kept_on_ots_and_the_band_sample_runs():
+    """A Latin-hypercube row of a set with a measured SAM layer modulus: bare silica refuses a layer modulus
+    (nothing to describe), so the row's SAM keys are left out there and said so; OTS keeps them."""
+    from calibration.pipeline import uncertainty_sample
+    from continuum.paper.cases import SCENES
+    from continuum.paper.samples import row_for_scene
+
+    row = {"surfaces.sam.layer_modulus": 4e9, "surfaces.sam.work_of_adhesion": 0.05, "surfaces.work_of_adhesion": 0.2}
+    kept, left = row_for_scene(SCENES / "rough_silica.toml", "paper", {}, row)
+    assert kept == {"surfaces.work_of_adhesion": 0.2} and sorted(left) == ["surfaces.sam.layer_modulus",
+                                                                           "surfaces.sam.work_of_adhesion"]
+    assert row_for_scene(SCENES / "rough_ots.toml", "paper", {}, row) == (row, [])
+    out = uncertainty_sample((str(SCENES / "rough_silica.toml"), "paper", row, 1))
+    assert "error" not in out and sorted(out["left_out"]) == sorted(left) and out["overrides"] == row
 
 
 # ------------------------------------------------------------------------------ one physical case

@@ -48,7 +48,7 @@ def fig4_choice_probe(params: str, fidelity: str | None = None) -> dict:
     stiff = None
     if ots.sam is not None and ots.sam.layer_modulus is not None:
         e_sub = ots.substrate.youngs_modulus
-        stiff = {"layer_modulus_Pa": e_sub, "declared_layer_modulus_Pa": ots.sam.layer_modulus,
+        stiff = {"layer_modulus_Pa": e_sub, "set_layer_modulus_Pa": ots.sam.layer_modulus,
                  "loop_ratio": loop_ratio(params, {}, {"surfaces.sam.layer_modulus": e_sub}, fidelity)}
     radius = {"surfaces.roughness.summit_radius": None}
     ratios = []
@@ -57,7 +57,7 @@ def fig4_choice_probe(params: str, fidelity: str | None = None) -> dict:
         ratios.append(loop_ratio(params, radius, radius, fidelity))
     crossing = next(([float(a), float(b)] for a, b, x, y in zip(PROBE_RADII, PROBE_RADII[1:], ratios, ratios[1:])
                      if (x - 1.0) * (y - 1.0) < 0), None)
-    return {"loop_ratio": loop_ratio(params, {}, {}, fidelity), "declared_summit_radius_m":
+    return {"loop_ratio": loop_ratio(params, {}, {}, fidelity), "set_summit_radius_m":
             ots.roughness.summit_radius, "stiff_layer": stiff,
             "summit_radius_scan": {"radius_m": [float(r) for r in PROBE_RADII], "loop_ratio": ratios},
             "crossing_m": crossing}

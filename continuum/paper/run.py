@@ -41,6 +41,9 @@ WET_EPS = tuple(np.geomspace(1e-8, 2.0, 12))
 WET_DRY_REL_TOL = 1e-9
 #: Relative bracket of the wet escape velocity (the menisci raise it by ~1e-4 to ~1e-2).
 WET_REL_TOL = 1e-7
+#: Largest v / v_esc - 1 the t_a band's scan is extended to when every scanned impact outlasts t_a (for a set
+#: whose escape velocity is tens of um/s, impacts at several times it still last longer than t_a = 25 us).
+MAX_BAND_EPS = 1e3
 #: Speeds sampled inside the band where dry impacts outlast t_a.
 BAND_POINTS = 6
 
@@ -192,14 +195,18 @@ def t_a_band_edge(duration: Callable[[float], float], t_a: float, scan: tuple, e
     """Where the dry impact time falls through t_a above the escape velocity: eps of v = v_esc (1 + eps).
 
     `duration(eps)` is the dry impact time (inf where it sticks), known to be >= t_a at eps = 0. The scan speeds
-    (eps values `scan`) bracket the crossing first; only a scan whose impacts outlast t_a up to one point and no
-    further (one crossing, from long to short) is bisected, in ln eps, to `ln_width` (below the scan's first
-    point the bracket's lower end is `eps_floor`, the escape velocity's own relative bracket). A scan that
-    crosses t_a more than once (the impact time is not monotone in the speed there), that starts short and turns
-    long, or that outlasts t_a to its fastest speed gives no edge: {'eps': None, 'reason': ...}. Returns {'eps',
-    'rel_tol' (the bracket's width in eps plus eps_floor), 'scan': [[eps, outlasts], ...]}."""
+    (eps values `scan`, extended by factors of 4 up to MAX_BAND_EPS while every impact outlasts t_a) bracket the
+    crossing first; only a scan whose impacts outlast t_a up to one point and no further (one crossing, from long
+    to short) is bisected, in ln eps, to `ln_width` (below the scan's first point the bracket's lower end is
+    `eps_floor`, the escape velocity's own relative bracket). A scan that crosses t_a more than once (the impact
+    time is not monotone in the speed there), that starts short and turns long, or that outlasts t_a up to
+    MAX_BAND_EPS gives no edge: {'eps': None, 'reason': ...}. Returns {'eps', 'rel_tol' (the bracket's width in
+    eps plus eps_floor), 'scan': [[eps, outlasts], ...]}."""
     grid = sorted(scan)
     long = [duration(e) >= t_a for e in grid]
+    while all(long) and grid[-1] < MAX_BAND_EPS:          # the band reaches past the scan: extend it upwards
+        grid.append(4.0 * grid[-1])
+        long.append(duration(grid[-1]) >= t_a)
     record = [[e, bool(x)] for e, x in zip(grid, long)]
     crossings = sum(a != b for a, b in zip(long, long[1:]))
     if crossings > 1 or (crossings == 1 and not long[0]):

@@ -112,7 +112,22 @@ def sample_overrides(case: Case, overrides: dict) -> dict:
     return {**case.overrides, **overrides, **pinned}
 
 
+def row_for_scene(scene: str | Path, params: str, overrides: dict, row: dict) -> tuple[dict, list[str]]:
+    """The keys of a sample's `row` that describe the scene: a row drawn for a whole parameter set carries the
+    SAM's values (work of adhesion, angle, range, layer modulus), which describe nothing on a scene without a
+    SAM (bare silica; the scene refuses a layer modulus there). Returns (row without them where the scene, with
+    `params` and its `overrides`, has no SAM; the keys left out)."""
+    sam_keys = [k for k in row if k.startswith("surfaces.sam.") and k != "surfaces.sam.coverage"]
+    if not sam_keys:
+        return dict(row), []
+    plain = resolve_scene(scene, params=params, overrides=overrides, override_label="sample scene")
+    if plain.scene.surfaces.sam is not None:
+        return dict(row), []
+    return {k: v for k, v in row.items() if k not in sam_keys}, sam_keys
+
+
 def _resolved(case: Case, params: str, overrides: dict, fidelity: str | None, max_bounces: int):
+    overrides, _ = row_for_scene(case.path, params, case.overrides, overrides)
     o = {**sample_overrides(case, overrides), "physics.half_space": RIGID,
          "numerics.max_bounces": min(max_bounces, case.overrides.get("numerics.max_bounces", max_bounces))}
     if fidelity is not None:
@@ -141,6 +156,9 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
     (a discrete impact costs ~0.3 s, an escape search ~15 of them). OTS runs only as many impacts as it needs
     to show whether it outbounces silica (silica's rebounds + 2)."""
     out = {"label": label, "overrides": overrides, "seed": _is_seed(overrides)}
+    left = row_for_scene(cases["rough_silica"].path, params, cases["rough_silica"].overrides, overrides)[1]
+    if left:
+        out["left_out_on_bare_silica"] = left
     laws = {}
     n_si = SAMPLE_MAX_BOUNCES
     for key, case in (("silica", cases["rough_silica"]), ("ots", cases["rough_ots"])):
