@@ -1,7 +1,7 @@
 """What `nanoimpact paper` costs, per set and per impact, against a floor; how the cost grows.
 
     python benchmarks/bench_paper.py [--sets paper,silicon,calibrated] [--workers 2]
-                                     [--baseline REV] [--skip-paper] [--whole] [--repeat 5]
+                                     [--baseline REV] [--skip-paper] [--whole] [--breakdown] [--repeat 5]
 
 Prints, from one run of this script (so the ratios are comparable on a shared machine):
 
@@ -16,6 +16,11 @@ Prints, from one run of this script (so the ratios are comparable on a shared ma
    runs, figures, checks and summary), for this tree and the baseline;
 3. how the cost grows with the number of bounces (the whole rough_silica run, 1-100 bounces) and with
    the table size (footprint tables at the `fast`, `standard` and `reference` resolutions, all at rtol 1e-8).
+
+With `--breakdown`, where the whole command's CPU goes (this tree only): the command process and its pool
+apart, the pool's CPU by kind of run, and two costs that cut across the runs, the rigid rough roller's
+footprint-table builds (`RigidRoughRoller._build`, per process: a table one worker built is built again
+in the other) and the figures' rendering (`atomic_save_figure`, in the runs and in the command process).
 
 The load average is printed at the start and the end: absolute times move by +-30 % on the shared
 2-core machine, ratios much less.
@@ -92,6 +97,73 @@ def whole_command(code_root: Path, sets: list[str], workers: int) -> tuple[float
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+BREAKDOWN_SNIPPET = """
+import json, os, resource, sys, time
+from continuum.compiled_contact import warm_up
+warm_up()
+import continuum.paper.run as run
+import continuum.paper.figures as figures
+import continuum.plots as plots
+from continuum.laws import rough_rigid
+log = open(sys.argv[4], "a", buffering=1)
+
+def timed(what, fn):
+    def wrapper(*a, **k):
+        cpu = time.process_time()
+        try:
+            return fn(*a, **k)
+        finally:
+            log.write(json.dumps({"pid": os.getpid(), "what": what, "cpu": time.process_time() - cpu}) + "\\n")
+    return wrapper
+
+def build(self, depth, _orig=rough_rigid.RigidRoughRoller._build):
+    fresh = depth not in self._kept_tables and (self._shared_key, depth) not in rough_rigid._SHARED_TABLES
+    return timed("table build" if fresh else "table reuse", _orig)(self, depth)
+
+rough_rigid.RigidRoughRoller._build = build
+plots.atomic_save_figure = timed("figure", plots.atomic_save_figure)
+figures.atomic_save_figure = timed("figure", figures.atomic_save_figure)
+_orig_run = run._run
+def _run(task):
+    out = _orig_run(task)
+    log.write(json.dumps({"pid": os.getpid(), "what": "run: " + out["kind"], "cpu": out["cpu_s"]}) + "\\n")
+    return out
+run._run = _run
+from calibration.cli import main
+rc = main(["paper", "--out", sys.argv[1], "--params", sys.argv[2], "--workers", sys.argv[3], "-q"])
+me = resource.getrusage(resource.RUSAGE_SELF)
+log.write(json.dumps({"pid": os.getpid(), "what": "command process", "cpu": me.ru_utime + me.ru_stime}) + "\\n")
+sys.exit(rc)
+"""
+
+
+def breakdown(sets: list[str], workers: int) -> dict:
+    """(wall s, CPU s of the command and its pool, {what: (CPU s in the command process, CPU s in the pool,
+    calls)}) of `nanoimpact paper` for all `sets` in one process with BREAKDOWN_SNIPPET's counters."""
+    import json
+    import resource
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    with tempfile.TemporaryDirectory() as folder:
+        log = Path(folder) / "cpu.jsonl"
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-c", BREAKDOWN_SNIPPET, str(Path(folder) / "out"), ",".join(sets),
+                               str(workers), str(log)], cwd=ROOT, env=env, capture_output=True, text=True)
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        if proc.returncode not in (0, 4):
+            raise RuntimeError(f"nanoimpact paper failed: {proc.stderr[-2000:]}")
+        rows = [json.loads(line) for line in log.read_text().splitlines()]
+    main_pid = next(r["pid"] for r in rows if r["what"] == "command process")
+    out: dict = {}
+    for r in rows:
+        here, pool, calls = out.get(r["what"], (0.0, 0.0, 0))
+        out[r["what"]] = (here + r["cpu"] * (r["pid"] == main_pid), pool + r["cpu"] * (r["pid"] != main_pid), calls + 1)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return {"wall": wall, "cpu": cpu, "parts": out}
+
+
 def export_revision(rev: str, dest: Path) -> Path:
     """The tree of git revision `rev` exported into `dest` (no worktree, nothing in .git changes)."""
     archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True, check=True).stdout
@@ -165,6 +237,18 @@ def per_bounce(repeat: int) -> list[tuple[int, float, int]]:
     return rows
 
 
+def print_breakdown(sets: list[str], workers: int) -> None:
+    print(f"\n## Where `nanoimpact paper --params {','.join(sets)}` spends its CPU ({workers} workers; load at start "
+          f"{load()})")
+    b = breakdown(sets, workers)
+    parts = b["parts"]
+    print(f"wall {b['wall']:.1f} s, CPU {b['cpu']:.1f} s (command process {parts['command process'][0]:.1f} s)")
+    print(f"{'what':28s} {'command CPU s':>14s} {'pool CPU s':>11s} {'calls':>6s}")
+    for what, (here, pool, calls) in sorted(parts.items(), key=lambda kv: -(kv[1][0] + kv[1][1])):
+        if what != "command process":
+            print(f"{what:28s} {here:14.1f} {pool:11.1f} {calls:6d}")
+
+
 def load() -> str:
     return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
@@ -176,6 +260,7 @@ def main(argv=None):
     parser.add_argument("--baseline", default=None, help="git revision to time the paper with as well")
     parser.add_argument("--skip-paper", action="store_true")
     parser.add_argument("--whole", action="store_true", help="also time the whole `nanoimpact paper` command")
+    parser.add_argument("--breakdown", action="store_true", help="where the whole command's CPU goes (this tree)")
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args(argv)
     sets = args.sets.split(",")
@@ -231,6 +316,8 @@ def main(argv=None):
         if args.baseline:
             (bw, bc), (nw, nc) = rows[f"baseline {args.baseline}"], rows["this tree"]
             print(f"{'speed-up':24s} wall {bw / nw:7.2f}    CPU {bc / nc:7.2f}")
+    if args.breakdown:
+        print_breakdown(sets, args.workers)
     print(f"\nload average at end: {load()}")
 
 
