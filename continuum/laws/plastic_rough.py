@@ -20,7 +20,7 @@ import numpy as np
 from ..rough.plastic_summits import PlasticGWSurface, PlasticSummitLaw, RollerFootprint
 from .base import ContactLaw
 
-__all__ = ["PlasticGWPunch", "PlasticGWRoller", "PlasticSummitsPunch"]
+__all__ = ["PlasticGWPunch", "PlasticGWRoller", "PlasticSummitsPunch", "PlasticDiscreteRoller"]
 
 
 class PlasticGWPunch(ContactLaw):
@@ -135,6 +135,7 @@ class PlasticSummitsPunch(ContactLaw):
 
     def forget_history(self) -> None:
         self.delta_max = np.zeros_like(self.heights)      # 0 < delta_y: virgin summits
+        self.max_contacts = 0
         self.reset()
 
     def reset(self) -> None:
@@ -191,15 +192,43 @@ class PlasticSummitsPunch(ContactLaw):
         self._loops += loops
         self._attached, self.delta_max = att, dm
         self._met |= att
+        self.max_contacts = max(self.max_contacts, int(att.sum()))
 
     def length_scale(self, mass, speed):
         return float(self.law.release_stretch(self.law.radius))
 
     def diagnostics(self):
         r_p, d_p = self.law.flattening(self.delta_max)
-        return {"summits_yielded": int(np.sum(self.delta_max > self.law.yield_approach)),
-                "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
+        yielded = self.delta_max > self.law.yield_approach
+        return {"summits_yielded": int(np.sum(yielded)), "max_contacts": self.max_contacts, "plastic_summits": True,
+                "plastic_radius": r_p[yielded].tolist(), "plastic_approach": d_p[yielded].tolist()}
 
     def describe(self):
         return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
                 "source": "Thornton & Ning (1998) on each summit, each carrying its flattening"}
+
+
+class PlasticDiscreteRoller(PlasticSummitsPunch):
+    """Rigid roller on a realisation of individual Thornton-Ning summits over a rigid substrate.
+
+    Under a rigid roller summit i at x_i has approach delta_i = e_i - z_top - gap with its effective height
+    e_i = z_i - x_i^2/2R (`continuum.laws.discrete_roller`), so the roller is the flat punch on the effective
+    heights. `effective_heights` are those the elastic discrete roller kept (e_i >= z_top - depth_keep, m); a
+    contact deeper than depth_keep is refused (summits below the cut would be missing)."""
+
+    name = "rough_roller_discrete_plastic"
+
+    def __init__(self, law: PlasticSummitLaw, effective_heights, sigma: float, depth_keep: float):
+        super().__init__(law, effective_heights)
+        self.sigma, self.depth_keep = float(sigma), float(depth_keep)
+
+    def accept(self, gap):
+        if -gap > self.depth_keep:
+            raise ValueError(f"discrete plastic roller: approach {-gap:.3g} m beyond the kept summits' depth "
+                             f"{self.depth_keep:.3g} m")
+        super().accept(gap)
+
+    def describe(self):
+        return {**super().describe(), "name": self.name, "depth_keep": self.depth_keep,
+                "source": "Thornton & Ning (1998) on each summit of the realisation, each carrying its flattening; "
+                          "rigid roller and substrate (effective heights z_i - x_i^2/2R)"}

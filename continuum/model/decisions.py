@@ -425,10 +425,10 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
     with the summits' E* (`summit_e_star`) and the softer partner's limiting pressure p_y (H, or 2.8 Y) decides.
 
-    Where they yield, the mean field of Thornton-Ning summits under a rigid roller runs
-    (`continuum.laws.plastic_rough.PlasticGWRoller`); it is built on JKR summits over a rigid substrate without
-    bridges, so under another summit law (`adhesion`), the half-space grid, discrete summits or menisci the summits
-    stay elastic and the record says why. A p_y below the summits' adhesive stress scale (they would yield on
+    Where they yield, Thornton-Ning summits under a rigid roller run (`continuum.laws.plastic_rough`: the GW mean
+    field, or the discrete realisation in mode 'discrete'); they are JKR summits over a rigid substrate without
+    bridges, so under another summit law (`adhesion`), the half-space or menisci the summits stay elastic and the
+    record says why, as do ensemble members (elastic discrete realisations). A p_y below the summits' adhesive stress scale (they would yield on
     snap-in, outside Thornton-Ning) is refused naming its key."""
     from nanoimpact.errors import InputError
 
@@ -449,8 +449,7 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
            f"(limiting contact pressure {soft.limiting_pressure:.3g} Pa from {soft.key}): {state}")
     blockers = [text for cond, text in (
         (adhesion != "jkr", f"the summit law is '{adhesion}' (Thornton-Ning summits are JKR summits)"),
-        (half_space, "the half-space grid roller carries elastic summits only"),
-        (rough.mode == "discrete", "discrete summits under the roller are elastic"),
+        (half_space, "the half-space roller carries elastic summits only"),
         (menisci, "the bridges' law wraps elastic summits")) if cond]
     used = yields and not blockers
     if used:
@@ -460,7 +459,10 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
             raise InputError(soft.key, soft.value, f"gives a limiting contact pressure of {soft.limiting_pressure:.4g} "
                              f"Pa, below the summits' adhesive stress scale E* a0/(pi beta) = {p_a:.4g} Pa (they "
                              "would yield on snap-in, outside the Thornton-Ning law)")
-        why += ": Thornton-Ning summits, rigid roller on their GW mean field"
+        why += (": Thornton-Ning summits under a rigid roller, " + ("each summit of the realisation"
+                if rough.mode == "discrete" else "their GW mean field"))
+        if rough.mode in ("auto", "ensemble"):
+            why += " (ensemble members, where an ensemble runs, keep elastic summits)"
     elif yields:
         why += "; " + "; ".join(blockers) + ": this run is elastic and overestimates the rebound"
     return PlasticityDecision(used, "plasticity_index", why, limiting_pressure=soft.limiting_pressure,

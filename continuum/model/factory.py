@@ -76,6 +76,18 @@ def plastic_rigid_roller(scene: Scene, summit_e_star: float, limiting_pressure: 
     return PlasticGWRoller(law, rough.sigma, rough.summit_density, z_max, body.radius, body.length)
 
 
+def plastic_discrete_roller(elastic: ContactLaw, scene: Scene, summit_e_star: float,
+                            limiting_pressure: float) -> ContactLaw:
+    """The realisation of the elastic discrete roller `elastic` (a rigid-substrate `DiscreteRoughRoller`: its kept
+    effective heights) with Thornton-Ning summits of limiting contact pressure p_y (Pa)."""
+    from ..laws.plastic_rough import PlasticDiscreteRoller
+    from ..rough.plastic_summits import PlasticSummitLaw
+    rough = scene.surfaces.roughness
+    law = PlasticSummitLaw(rough.summit_radius, scene.surfaces.interface_work_of_adhesion, summit_e_star,
+                           limiting_pressure)
+    return PlasticDiscreteRoller(law, elastic.eff, rough.sigma, elastic.depth_keep)
+
+
 def grid_roller(surface, scene: Scene) -> ContactLaw:
     """Averaged rough roller on the elastic half-space (grid of scene.numerics.grid_points cells)."""
     from ..laws.rough_roller import RoughRoller

@@ -179,7 +179,9 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         wet = menisci if menisci is not None else (m.choice == "on")
         law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, estimate=estimate, regime=regime)
         plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet)
-        if plastic.used:
+        if plastic.used and scene.surfaces.roughness.mode == "discrete":
+            law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure)
+        elif plastic.used:
             law = factory.plastic_rigid_roller(scene, regime.e_star, plastic.limiting_pressure,
                                                record["datum"]["z_max"])
             record["table"] = {"used": False, "why": "plastic summits: the mean field is summed state by state "
