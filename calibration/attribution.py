@@ -154,11 +154,17 @@ def _base_origin(base: str | None) -> dict:
     return dict((tomllib.loads(find_params(base).read_text()).get("meta") or {}).get("origin") or {})
 
 
+def holds_nominally(c: Mapping) -> bool:
+    """Whether a claim holds on its set's own (nominal) runs: the state before the samples judged it (the
+    reverts run no samples, so a base set's claim is compared on its nominal runs too)."""
+    return c.get("nominal_state", c["state"]) == "pass" if "state" in c else bool(c["pass"])
+
+
 def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],
                    by_revert: Mapping[str, Iterable[Mapping]], groups: Iterable[Revert]) -> tuple[ClaimWhy, ...]:
     """One ClaimWhy per claim that fails with the calibrated set, from the claims of the calibrated set, the base
     set and each revert set (`by_revert`: revert set name -> its claims). Pure: no run here."""
-    base_pass = {c["name"]: bool(c["pass"]) for c in base}
+    base_pass = {c["name"]: holds_nominally(c) for c in base}
     groups = tuple(groups)
     restored = {g.set_name: {c["name"] for c in by_revert.get(g.set_name, ()) if c["pass"]} for g in groups}
     out = []
@@ -167,8 +173,8 @@ def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],
             continue
         name = c["name"]
         if c.get("nominal_state") == "pass":
-            out.append(ClaimWhy(name, "samples", (), f"holds on the set's own runs and fails over its samples "
-                                f"({c.get('reason', 'holds_fraction below the criterion')})"))
+            out.append(ClaimWhy(name, "samples", (), f"holds on the set's own runs; over its samples: "
+                                f"{c.get('reason', 'holds_fraction below the criterion')}"))
             continue
         if name not in base_pass:
             out.append(ClaimWhy(name, "not run", (), "the base set's cases did not evaluate this claim"))
@@ -209,8 +215,8 @@ def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]]
     checks = list(paper_checks)
     cal = [c for c in checks if c["set"] == set_name]
     base = [c for c in checks if c["set"] == base_name]
-    base_pass = {c["name"] for c in base if c["pass"]}
-    needed = [c for c in cal if not c["pass"] and c["name"] in base_pass]
+    base_pass = {c["name"] for c in base if holds_nominally(c)}
+    needed = [c for c in cal if not c["pass"] and c.get("nominal_state") != "pass" and c["name"] in base_pass]
     groups = reverts(rows, set_name)
     by_revert: dict[str, list] = {}
     if needed and groups:

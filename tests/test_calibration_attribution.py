@@ -168,6 +168,10 @@ def test_failures_through_several_values_the_base_set_or_the_samples_are_not_acc
                          {g.set_name: _named(g.set_name, {"a": False, "b": False, "c": False}) for g in groups}, groups)
     causes = {w.claim: w.cause for w in why}
     assert causes == {"a": "several", "b": "base fails too", "c": "samples"}
+    # a base set that holds on its own runs and fails only over its seeds still counts as holding
+    base = _named("paper", {"a": True, "b": False, "c": True})
+    base[1].update(state="fail", nominal_state="pass")
+    assert explain_claims(cal, base, {}, groups)[1].cause == "not run"
     acc = {a["claim"]: a for a in acceptance(cal, why, groups)}
     assert not any(a["accepted"] for a in acc.values())
     assert "no single measured value" in acc["a"]["why"] and "base set too" in acc["b"]["why"]
