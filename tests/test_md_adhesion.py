@@ -633,6 +633,11 @@ def test_equilibrated_ots_smoke_anneals_contacts_each_registry_and_pulls_out_and
     assert w["systematic_hysteresis"] == pytest.approx(0.5 * abs(q["adhesion_hysteresis"]["value"]))
     assert q["adhesion_hysteresis"]["value"] == pytest.approx(w["value_out"] - w["value_back"])
     assert any(n.startswith("out and back") for n in r["notes"])
+    # T dS per registry: each registry's dE/A from its own contact leg against its own chain's W_F, averaged
+    tds = q["entropic_term_TdS"]
+    assert tds["registries"] == [0, 1]
+    assert tds["per_registry"]["1"][0] == pytest.approx(rc["energy_work_J_m2"] -
+                                                        r["details"]["pmf_windows"]["registry_work_J_m2"][1])
 
 
 @pytest.mark.md

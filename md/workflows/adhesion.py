@@ -360,8 +360,13 @@ class _AdhesionAnalysis:
             wf_err = max(wf_err, A.registry_average(self.w_reg, self.w_reg_err)["stderr"])
         self.wf_err = wf_err
         w_e = w["value"] + self.w_tail_static
-        self.tds_rec = A.entropic_term({0: (w_e, w["stderr"])}, {0: (self.w_reg[0], self.w_reg_err[0])})
-        self.tds, self.tds_err = self.tds_rec["per_registry"][0]
+        # dE/A of every registry with its own zero-load contact (registry 0: the contact leg; the others with
+        # registry_contact_steps), each against its own chain's W_F; T dS is their average
+        e_reg = {0: (w_e, w["stderr"])} | {int(r): (c["energy_work_J_m2"], c["stderr_J_m2"])
+                                           for r, c in self.details.get("registry_contacts", {}).items()}
+        self.tds_rec = A.entropic_term(e_reg, {r: (self.w_reg[r], self.w_reg_err[r]) for r in range(self.n_reg)})
+        self.tds, self.tds_err = (self.tds_rec["per_registry"][0] if len(self.tds_rec["registries"]) == 1 else
+                                  (self.tds_rec["mean"], self.tds_rec["stderr"]))
         self.repulsive = bool(ti["repulsive_end"])
         q, tail_on, n_reg = self.q, self.tail_on, self.n_reg
         q["work_of_adhesion_free_energy"] = quantity_record(
@@ -370,10 +375,16 @@ class _AdhesionAnalysis:
                                                                    "included" if tail_on else "") + ")",
             discretisation_error=self.wf_disc, value_pchip=self.wf_pchip, repulsive_end=self.repulsive,
             registry_spread=float(np.std(self.w_reg, ddof=1)) if n_reg >= 2 else 0.0, registries=n_reg)
-        q["entropic_term_TdS"] = quantity_record(self.tds, self.tds_err, "J/m^2",
-                                    kind="T dS / A = (dE - dF) / A of registry 0: dE/A from the zero-load contact "
-                                         "leg (registry 0) and W_F of registry 0's own chain",
-                                    discretisation_error=self.wf_disc, registry=0)
+        regs = self.tds_rec["registries"]
+        q["entropic_term_TdS"] = quantity_record(
+            self.tds, self.tds_err, "J/m^2", discretisation_error=self.wf_disc,
+            kind="T dS / A = (dE - dF) / A of registry 0: dE/A from the zero-load contact leg (registry 0) and W_F of "
+                 "registry 0's own chain" if regs == [0] else
+                 f"T dS / A = (dE - dF) / A averaged over registries {regs}, each from its own zero-load contact leg "
+                 "and its own chain's W_F",
+            **({"registry": 0} if regs == [0] else {"registries": regs,
+                                                   "per_registry": {str(r): v for r, v in
+                                                                    self.tds_rec["per_registry"].items()}}))
         if tail_on:
             q["dispersion_tail_work"] = quantity_record(wf - self.ti_cut["value"], None, "J/m^2",
                                            kind="static dispersion beyond the cutoff for TraPPE pairs, in W_F: "
