@@ -121,7 +121,10 @@ class PlasticSummitsPunch(ContactLaw):
 
     Each summit carries its deepest approach (hence R_p and delta_p) into later contacts; `forget_history` returns
     them to virgin summits. A summit is met at delta = delta_p (its force jumps onto the JKR curve of R_p there, at
-    no cost in energy) and lets go at the fold delta_p - delta_c(R_p), booking that branch's loop."""
+    no cost in energy) and lets go at the fold delta_p - delta_c(R_p), booking that branch's loop.
+
+    Cost: the summits are kept sorted by height, and a state is evaluated on the prefix that can be attached
+    (delta_i >= -max delta_c(R_p), since delta_p >= 0), so a call costs O(summits within reach)."""
 
     name = "plastic_summits_punch"
     has_history = True
@@ -129,38 +132,55 @@ class PlasticSummitsPunch(ContactLaw):
 
     def __init__(self, law: PlasticSummitLaw, heights):
         self.law = law
-        self.heights = np.asarray(heights, float)
-        self.z_top = float(np.max(self.heights))
+        self.heights = np.sort(np.asarray(heights, float))[::-1].copy()      # descending
+        self._neg = -self.heights                                            # ascending, for searchsorted
+        self.z_top = float(self.heights[0])
         self.forget_history()
 
     def forget_history(self) -> None:
         self.delta_max = np.zeros_like(self.heights)      # 0 < delta_y: virgin summits
         self.max_contacts = 0
+        self._reach = float(self.law.release_stretch(self.law.radius))
+        self._w_total = 0.0                               # plastic work of the accepted state (J)
         self.reset()
 
     def reset(self) -> None:
         self._attached = np.zeros(self.heights.size, bool)
         self._met = np.zeros(self.heights.size, bool)
-        self._w0 = float(np.sum(self.law.plastic_work(self.delta_max)))
+        self._w0 = self._w_total
         self._loops = 0.0
+        self._memo = None
+
+    def _prefix(self, gap) -> int:
+        """Summits that can be attached at gap: delta_i = z_i - z_top - gap >= -reach."""
+        return int(np.searchsorted(self._neg, -(self.z_top + gap - self._reach), side="right"))
 
     def _trial(self, gap):
-        """(delta, attached, deepest approach, loops of the summits letting go now) at gap (m)."""
-        delta = self.heights - self.z_top - gap
-        r_p, d_p = self.law.flattening(self.delta_max)
-        release = d_p - self.law.release_stretch(r_p)
-        attached = (delta >= d_p) | (self._attached & (delta > release))
-        lost = self._attached & ~attached
-        dm = np.where(attached, np.maximum(self.delta_max, delta), self.delta_max)
-        loops = float(np.sum(self.law.loop_energy(self.delta_max[lost]))) if lost.any() else 0.0
-        return delta, attached, dm, loops
+        """(k, delta, attached, deepest approach, loops letting go now, plastic work change) on the first k summits;
+        summits beyond k keep their accepted state and are free."""
+        if self._memo is not None and self._memo[0] == gap:
+            return self._memo[1]
+        k = max(self._prefix(gap), int(np.flatnonzero(self._attached)[-1]) + 1 if self._attached.any() else 0)
+        delta = self.heights[:k] - self.z_top - gap
+        dm0, held = self.delta_max[:k], self._attached[:k]
+        r_p, d_p = self.law.flattening(dm0)
+        attached = (delta >= d_p) | (held & (delta > d_p - self.law.release_stretch(r_p)))
+        lost = held & ~attached
+        dm = np.where(attached, np.maximum(dm0, delta), dm0)
+        grew = dm > dm0
+        loops = float(np.sum(self.law.loop_energy(dm0[lost]))) if lost.any() else 0.0
+        dw = (float(np.sum(self.law.plastic_work(dm[grew])) - np.sum(self.law.plastic_work(dm0[grew])))
+              if grew.any() else 0.0)
+        out = (k, delta, attached, dm, loops, dw)
+        self._memo = (gap, out)
+        return out
 
     def _values(self, gap):
-        delta, att, dm, loops = self._trial(gap)
+        k, delta, att, dm, loops, dw = self._trial(gap)
         if not att.any():
-            return 0.0, 0.0, dm, loops
+            return 0.0, 0.0, loops, dw
         f, en = self.law.branch(delta[att], dm[att])
-        return float(np.sum(f)), float(np.sum(en)), dm, loops
+        return float(np.sum(f)), float(np.sum(en)), loops, dw
 
     def force(self, gap):
         return self._values(gap)[0]
@@ -173,35 +193,38 @@ class PlasticSummitsPunch(ContactLaw):
         return self._values(gap)[1]
 
     def dissipated(self, gap):
-        _, _, dm, loops = self._values(gap)
-        return float(np.sum(self.law.plastic_work(dm))) - self._w0 + self._loops + loops
+        _, _, loops, dw = self._values(gap)
+        return self._w_total + dw - self._w0 + self._loops + loops
 
     def release_gap(self):
-        r_p, d_p = self.law.flattening(self.delta_max)
-        release = self.heights - d_p + self.law.release_stretch(r_p) - self.z_top
         met = self._met if self._met.any() else np.ones_like(self._met)
-        return float(np.max(release[met]))
+        r_p, d_p = self.law.flattening(self.delta_max[met])
+        return float(np.max(self.heights[met] - d_p + self.law.release_stretch(r_p))) - self.z_top
 
     def on_release(self):
         held = self._attached
-        return (float(np.sum(self.law.plastic_work(self.delta_max))) - self._w0 + self._loops
+        return (self._w_total - self._w0 + self._loops
                 + float(np.sum(self.law.loop_energy(self.delta_max[held]))))
 
     def accept(self, gap):
-        _, att, dm, loops = self._trial(gap)
+        k, _, att, dm, loops, dw = self._trial(gap)
         self._loops += loops
-        self._attached, self.delta_max = att, dm
-        self._met |= att
+        self._w_total += dw
+        self._attached[:k], self.delta_max[:k] = att, dm
+        self._met[:k] |= att
+        self._memo = None
         self.max_contacts = max(self.max_contacts, int(att.sum()))
+        if att.any():
+            self._reach = max(self._reach, float(np.max(self.law.release_stretch(self.law.flattening(dm[att])[0]))))
 
     def length_scale(self, mass, speed):
         return float(self.law.release_stretch(self.law.radius))
 
     def diagnostics(self):
-        r_p, d_p = self.law.flattening(self.delta_max)
         yielded = self.delta_max > self.law.yield_approach
+        r_p, d_p = self.law.flattening(self.delta_max[yielded])
         return {"summits_yielded": int(np.sum(yielded)), "max_contacts": self.max_contacts, "plastic_summits": True,
-                "plastic_radius": r_p[yielded].tolist(), "plastic_approach": d_p[yielded].tolist()}
+                "plastic_work": self._w_total, "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
 
     def describe(self):
         return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
