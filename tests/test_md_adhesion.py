@@ -654,3 +654,13 @@ def test_silica_registries_smoke_lowers_each_registry_into_its_own_contact(md_sm
     assert np.ptp(c1["z_back"]) > 0                       # free along z
     n_out = r["settings"]["pmf_windows"] + len(r["settings"]["pmf_extra_windows_A"])
     assert sum(w.startswith("o") for w in r["details"]["pmf_windows"]["window"]) == n_out
+
+
+@pytest.mark.md
+def test_rank1_two_registries_are_reported_degenerate(needs_lammps, cache):
+    """adhesion_silica_ots at smoke with the shipped quick recipes' rank-1 n = 2 registries: the result names the
+    second registry as a repeat of the first (its offset is the (111) cell's centring vector)."""
+    r = _run(_recipe("adhesion_silica_ots", lateral_registries=2), cache).result
+    assert r["details"]["pmf_windows"]["registry_offsets_A"][1] == pytest.approx([2.531442, 4.384587], abs=1e-6)
+    (note,) = [n for n in r["notes"] if n.startswith("REGISTRIES DEGENERATE")]
+    assert "1 repeats 0" in note and "2 chains sample 1 distinct registry" in note
