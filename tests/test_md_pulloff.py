@@ -96,7 +96,8 @@ import json  # noqa: E402
 from md import units as U  # noqa: E402
 from md.recipe import RecipeError, load_recipe, parse_recipe  # noqa: E402
 from md.workflows import get_workflow  # noqa: E402
-from md.workflows.pulloff import _residual_drag, _speed_summary, leg_name, tip_offsets  # noqa: E402
+from md.workflows.pulloff import _residual_drag, _speed_summary  # noqa: E402
+from md.workflows.pulloff_protocol import leg_name, tip_offsets  # noqa: E402
 
 
 def _table(name: str, fidelity: str = "smoke", **override) -> dict:

@@ -20,25 +20,21 @@ pulloff
 from __future__ import annotations
 
 import math
-from dataclasses import replace
-from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from md import analysis as A
-from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
 from md import units as U
+from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
 from md.build import flip_upside_down, graft_dome, place_on, silica_asperity
+from md.engine.plan import Analysis, Leg, Plan
 from md.system.atoms import as_system
 from md.system.lammps_data import read_atoms, write_data
-from md.engine.plan import Analysis, Leg, Plan, Stage
 from md.system.topology import System
-
-from md.workflows.common import (common_define, derived_seed, equilibrate_stage, figure_writer, forcefield_of,
-                                 fresh_from_data, intersect_ids, minimize_lines, quantity_record,
-                                 restart_header_lines, round_up, Settings, silica_face_of, stage_list, steps_of,
-                                 surface_slab, system_summary, thermostat_lines, Workflow)
+from md.workflows.common import (derived_seed, figure_writer, forcefield_of, intersect_ids, quantity_record,
+                                 Settings, silica_face_of, surface_slab, system_summary, Workflow)
+from md.workflows.pulloff_protocol import leg_name, measures_flat, position_legs, shift_tip, tip_offsets
 
 # ================================================================================================ pull-off
 
@@ -103,11 +99,11 @@ class PullOff(Workflow):
         legs: list[Leg] = []
         for p, offset in enumerate(info.get("tip_offsets_A", [(0.0, 0.0)])):
             data = run_dir / ("system.data" if p == 0 else f"system_p{p}.data")
-            write_data(system if p == 0 else _shift_tip(system, offset), ff, data)
-            legs += _position_legs(s, ff, data, groups, n, p, run_dir)
+            write_data(system if p == 0 else shift_tip(system, offset), ff, data)
+            legs += position_legs(s, ff, data, groups, n, p, run_dir)
         info.update(n_flat=int(len(groups["flat"])), n_tip=int(len(groups["tip"])),
                     tip_mobile_mass_g_mol=float(system.masses[tip_mobile].sum()), tip_thermostat=s.tip_thermostat)
-        if _measures_flat(s):
+        if measures_flat(s):
             info.update(flat_thermostat=s.flat_thermostat, n_flat_sam=int(len(groups.get("flat_sam", ()))))
         return Plan(legs=legs, timestep_fs=s.timestep_fs, n_atoms=n,
                     seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": derived_seed(seed, 3, 1),
@@ -319,119 +315,6 @@ class _PullOffAnalysis:
         ax.legend(fontsize=7)
 
 
-def leg_name(base: str, position: int) -> str:
-    """The name of a leg at tip position ``position``: position 0 keeps the plain name (``approach``,
-    ``retract_0``), the others carry ``_p<k>`` (``approach_p1``, ``retract_p1_0``)."""
-    if position == 0:
-        return base
-    head, _, tail = base.partition("_")
-    return f"{head}_p{position}" + (f"_{tail}" if tail else "")
-
-
-def _measures_flat(s: Settings) -> bool:
-    """Whether the flat's thermostat force is sampled (columns f_flat, p_flat): with the silica-only flat
-    thermostat or several tip positions."""
-    return s.flat_thermostat != "mobile" or int(s.tip_positions) > 1
-
-
-def tip_offsets(n: int, cell: tuple[float, float]) -> list[tuple[float, float]]:
-    """``n`` lateral offsets (A) of the tip over the flat: the first zero, the others the R2 quasi-random sequence
-    (Roberts 2018: k (1/phi2, 1/phi2^2) mod 1, phi2 the plastic number) over the fundamental domain [0, 1) x
-    [0, 1/2) of the flat's rectangular surface cell ``cell``. That cell is centred on the cristobalite faces
-    (its (1/2, 1/2) point is a lattice translation), so the half cell is the primitive cell and no offset but the
-    first is a lattice translation (or a copy of another)."""
-    phi2 = 1.324717957244746
-    a = np.array([1.0 / phi2, 1.0 / phi2 ** 2])
-    k = np.arange(int(n))[:, None]
-    frac = np.mod(k * a, 1.0) * np.array([1.0, 0.5])
-    return [(round(float(u * cell[0]), 6), round(float(v * cell[1]), 6)) for u, v in frac]
-
-
-def _shift_tip(system: System, offset) -> System:
-    """The system with the tip (asperity and holder, group 'adsorbate') moved laterally by ``offset`` (A); the
-    data writer wraps it into the periodic box."""
-    pos = system.positions.copy()
-    pos[system.group("adsorbate"), :2] += np.asarray(offset, float)
-    return replace(system, positions=pos)
-
-
-def _columns(s: Settings) -> dict[str, str]:
-    columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_holder": "v_zh", "tip_zmin": "v_tipmin",
-               "flat_zmax": "v_flatmax", "f_holder": "f_hold_holder[3]", "p_tip": "v_ptip"}
-    if _measures_flat(s):
-        columns.update(f_flat="f_hold_flat[3]", p_flat="v_pflat")
-    return columns
-
-
-def _define(s: Settings, salt: int):
-    """The per-(re)start commands of every pull-off leg: holds, the group/group force, sampled variables and the
-    thermostats (``salt`` varies the Langevin seeds between legs)."""
-    def d(step: int) -> list[str]:
-        return common_define(s, "mobile") + [
-            "neigh_modify exclude group flat_fixed flat_fixed",
-            "neigh_modify exclude group holder_rigid holder_rigid",
-            "fix hold_flat flat_fixed setforce 0.0 0.0 0.0",
-            "fix hold_holder holder_rigid setforce 0.0 0.0 0.0",
-            "fix move_holder holder_rigid nve",
-            "compute gg tip group/group flat kspace yes",
-            "variable zh equal xcm(holder_rigid,z)", "variable tipmin equal bound(tip,zmin)",
-            "variable flatmax equal bound(flat,zmax)",
-            "variable ptip equal mass(tip_mobile)*vcm(tip_mobile,z)"] + \
-            (["variable pflat equal mass(flat_mobile)*vcm(flat_mobile,z)"] if _measures_flat(s) else []) + \
-            _pulloff_thermostat(s, step, salt)
-    return d
-
-
-def _position_legs(s: Settings, ff, data: Path, groups: Mapping[str, Any], n: int, p: int,
-                   run_dir: Path) -> list[Leg]:
-    """The legs of tip position ``p``: its approach (equilibrate, approach, hold: its own contact) and, from the
-    restart at the end of its hold, ``retract_repeats`` retractions per speed. Position 0 has the seeds and salts
-    of a single-position run; the others shift them."""
-    dt, si, seed, t = s.timestep_fs, s.sample_interval, int(s.seed), s.temperature_K
-    v_app = U.m_per_s_to_angstrom_per_fs(s.approach_speed_m_s)
-    n_app = round_up(s.approach_distance_A / (v_app * dt), si)
-    columns = _columns(s)
-    base = 1000 * p
-    extra = ["group flat_silica subtract flat_mobile flat_sam"] if "flat_sam" in groups else []
-
-    def fresh(leg_dir: Path) -> list[str]:
-        return fresh_from_data(ff, data, s, groups) + [
-            "group held union flat_fixed holder_rigid", "group mobile subtract all held",
-            "group flat_mobile subtract flat flat_fixed", "group tip_mobile subtract tip holder_rigid"] + extra
-
-    vz = lambda v: f"velocity holder_rigid set 0.0 0.0 {v:.10g} units box"
-    approach = Leg(
-        name=leg_name("approach", p), fresh=fresh, define=_define(s, base),
-        prepare=lambda d: minimize_lines(s, d / "minimized.data"), restart_head=restart_header_lines(s),
-        stages=stage_list(equilibrate_stage(s, "mobile", 1 + base, (vz(0.0),)),
-                          Stage("approach", n_app, (vz(-v_app),)),
-                          Stage("hold", steps_of(s.hold_steps, s.sample_interval), (vz(0.0),))),
-        columns=columns, sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
-        info={"v_approach_A_fs": v_app, **({"position": p} if s.tip_positions > 1 else {})})
-    legs = [approach]
-    approach_dir = run_dir / "legs" / approach.name
-    repeats = int(s.retract_repeats)
-    for k, v in enumerate(s.retract_speeds_m_s):
-        v_ret = U.m_per_s_to_angstrom_per_fs(v)
-        n_ret = round_up(s.retract_distance_A / (v_ret * dt), si)
-        for j in range(repeats):
-            def fresh_retract(leg_dir: Path, _total=approach.total_steps) -> list[str]:
-                return restart_header_lines(s)(approach_dir / f"restart.{_total}") + [f"timestep {dt:g}"]
-            stages = [Stage("retract", n_ret, (vz(v_ret),))]
-            if repeats > 1:     # independent pulls: fresh velocities, then hold_steps more in contact
-                vseed = derived_seed(seed, 7, k, j) if p == 0 else derived_seed(seed, 7, k, j, p)
-                stages = stage_list(Stage("rehold", steps_of(s.hold_steps, s.sample_interval), (
-                    f"velocity mobile create {t:g} {vseed} mom yes rot no dist gaussian",
-                    vz(0.0)), sampled=False)) + stages
-            legs.append(Leg(name=leg_name(f"retract_{k}" + (f"_{j}" if j else ""), p), fresh=fresh_retract,
-                            define=_define(s, base + 100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
-                            restart_head=restart_header_lines(s), stages=stages, columns=columns,
-                            sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
-                            info={"speed_m_s": v, "v_A_fs": v_ret, "repeat": j,
-                                  **({"position": p} if s.tip_positions > 1 else {})}))
-    return legs
-
-
 def _student_t(n: int) -> float:
     """Student-t factor of the one-sigma (68.27 %) interval of a mean of ``n`` samples whose stderr comes from
     their own spread (n - 1 degrees of freedom; JCGM 100:2008, annex G): 1.84 for 2, 1.32 for 3, -> 1."""
@@ -514,38 +397,6 @@ def _tabor_note(R_m: float, w_eff: float, z0_m: float, surface: str) -> str:
     if surface == "ots":
         out += "; the OTS layers are far more compliant than silica, so the coated contact's mu is larger"
     return out + "."
-
-
-def _thermostat_fix(name: str, group: str, settings: Settings, step: int, salt: int) -> list[str]:
-    """A named thermostat fix on ``group`` (Langevin + nve, or Nose-Hoover nvt)."""
-    t = settings.temperature_K
-    damp = settings.thermostat_damping_fs
-    if settings.thermostat == "nose-hoover":
-        return [f"fix {name} {group} nvt temp {t:g} {t:g} {damp:g}"]
-    return [f"fix {name} {group} langevin {t:g} {t:g} {damp:g} {derived_seed(settings.seed, 17, salt, step)} zero yes",
-            f"fix {name}_nve {group} nve"]
-
-
-def _pulloff_thermostat(s: Settings, step: int, salt: int) -> list[str]:
-    """The pull-off thermostats (recipe ``tip_thermostat``, ``flat_thermostat``): the flat's mobile atoms (or only
-    its silica, the SAM then NVE); the asperity's mobile
-    atoms in its own frame ('comoving': a temp/com bias, so drag and noise act on the thermal velocities only and
-    sum to zero over the asperity), not at all ('none': NVE), or together with the
-    flat in the lab frame ('lab')."""
-    mode = s.tip_thermostat
-    if mode == "lab":
-        return thermostat_lines("mobile", s, step, salt)
-    if s.flat_thermostat == "silica" and s.surface == "ots":
-        cmds = _thermostat_fix("thermo_flat", "flat_silica", s, step, 2 * salt) + \
-            ["fix integrate_flat_sam flat_sam nve"]
-    else:
-        cmds = _thermostat_fix("thermo_flat", "flat_mobile", s, step, 2 * salt)
-    if mode == "comoving":
-        cmds += ["compute tip_com tip_mobile temp/com"] + \
-            _thermostat_fix("thermo_tip", "tip_mobile", s, step, 2 * salt + 1) + ["fix_modify thermo_tip temp tip_com"]
-    else:
-        cmds += ["fix integrate_tip tip_mobile nve"]
-    return cmds
 
 
 def _local_noise(r: Mapping[str, Any], smooth: int | None) -> float | None:
