@@ -378,3 +378,24 @@ def test_compiled_window_table_evaluation_is_the_numpy_one(z_max):
         for g, w in zip(got, want):
             assert np.max(np.abs(g - w)) <= 1e-12 * np.max(np.abs(w))
         assert np.array_equal(table(a, b, deriv=False)[0], got[0])
+
+
+def test_surfaces_of_the_same_summits_share_tables_that_are_the_freshly_built_ones():
+    """The tables depend on dimensionless inputs only (heights in sigma, the JKR window in delta_c): a second
+    surface of the same summits takes the first one's, and every quantity it gives, deep, in the window and above
+    the tallest summit, is bit for bit that of tables built afresh; another work of adhesion builds its own."""
+    from continuum.rough import gw_tables
+
+    stats = SummitStatistics(6e-9, 1e13, 2e-7)
+    first = GWJKRSurface(stats, 0.06, 1e10, z_max=4.0, resolution="fast")
+    shared = GWJKRSurface(stats, 0.06, 1e10, z_max=4.0, resolution="fast")
+    assert shared._t1q is first._t1q and shared._t2 is first._t2
+    gw_tables._BUILT.clear()
+    fresh = GWJKRSurface(stats, 0.06, 1e10, z_max=4.0, resolution="fast")
+    assert fresh._t1q is not first._t1q
+    other = GWJKRSurface(stats, 0.03, 1e10, z_max=4.0, resolution="fast")
+    assert other._t2 is not fresh._t2
+    d = np.linspace(-12.0, 4.5, 400) * stats.sigma
+    for zeta in (d, d - 0.5 * first.release_stretch, d - first.release_stretch):
+        for what in ("pressure", "energy", "contact_fraction"):
+            assert np.array_equal(getattr(shared, what)(d, zeta), getattr(fresh, what)(d, zeta)), what

@@ -19,11 +19,39 @@ from .gw_layout import (_BUILD_BLOCK, _DH, _DT_PANEL, _GL_W, _GL_X, _H_ZERO, _HE
 from .summits import _phi, _s_of_x, gw_integral
 
 
+#: Tables built in this process, by what they are a function of (`GWTables._table_key`): a sweep, a bisection or
+#: a regime estimate builds surfaces of the same summits again and again (a dozen per run, ~10 ms each).
+_BUILT: dict = {}
+#: Table sets kept (the oldest is dropped first): megabytes each at the standard resolution.
+MAX_KEPT = 16
+
+
 class GWTables:
     """Table building of `GWJKRSurface` (its constructor calls `_build`)."""
 
     # ------------------------------------------------------------------------------ build
+    def _table_key(self) -> tuple:
+        """Everything the tables depend on, all dimensionless (heights in sigma, the JKR window in delta_c): the
+        spacing multiplier, the truncation, the table ranges, lambda = delta_c / sigma, the release point x_r and
+        the detachment rule. Surfaces of the same key have the same tables bit for bit."""
+        return (self._scale, self.truncated, self._tmax, self._hlo, self._hlo2, self._ttop, self.adhesive,
+                self._lam, self._xr, self.detachment)
+
     def _build(self):
+        """Set the tables (the attributes `_build_tables` sets), built once per key in this process and shared,
+        read only, by every surface of that key."""
+        key = self._table_key()
+        tables = _BUILT.get(key)
+        if tables is None:
+            before = set(vars(self))
+            self._build_tables()
+            tables = {name: value for name, value in vars(self).items() if name not in before}
+            if len(_BUILT) >= MAX_KEPT:
+                _BUILT.pop(next(iter(_BUILT)))
+            _BUILT[key] = tables
+        vars(self).update(tables)
+
+    def _build_tables(self):
         dh = _DH * self._scale
         if self.truncated:
             self._umax = self._tmax - self._hlo
