@@ -478,7 +478,8 @@ def _md_origin(src: Source, res: dict, entry: dict) -> dict:
 
 def pulloff_validation(results: dict[str, dict]) -> dict:
     """F / (2 pi R) of each pull-off (DMT) against the flat-slab W_F of the same surfaces: the ratio and the
-    difference in units of the combined stderr. Validation only: nothing here enters the set."""
+    difference in units of the combined stderr, and Tabor's parameter of the pair from the current results
+    (:func:`_tabor`), which says how far DMT is the right limit. Validation only: nothing here enters the set."""
     out = {}
     for pull, adh in VALIDATION:
         rp, ra = results.get(pull), results.get(adh)
@@ -496,9 +497,26 @@ def pulloff_validation(results: dict[str, dict]) -> dict:
         out[pull] = {"F_over_2piR": v1, "F_over_2piR_stderr": e1 or None, "W_F": v2, "W_F_stderr": e2 or None,
                      "ratio": v1 / v2, "difference_in_stderr": (v1 - v2) / err if err > 0 else None,
                      "adhesion_recipe": adh, "residual_drag_N": drag.get("value"),
-                     "note": "pull-off F / (2 pi R) (DMT) against the flat-slab work of adhesion; validation only"}
+                     "note": "pull-off F / (2 pi R) (DMT) against the flat-slab work of adhesion; validation only",
+                     **_tabor(rp, qa, v2)}
     return out
 
+
+def _tabor(pull: dict, adhesion_q: dict, work: float) -> dict:
+    """Tabor's mu and Maugis' lambda of a pull-off (md.analysis.pulloff.tabor_parameter) from the current results:
+    R the pull-off's asperity radius, W the flat-slab W_F, z0 the flat-slab range, E* of silica on silica
+    (md.analysis.pulloff.SILICA_E_STAR_PA, a declared choice: the MD asperity's moduli are not measured). For an
+    OTS pair the layers are far more compliant than silica, so its mu is larger than this. Empty when a number
+    is missing."""
+    from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
+
+    radius_A = (pull.get("settings") or {}).get("asperity_radius_A")
+    z0 = (adhesion_q.get("interaction_range_z0") or {}).get("value")
+    if not radius_A or not z0 or not work > 0:
+        return {}
+    t = tabor_parameter(radius_A * 1e-10, work, SILICA_E_STAR_PA, z0)
+    return {"tabor_mu": t["mu"], "maugis_lambda": t["lambda"], "tabor_e_star_Pa": SILICA_E_STAR_PA,
+            "tabor_note": "R of the pull-off, W_F and z0 of the flat slabs, E* of silica on silica"}
 
 
 # ----------------------------------------------------------------------------- TOML writing

@@ -523,3 +523,18 @@ def test_the_sam_layer_modulus_is_derived_from_committed_windows_and_converted_t
     assert table2["surfaces"]["sam"]["layer_modulus"] == row["base_value"]
     assert table2["meta"]["rejected"]["surfaces.sam.layer_modulus"]["kept"] == "base set value"
 
+
+def test_pulloff_validation_carries_tabor_mu_of_the_current_results():
+    """mu = (R W^2 / (E*^2 z0^3))^(1/3) from the pull-off's radius and the flat slab's W_F and z0, with E* of silica
+    on silica: R = 1.5 nm, W = 0.196 J/m^2, z0 = 0.2075 nm give mu = 0.167 at E* = 37.0 GPa."""
+    from calibration.mdset import pulloff_validation
+    from md.analysis.pulloff import SILICA_E_STAR_PA
+
+    res = _results()
+    res["pulloff_silica"]["settings"] = {"asperity_radius_A": 15.0}
+    res["pulloff_silica"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.096, "stderr": 0.004}
+    res["adhesion_silica"]["quantities"]["work_of_adhesion_free_energy"]["value"] = 0.196
+    res["adhesion_silica"]["quantities"]["interaction_range_z0"] = {"value": 0.2075e-9, "stderr": 0.1e-9}
+    v = pulloff_validation(res)["pulloff_silica"]
+    mu = (1.5e-9 * 0.196 ** 2 / (SILICA_E_STAR_PA ** 2 * 0.2075e-9 ** 3)) ** (1 / 3)
+    assert v["tabor_mu"] == pytest.approx(mu, rel=1e-12) and v["maugis_lambda"] == pytest.approx(1.157 * mu, rel=1e-3)
