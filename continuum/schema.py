@@ -186,8 +186,9 @@ FIELDS: tuple[Field, ...] = (
           "strength; the flattening is carried into later impacts). 'auto': on when the first impact is faster "
           "than the yield velocity, off (recorded) when no yield key is given. Rough contact: 'auto' runs Thornton-Ning "
           "summits where their plasticity index psi = (E*/p_y) sqrt(sigma/beta) >= 0.6 (Greenwood & Williamson "
-          "1966) and they are JKR summits over a rigid substrate without bridges, in the mean field or discrete "
-          "(else elastic summits, recorded with psi).", "auto",
+          "1966) or the first impact's estimated depth passes their yield approach, and they are JKR summits over a "
+          "rigid substrate without bridges, in the mean field or discrete (else elastic summits, recorded with "
+          "psi).", "auto",
           choices=("auto", "on", "off")),
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",

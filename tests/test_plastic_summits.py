@@ -280,3 +280,26 @@ def test_plastic_roller_dissipates_more_and_remembers_the_spot():
         assert run.bounces[0].energy_lost == pytest.approx(run.bounces[0].energy_booked, rel=1e-5)
     lost = [r.bounces[0].energy_lost for r in (elastic, first, second)]
     assert lost[1] > 2.0 * lost[0] and lost[2] < 0.5 * lost[1]
+
+
+def test_auto_takes_plastic_summits_when_the_impact_reaches_their_yield_approach():
+    """psi < 0.6 (a hard surface) but an impact estimated deeper than a summit's yield approach delta_y (JKR centre
+    pressure = p_y at a_y, Thornton & Ning 1998) yields the tallest summits: 'auto' takes them, decided by the
+    depth; shallower, it stays elastic."""
+    from pathlib import Path
+
+    from continuum.model.decisions import plasticity_decision
+    from continuum.model.regime import summit_e_star
+    from continuum.scene import resolve_scene
+
+    hardness = 3.5e9
+    scene = resolve_scene(Path(__file__).resolve().parents[1] / "inputs" / "scenes" / "rough_silica.toml",
+                          overrides={"surfaces.substrate.hardness": hardness}).scene
+    rough, w, e_s = scene.surfaces.roughness, scene.surfaces.interface_work_of_adhesion, summit_e_star(scene)
+    a_y = float(tn.yield_radius(hardness, rough.summit_radius, w, e_s))
+    d_y = float(jkr.approach_from_radius(a_y, rough.summit_radius, w, e_s))
+    deep = plasticity_decision(scene, "jkr", 0.1, depth=1.5 * d_y).record()
+    shallow = plasticity_decision(scene, "jkr", 0.1, depth=0.5 * d_y).record()
+    assert deep["plasticity_index"] < 0.6 and deep["summit_yield_approach"] == pytest.approx(d_y, rel=1e-12)
+    assert deep["used"] and deep["decided_by"] == "estimated_depth" and deep["estimated_depth"] == 1.5 * d_y
+    assert not shallow["used"] and not shallow["summits_yield"] and shallow["decided_by"] == "plasticity_index"

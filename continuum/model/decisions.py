@@ -386,7 +386,11 @@ class PlasticityDecision:
     plasticity_index: float | None = None
     """Rough contact: the summits' Greenwood-Williamson psi = (E*/p_y) sqrt(sigma/beta) (`summit_plasticity`)."""
     summits_yield: bool | None = None
-    """Rough contact: what 'auto' decides from psi (True: plastic summits matter), whether or not they run."""
+    """Rough contact: what 'auto' decides from psi or the depth (True: plastic summits matter), run or not."""
+    summit_yield_approach: float | None = None
+    """Rough contact: the approach (m) at which a summit yields (JKR centre pressure = p_y)."""
+    estimated_depth: float | None = None
+    """Rough contact: the first impact's estimated depth below the tallest summit (m), where estimated."""
 
     def record(self) -> dict:
         rec: dict = {}
@@ -395,6 +399,7 @@ class PlasticityDecision:
                                for p in self.partners]
         if self.plasticity_index is not None:
             rec.update(plasticity_index=self.plasticity_index, summits_yield=self.summits_yield,
+                       summit_yield_approach=self.summit_yield_approach, estimated_depth=self.estimated_depth,
                        limiting_pressure=self.limiting_pressure, from_key=self.from_key,
                        thresholds={"elastic_below": PSI_ELASTIC, "plastic_above": PSI_PLASTIC},
                        source="Greenwood & Williamson, Proc. R. Soc. Lond. A 295 (1966) 300")
@@ -420,20 +425,28 @@ def _yield_values(scene: Scene) -> dict:
 PSI_ELASTIC, PSI_PLASTIC = 0.6, 1.0
 
 
-def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = False,
-                      menisci: bool = False) -> PlasticityDecision:
+def _summit_yield_approach(scene: Scene, limiting_pressure: float, e_s: float) -> float:
+    """Approach (m) at which a summit's JKR centre pressure reaches p_y (`thornton_ning.yield_radius`)."""
+    from ..reference import thornton_ning as tn
+    beta, w = scene.surfaces.roughness.summit_radius, scene.surfaces.interface_work_of_adhesion
+    a_y = float(tn.yield_radius(limiting_pressure, beta, w, e_s))
+    return float(jkr_ref.approach_from_radius(a_y, beta, w, e_s))
+
+
+def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = False, menisci: bool = False,
+                      depth: float | None = None) -> PlasticityDecision:
     """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
-    with the summits' E* (`summit_e_star`) and the softer partner's limiting pressure p_y (H, or 2.8 Y) decides.
+    (the summits' E*, `summit_e_star`; the softer partner's limiting pressure p_y, H or 2.8 Y) decides for the
+    surface under any practical load; the first impact's estimated depth below the tallest summit (`depth`, m,
+    `continuum.estimates`) beyond a summit's yield approach delta_y decides for an impact hard enough to yield
+    the tallest summits of an otherwise elastic surface.
 
     Where they yield, Thornton-Ning summits under a rigid roller run (`continuum.laws.plastic_rough`: the GW mean
     field, or the discrete realisation in mode 'discrete'); they are JKR summits over a rigid substrate without
     bridges, so under another summit law (`adhesion`), the half-space or menisci the summits stay elastic and the
-    record says why, as do ensemble members (elastic discrete realisations). A p_y below the summits' adhesive stress scale (they would yield on
-    snap-in, outside Thornton-Ning) is refused naming its key."""
-    from nanoimpact.errors import InputError
-
+    record says why, as do ensemble members (elastic discrete realisations). A p_y below the summits' adhesive
+    stress scale (they would yield on snap-in, outside Thornton-Ning) is refused naming its key."""
     from ..limiting_pressure import partner_limits, softer_partner
-    from ..reference import thornton_ning as tn
 
     limits = tuple(partner_limits(_yield_values(scene)))
     soft = softer_partner(list(limits))
@@ -443,37 +456,54 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     rough = scene.surfaces.roughness
     e_s = summit_e_star(scene)
     psi = e_s / soft.limiting_pressure * math.sqrt(rough.sigma / rough.summit_radius)
-    yields = psi >= PSI_ELASTIC
-    state = ("most summits yield" if psi > PSI_PLASTIC else "some summits yield") if yields else "summits stay elastic"
-    why = (f"auto: plasticity index psi = {psi:.3g} " + (">=" if yields else "<") + f" {PSI_ELASTIC} "
+    d_y = _summit_yield_approach(scene, soft.limiting_pressure, e_s)
+    by_psi, by_depth = psi >= PSI_ELASTIC, depth is not None and depth > d_y
+    yields = by_psi or by_depth
+    state = ("most summits yield" if psi > PSI_PLASTIC else "some summits yield") if by_psi else "summits stay elastic"
+    why = (f"auto: plasticity index psi = {psi:.3g} " + (">=" if by_psi else "<") + f" {PSI_ELASTIC} "
            f"(limiting contact pressure {soft.limiting_pressure:.3g} Pa from {soft.key}): {state}")
+    if depth is not None:
+        why += (f"; the first impact's estimated depth {depth:.3g} m " + (">" if by_depth else "<=")
+                + f" the summits' yield approach {d_y:.3g} m")
     blockers = [text for cond, text in (
         (adhesion != "jkr", f"the summit law is '{adhesion}' (Thornton-Ning summits are JKR summits)"),
         (half_space, "the half-space roller carries elastic summits only"),
         (menisci, "the bridges' law wraps elastic summits")) if cond]
     used = yields and not blockers
     if used:
-        w = scene.surfaces.interface_work_of_adhesion
-        p_a = float(tn.adhesive_stress_scale(rough.summit_radius, w, e_s))
-        if soft.limiting_pressure <= p_a:
-            raise InputError(soft.key, soft.value, f"gives a limiting contact pressure of {soft.limiting_pressure:.4g} "
-                             f"Pa, below the summits' adhesive stress scale E* a0/(pi beta) = {p_a:.4g} Pa (they "
-                             "would yield on snap-in, outside the Thornton-Ning law)")
+        _check_summit_limit(scene, soft, e_s)
         why += (": Thornton-Ning summits under a rigid roller, " + ("each summit of the realisation"
                 if rough.mode == "discrete" else "their GW mean field"))
         if rough.mode in ("auto", "ensemble"):
             why += " (ensemble members, where an ensemble runs, keep elastic summits)"
     elif yields:
         why += "; " + "; ".join(blockers) + ": this run is elastic and overestimates the rebound"
-    return PlasticityDecision(used, "plasticity_index", why, limiting_pressure=soft.limiting_pressure,
-                              from_key=soft.key, partners=limits, plasticity_index=psi, summits_yield=yields)
+    return PlasticityDecision(used, "plasticity_index" if by_psi or not by_depth else "estimated_depth", why,
+                              limiting_pressure=soft.limiting_pressure, from_key=soft.key, partners=limits,
+                              plasticity_index=psi, summits_yield=yields, summit_yield_approach=d_y,
+                              estimated_depth=depth)
+
+
+def _check_summit_limit(scene: Scene, soft, e_s: float) -> None:
+    """Raise InputError naming the partner's key unless p_y lies above the summits' adhesive stress scale E* a0/(pi
+    beta) (below it they would yield on snap-in, outside the Thornton-Ning law) and below their E*."""
+    from nanoimpact.errors import InputError
+
+    from ..reference import thornton_ning as tn
+    beta, w = scene.surfaces.roughness.summit_radius, scene.surfaces.interface_work_of_adhesion
+    try:
+        tn.check_limiting_pressure(soft.limiting_pressure, beta, w, e_s, key=soft.key)
+    except InputError as err:
+        raise InputError(soft.key, soft.value, f"gives a limiting contact pressure of {soft.limiting_pressure:.4g} "
+                         f"Pa for the summits; {err.allowed}") from None
 
 
 def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space: bool = False,
-                        menisci: bool = False) -> PlasticityDecision:
+                        menisci: bool = False, depth: float | None = None) -> PlasticityDecision:
     """Elastic-plastic smooth sphere or not, for the adhesion law that runs (`adhesion`) and the first impact's
     `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key. Rough
-    contact: `summit_plasticity` (with the half-space and menisci decisions)."""
+    contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
+    `depth`, m)."""
     from ..limiting_pressure import partner_limits, softer_partner
     from ..reference import thornton_ning as tn
 
@@ -481,7 +511,7 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
     if choice == "off":
         return PlasticityDecision(False, "scene", "physics.plasticity = 'off' set in the scene")
     if scene.contact == "rough":
-        return summit_plasticity(scene, adhesion, half_space, menisci)
+        return summit_plasticity(scene, adhesion, half_space, menisci, depth)
     if scene.body.shape != "sphere":
         return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; a smooth "
                                   "roller stays elastic (the line-contact yield warning says where it would yield)")

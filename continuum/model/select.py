@@ -178,7 +178,8 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         hs = half_space_decision(scene, regime)
         wet = menisci if menisci is not None else (m.choice == "on")
         law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, estimate=estimate, regime=regime)
-        plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet)
+        plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet,
+                                      depth=estimate.depth if estimate is not None else None)
         if plastic.used and scene.surfaces.roughness.mode == "discrete":
             law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure)
         elif plastic.used:
