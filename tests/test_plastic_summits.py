@@ -303,3 +303,18 @@ def test_auto_takes_plastic_summits_when_the_impact_reaches_their_yield_approach
     assert deep["plasticity_index"] < 0.6 and deep["summit_yield_approach"] == pytest.approx(d_y, rel=1e-12)
     assert deep["used"] and deep["decided_by"] == "estimated_depth" and deep["estimated_depth"] == 1.5 * d_y
     assert not shallow["used"] and not shallow["summits_yield"] and shallow["decided_by"] == "plasticity_index"
+
+
+@pytest.mark.parametrize("speed", [3.0, 10.0])
+def test_one_discrete_summit_in_the_driver_is_the_thornton_ning_impact(speed):
+    """A punch on one summit is a sphere of the summit's radius hitting a flat: the driver's restitution and booked
+    loss equal Thornton-Ning's closed-form impact (a sphere of that mass), to the integrator's tolerance."""
+    rho = 2330.0
+    mass = float(tn.sphere_mass(BETA, rho))
+    punch = PlasticSummitsPunch(PlasticSummitLaw(BETA, W, E, P_Y), [0.0])
+    run = simulate(punch, mass, 0.0, impact_velocity=speed, settings=DriverSettings(rtol=1e-10, max_bounces=1))
+    ref = tn.impact(speed, BETA, W, E, rho, P_Y)
+    b = run.bounces[0]
+    assert ref.yielded[0] and run.status == "escaped"
+    assert b.restitution == pytest.approx(ref.restitution[0], rel=1e-6)
+    assert b.energy_booked == pytest.approx(ref.plastic_loss[0] + ref.adhesive_loss[0], rel=1e-9)
