@@ -128,7 +128,8 @@ def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any, t
         summits = patch_summits(plan.field, offset, plan.footprint_half_width, member.body.length)
     law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
                                   plan.footprint_half_width, plan.summit_law, summits)
-    return member, law, offset
+    from .model.select import plastic_member     # Thornton-Ning summits where the scene's summits yield
+    return member, plastic_member(member, law, plan.speed), offset
 
 
 def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:

@@ -318,3 +318,21 @@ def test_one_discrete_summit_in_the_driver_is_the_thornton_ning_impact(speed):
     assert ref.yielded[0] and run.status == "escaped"
     assert b.restitution == pytest.approx(ref.restitution[0], rel=1e-6)
     assert b.energy_booked == pytest.approx(ref.plastic_loss[0] + ref.adhesive_loss[0], rel=1e-9)
+
+
+@pytest.mark.parametrize("hardness,name", [(8.3e9, "rough_roller_discrete_jkr"),
+                                           (0.25e9, "rough_roller_discrete_plastic")])
+def test_ensemble_members_take_the_scenes_summit_plasticity(hardness, name):
+    """An ensemble member's realisation runs plastic summits exactly where the mean field does."""
+    from pathlib import Path
+
+    from continuum.ensemble_run import member_law, member_plan
+    from continuum.model.regime import first_impact_speed
+    from continuum.scene import resolve_scene
+
+    resolved = resolve_scene(Path(__file__).resolve().parents[1] / "inputs" / "scenes" / "rough_silica.toml",
+                             overrides={"surfaces.substrate.hardness": hardness, "physics.half_space": "off"})
+    scene = resolved.scene
+    plan = member_plan(scene, first_impact_speed(scene))
+    _, law, _ = member_law(scene, 3, plan)
+    assert law.name == name

@@ -444,8 +444,9 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     Where they yield, Thornton-Ning summits under a rigid roller run (`continuum.laws.plastic_rough`: the GW mean
     field, or the discrete realisation in mode 'discrete'); they are JKR summits over a rigid substrate without
     bridges, so under another summit law (`adhesion`), the half-space or menisci the summits stay elastic and the
-    record says why, as do ensemble members (elastic discrete realisations). A p_y below the summits' adhesive
-    stress scale (they would yield on snap-in, outside Thornton-Ning) is refused naming its key."""
+    record says why; ensemble members take the same decision (`continuum.model.select.plastic_member`). A p_y below
+    the summits' adhesive stress scale (they would yield on snap-in, outside Thornton-Ning) is refused naming its
+    key."""
     from ..limiting_pressure import partner_limits, softer_partner
 
     limits = tuple(partner_limits(_yield_values(scene)))
@@ -475,7 +476,7 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
         why += (": Thornton-Ning summits under a rigid roller, " + ("each summit of the realisation"
                 if rough.mode == "discrete" else "their GW mean field"))
         if rough.mode in ("auto", "ensemble"):
-            why += " (ensemble members, where an ensemble runs, keep elastic summits)"
+            why += " (and each ensemble member's realisation, where an ensemble runs)"
     elif yields:
         why += "; " + "; ".join(blockers) + ": this run is elastic and overestimates the rebound"
     return PlasticityDecision(used, "plasticity_index" if by_psi or not by_depth else "estimated_depth", why,

@@ -5,6 +5,8 @@ resolution, cost checks) -> law (`factory`) -> record (`record`, result.json -> 
 """
 from __future__ import annotations
 
+import functools
+
 from ..estimates import check_table_cost
 from ..laws.base import ContactLaw
 from ..reference import jkr as jkr_ref
@@ -13,7 +15,7 @@ from . import factory
 from . import record as rec
 from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, half_space_decision,
                         menisci_decision, plasticity_decision, summit_law)
-from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of
+from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of, summit_e_star
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
@@ -160,6 +162,33 @@ def _with_work_of_adhesion(scene: Scene, w: float) -> Scene:
     if surf.sam is not None:
         return replace(scene, surfaces=replace(surf, sam=replace(surf.sam, work_of_adhesion=w)))
     return replace(scene, surfaces=replace(surf, work_of_adhesion=w))
+
+
+@functools.lru_cache(maxsize=16)
+def _members_plasticity(scene: Scene, speed: float):
+    """The summit-plasticity decision an ensemble's members share: that of the scene (any seed, mode 'discrete') at
+    first-impact `speed` (m/s), with its adhesion, half-space and impact-estimate decisions; once per process."""
+    regime = regime_of(scene, speed)
+    estimate = regime.estimate
+    return plasticity_decision(scene, adhesion_decision(scene, regime).law, speed,
+                               half_space=half_space_decision(scene, regime).used,
+                               depth=estimate.depth if estimate is not None else None)
+
+
+def plastic_member(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
+    """An ensemble member's discrete roller `law` with Thornton-Ning summits where the scene's summits yield
+    (`summit_plasticity`, decided as for the mean field), else `law` itself."""
+    from dataclasses import replace
+    surf = member.surfaces
+    keys = (surf.body.yield_strength, surf.body.hardness, surf.substrate.yield_strength, surf.substrate.hardness)
+    if member.contact != "rough" or member.physics.plasticity == "off" or all(k is None for k in keys):
+        return law
+    rough = member.surfaces.roughness
+    shared = replace(member, surfaces=replace(member.surfaces, roughness=replace(rough, seed=0)))
+    decision = _members_plasticity(shared, float(speed))
+    if not decision.used:
+        return law
+    return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure)
 
 
 def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None) -> tuple[ContactLaw, dict]:
