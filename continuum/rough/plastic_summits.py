@@ -105,8 +105,10 @@ class PlasticSummitLaw:
         over = np.maximum(dm - self.yield_approach, 0.0) if math.isfinite(self.yield_approach) else np.zeros_like(dm)
         yielded = over > 0.0
         w, e, beta = self.work_of_adhesion, self.e_star, self.radius
-        a = np.sqrt(self.yield_radius**2 + beta * over) if yielded.any() else np.ones_like(dm)
-        f = self.yield_force + self.plastic_slope * over if yielded.any() else np.zeros_like(dm)
+        if not yielded.any():
+            return np.full_like(dm, beta), np.zeros_like(dm)
+        a = np.sqrt(self.yield_radius**2 + beta * over)
+        f = self.yield_force + self.plastic_slope * over
         r_p = np.where(yielded, 4.0 * e * a**3 / (3.0 * (f + np.sqrt(8.0 * math.pi * w * e * a**3))), beta)
         d_p = np.where(yielded, dm - np.asarray(jkr.approach_from_radius(a, r_p, w, e), float), 0.0)
         return r_p, d_p
