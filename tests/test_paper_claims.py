@@ -256,6 +256,24 @@ def test_a_rows_sam_values_are_left_out_on_bare_silica_and_kept_on_ots_and_the_b
     assert "error" not in out and sorted(out["left_out"]) == sorted(left) and out["overrides"] == row
 
 
+def test_a_sigma_whose_escape_search_is_refused_leaves_only_the_escape_trend_undecided(monkeypatch):
+    """The law refuses a bracket speed at 30 nm (its footprint tables would cost too much): that sigma has no
+    escape velocity and says why, the others stand, and the trend is not evaluable with the reason."""
+    from continuum.paper import samples
+    from continuum.scene import SceneError
+
+    def search(law, mass, g, v0, rtol, *a):
+        if law.surface.stats.sigma > 20e-9:
+            raise SceneError("surfaces.roughness.sigma", 3e-8, "tables too costly")
+        return {"escape_velocity": 1e-3 / law.surface.stats.sigma ** 0.5 * 1e-4}
+
+    monkeypatch.setattr(samples, "escape_search", search)
+    esc = samples._escape_over_sigma("paper", {}, "fast", {"escape_velocity": 1e-3 / 6e-9 ** 0.5 * 1e-4})
+    assert "tables too costly" in esc[max(esc)]["reason"] and all(esc[x]["escape_velocity"] for x in sorted(esc)[:-1])
+    e = checks.escape_trend("t", list(esc.items()))
+    assert e["state"] == NOT_EVALUABLE and "sigma 30 nm: refused" in e["reason"]
+
+
 # ------------------------------------------------------------------------------ one physical case
 def test_a_sam_that_adheres_more_than_bare_silica_fails_the_sam_claims():
     """The paper set with the OTS work of adhesion raised above bare silica's (0.3 > 0.12 J/m^2): OTS's adhesive
