@@ -81,14 +81,17 @@ def scene_override(text: str) -> tuple[str, object]:
 
 
 def ensemble_summary(ens: dict) -> str:
-    """Two lines on an ensemble: stick probabilities, rebound counts and first rebounds (median, 5-95 %)."""
+    """Two lines on an ensemble: stick probabilities, rebound counts and first rebounds (median, 5-95 %); a third
+    with the members' escape velocities where the scene asked for them."""
     p, r = ens["stick_probability"], ens["rebounds"]
     first = ens.get("first_rebound_over_h0") or ens["first_rebound_m"]
     unit = "h0" if "first_rebound_over_h0" in ens else "m"
+    v = (ens.get("escape_velocity") or {}).get("m_per_s")
+    escape = (f"\n  escape velocity median {v['p50']:.3g} m/s (5-95 %: {v['p5']:.3g}-{v['p95']:.3g})" if v else "")
     return (f"ensemble of {ens['members']} realisations (master seed {ens['master_seed']}, {ens['wall_s']:.2f} s): "
             f"stick probability {p['first_impact']['value']:.3f} at the first impact, {p['within_run']['value']:.3f} "
             f"within the run\n  rebounds median {r['p50']:g} (5-95 %: {r['p5']:g}-{r['p95']:g}); first rebound median "
-            f"{first['p50']:.3g} {unit} (5-95 %: {first['p5']:.3g}-{first['p95']:.3g})")
+            f"{first['p50']:.3g} {unit} (5-95 %: {first['p5']:.3g}-{first['p95']:.3g})" + escape)
 
 
 def cmd_impact(args) -> int:

@@ -315,10 +315,14 @@ def test_without_the_scene_key_the_ensemble_says_no_escape_velocities_were_asked
     assert all(o.escape is None for o in ens.outcomes) and np.isnan(ens.escape_velocities()).all()
 
 
-def test_the_ensemble_figure_shows_the_escape_velocity_spread():
+def test_the_ensemble_figure_and_summary_show_the_escape_velocity_spread():
     from continuum import plots
+    from continuum.cli import ensemble_summary
 
     scene = _scene(**{"numerics.max_bounces": 1})
     with_escape = run_ensemble(scene, members=3, seed=2, escape=True, escape_rel_tol=0.1).to_record()
+    without = run_ensemble(scene, members=2, seed=2).to_record()
     assert len(plots.ensemble_spread(with_escape).figure.axes) == 2
-    assert len(plots.ensemble_spread(run_ensemble(scene, members=2, seed=2).to_record()).figure.axes) == 1
+    assert len(plots.ensemble_spread(without).figure.axes) == 1
+    assert "escape velocity median" in ensemble_summary(with_escape)
+    assert "escape velocity" not in ensemble_summary(without)
