@@ -220,9 +220,14 @@ def _acceptance_text(a: Mapping[str, Any], probe: Mapping[str, Any] | None) -> s
         decides = [f"{w} ({kind.get(k, 'origin not given')})" for w, k, on in
                    (("the compliant layer", LAYER, stiff and stiff["loop_ratio"] < 1), ("the summit radius", RADIUS,
                                                                                          cross)) if on]
-        text += (" Probed: " + "; ".join(parts) + ". " +
-                 (f"It is decided by {' and '.join(decides)}." if decides else
-                  "Neither the layer nor the summit radius alone restores it."))
+        if probe["loop_ratio"] < 1:
+            verdict_text = ("With the set's own values the loop of OTS is the smaller; the samples' inputs carry "
+                            "the ratio across 1 (its band in `paper-checks.json`).")
+        elif decides:
+            verdict_text = f"It is decided by {' and '.join(decides)}."
+        else:
+            verdict_text = "Neither the layer nor the summit radius alone restores it."
+        text += " Probed: " + "; ".join(parts) + ". " + verdict_text
     return text
 
 

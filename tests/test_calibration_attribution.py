@@ -191,6 +191,8 @@ def test_the_report_says_per_claim_whether_it_is_accepted_with_its_sample_fracti
     assert text.startswith("**Acceptance:** not accepted (holds on 0.00 of 17 samples)")
     assert "0.0002 with the SAM layer as stiff as its substrate" in text and "between 0.5 and 0.8 um" in text
     assert "decided by the compliant layer (md) and the summit radius (chosen)" in text
+    holds = _acceptance_text(a, dict(probe, loop_ratio=0.1))
+    assert "decided by" not in holds and "the loop of OTS is the smaller" in holds
 
 
 def test_a_compliant_sam_layer_raises_the_ots_loop():
