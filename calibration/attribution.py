@@ -202,7 +202,8 @@ def explain_claims(calibrated: Iterable[Mapping], base: Iterable[Mapping],
 
 def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]], paper_checks: Iterable[Mapping],
                      set_name: str, base_name: str, out: str | Path, *, executor=None,
-                     progress: Callable[[str], None] | None = None, set_path: str | None = None) -> dict:
+                     progress: Callable[[str], None] | None = None, set_path: str | None = None,
+                     uncertainty_rows: list[Mapping] | None = None) -> dict:
     """Run the reverts a failing claim needs and explain every claim that fails with `set_name`.
 
     `table` is the calibrated set as written, `rows` its value rows, `paper_checks` the claims of the paper step
@@ -241,7 +242,9 @@ def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]]
             k: (origin.get(k) or {}).get("kind", "origin not given")
             for k in ("surfaces.sam.layer_modulus", "surfaces.roughness.summit_radius")})
     return {"reverts": [g.to_dict() for g in groups], "claims": [w.to_dict() for w in whys],
-            "ran": bool(by_revert), "acceptance": acceptance(cal, whys, groups), "choices": choices}
+            "ran": bool(by_revert), "choices": choices,
+            "acceptance": acceptance(cal, whys, groups, uncertainty_rows,
+                                     ((table.get("meta") or {}).get("calibration") or {}).keys())}
 
 
 def _direction(claim: str, g: Revert) -> tuple[bool | None, str]:
@@ -261,12 +264,50 @@ def _direction(claim: str, g: Revert) -> tuple[bool | None, str]:
     return None, f"no declared physical direction for {g.label} on this claim"
 
 
+#: Rank correlation (Spearman) of a measured input with a claim's margin over the uncertainty rows above which
+#: the input is named as what carries the claim across its threshold (a declared choice: |rho| >= 0.5 is a
+#: strong monotone association for 16 rows).
+RANK_CORRELATION = 0.5
+
+
+def _through_uncertainty(c: Mapping, rows: list[Mapping] | None, measured: Iterable[str]) -> tuple[bool, str] | None:
+    """A claim that holds on its own runs and fails over the Latin-hypercube rows: the measured input whose
+    sampled values rank-correlate most with the claim's margin over the rows (scipy.stats.spearmanr), and whether
+    the sign is the one physics predicts (PHYSICAL_DIRECTION). None without rows or decided row margins."""
+    from scipy.stats import spearmanr
+
+    if not rows:
+        return None
+    pairs = [(rows[int(m["label"].split()[-1]) - 1], m["margin"]) for m in c.get("sample_margins", [])
+             if m["label"].startswith("uncertainty") and m["margin"] is not None and m["state"] != "not_evaluable"]
+    if len(pairs) < 5:
+        return None
+    margins = [max(min(m, 1e300), -1e300) for _, m in pairs]      # stuck impacts give -inf: the rank is what counts
+    rho = {k: float(spearmanr([r[k] for r, _ in pairs], margins)[0]) for k in measured
+           if all(k in r for r, _ in pairs)}
+    rho = {k: v for k, v in rho.items() if v == v}
+    if not rho:
+        return None
+    key = max(rho, key=lambda k: abs(rho[k]))
+    declared = PHYSICAL_DIRECTION.get(c["name"], {}).get(key)
+    text = f"over {len(pairs)} rows the margin follows the measured `{key}` most (rank correlation {rho[key]:+.2f})"
+    if abs(rho[key]) < RANK_CORRELATION:
+        return False, text + f", below {RANK_CORRELATION:g}: no measured value carries it"
+    if declared is None:
+        return False, text + ", a direction physics declares none for"
+    ok = bool((rho[key] > 0) == (declared > 0))
+    return ok, text + (", the direction physics predicts" if ok else ", the opposite of what physics predicts")
+
+
 def acceptance(calibrated: Iterable[Mapping], whys: Iterable[ClaimWhy | Mapping],
-               groups: Iterable[Revert]) -> list[dict]:
+               groups: Iterable[Revert], rows: list[Mapping] | None = None,
+               measured: Iterable[str] = ()) -> list[dict]:
     """Per claim that fails with the calibrated set: accepted when it fails through measured values only, i.e. one
     MD value put back alone restores it (cause 'single') and the direction is the one physics predicts
-    (`_direction`); otherwise not accepted, with the reason. Each entry carries the claim's holds_fraction and
-    sample count. Pure."""
+    (`_direction`), or it holds on its own runs and fails over the uncertainty rows (`rows`, the overrides of
+    'uncertainty i' in order) through one measured input's spread (`_through_uncertainty`, over the `measured`
+    keys) in that direction; otherwise not accepted, with the reason. Each entry carries the claim's
+    holds_fraction and sample count. Pure."""
     by = {c["name"]: c for c in calibrated}
     groups = {g.label: g for g in groups}
     out = []
@@ -275,7 +316,10 @@ def acceptance(calibrated: Iterable[Mapping], whys: Iterable[ClaimWhy | Mapping]
         c = by.get(w["claim"], {})
         entry = {"claim": w["claim"], "accepted": False, "holds_fraction": c.get("holds_fraction"),
                  "samples": c.get("samples"), "cause": w["cause"]}
-        if w["cause"] != "single":
+        spread = _through_uncertainty(c, rows, list(measured)) if w["cause"] == "samples" else None
+        if spread is not None:
+            entry["accepted"], entry["why"] = spread[0], "holds on the set's own runs; " + spread[1]
+        elif w["cause"] != "single":
             entry["why"] = {"base fails too": "fails with the base set too: not a measured value's doing",
                             "several": "no single measured value put back restores it",
                             "samples": "holds on the set's own runs: the spread over its samples fails it",

@@ -570,13 +570,15 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         keys, samples = sample_inputs(table["meta"].get("calibration", {}), cal.uncertainty.ranges,
                                       cal.uncertainty.samples, cal.uncertainty.seed)
         # the new set's claims judged over the calibration's own Latin-hypercube rows and the discrete seeds
+        rows_paper = paper_uncertainty(cal.uncertainty, samples, set_path)
         paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None,   # the user's executor
-                           seeds=DEFAULT_SEEDS, uncertainty=paper_uncertainty(cal.uncertainty, samples, set_path))
+                           seeds=DEFAULT_SEEDS, uncertainty=rows_paper)
         timings["paper_s"] = time.perf_counter() - t
         # 3b. why a claim that holds with the base set fails with the new one: each MD value put back alone
         t = time.perf_counter()
         attribution = attribute_claims(table, rows, paper["checks"], Path(set_path).stem, Path(cal.base).stem,
-                                       out / "attribution", executor=ex, progress=progress, set_path=str(set_path))
+                                       out / "attribution", executor=ex, progress=progress, set_path=str(set_path),
+                                       uncertainty_rows=rows_paper[Path(set_path).stem])
         timings["attribution_s"] = time.perf_counter() - t
         # 4. uncertainty
         t = time.perf_counter()

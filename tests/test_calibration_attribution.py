@@ -206,3 +206,26 @@ def test_a_compliant_sam_layer_raises_the_ots_loop():
     assert soft > 10 * stiff
     small, large = ({"surfaces.roughness.summit_radius": r} for r in (0.1e-6, 1e-6))
     assert loop_ratio("calibrated", large, large) < loop_ratio("calibrated", small, small)
+
+
+def test_a_claim_failing_over_its_rows_is_accepted_when_a_measured_inputs_spread_carries_it_the_physical_way():
+    """Fig 4's loop over six Latin-hypercube rows: the margin falls as silica's measured range z0 rises (a longer
+    range lowers the summits' Tabor parameter and silica's loop), rank correlation -1: accepted; the same margins
+    rising with z0 would be the opposite of physics: not accepted. A user range (sigma) is never named."""
+    from calibration.attribution import acceptance
+
+    name = "fig4_ots_loop_smaller_than_silica"
+    z0 = [0.1e-9, 0.15e-9, 0.2e-9, 0.25e-9, 0.3e-9, 0.4e-9]
+    rows = [{"surfaces.interaction_range": z, "surfaces.roughness.sigma": 6e-9 + 1e-10 * (i % 2)}
+            for i, z in enumerate(z0)]
+    for sign, accepted in ((-1, True), (+1, False)):
+        c = {"name": name, "pass": False, "state": "fail", "nominal_state": "pass", "holds_fraction": 0.5,
+             "samples": 7, "reason": "holds on 3 of 7",
+             "sample_margins": [{"label": f"uncertainty {i + 1}", "margin": sign * (z - 0.25e-9) * 1e10,
+                                 "state": "pass" if sign * (z - 0.25e-9) > 0 else "fail"} for i, z in enumerate(z0)]}
+        why = explain_claims([c], _named("paper", {name: True}), {}, ())
+        (a,) = acceptance([c], why, (), rows, ["surfaces.interaction_range", "surfaces.work_of_adhesion"])
+        assert a["cause"] == "samples" and a["accepted"] is accepted, a
+        assert "`surfaces.interaction_range`" in a["why"] and f"{sign:+.2f}" in a["why"]
+    (none,) = acceptance([c], why, (), None, ["surfaces.interaction_range"])
+    assert none["accepted"] is False and "spread over its samples" in none["why"]

@@ -153,6 +153,8 @@ def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> li
                                                                           if p[name].get("reason") else {})}
                    for p, b in zip(per, samples) if p[name]["state"] == FAIL
                    and not (name in FULL_ONLY and b.get("seed"))]
+        e["sample_margins"] = [{"label": b["label"], "margin": p[name]["margin"], "state": p[name]["state"]}
+                               for p, b in zip(per, samples) if not (name in FULL_ONLY and b.get("seed"))]
         if failing:
             e["failing_samples"] = failing
             if e["state"] == FAIL and nom[name]["state"] != FAIL:
