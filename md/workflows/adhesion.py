@@ -502,8 +502,10 @@ class _AdhesionAnalysis:
             f"height {self.zc:.2f} A; chains: each window continues from its neighbour): dF/A = {wf:.4f} +/- "
             f"{wf_err:.4f} J/m^2 (trapezoid from the zero-force point {self.ti['zero_force_separation_A']:+.2f} A; "
             f"PCHIP gives {self.wf_pchip:.4f}, grid error {self.wf_disc:.4f}: the larger of the two quadratures' "
-            f"difference and the largest interval bound 1/2 |df| dd over the detachment region); T dS/A of registry "
-            f"0 (its contact leg's dE against its own chain's W_F) = {self.tds:.4f} +/- {self.tds_err:.4f} J/m^2. "
+            f"difference and the largest interval bound 1/2 |df| dd over the detachment region); T dS/A of "
+            f"registr{'y' if len(self.tds_rec['registries']) == 1 else 'ies'} "
+            f"{', '.join(map(str, self.tds_rec['registries']))} (each zero-load contact's dE against its own "
+            f"chain's W_F) = {self.tds:.4f} +/- {self.tds_err:.4f} J/m^2. "
             f"The stderr is statistical with the chained windows' errors correlated (lag-1 rho = {self.rho:.2f} from "
             f"the replicate chains), and at least the registries' spread of W_F times the Student-t factor of "
             f"{n_reg} registries; the discretisation error is given beside it."]
