@@ -41,8 +41,10 @@ class Bounce:
     """One impact. Times in s, speeds in m/s (magnitudes), forces in N, lengths in m, energies in J.
 
     `max_penetration` is the largest approach -h reached (m); `rebound_height` is the apex of the
-    following flight above the contact datum (None if the body escapes without gravity or stays
-    stuck); `energy_lost` is the mechanical energy lost over the contact, from the motion;
+    following flight above the touch level (the law's `touch_gap`, where the contact starts and
+    from which `simulate`'s release height is measured: a first impact from rest rebounds to
+    release height - energy_lost / (m g), so a rebound above the release height would mean energy
+    created; None if the body escapes without gravity or stays stuck); `energy_lost` is the mechanical energy lost over the contact, from the motion;
     `energy_booked` is what the law's own loss terms booked over the same contact.
     """
 
@@ -132,7 +134,8 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
              progress: Callable[[Bounce], None] | None = None) -> ImpactRun:
     """Drop or throw a body of `mass` (kg) onto the surface described by `law`.
 
-    Give `release_height` (m above the datum, from rest) or `impact_velocity` (m/s at touch).
+    Give `release_height` (m above the touch level `law.touch_gap`, from rest) or `impact_velocity` (m/s at
+    touch).
     """
     if (release_height is None) == (impact_velocity is None):
         raise ValueError("give exactly one of release_height and impact_velocity")
@@ -317,7 +320,7 @@ class _ContactRun:
         free = end is None
         rebound = None
         if free and gravity > 0.0:
-            rebound = gap_end + v_end * v_end / (2.0 * gravity)
+            rebound = gap_end + v_end * v_end / (2.0 * gravity) - self.law.touch_gap
         b = Bounce(index=self.index, t_contact=t0, t_release=t_end if free else None,
                    duration=(t_end - t0) if free else None, v_impact=speed,
                    v_rebound=abs(v_end) if free else 0.0,
