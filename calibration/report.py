@@ -282,7 +282,9 @@ def report_markdown(rec: CalibrationReport) -> str:
                   for c in differ]
         n_acc = sum(a["accepted"] for a in accept.values())
         lines += ["", f"**Accepted failures:** {n_acc} of {len(differ)} (a failure is accepted when one measured value "
-                      "put back alone restores the claim and the measured value moved it the way physics predicts, "
+                      "put back alone restores the claim, or, for a claim that holds on the set's own runs, one "
+                      "measured input's spread over the Latin-hypercube rows carries it across (|Spearman rho| >= "
+                      "0.5 with its margin), in the direction physics predicts: "
                       "`calibration.attribution.PHYSICAL_DIRECTION`)."]
     b = rec.bands
     lines += ["", "## Uncertainty", "",
