@@ -6,6 +6,7 @@ the packages is nanoimpact's own source tree (its pyproject.toml and inputs/ bes
 """
 from __future__ import annotations
 
+import functools
 import subprocess
 from pathlib import Path
 
@@ -25,8 +26,14 @@ def source_checkout() -> Path | None:
 def git_commit() -> str | None:
     """HEAD of the source checkout (with '+dirty' if tracked files have uncommitted changes), or None."""
     root = source_checkout()
-    if root is None:
-        return None
+    return None if root is None else _commit_of(root)
+
+
+@functools.lru_cache(maxsize=4)
+def _commit_of(root: Path) -> str | None:
+    """`git_commit` of the checkout at `root`, asked once per process: the code a process runs is what it imported
+    when it started, so the first answer is the one its records should carry; a process pool forked after a first
+    call inherits it instead of starting two git processes per run."""
     try:
         head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
                               timeout=5)
