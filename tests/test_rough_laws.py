@@ -98,3 +98,31 @@ def test_mean_plane_datum_shifts_the_release_by_the_tallest_summit_or_refuses():
     with pytest.raises(SceneError, match="start in contact"):
         run_impact(resolve_scene(SILICA, overrides={**base, "surfaces.roughness.datum": "mean_plane",
                                                     "release_height": 0.5 * z_top}))
+
+
+def test_footprint_tables_of_the_compiled_quadrature_are_the_numpy_quadratures():
+    """A rigid roller's whole footprint tables on Maugis-Dugdale summits (the paper's calibrated sets' summits), built
+    by the compiled quadrature (whole panels read once-computed node values, cut panels interpolate per state) and
+    by its NumPy reference form (`GWBranchSurface._integrals_numpy`, every node interpolated): the same panels,
+    nodes and interpolation, so the tables agree to the round-off of a few hundred terms (1e-12 of their largest
+    value), far inside the tables' own spline error (docs/model.md)."""
+    import numpy as np
+
+    from continuum.rough.branch_laws import make_summit_law
+    from continuum.rough.gw_branches import GWBranchSurface
+    from continuum.rough.summits import SummitStatistics
+
+    sigma, beta = 6e-9, 0.2e-6
+    law = make_summit_law("maugis_dugdale", beta, 0.12, 30e9, z0=0.3e-9, delta_max=30 * sigma)
+    tables = []
+    for form in ("compiled", "numpy"):
+        surface = GWBranchSurface(SummitStatistics(sigma, 1e13, beta), law, z_max=4.07)
+        if form == "numpy":
+            surface._integrals = surface._integrals_numpy
+        roller = RigidRoughRoller(surface, 5e-6, 3.28e-3, resolution="fast")
+        roller._shared_key = None              # built here, not read from the other form's shared tables
+        roller._build(1.5 * sigma)
+        tables.append((roller._force.get_coeffs(), roller._energy.get_coeffs(), roller._count.c))
+    for ours, ref in zip(*tables):
+        assert np.max(np.abs(ref)) > 0
+        np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
