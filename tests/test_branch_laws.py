@@ -69,6 +69,19 @@ def test_maugis_dugdale_branches_meet_at_the_edge_of_contact():
         assert float(p) * p_s == pytest.approx(-math.pi * sigma0 * c_e**2, rel=1e-5, abs=0)
 
 
+@pytest.mark.parametrize("lam", [0.05, 1.0, 30.0])
+def test_one_maugis_solve_gives_force_approach_and_m(lam):
+    """`md_solution` (one root per radius, what the Maugis-Dugdale summit law is built from) is
+    `md_force_and_approach` and `md_m_of_A` (a root each), number for number, with m = c/a >= 1."""
+    A = np.geomspace(1e-6, 30.0, 60)
+    p, d, m = md_ref.md_solution(A, lam)
+    p2, d2 = md_ref.md_force_and_approach(A, lam)
+    np.testing.assert_array_equal(p, p2)
+    np.testing.assert_array_equal(d, d2)
+    np.testing.assert_array_equal(m, md_ref.md_m_of_A(A, lam))
+    assert np.all(m >= 1.0)
+
+
 @pytest.mark.parametrize("z0", [0.05e-9, 0.3e-9, 1e-9, 8e-9])
 def test_maugis_dugdale_pull_off_matches_the_reference_solution(z0):
     law = _law("maugis_dugdale", z0)

@@ -182,10 +182,15 @@ def md_m_of_A(A, lam):
     return _out(np.sqrt(1.0 + t * t))
 
 
-def _pd(A, lam):
+def _pdt(A, lam):
     t = _t_of_A(A, lam)
     _, _, _, _, b3 = _brackets(t)
-    return A**3 - lam * A * A * b3, A * A - 4.0 / 3.0 * lam * A * t
+    return A**3 - lam * A * A * b3, A * A - 4.0 / 3.0 * lam * A * t, t
+
+
+def _pd(A, lam):
+    p, d, _ = _pdt(A, lam)
+    return p, d
 
 
 def md_force_and_approach(A, lam):
@@ -198,6 +203,15 @@ def md_force_and_approach(A, lam):
     f = np.vectorize(lambda x: _pd(float(x), float(lam)), otypes=[float, float])
     p, d = f(A)
     return _out(p), _out(d)
+
+
+def md_solution(A, lam):
+    """(Pbar, Dbar, m) at normalised contact radii A > 0: `md_force_and_approach` and `md_m_of_A` from one root of
+    Maugis' equation per A (the same numbers; a tabulated summit law needs all three at ~2000 radii)."""
+    A = np.asarray(A, float)
+    f = np.vectorize(lambda x: _pdt(float(x), float(lam)), otypes=[float, float, float])
+    p, d, t = f(A)
+    return _out(p), _out(d), _out(np.sqrt(1.0 + t * t))
 
 
 def md_curve(radius, work_of_adhesion, e_star, sigma0, n=200, A_min=1e-3, A_max=3.0):

@@ -43,7 +43,7 @@ Models (SI; E* Johnson's contact modulus, dgamma Dupre's work of adhesion)
 * A SAM as a compliant layer on each summit does not enter here: the laws take the coated summits' contact
   modulus E* (``continuum.physics.coated``, ``continuum.model.regime.coated_summits``).
 
-Cost: building a Maugis-Dugdale law solves Maugis' equation at ~2000 contact radii (~0.2 s); JKR and
+Cost: building a Maugis-Dugdale law solves Maugis' equation once at each of ~2000 contact radii (~0.1 s); JKR and
 DMT are closed form. Branches are tabulated on ~4000 points and evaluated by linear interpolation
 (measured error against the closed forms: tests/test_branch_laws.py).
 """
@@ -304,8 +304,8 @@ def maugis_dugdale_law(beta, w, e_star, z0, *, delta_max, n_contact=2000, n_free
     p_nc = -math.pi * sigma0 * c * c
     a_top = math.sqrt((delta_max + 4 * d_s) / d_s) * 1.2 + 2.0          # A with Dbar ~ A^2 beyond delta_max
     A = _radii(a_top, 1e-6, n_contact)
-    pbar, dbar = md_ref.md_force_and_approach(A, lam)
-    m = np.asarray(md_ref.md_m_of_A(A, lam), float)
+    pbar, dbar, m = md_ref.md_solution(A, lam)
+    m = np.asarray(m, float)
     p_c = np.asarray(pbar, float) * p_s
     cz = m * A * a_s
     d_c = np.asarray(dbar, float) * d_s
