@@ -63,6 +63,22 @@ def test_paper_output_has_figures_data_summary_and_case_results(paper_run):
     assert "Parameter set `paper`" in summary and "Verification (" in summary and "Reproduction (" in summary
     result = json.loads((out / "cases" / "rough_silica" / "paper" / "result.json").read_text())
     assert result["schema_version"] == "2.0" and result["n_bounces"] >= 2
+    # a case's own figures only on request; the summary says where they go and how to get them
+    case = out / "cases" / "rough_silica" / "paper"
+    assert (case / "timeseries.csv").is_file() and not list(case.glob("*.png"))
+    assert "`nanoimpact paper --case-figures`" in summary and "cases/<case>/<set>/" in summary
+
+
+def test_a_case_draws_its_own_figures_on_request(tmp_path):
+    """`case_figures` (`nanoimpact paper --case-figures`): the impact run writes what `nanoimpact impact` writes."""
+    from continuum.paper.cases import dry_cases
+    from continuum.paper.run import _impact_task
+
+    hertz = next(c for c in dry_cases() if c.name == "hertz")
+    item = _impact_task(hertz, "paper", None, str(tmp_path), figures=True)
+    names = {p.name for p in (tmp_path / "cases" / "hertz" / "paper").iterdir()}
+    assert {"result.json", "timeseries.csv", "height.png", "impacts.png"} <= names, names
+    assert item["result"]["n_bounces"] >= 1
 
 
 def test_the_calibration_judges_its_new_sets_claims_on_its_own_latin_hypercube_rows():

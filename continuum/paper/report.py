@@ -177,7 +177,7 @@ def claim_tables(set_checks: list[dict]) -> list[str]:
 def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, workers: int | None = None,
                executor_name: str = "processes", scheduler: str | None = None, executor=None,
                progress: Callable[[str], None] = print, draw_figures: bool = True, seeds: int = 0,
-               uncertainty: dict[str, list[dict]] | None = None) -> dict:
+               uncertainty: dict[str, list[dict]] | None = None, case_figures: bool = False) -> dict:
     """Run every case for every set into `out`; returns {"checks": [...], "wall_s": ...}.
 
     The sampled reproduction claims run on the nominal set, on `seeds` discrete-summit seeds per set (the command
@@ -186,7 +186,8 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
     `samples.read_uncertainty_csv` of a calibration's uncertainty.csv, or the calibration's own draws).
 
     `draw_figures=False` draws none of Figs 4-8b (the claims, summary.md and checks.json are the same): for callers
-    that want the claims alone, such as the calibration's claim attribution.
+    that want the claims alone, such as the calibration's claim attribution. `case_figures=True` also draws each
+    impact case's own height.png and impacts.png beside its result.json (`nanoimpact paper --case-figures`).
 
     Where the runs go: `executor` (an open nanoimpact.executors object, e.g. the calibration's), else a new
     `executor_name` executor with `workers` and `scheduler` (default: a local pool of CPU-count processes)."""
@@ -209,7 +210,8 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
 
     collected = run_paper(sets, out, fidelity=fidelity, workers=workers, executor_name=executor_name,
                           scheduler=scheduler, executor=executor, progress=progress,
-                          on_set_done=draw if draw_figures else None, seeds=seeds, uncertainty=uncertainty)
+                          on_set_done=draw if draw_figures else None, seeds=seeds, uncertainty=uncertainty,
+                          case_figures=case_figures)
     all_checks, summary = [], ["# nanoimpact paper: dry, wet and SAM cases", "",
                                f"Parameter sets: {', '.join(sets)}; fidelity: {fidelity or 'scene default'}. "
                                "h0 = release height; a rebound counts if it rises above 1e-3 h0.", ""]
@@ -224,6 +226,9 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
         summary += ["Escape velocities (m/s): " + ", ".join(f"{c} {_fmt(v)}" for c, v in sorted(esc.items())), ""]
         summary += wet_lines(set_name, wet, impacts) + [""]
     wall = time.perf_counter() - start
+    summary += [("Each case's own figures (height.png, impacts.png) are in cases/<case>/<set>/ beside its result.json."
+                 if case_figures else "Each case's result.json and timeseries.csv are in cases/<case>/<set>/; its own "
+                 "figures (height.png, impacts.png) are drawn there with `nanoimpact paper --case-figures`."), ""]
     summary += [f"Total wall time {wall:.1f} s (runs {collected['total_wall_s']:.1f} s).", ""]
     record = {"checks": all_checks, "sets": sets, "fidelity": fidelity, "wall_s": wall, "seeds": seeds,
               "uncertainty_samples": {k: len(v) for k, v in (uncertainty or {}).items()},

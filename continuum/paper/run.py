@@ -1,7 +1,8 @@
 """Run the paper's cases for each parameter set, in parallel, and write everything into one folder.
 
 Layout of `--out DIR`:
-    cases/<case>/<set>/result.json (+ timeseries.csv, height.png, impacts.png)   the impact schema
+    cases/<case>/<set>/result.json, timeseries.csv                              the impact schema
+                       (+ height.png, impacts.png with `case_figures`, `nanoimpact paper --case-figures`)
     fig4.png fig5a.png fig5b.png fig6.png fig7.png fig8a.png                       figures
     data/fig*.csv                                                                  the data behind them
     summary.md                                                                     per case and set
@@ -26,6 +27,7 @@ from .. import menisci as men
 from ..compiled_contact import warm_up
 from ..escape import single_impact
 from ..impact import first_impact_speed, run_impact, write_impact
+from ..results import write_run
 from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
@@ -64,11 +66,17 @@ def resolve_case(case: Case, params: str, fidelity: str | None) -> ResolvedScene
     return resolve_scene(case.path, params=params, overrides=overrides, override_label=f"paper case {case.name}")
 
 
-def _impact_task(case: Case, params: str, fidelity: str | None, out: str) -> dict:
+def _impact_task(case: Case, params: str, fidelity: str | None, out: str, figures: bool = False) -> dict:
+    """One dry or wet case's impact run, written as `nanoimpact impact` writes it; its own diagnostic figures
+    (height.png, impacts.png: ~0.15 s of matplotlib per case, a tenth of the paper command's CPU over its 36
+    runs, and no paper figure reads them) only with `figures`."""
     resolved = resolve_case(case, params, fidelity)
     result, trace = run_impact(resolved)
     folder = Path(out) / "cases" / case.name / Path(params).stem
-    write_impact(folder, result, trace)
+    if figures:
+        write_impact(folder, result, trace)
+    else:
+        write_run(folder, result, trace)
     return {"kind": "impact", "case": case.name, "set": Path(params).stem, "folder": str(folder),
             "result": result}
 
@@ -281,18 +289,21 @@ def sample_tasks(s: str, fidelity: str | None, seeds: int, uncertainty: list[dic
 
 
 def paper_tasks(sets: list[str], out: Path, fidelity: str | None, seeds: int = 0,
-                uncertainty: dict[str, list[dict]] | None = None) -> list[tuple[str, tuple]]:
+                uncertainty: dict[str, list[dict]] | None = None,
+                case_figures: bool = False) -> list[tuple[str, tuple]]:
     """The runs of every set, set after set; within a set the longest first (the sampled bundles, the wet
     near-escape sweeps, then the Fig 8a sweeps, the impacts, Fig 4's curves), so no long run starts last and the
     first sets finish early: `run_paper` hands each finished set to its caller (its figures) while the pool runs
-    the next. `seeds` and `uncertainty` ({set name: [overrides, ...]}): `sample_tasks`."""
+    the next. `seeds` and `uncertainty` ({set name: [overrides, ...]}): `sample_tasks`; `case_figures`: the impact
+runs draw their own figures (`_impact_task`)."""
     tasks = []
     for s in sets:
         tasks += sample_tasks(s, fidelity, seeds, (uncertainty or {}).get(Path(s).stem, []))
         tasks += [("wet", (case, s, fidelity)) for case in wet_cases()]
         tasks += [("sweep", (case, s, fidelity)) for case in fig8_cases()]
         # absolute: the runs write there from the workers, whose working directory may differ (a Dask cluster)
-        tasks += [("impact", (case, s, fidelity, str(out.resolve()))) for case in dry_cases() + wet_cases()]
+        tasks += [("impact", (case, s, fidelity, str(out.resolve()), case_figures))
+                  for case in dry_cases() + wet_cases()]
         tasks.append(("curves", (s, fidelity)))
     return tasks
 
@@ -306,11 +317,12 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
               executor_name: str = "processes", scheduler: str | None = None, executor=None,
               progress: Callable[[str], None] = print,
               on_set_done: Callable[[str, dict], None] | None = None, seeds: int = 0,
-              uncertainty: dict[str, list[dict]] | None = None) -> dict:
+              uncertainty: dict[str, list[dict]] | None = None, case_figures: bool = False) -> dict:
     """Run every dry case and sweep for every parameter set; returns the collected outputs.
 
     With the sampled claims' bundles (`sample_tasks`): the nominal one always, `seeds` discrete-summit seeds and
     the `uncertainty` rows ({set name: [scene overrides, ...]}) per set; collected["bundles"][(label, set)].
+    `case_figures`: each impact run also draws its own height.png and impacts.png (`_impact_task`).
 
     Runs go to `executor` (an object from nanoimpact.executors, left open: its owner closes it) or, without one,
     to a new `executor_name` executor (default: a local process pool of `workers`, default the CPU count).
@@ -319,7 +331,7 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = paper_tasks(sets, out, fidelity, seeds, uncertainty)
+    tasks = paper_tasks(sets, out, fidelity, seeds, uncertainty, case_figures)
     left = {}
     for task in tasks:
         left[_set_of(task)] = left.get(_set_of(task), 0) + 1
