@@ -78,7 +78,7 @@ def draw(rows: list[dict], ti: dict, path: Path) -> None:
     lo, hi = ti["theta_deg"] - ti["stderr_deg"], ti["theta_deg"] + ti["stderr_deg"]
     ax.axhspan(lo, hi, color="0.85", label=f"W_SL by TI: {ti['theta_deg']:.1f} ± {ti['stderr_deg']:.1f}°")
     for k, y in enumerate((105.0, 120.0)):
-        ax.axhline(y, color="0.5", ls="--", lw=0.8, label="issue 11 target 105–120°" if k == 0 else None)
+        ax.axhline(y, color="0.5", ls="--", lw=0.8, label="acceptance window 105–120°" if k == 0 else None)
     styles = {"contact_angle_ots-quick": ("C0", "o", ":"), "contact_angle_ots_long-quick": ("C0", "s", "-"),
               "contact_angle_ots_large-quick": ("C3", "^", "-")}
     for r in rows:
