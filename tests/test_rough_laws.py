@@ -126,3 +126,31 @@ def test_footprint_tables_of_the_compiled_quadrature_are_the_numpy_quadratures()
     for ours, ref in zip(*tables):
         assert np.max(np.abs(ref)) > 0
         np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+@pytest.mark.parametrize("name, z0", [("maugis_dugdale", 0.3e-9), ("maugis_dugdale", 1e-9), ("jkr", 0.3e-9),
+                                      ("dmt", 0.3e-9)])
+def test_footprint_tables_by_threshold_are_the_state_by_state_sums(name, z0):
+    """The tables' deep states summed for every window at once (`GWBranchSurface.values_by_threshold`: each panel's
+    sums once per separation, only the panel a threshold cuts per window) against `_integrate` state by state on
+    the same (gap, window) grid: the same panels, nodes and values, so they agree to the round-off of reordered
+    sums (1e-12 of the largest value; cutting the threshold's panel differently moves them by ~1e-6)."""
+    import numpy as np
+
+    from continuum.rough.branch_laws import make_summit_law
+    from continuum.rough.gw_branches import GWBranchSurface
+    from continuum.rough.summits import SummitStatistics
+
+    sigma, beta = 3e-9, 0.2e-6
+    law = make_summit_law(name, beta, 0.12, 10e9, z0=z0, delta_max=30 * sigma)
+    roller = RigidRoughRoller(GWBranchSurface(SummitStatistics(sigma, 1e13, beta), law, z_max=4.07), 5e-6, 3.28e-3,
+                              resolution="fast")
+    h = np.linspace(-2 * sigma, roller.end_gap, 61)
+    w = np.linspace(0.0, 1.0, roller.res[2])
+    r = roller.release_stretch - (roller.release_stretch - roller._r_in) * w * w
+    ours = roller._table_values(h, r)
+    H, R = np.meshgrid(h, r, indexing="ij")
+    ref = roller._integrate(("pressure", "energy"), H, R)
+    for q, q_ref in zip(ours, ref):
+        assert np.max(np.abs(q_ref)) > 0
+        np.testing.assert_allclose(q, q_ref, rtol=0, atol=1e-12 * np.max(np.abs(q_ref)))

@@ -130,6 +130,42 @@ class RigidRoughRoller(RoughRollerBase):
                  "contacts": self.surface.contacts}[n] for n in names]
         return lambda d, zeta: np.stack([f(d, zeta) for f in funs])
 
+    def _table_values(self, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Force and energy tables, shape (2, h.size, r.size): `_integrate` at every (h, r) of the grid.
+
+        On a quadrature surface (`GWBranchSurface`) the footprint's deep part, s in [0, sqrt(-h)] where the
+        separation is below the tallest summit, has the same nodes for every window, so its states are evaluated
+        for all windows at once (`GWBranchSurface.values_by_threshold`); the part beyond the tallest summit,
+        s in [sqrt(-h), sqrt(max(r, reach) - h)], only meets summits within reach and is summed as `_integrate`
+        does. Both are `_integrate`'s Gauss-Legendre sums (to round-off: tests/test_rough_laws.py); a
+        Maugis-Dugdale table of 1e4 nodes builds in ~0.4 s instead of ~0.7 s."""
+        if self.surface_kind != "generic":
+            H, R = np.meshgrid(h, r, indexing="ij")
+            return self._integrate(("pressure", "energy"), H, R)
+        nodes, weights = np.polynomial.legendre.leggauss(self.res[3])
+        names = ("pressure", "energy")
+        out = np.zeros((2, h.size, r.size))
+        # deep part: rows with h < 0 (above the tallest summit it is empty), in blocks of bounded size
+        deep = np.flatnonzero(h < 0.0)
+        step = max(1, _BLOCK_STATES // (nodes.size * r.size))
+        for i in range(0, deep.size, step):
+            rows = deep[i:i + step]
+            half = 0.5 * np.sqrt(-h[rows])
+            s = half[:, None] + half[:, None] * nodes
+            d = self.z_top + h[rows, None] + s * s
+            q = self.surface.values_by_threshold(names, d.ravel(), r).reshape(2, rows.size, nodes.size, r.size)
+            out[:, rows] = np.einsum("qhkw,hk->qhw", q, half[:, None] * weights)
+        # beyond the tallest summit: each window its own top
+        H, R = np.meshgrid(h, r, indexing="ij")
+        top = np.sqrt(np.maximum(np.maximum(R, self.reach) - H, 0.0))
+        kink = np.minimum(np.sqrt(np.maximum(-H, 0.0)), top)
+        half = 0.5 * (top - kink)
+        s = (kink + top)[..., None] * 0.5 + half[..., None] * nodes
+        d = self.z_top + H[..., None] + s * s
+        q = self._surface_values(names)(d.ravel(), (d - R[..., None]).ravel()).reshape((2,) + d.shape)
+        out += np.sum(q * (half[..., None] * weights), axis=-1)
+        return 2.0 * self.length * math.sqrt(2.0 * self.radius) * out
+
     #: Nodes and surface states of the footprint tables for a design depth (`continuum.laws.costs.table_shape`).
     table_shape = staticmethod(table_shape)
 
@@ -162,8 +198,7 @@ class RigidRoughRoller(RoughRollerBase):
         h = np.arange(-depth, self.end_gap + 2 * step, step)
         w = np.linspace(0.0, 1.0, n_w)
         r = self.release_stretch - (self.release_stretch - self._r_in) * w * w
-        H, R = np.meshgrid(h, r, indexing="ij")
-        force, energy = self._integrate(("pressure", "energy"), H, R)
+        force, energy = self._table_values(h, r)
         self._force = RectBivariateSpline(h, w, force, kx=3, ky=3)
         self._energy = RectBivariateSpline(h, w, energy, kx=3, ky=3)
         contacts = self._integrate("contacts", h, np.full_like(h, self.attach_stretch))

@@ -210,6 +210,22 @@ class GWBranchSurface:
         order of `names`, summed in one pass: each the same sum as `pressure`, `energy`, `contact_fraction`."""
         return self._integrals(tuple((n, "total") for n in names), d, zeta)
 
+    def values_by_threshold(self, names, d, r):
+        """`values` at every separation d (1-D, m) for every window r (1-D, m), the threshold zeta = d - r: shape
+        (len(names), d.size, r.size), the same sums as `values` (to round-off). The states of a grid share every panel's
+        sum but the one each threshold cuts, so those are taken once per separation
+        (`branch_kernel.integrals_by_threshold`); a rigid roller's footprint tables evaluate their deep states this
+        way."""
+        d = np.ascontiguousarray(np.asarray(d, float).ravel())
+        r = np.asarray(r, float).ravel()
+        _, x_top = self._limits(d, d)
+        x_th = np.ascontiguousarray(np.maximum(np.minimum(-r, self.delta_in), self.delta_out))
+        kinds = np.array([_KINDS[(n, "total")] for n in names], np.int64)
+        out = np.zeros((len(names), d.size, r.size))
+        _bk.integrals_by_threshold(d, np.ascontiguousarray(x_top[:, 0]), x_th, self._edges, _GL_X, _GL_W, self.sigma,
+                                   *self._tables, kinds, out)
+        return self.density * out
+
     def profile(self, d, zeta):
         """(p, compressive part, tensile part, contact fraction) at once: what a footprint snapshot records,
         each the same sum as `pressure`, `pressure_parts` and `contact_fraction` give."""
