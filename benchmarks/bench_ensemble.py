@@ -1,4 +1,4 @@
-"""Seconds for an ensemble of discrete realisations of `rough_silica` (issue target: 64 members in <= 20 s on the
+"""Seconds for an ensemble of discrete realisations of `rough_silica` (target: 64 members in <= 20 s on the
 2-core machine), on the executors of `nanoimpact.executors`, with the machine's load average beside each number.
 
     python benchmarks/bench_ensemble.py [--params calibrated,paper] [--members 64] [--half-space N] [--escape]
