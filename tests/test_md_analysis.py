@@ -912,3 +912,29 @@ def test_entropic_term_compares_energy_and_free_energy_of_the_same_registry():
     assert both["registries"] == [0, 1] and both["mean"] == pytest.approx(0.035)
     with pytest.raises(ValueError, match="no registry"):
         entropic_term({1: (0.3, 0.0)}, {0: (0.25, 0.01)})
+
+
+@pytest.mark.parametrize("d, fraction", [(0.0, 0.5), (12.0, 0.0), (30.0, 0.0), (-12.0, 1.0), (-40.0, 1.0), (6.0, 5.0 / 32.0)])
+def test_cutoff_crossing_work_counts_the_liquid_inside_the_cutoff_sphere(d, fraction):
+    """One site at depth d below the liquid's plane misses C6 / r_c^6 for every liquid site within r_c: n C6 V / r_c^6
+    with V the sphere's part inside the liquid (half at the plane, none a cutoff below it, all of it a cutoff inside;
+    at d = r_c/2 the cap of height r_c/2 holds 5/32 of the sphere)."""
+    from md.analysis import cutoff_crossing_work
+
+    c6, n, rc = 1.5e3, 0.0334, 12.0
+    full = n * c6 * (4.0 / 3.0) * np.pi * rc**3 / rc**6
+    assert cutoff_crossing_work([-d], c6, 0.0, n, rc, 1.0) == pytest.approx(fraction * full, rel=1e-12, abs=1e-300)
+
+
+def test_cutoff_crossing_work_is_half_the_tail_beyond_the_cutoff_for_two_half_spaces():
+    """Two half-spaces in contact: beyond-cutoff tail pi C n rho / (2 r_c^2), shifted pairs inside pi C n rho /
+    (4 r_c^2) (md-review-2 section 3), so the shifted potential's W_SL misses 1.5 times the tail, not the tail alone.
+    A wrong cap volume or a missing sign moves the ratio off 1/2."""
+    from md.analysis import cutoff_crossing_work, dispersion_tail_work
+
+    c6, n, rho_s, rc, dz = 1.0e3, 0.0334, 0.03, 12.0, 0.01
+    z = -(dz * (np.arange(int(300.0 / dz)) + 0.5))
+    area = 1.0 / (rho_s * dz)
+    crossing = cutoff_crossing_work(z, c6, 0.0, n, rc, area)
+    assert crossing == pytest.approx(np.pi * c6 * n * rho_s / (4.0 * rc**2), rel=1e-4)
+    assert crossing / dispersion_tail_work(z, c6, 0.0, n, rc, area) == pytest.approx(0.5, rel=2e-3)

@@ -469,16 +469,24 @@ def test_silica_smoke_run_reports_the_angle_at_the_waters_plane_with_w_sl_and_dr
 @pytest.mark.md
 def test_ots_smoke_run_adds_the_water_trappe_dispersion_beyond_the_cutoff(md_smoke):
     """On OTS the SAM's CH2/CH3 sites are stored with the water and the dispersion beyond the cutoff between them
-    is added to W_SL: cos theta = cos theta_as_simulated + dW / gamma_lv, dW > 0 (more adhesion, a lower angle)."""
+    is added to W_SL, with the shifted pairs inside it: cos theta = cos theta_as_simulated + dW / gamma_cut, dW > 0
+    (more adhesion, a lower angle), gamma_cut the water's tension as simulated."""
     r = md_smoke("contact_angle_ots").outcome.result
     q, d = r["quantities"], r["details"]
     assert r["system"]["tail_site_ids"] and len(r["system"]["tail_site_c6_kcal_A6"]) == len(r["system"]["tail_site_ids"])
     # the smoke droplet (fixed seeds, one rank) sits on the SAM and is measured; a droplet that never touched it
     # fails here instead of skipping the physics below
     assert d["status"] == "measured" and "contact_angle_as_simulated" in q
-    dw, gamma = q["dispersion_tail_work_sl"]["value"], q["surface_tension_lv"]["value"]
-    assert 0.0 < dw < 0.02                                   # dispersion only attracts; a few mJ/m^2
-    assert d["dispersion_tail"]["sites"] > 0 and d["dispersion_tail"]["cutoff_A"] == 12.0
+    dw, tail = q["dispersion_tail_work_sl"]["value"], d["dispersion_tail"]
+    assert 0.0 < dw < 0.03                                   # dispersion only attracts; a few mJ/m^2
+    assert tail["sites"] > 0 and tail["cutoff_A"] == 12.0
+    # the shifted pairs inside the cutoff add attraction too, and the water's tension is the one it was simulated
+    # with: the published full-LJ value less the LJ tail at the cutoff (a few mN/m for SPC/E at 12 A)
+    assert tail["inside_cutoff_shift_J_m2"] > 0.0 and dw == pytest.approx(
+        tail["beyond_cutoff_J_m2"] + tail["inside_cutoff_shift_J_m2"], rel=1e-9)
+    gamma = tail["gamma_cut_N_m"]
+    assert gamma == pytest.approx(q["surface_tension_lv"]["value"] - tail["gamma_tail_N_m"], rel=1e-12)
+    assert 0.002 < tail["gamma_tail_N_m"] < 0.006
     sim = math.radians(q["contact_angle_as_simulated"]["value"])
     # Young-Dupre with the tail added to W_SL (an independent relation applied to the run's own numbers), and
     # the angle moves: the tail is in the reported angle

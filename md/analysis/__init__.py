@@ -36,7 +36,7 @@ from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, A
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
                                        block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
                                        shape_check,
-                                       dispersion_tail_work, tail_antiderivative)
+                                       dispersion_tail_work, tail_antiderivative, cutoff_crossing_work)
 from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
                                      angle_from_work_of_adhesion_sl, tether_correction,
                                      film_lower_dividing_plane)
@@ -56,7 +56,7 @@ __all__ = [
     "MAUGIS_LJ93",
     "energy_separation_work", "work_from_energy_curve",
     "ContactAngle", "fit_contact_angle", "fit_circle", "dividing_plane", "wetting_bound", "block_drift",
-    "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work", "tail_antiderivative",
+    "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work", "tail_antiderivative", "cutoff_crossing_work",
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
     "gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
     "tether_correction", "film_lower_dividing_plane", "pull_off_analysis", "fit_traction_law", "rate_extrapolation",

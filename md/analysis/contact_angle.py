@@ -369,6 +369,27 @@ def dispersion_tail_work(site_z_A, c6, z_plane_A, number_density_A3, r_cut_A, ar
         float(z_plane_A) - z, r_cut_A)))
 
 
+def cutoff_crossing_work(site_z_A, c6, z_plane_A, number_density_A3, r_cut_A, area_A2):
+    """Work of adhesion per area (kcal/mol/A^2, > 0 = more adhesion) that a truncated r^-6 attraction misses
+    inside its cutoff. Plain `lj/cut` puts no impulse at r_c, so a run's forces are those of the shifted potential
+    u(r) - u(r_c): each liquid-site pair closer than r_c misses the constant u(r_c) ~ -C6 / r_c^6 (its r^-12 part,
+    (sigma/r_c)^6 ~ 1e-3 of it, left out). With the liquid a uniform half-space above ``z_plane_A`` (as in
+    :func:`dispersion_tail_work`), a site at depth d = z_plane - z has within r_c the liquid volume of a spherical
+    cap, V(d) = pi (r_c - d)^2 (2 r_c + d) / 3 for |d| < r_c (0 for d >= r_c, 4/3 pi r_c^3 for d <= -r_c), so
+
+        dW = (n / A) sum_j C6_j V(d_j) / r_c^6.
+
+    Beside the beyond-cutoff tail it turns the shifted-potential W_SL into the full potential's; for two
+    half-spaces in contact it is half that tail (pi C n^2 / (4 r_c^2) against pi C n^2 / (2 r_c^2)), the term the
+    droplets' correction lacked (md-review-2 F8; the same bookkeeping as the adhesion workflow's force route)."""
+    z = np.asarray(site_z_A, float)
+    c = np.broadcast_to(np.asarray(c6, float), z.shape)
+    rc = float(r_cut_A)
+    d = np.clip(float(z_plane_A) - z, -rc, rc)
+    volume = np.pi * (rc - d) ** 2 * (2.0 * rc + d) / 3.0
+    return float(number_density_A3) / float(area_A2) * float(np.sum(c * volume)) / rc**6
+
+
 try:  # ContactAngle needs MDAnalysis; the functions above do not
     from MDAnalysis.analysis.base import AnalysisBase as _AnalysisBase
 except ImportError:  # pragma: no cover - exercised only without the md extra

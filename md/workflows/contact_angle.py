@@ -293,10 +293,13 @@ class _DropletAnalysis:
                 "circle fit at the water's dividing plane, plus the water-TraPPE dispersion beyond the cutoff "
                 "(static: W_SL + dW_tail, md.analysis.dispersion_tail_work)"))
             self.notes.append(tail["note"])
+            gamma = tail["details"]["gamma_cut_N_m"]     # the angle was turned through the water as simulated
         self.tail = tail
         wl = A.work_of_adhesion_sl(gamma, self.angle, None, self.angle_err)
-        q["work_of_adhesion_sl"] = quantity_record(wl["value"], wl["stderr"], "J/m^2",
-                                      kind="Young-Dupre W_SL = gamma_lv (1 + cos theta), this water model's gamma")
+        q["work_of_adhesion_sl"] = quantity_record(wl["value"], wl["stderr"], "J/m^2", kind=(
+            "Young-Dupre W_SL = gamma_lv (1 + cos theta), this water model's gamma" if tail is None else
+            "Young-Dupre W_SL = gamma_cut (1 + cos theta) = W_SL as simulated + dW, with the water's tension as "
+            "simulated (its pairs cut at the cutoff)"))
         q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
                                      kind="gamma_lv cos theta (meniscus force), this water model's gamma")
         return status
@@ -411,13 +414,26 @@ class _DropletAnalysis:
         ax.legend(fontsize=7)
 
 
+def _truncated_gamma(s, number_density_A3: float, gamma_full: float) -> tuple[float, float]:
+    """The liquid-vapour tension of the water as the run simulates it (LJ cut at the run's cutoff, no tail): the
+    model's published full-LJ gamma less Blokhuis et al.'s LJ tail at that cutoff for a sharp interface at the
+    droplet's own bulk density (md.analysis.lj_tail_correction; a finite interface width lowers the tail by a few
+    per cent). Returns (gamma, tail), N/m."""
+    ow = forcefield_of(water_forcefield_names(s.water_model)).atom_type("OW")
+    tail = A.lj_tail_correction(ow.epsilon, ow.sigma, number_density_A3, s.cutoff_A)
+    return gamma_full - tail, tail
+
+
 def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
-    """The water-TraPPE dispersion beyond the cutoff on a measured angle (None where the substrate has no TraPPE
-    site, or a run planned before the sites were stored): dW per frame from the sites' heights under the water's
-    dividing plane (md.analysis.dispersion_tail_work, the water at its bulk density above the plane), then
-    Young-Dupre with it, cos theta' = cos theta + dW / gamma_lv. Returns the corrected angle and its stderr (first
-    order, the angle's and dW's errors independent), dW (J/m^2) with its stderr (statistical inefficiency of the
-    per-frame series), a note and the details."""
+    """The water-TraPPE dispersion the cutoff leaves out, on a measured angle (None where the substrate has no
+    TraPPE site, or a run planned before the sites were stored). Per frame, from the sites' heights under the
+    water's dividing plane (the water at its bulk density above it): the r^-6 tail beyond the cutoff
+    (md.analysis.dispersion_tail_work) plus the constant u(r_c) the shifted forces miss for every pair inside it
+    (md.analysis.cutoff_crossing_work). Young-Dupre with the water's tension as simulated (water-water pairs keep
+    the cutoff; `gamma` is the model's full-LJ value, lowered here by the tail at the cutoff):
+    cos theta' = cos theta + dW / gamma_cut. Returns the corrected angle and its stderr (first order, the angle's
+    and dW's errors independent), dW (J/m^2) with its stderr (statistical inefficiency of the per-frame series),
+    a note and the details."""
     site_ids = info.get("tail_site_ids") or []
     if not site_ids:
         return None
@@ -426,25 +442,33 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
         return None
     n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(U.WATER_MOLAR_MASS)
     z_ref = float(r.reference_z)
-    per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, z_ref, n_w, s.cutoff_A,
-                                                 float(box[k][0] * box[k][1])) for k in range(len(pos))])
-    st = A.timeseries_stats(per_frame, equilibrate=False)
+    per_frame = np.array([[f(pos[k, is_site, 2], c6, z_ref, n_w, s.cutoff_A, float(box[k][0] * box[k][1]))
+                           for f in (A.dispersion_tail_work, A.cutoff_crossing_work)] for k in range(len(pos))])
+    st = A.timeseries_stats(per_frame.sum(axis=1), equilibrate=False)
     dw = U.kcal_per_mol_A2_to_J_per_m2(st["mean"])
     dw_err = U.kcal_per_mol_A2_to_J_per_m2(st["stderr"]) if np.isfinite(st["stderr"]) else None
+    gamma_cut, gamma_tail = _truncated_gamma(s, n_w, gamma)
     th = np.radians(angle)
-    cos_new = np.cos(th) + dw / gamma
+    cos_new = np.cos(th) + dw / gamma_cut
     wets = bool(cos_new >= 1.0)
     new = 0.0 if wets else float(np.degrees(np.arccos(max(cos_new, -1.0))))
     new_err = None
     if not wets and angle_err is not None:
-        var = (np.sin(th) * np.radians(angle_err)) ** 2 + ((dw_err or 0.0) / gamma) ** 2
+        var = (np.sin(th) * np.radians(angle_err)) ** 2 + ((dw_err or 0.0) / gamma_cut) ** 2
         new_err = float(np.degrees(np.sqrt(var) / max(np.sin(np.radians(new)), 1e-12)))
-    note = (f"water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff added statically: dW_SL = "
-            f"{dw * 1e3:.2f} mJ/m^2 ({int(is_site.sum())} CH2/CH3 sites under the water's dividing plane, water at its "
-            f"bulk density above it), so theta = {angle:.1f} deg as simulated -> {new:.1f} deg "
-            "(cos theta + dW/gamma_lv); the water-water and IFF pairs keep the plain cutoff.")
+    beyond, crossing = (U.kcal_per_mol_A2_to_J_per_m2(float(np.mean(per_frame[:, i]))) for i in (0, 1))
+    note = (f"water-TraPPE dispersion the {s.cutoff_A:g} A cutoff leaves out, added statically: dW_SL = "
+            f"{dw * 1e3:.2f} mJ/m^2 (beyond the cutoff {beyond * 1e3:.2f}, the shifted pairs inside it "
+            f"{crossing * 1e3:.2f}; {int(is_site.sum())} CH2/CH3 sites under the water's dividing plane, water at its "
+            f"bulk density above it), so theta = {angle:.1f} deg as simulated -> {new:.1f} deg (cos theta + dW / "
+            f"gamma_cut, gamma_cut = {gamma_cut * 1e3:.1f} mN/m: the water's tension as simulated, the model's "
+            f"{gamma * 1e3:.1f} less its {gamma_tail * 1e3:.1f} mN/m LJ tail); the water-water and IFF pairs keep "
+            "the plain cutoff.")
     return {"angle": new, "angle_stderr": new_err, "wets": wets, "work": dw, "work_stderr": dw_err, "note": note,
-            "kind": "water-TraPPE dispersion beyond the cutoff, per area of wetted SAM (static half-space sum)",
-            "details": {"per_frame_J_m2": U.kcal_per_mol_A2_to_J_per_m2(per_frame).tolist(),
+            "kind": "water-TraPPE dispersion the cutoff leaves out (beyond it and the shifted pairs inside it), per "
+                    "area of wetted SAM (static half-space sums)",
+            "details": {"per_frame_J_m2": U.kcal_per_mol_A2_to_J_per_m2(per_frame.sum(axis=1)).tolist(),
+                        "beyond_cutoff_J_m2": beyond, "inside_cutoff_shift_J_m2": crossing,
+                        "gamma_cut_N_m": gamma_cut, "gamma_tail_N_m": gamma_tail,
                         "g": st["g"], "cutoff_A": s.cutoff_A, "water_number_density_A3": n_w,
                         "plane_z_A": z_ref, "sites": int(is_site.sum()), "angle_as_simulated_deg": angle}}
