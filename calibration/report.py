@@ -148,7 +148,7 @@ def _work_sentence(rows: tuple[ValueRow, ...]) -> str:
 
 
 def _validation_lines(validation: Mapping[str, Any]) -> list[str]:
-    """The pull-off check: F / (2 pi R) (DMT; an MD-scale asperity has Tabor mu ~ 0.06) against the flat-slab W_F
+    """The pull-off check: F / (2 pi R) (DMT: an MD-scale asperity's Tabor mu, computed from the run and in [meta.validation], is small) against the flat-slab W_F
     of the same pair, as a ratio and in combined stderrs. Nothing of it enters the set."""
     if not validation:
         return []
