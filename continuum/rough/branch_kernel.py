@@ -126,15 +126,12 @@ def integrals(d, x_th, x_top, edges, gl_x, gl_w, sigma, xa, fa, xr, fr, kinds, o
     kinds[n]: (column of fa/fr, mode) with mode 0 value, 1 positive part, 2 negative part, 3 pi value^2.
     A panel that the state's branch interval holds whole reads its nodes' values from `_panel_values`; a cut
     one (at the threshold or the top) interpolates at its own nodes."""
-    nq = kinds.shape[0]
-    norm = _SQRT2PI * sigma
     xs, ws, vals = _panel_values(edges, gl_x, gl_w, xa, fa, xr, fr)
     for i in range(d.size):
         di, th, top = d[i], x_th[i], x_top[i]
         for branch in range(2):
             xp = xa if branch == 0 else xr
             fp = fa if branch == 0 else fr
-            lo = -1
             # panels wholly above the threshold (approach) or below it (retreat) are empty: not visited
             j0 = 0 if branch == 0 else max(np.searchsorted(edges, th, side="right") - 1, 0)
             for j in range(j0, edges.size - 1):
@@ -145,27 +142,7 @@ def integrals(d, x_th, x_top, edges, gl_x, gl_w, sigma, xa, fa, xr, fr, kinds, o
                     a, b = e0, min(min(e1, th), top)
                 else:
                     a, b = max(e0, th), min(e1, top)
-                half = 0.5 * max(b - a, 0.0)
-                if half == 0.0:
-                    continue
-                whole = a == e0 and b == e1
-                mid = 0.5 * (a + b)
-                for k in range(gl_x.size):
-                    if whole:
-                        x, w = xs[j, k], ws[j, k]
-                    else:
-                        x = mid + half * gl_x[k]
-                        w = half * gl_w[k]
-                    z = (di + x) / sigma
-                    phi = math.exp(-0.5 * z * z) / norm
-                    if not whole:
-                        lo = _cell_from(x, xp, lo)
-                    for n in range(nq):
-                        if whole:
-                            q = vals[branch, kinds[n, 0], j, k]
-                        else:
-                            q = _interp(x, lo, xp, fp[kinds[n, 0]])
-                        out[n, i] += _mode(q, kinds[n, 1]) * phi * w
+                _add_panel(out[:, i], di, a, b, edges, j, branch, xs, ws, vals, gl_x, gl_w, xp, fp, sigma, kinds)
 
 
 @njit(cache=True, error_model="numpy")
