@@ -11,6 +11,7 @@ import io
 import json
 import logging
 import math
+import re
 from contextlib import redirect_stdout
 from pathlib import Path
 
@@ -293,5 +294,8 @@ def test_mpirun_two_ranks_runs_a_recipe(needs_lammps, tmp_path):
     assert r["np"] == 2 and r["provenance"]["engine"] == "mpirun -np 2 lmp"
     log = (outcome.run_dir / "legs" / "film" / "log.lammps").read_text()
     assert log.count("Loop time of") >= 3 and "on 2 procs" in log         # the minimisation and the chunks
+    # the ranks split the film's plane, not its normal (md.engine.lammps.DECOMPOSITION): every chunk's grid
+    grids = re.findall(r"(\d+) by (\d+) by (\d+) MPI processor grid", log)
+    assert grids and all(g[2] == "1" and int(g[0]) * int(g[1]) == 2 for g in grids)
     assert r["legs"]["film"]["total_steps"] == 400
     assert math.isfinite(r["quantities"]["surface_tension"]["value"])

