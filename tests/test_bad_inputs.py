@@ -317,6 +317,7 @@ def option_cases():
             cases.append((f"{cmd[0]}-workers-{v or 'empty'}", [*cmd, "--workers", v, "--out", OUT], "--workers"))
     for v in ("0", "-2", "two", "1e3"):
         cases.append((f"md-np-{v}", ["md", "adhesion_silica", "--np", v, "--out", OUT], "--np"))
+        cases.append((f"md-jobs-{v}", ["md", "adhesion_silica", "--jobs", v, "--out", OUT], "--jobs"))
         cases.append((f"doctor-np-{v}", ["doctor", "--np", v], "--np"))
     for v in ("0", "-5", "soon", "nan"):
         cases.append((f"doctor-timeout-{v}", ["doctor", "--timeout", v], "--timeout"))

@@ -1,8 +1,9 @@
 """What a workflow hands the engine: the plan data model (a leaf: it imports nothing of md).
 
 Vocabulary
-    A *run* is one recipe at one fidelity (a :class:`Job`). It consists of *legs* (independent LAMMPS simulations
-    run one after the other: the contact and the separated slabs, one PMF window, one retraction speed, ...). A
+    A *run* is one recipe at one fidelity (a :class:`Job`). It consists of *legs* (separate LAMMPS simulations:
+    the contact and the separated slabs, one PMF window, one retraction speed, ...), run one after the other, or
+    with ``jobs`` > 1 each as soon as the legs it reads from (:attr:`Leg.after`) are done. A
     leg is a list of *stages* (equilibrate, sample, approach, hold, retract) run in *chunks* of ``chunk_steps``.
     A workflow is anything with ``plan(settings, run_dir) -> Plan`` and ``analyse(ctx) -> Analysis``
     (:class:`Planner`); the engine never imports one.
@@ -15,7 +16,7 @@ from typing import Any, Callable, Mapping, Protocol, Sequence
 
 import numpy as np
 
-__all__ = ["Stage", "Frames", "Leg", "Plan", "Analysis", "Job", "Planner", "id_ranges"]
+__all__ = ["Stage", "Frames", "Leg", "Plan", "Analysis", "Job", "Planner", "id_ranges", "leg_dependencies"]
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,10 @@ class Leg:
     n_atoms: int
     frames: Frames | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    #: names of the legs whose output this leg reads (a restart, a minimised structure); ``None``: every earlier
+    #: leg, the safe default for a workflow that does not say. With ``jobs`` > 1 the engine starts a leg as soon
+    #: as these are done (:func:`leg_dependencies`).
+    after: tuple[str, ...] | None = None
 
     @property
     def total_steps(self) -> int:
@@ -72,6 +77,24 @@ class Leg:
                 return k, start, start + s.steps
             start += s.steps
         return len(self.stages), start, start
+
+
+def leg_dependencies(legs: Sequence[Leg]) -> dict[str, frozenset[str]]:
+    """Leg name -> the names it must wait for: its ``after``, or every earlier leg where ``after`` is None. A leg
+    may wait only for legs planned before it (so the plan's order is always a valid sequential order); a name
+    that is unknown or later raises ValueError naming both legs."""
+    out: dict[str, frozenset[str]] = {}
+    for k, leg in enumerate(legs):
+        if leg.name in out:
+            raise ValueError(f"plan: leg name {leg.name!r} appears twice")
+        if leg.after is None:
+            out[leg.name] = frozenset(l.name for l in legs[:k])
+            continue
+        for name in leg.after:
+            if name not in out:
+                raise ValueError(f"plan: leg {leg.name!r} waits for {name!r}, which is not a leg planned before it")
+        out[leg.name] = frozenset(leg.after)
+    return out
 
 
 @dataclass

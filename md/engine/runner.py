@@ -29,6 +29,17 @@ One writer per run directory
     ``--out`` atomically (unique temporary name, fsync, rename: :mod:`nanoimpact.fileio`); ``samples.csv`` is
     appended to, and ``--resume`` drops rows past the committed restart and a torn last row.
 
+Legs in parallel
+    ``jobs`` > 1 runs up to that many legs at once, each in a forked child process (``np`` ranks each), a leg
+    starting as soon as the legs it reads from (:attr:`~md.engine.plan.Leg.after`) are done; legs of a workflow
+    that declares nothing wait for every earlier leg, so they still run one after the other. A leg's result
+    does not depend on when it runs (its inputs are its predecessors' restarts, its seeds its own), so the
+    samples are the same as in one process. The children are forked, not spawned, because legs hold closures;
+    the parent never loads LAMMPS before forking. The parent follows the children's committed ``state.json``
+    for the progress bar; a failed child stops the others (their last restarts stay, for ``--resume``) and its
+    error is raised here. Independent legs are what a many-core machine gains from: the systems are small and
+    MPI scales poorly on them.
+
 Errors
     A LAMMPS error (lost atoms, bad parameters, ...) raises :class:`~md.engine.lammps.MDRunError`;
     ``result.json`` is written only at the very end (temporary file + rename), so a failed run never leaves one.
@@ -52,8 +63,8 @@ import numpy as np
 
 from md import units
 from md.engine.hashing import forcefield_hashes, lammps_version, package_version, run_hash
-from md.engine.lammps import InProcess, MpiRun
-from md.engine.plan import Job, Leg, Plan, Planner
+from md.engine.lammps import InProcess, MDRunError, MpiRun
+from md.engine.plan import Job, Leg, Plan, Planner, leg_dependencies
 from md.engine.store import (RunContext, RunOutcome, run_dir_for, export, leg_state, parse_ave_time,
                              parse_dump, truncate_samples, write_csv)
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, clean_json
@@ -230,11 +241,12 @@ def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache
             resume: bool = False, np_: int = 1, progress: bool = True, force: bool = False,
             stop_after_chunks: int | None = None, extra_commands: Sequence[str] = (),
             echo: Callable[[str], None] | None = None, wait: bool = True,
-            wait_timeout: float | None = None) -> RunOutcome:
+            wait_timeout: float | None = None, jobs: int = 1) -> RunOutcome:
     """Run ``job`` with ``workflow``'s plan and analysis (or reuse the cached result) and copy the result into
     ``out``.
 
-    ``np_`` > 1 runs every chunk with ``mpirun -np np_``. ``force`` ignores a cached result. ``stop_after_chunks``
+    ``np_`` > 1 runs every chunk with ``mpirun -np np_``; ``jobs`` > 1 runs up to that many independent legs at
+    once (module docstring, "Legs in parallel"). ``force`` ignores a cached result. ``stop_after_chunks``
     and ``extra_commands`` (LAMMPS commands issued after each leg's set-up) are for tests and debugging. What the
     run does (reused, discarded, resumed, written) is logged at INFO on ``md.engine.runner``; ``echo``, if given,
     receives the same lines.
@@ -258,12 +270,12 @@ def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache
                   hint="wait for it to finish and run again, or leave out --no-wait to wait for it"):
         return _run_locked(job, workflow, digest, hashed, run_dir, out=out, resume=resume, np_=np_,
                            progress=progress, force=force, stop_after_chunks=stop_after_chunks,
-                           extra_commands=extra_commands, say=say)
+                           extra_commands=extra_commands, say=say, jobs=jobs)
 
 
 def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], run_dir: Path, *, out,
                 resume: bool, np_: int, progress: bool, force: bool, stop_after_chunks: int | None,
-                extra_commands: Sequence[str], say: Callable[[str], None]) -> RunOutcome:
+                extra_commands: Sequence[str], say: Callable[[str], None], jobs: int = 1) -> RunOutcome:
     """:func:`run_job`'s work on ``run_dir``; the caller holds its lock."""
     result_path = run_dir / "result.json"
     if result_path.exists() and not force and not extra_commands:
@@ -288,11 +300,11 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         if done:
             say(f"resuming {run_dir.name} at {done} of {total} steps")
     say(f"{job.name} [{job.fidelity}]: {len(plan.legs)} leg(s), {plan.n_atoms} atoms, {total} MD steps, "
-        f"run directory {run_dir}")
+        f"run directory {run_dir}" + (f", up to {jobs} legs at a time" if jobs > 1 else ""))
     t_start = time.perf_counter()
     legs_state = _run_legs(job, plan, run_dir, done=done, total=total, np_=np_, resume=resume, progress=progress,
-                           stop_after_chunks=stop_after_chunks, extra_commands=extra_commands)
-    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_,
+                           stop_after_chunks=stop_after_chunks, extra_commands=extra_commands, jobs=jobs)
+    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_, jobs=jobs,
                                  reanalysed=resume and done == total, t_start=t_start)
     atomic_write_text(result_path, json.dumps(clean_json(result), indent=1))
     say(f"wrote {result_path}")
@@ -300,16 +312,28 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
 
 
 def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int, resume: bool, progress: bool,
-              stop_after_chunks: int | None, extra_commands: Sequence[str]) -> dict[str, Any]:
-    """Every leg of ``plan`` in order (:func:`_run_leg`), behind a progress bar if asked; their final states."""
+              stop_after_chunks: int | None, extra_commands: Sequence[str], jobs: int = 1) -> dict[str, Any]:
+    """Every leg of ``plan`` in order (:func:`_run_leg`), or up to ``jobs`` at once (:func:`_run_legs_parallel`),
+    behind a progress bar if asked; their final states."""
+    if jobs > 1 and stop_after_chunks is not None:
+        raise ValueError("stop_after_chunks counts chunks of one process; it needs jobs = 1")
     bar = None
     if progress:
         try:
             from tqdm import tqdm   # noqa: PLC0415
+            if jobs > 1:
+                tqdm.monitor_interval = 0        # no monitor thread in a process that forks
             bar = tqdm(total=total, initial=done, unit="step", desc=job.name, file=sys.stderr,
                        dynamic_ncols=True, leave=False)
         except ImportError:
             bar = None
+    if jobs > 1:
+        try:
+            return _run_legs_parallel(plan, run_dir, jobs=jobs, np_=np_, resume=resume, bar=bar,
+                                      extra_commands=extra_commands, name=job.name)
+        finally:
+            if bar is not None:
+                bar.close()
     legs_state: dict[str, Any] = {}
     counter = [0]
     try:
@@ -325,8 +349,96 @@ def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int,
     return legs_state
 
 
+#: Seconds between the parent's looks at its children's progress (``jobs`` > 1); a child's end wakes it at once.
+POLL_S = 2.0
+
+
+def _leg_error_path(leg_dir: Path) -> Path:
+    return leg_dir.parent / f"{leg_dir.name}.error"
+
+
+def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: Sequence[str]) -> None:
+    """A forked child's whole life: run one leg; on any error write its message beside the leg directory for the
+    parent and exit 1 (os._exit: the parent's inherited buffers and exit handlers are not the child's)."""
+    code = 0
+    try:
+        _run_leg(leg, leg_dir, np_=np_, resume=resume, progress=None, chunk_counter=[0], stop_after_chunks=None,
+                 extra_commands=extra_commands)
+    except BaseException as exc:  # noqa: BLE001 -- everything a child meets must reach the parent
+        msg = str(exc) or type(exc).__name__
+        with contextlib.suppress(OSError):
+            atomic_write_text(_leg_error_path(leg_dir), f"{type(exc).__name__}: {msg}")
+        code = 1
+    finally:
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+            sys.stderr.flush()
+    os._exit(code)
+
+
+def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool, bar,
+                       extra_commands: Sequence[str], name: str = "md") -> dict[str, Any]:
+    """Up to ``jobs`` legs at once, each in a forked child, a leg started (in plan order) once every leg it waits
+    for (:func:`~md.engine.plan.leg_dependencies`) is done; the legs' final states."""
+    import multiprocessing as mp                           # noqa: PLC0415
+    from multiprocessing.connection import wait as mp_wait   # noqa: PLC0415
+    ctx = mp.get_context("fork")
+    waits = leg_dependencies(plan.legs)
+    legs_dir = run_dir / "legs"
+    done = {l.name for l in plan.legs if leg_state(legs_dir / l.name).get("done")}
+    counted = {l.name: int(leg_state(legs_dir / l.name).get("step", 0)) for l in plan.legs}
+    running: dict[str, Any] = {}
+
+    def follow() -> None:
+        if bar is None:
+            return
+        for leg_name in running:
+            step = int(leg_state(legs_dir / leg_name).get("step", 0))
+            if step > counted[leg_name]:
+                bar.update(step - counted[leg_name])
+                counted[leg_name] = step
+        bar.set_description(f"{name}:{','.join(running)}"[:70])
+
+    try:
+        while len(done) < len(plan.legs):
+            for leg in plan.legs:
+                if len(running) >= jobs:
+                    break
+                if leg.name in done or leg.name in running or not waits[leg.name] <= done:
+                    continue
+                leg_dir = legs_dir / leg.name
+                with contextlib.suppress(FileNotFoundError):
+                    _leg_error_path(leg_dir).unlink()
+                proc = ctx.Process(target=_leg_child, args=(leg, leg_dir, np_, resume, tuple(extra_commands)),
+                                   name=f"md leg {leg.name}", daemon=False)
+                proc.start()
+                running[leg.name] = proc
+                log.info("leg %s started (pid %d)", leg.name, proc.pid)
+            if not running:     # cannot happen for a valid plan: leg_dependencies only allows earlier legs
+                raise RuntimeError(f"no leg can start; done: {sorted(done)}")
+            mp_wait([p.sentinel for p in running.values()], timeout=POLL_S)
+            for leg_name, proc in list(running.items()):
+                if proc.exitcode is None:
+                    continue
+                proc.join()
+                del running[leg_name]
+                if proc.exitcode != 0:
+                    err = _leg_error_path(legs_dir / leg_name)
+                    msg = err.read_text() if err.exists() else f"the leg's process ended with code {proc.exitcode}"
+                    raise MDRunError(f"leg {leg_name!r} failed: {msg}", "", legs_dir / leg_name / "log.lammps")
+                done.add(leg_name)
+                log.info("leg %s done", leg_name)
+            follow()
+    finally:
+        for proc in running.values():           # an error or an interrupt: stop the others at once
+            proc.terminate()
+        for proc in running.values():
+            proc.join()
+    return {l.name: leg_state(legs_dir / l.name) for l in plan.legs}
+
+
 def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path, legs_state: Mapping[str, Any], *,
-                        np_: int, reanalysed: bool, t_start: float) -> dict[str, Any]:
+                        np_: int, reanalysed: bool, t_start: float, jobs: int = 1) -> dict[str, Any]:
     """The workflow's analysis of the finished legs, its curves and figures exported (a figure that fails is
     named in the notes, never loses the run), and the run's ``result.json`` record."""
     analysis = wf.analyse(RunContext(run_dir, plan, job.settings))
@@ -367,6 +479,7 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
         "wall_s": {"dynamics": dyn_wall, "total_this_invocation": time.perf_counter() - t_start},
         "atom_steps_per_s": atom_steps / dyn_wall if dyn_wall > 0 else None,
         "np": np_,
+        "jobs": jobs,
         "seeds": plan.seeds,
         "settings": dict(job.settings),
         "system": plan.system_info,

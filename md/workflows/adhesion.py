@@ -619,7 +619,7 @@ class _AdhesionLegs:
         velocity = (f"velocity mobile create {s.temperature_K:g} {derived_seed(s.seed, 3, 5)} mom yes rot no "
                     f"dist gaussian",)
         frames = Frames("chain_axes", round_up(steps / ANNEAL_FRAMES, si)) if len(self.axes) else None
-        return Leg(name="anneal", fresh=fresh, prepare=lambda d: minimize_lines(s),
+        return Leg(name="anneal", fresh=fresh, prepare=lambda d: minimize_lines(s), after=(),
                    stages=[Stage("anneal", steps, velocity)], frames=frames,
                    info={"chain_axes": self.axes.tolist()}, **{**self.base, "define": self.define(False, 5)})
 
@@ -632,7 +632,7 @@ class _AdhesionLegs:
                 return self.from_leg(self.run_dir / "legs" / "anneal", steps_of(s.sam_anneal_steps, s.sample_interval),
                                      (0.0, 0.0, -s.separation_A))(leg_dir)
             return fresh_from_data(self.ff, self.data, s, self.groups) + self.setup_groups()
-        return Leg(name="contact", fresh=fresh_contact,
+        return Leg(name="contact", fresh=fresh_contact, after=("anneal",) if annealed else (),
                    prepare=lambda d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"]
                    + minimize_lines(s, d / "minimized.data") + ["unfix back_min", _BACK_RIGID],
                    stages=stage_list(equilibrate_stage(s, "mobile", 1), self.sample),
@@ -646,7 +646,7 @@ class _AdhesionLegs:
         def fresh(leg_dir: Path) -> list[str]:
             return fresh_from_data(self.ff, minimized, s, self.groups) + self.setup_groups() + \
                 ([f"displace_atoms upper move 0.0 0.0 {shift:.6f} units box"] if shift else [])
-        return Leg(name="separated", fresh=fresh, prepare=lambda d: ["reset_timestep 0"],
+        return Leg(name="separated", fresh=fresh, prepare=lambda d: ["reset_timestep 0"], after=("contact",),
                    stages=stage_list(equilibrate_stage(s, "mobile", 2), self.sample),
                    **{**self.base, "define": self.define(False, 2)})
 
@@ -695,15 +695,17 @@ class _AdhesionLegs:
                     fresh = self.from_leg(self.run_dir / "legs" / f"pmf_r{r}_{prev}", total,
                                           (0.0, 0.0, d_nom - nominal[prev]))
                 nominal[suffix] = d_nom
+                came_from = f"pmf_r{r}_{prev}" if prev else (start.name if start is not None else "contact")
                 legs.append(Leg(name=f"pmf_r{r}_{suffix}", fresh=fresh, prepare=prepare, stages=stages,
+                                after=(came_from,),
                                 frames=self.frames(s.pmf_sample_steps, TAIL_FRAMES_WINDOW, self.tail and r == 0),
                                 info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
-                                      "continues": f"pmf_r{r}_{prev}" if prev else
-                                      (start.name if start is not None else "contact")},
+                                      "continues": came_from},
                                 **{**self.base, "define": self.define(False, salt)}))
                 salt += 1
             for suffix, d_nom, prev, repeats in self.wf.return_chain(s):
                 legs.append(Leg(name=f"pmf_r{r}_{suffix}", prepare=lambda _d: ["reset_timestep 0"], stages=stages,
+                                after=(f"pmf_r{r}_{prev}",),
                                 fresh=self.from_leg(self.run_dir / "legs" / f"pmf_r{r}_{prev}", total,
                                                     (0.0, 0.0, d_nom - nominal[prev])),
                                 info={"shift_A": float(d_nom), "registry": r, "offset_A": [dx, dy],
@@ -725,8 +727,8 @@ class _AdhesionLegs:
         warm = round_up(steps / 5, si)
         velocity = (f"velocity mobile create {s.temperature_K:g} {derived_seed(s.seed, 3, 20 + r)} mom yes rot no "
                     f"dist gaussian",)
-        return Leg(name=f"contact_r{r}", fresh=self.from_leg(self.contact_dir, contact.total_steps,
-                                                             (offset[0], offset[1], lift)),
+        return Leg(name=f"contact_r{r}", after=("contact",),
+                   fresh=self.from_leg(self.contact_dir, contact.total_steps, (offset[0], offset[1], lift)),
                    prepare=lambda _d: ["unfix back_rigid", "fix back_min upper_back setforce 0.0 0.0 0.0"] + approach
                    + ["unfix back_min", _BACK_RIGID, "reset_timestep 0"],
                    stages=stage_list(Stage("equilibrate", warm, velocity, sampled=False),

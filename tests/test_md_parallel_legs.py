@@ -1,0 +1,142 @@
+"""Legs in parallel (``nanoimpact md --jobs J``): which legs wait for which (:func:`md.engine.plan.leg_dependencies`),
+the scheduler's order and overlap, a failing leg stopping the run, and -- with LAMMPS -- the same samples as the
+one-process run on the adhesion recipe with the richest dependency graph (anneal, contacts, chains out and back).
+
+The scheduler tests replace the leg runner with a stand-in that sleeps and records when it ran (the forked
+children inherit it), so they need no LAMMPS and take about a second each.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from md.engine import runner
+from md.engine.lammps import MDRunError
+from md.engine.plan import Leg, Plan, Stage, leg_dependencies
+
+
+def _leg(name: str, after=None, steps: int = 10) -> Leg:
+    return Leg(name=name, fresh=lambda d: [], define=lambda step: [], prepare=lambda d: [],
+               restart_head=lambda p: [], stages=[Stage("run", steps)], columns={}, sample_interval=1,
+               chunk_steps=steps, n_atoms=1, after=after)
+
+
+def _plan(legs) -> Plan:
+    return Plan(legs=list(legs), timestep_fs=1.0, n_atoms=1, seeds={}, forcefield_files=[])
+
+
+def test_a_leg_without_after_waits_for_every_earlier_leg_and_named_ones_only_for_those():
+    legs = [_leg("a", ()), _leg("b", ("a",)), _leg("c", ("a",)), _leg("d")]
+    w = leg_dependencies(legs)
+    assert w == {"a": frozenset(), "b": {"a"}, "c": {"a"}, "d": {"a", "b", "c"}}
+
+
+@pytest.mark.parametrize("legs, word", [
+    ([_leg("a", ("b",)), _leg("b", ())], "'b', which is not a leg planned before it"),   # a later leg
+    ([_leg("a", ("zz",))], "'zz'"),                                                     # an unknown one
+    ([_leg("a", ()), _leg("a", ())], "appears twice"),
+])
+def test_a_wait_for_a_later_or_unknown_leg_is_refused_naming_both(legs, word):
+    with pytest.raises(ValueError, match="plan: leg") as info:
+        leg_dependencies(legs)
+    assert word in str(info.value)
+
+
+def _stand_in(record: Path, seconds: dict[str, float], fail: str | None = None):
+    """A leg runner that sleeps, appends (name, start, end) to ``record`` and commits a done state."""
+    def run_leg(leg, leg_dir, **_):
+        t0 = time.monotonic()
+        time.sleep(seconds.get(leg.name, 0.3))
+        if leg.name == fail:
+            raise RuntimeError(f"boom in {leg.name}")
+        leg_dir.mkdir(parents=True, exist_ok=True)
+        (leg_dir / "state.json").write_text(json.dumps({"done": True, "step": leg.total_steps}))
+        with open(record, "a") as fh:
+            fh.write(json.dumps([leg.name, t0, time.monotonic()]) + "\n")
+    return run_leg
+
+
+def test_legs_start_when_what_they_read_is_done_and_independent_ones_overlap(tmp_path, monkeypatch):
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"b": 0.6, "c": 0.6}))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    legs = [_leg("a", ()), _leg("b", ("a",)), _leg("c", ("a",)), _leg("d")]
+    states = runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=False, bar=None,
+                                       extra_commands=())
+    assert all(states[n]["done"] for n in "abcd")
+    ran = {n: (t0, t1) for n, t0, t1 in map(json.loads, record.read_text().splitlines())}
+    assert ran["b"][0] >= ran["a"][1] and ran["c"][0] >= ran["a"][1]       # they read a's restart
+    assert ran["b"][0] < ran["c"][1] and ran["c"][0] < ran["b"][1]         # b and c overlap: two jobs
+    assert ran["d"][0] >= max(ran["b"][1], ran["c"][1])                     # after=None: waits for all
+
+
+def test_one_job_at_a_time_never_overlaps(tmp_path, monkeypatch):
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    legs = [_leg("a", ()), _leg("b", ()), _leg("c", ())]
+    runner._run_legs_parallel(_plan(legs), tmp_path, jobs=1, np_=1, resume=False, bar=None, extra_commands=())
+    spans = sorted((t0, t1) for _, t0, t1 in map(json.loads, record.read_text().splitlines()))
+    assert all(spans[k + 1][0] >= spans[k][1] for k in range(len(spans) - 1))
+
+
+def test_a_failing_leg_stops_the_others_and_its_error_names_it(tmp_path, monkeypatch):
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"slow": 60.0, "bad": 0.2}, fail="bad"))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    legs = [_leg("slow", ()), _leg("bad", ()), _leg("later", ("bad",))]
+    t0 = time.monotonic()
+    with pytest.raises(MDRunError, match=r"leg 'bad' failed: RuntimeError: boom in bad"):
+        runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=False, bar=None,
+                                  extra_commands=())
+    assert time.monotonic() - t0 < 20.0                     # the 60-s leg was stopped, not waited for
+    assert not record.exists()                              # nothing finished; 'later' never started
+    assert not (tmp_path / "later").exists()
+
+
+def test_legs_already_done_are_not_run_again(tmp_path, monkeypatch):
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    (tmp_path / "legs" / "a").mkdir(parents=True)
+    (tmp_path / "legs" / "a" / "state.json").write_text(json.dumps({"done": True, "step": 10}))
+    legs = [_leg("a", ()), _leg("b", ("a",))]
+    runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=True, bar=None, extra_commands=())
+    assert [json.loads(l)[0] for l in record.read_text().splitlines()] == ["b"]
+
+
+def test_stop_after_chunks_needs_one_job():
+    with pytest.raises(ValueError, match="jobs = 1"):
+        runner._run_legs(None, _plan([_leg("a", ())]), Path("."), done=0, total=10, np_=1, resume=False,
+                         progress=False, stop_after_chunks=1, extra_commands=(), jobs=2)
+
+
+@pytest.mark.md
+def test_two_jobs_give_the_samples_of_one_process_on_the_equilibrated_ots_recipe(needs_lammps, md_smoke, tmp_path):
+    """adhesion_ots_equilibrated at smoke: anneal -> contact -> separated, registry 1's own contact, two chains out
+    and back. The same recipe with --jobs 2 (a fresh CLI process, so nothing has loaded LAMMPS before the fork)
+    must give every leg's samples byte for byte, and the same quantities."""
+    one = md_smoke("adhesion_ots_equilibrated").outcome
+    cache = tmp_path / "cache"
+    code = "import sys; from calibration.cli import main; sys.exit(main(sys.argv[1:]))"
+    proc = subprocess.run([sys.executable, "-c", code, "-q", "md", "adhesion_ots_equilibrated", "--fidelity",
+                           "smoke", "--jobs", "2", "--cache", str(cache), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    two_dir = next(p for p in cache.iterdir() if p.is_dir())
+    two = json.loads((two_dir / "result.json").read_text())
+    assert two["jobs"] == 2 and two["run_hash"] == one.result["run_hash"]
+    legs = sorted(p.name for p in (one.run_dir / "legs").iterdir() if p.is_dir())
+    assert len(legs) > 5 and legs == sorted(p.name for p in (two_dir / "legs").iterdir() if p.is_dir())
+    for leg in legs:
+        a = (one.run_dir / "legs" / leg / "samples.csv").read_bytes()
+        b = (two_dir / "legs" / leg / "samples.csv").read_bytes()
+        assert a == b, f"leg {leg}: samples differ between one process and two jobs"
+    for name, q in one.result["quantities"].items():
+        assert two["quantities"][name]["value"] == q["value"], name
