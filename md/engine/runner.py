@@ -388,6 +388,7 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
     done = {l.name for l in plan.legs if leg_state(legs_dir / l.name).get("done")}
     counted = {l.name: int(leg_state(legs_dir / l.name).get("step", 0)) for l in plan.legs}
     running: dict[str, Any] = {}
+    shown = [""]
 
     def follow() -> None:
         if bar is None:
@@ -397,7 +398,10 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
             if step > counted[leg_name]:
                 bar.update(step - counted[leg_name])
                 counted[leg_name] = step
-        bar.set_description(f"{name}:{','.join(running)}"[:70])
+        desc = f"{name}:{','.join(running)}"[:70]
+        if desc != shown[0]:            # a redraw only when the set of running legs changes
+            bar.set_description(desc)
+            shown[0] = desc
 
     try:
         while len(done) < len(plan.legs):
