@@ -52,8 +52,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "'mpirun -np N lmp' with the wheel's binaries")
     p.add_argument("--jobs", type=positive_int, default=1, metavar="J",
                    help="legs run at once (>= 1, default 1), each in its own process with --np ranks: a leg "
-                        "starts when the legs it continues from are done (adhesion registries and window chains "
-                        "run side by side; other recipes' legs still follow one another). Uses J x N cores")
+                        "starts when the legs it continues from are done (adhesion registries and window chains, "
+                        "pull-off tip positions and retractions run side by side; other recipes' legs still follow "
+                        "one another). Uses J x N cores")
     p.add_argument("--cache", help="cache directory for run directories (overrides NANOIMPACT_CACHE)")
     p.add_argument("--force", action="store_true", help="run again even if a finished result is cached")
     p.add_argument("--no-wait", dest="wait", action="store_false",

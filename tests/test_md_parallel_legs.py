@@ -140,3 +140,24 @@ def test_two_jobs_give_the_samples_of_one_process_on_the_equilibrated_ots_recipe
         assert a == b, f"leg {leg}: samples differ between one process and two jobs"
     for name, q in one.result["quantities"].items():
         assert two["quantities"][name]["value"] == q["value"], name
+
+
+@pytest.mark.parametrize("name", ["adhesion_ots_equilibrated", "adhesion_silica_registries", "pulloff_ots_positions"])
+def test_every_leg_waits_for_exactly_the_legs_whose_files_it_reads(name, tmp_path):
+    """The declared graph against the commands: the leg directories a leg's set-up names (a restart, a minimised
+    structure) are the legs it waits for -- no more (it would lose parallelism), no fewer (it would read a file
+    that is not there yet). Planned at smoke; nothing runs."""
+    from md.recipe import load_recipe
+    from md.workflows import get_workflow
+    from md.workflows.facade import job_for
+    rec = load_recipe(name)
+    plan = get_workflow(rec.workflow).plan(job_for(rec, "smoke").settings, tmp_path)
+    waits = leg_dependencies(plan.legs)
+    names = {leg.name for leg in plan.legs}
+    assert all(leg.after is not None for leg in plan.legs)
+    for leg in plan.legs:
+        text = " ".join(leg.fresh(tmp_path / "legs" / leg.name))
+        read = {n for n in names if f"/legs/{n}/" in text}
+        assert read == set(waits[leg.name]), (leg.name, read, waits[leg.name])
+    assert any(len(w) == 0 for w in waits.values())
+    assert sum(1 for w in waits.values() if len(w) <= 1) == len(plan.legs)

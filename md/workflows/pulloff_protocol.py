@@ -97,8 +97,8 @@ def position_legs(s: Settings, ff, data: Path, groups: Mapping[str, Any], n: int
             "group flat_mobile subtract flat flat_fixed", "group tip_mobile subtract tip holder_rigid"] + extra
 
     vz = lambda v: f"velocity holder_rigid set 0.0 0.0 {v:.10g} units box"
-    approach = Leg(
-        name=leg_name("approach", p), fresh=fresh, define=leg_define(s, base),
+    approach = Leg(                       # reads only its position's data file: starts at once with --jobs
+        name=leg_name("approach", p), fresh=fresh, define=leg_define(s, base), after=(),
         prepare=lambda d: minimize_lines(s, d / "minimized.data"), restart_head=restart_header_lines(s),
         stages=stage_list(equilibrate_stage(s, "mobile", 1 + base, (vz(0.0),)),
                           Stage("approach", n_app, (vz(-v_app),)),
@@ -121,6 +121,7 @@ def position_legs(s: Settings, ff, data: Path, groups: Mapping[str, Any], n: int
                     f"velocity mobile create {t:g} {vseed} mom yes rot no dist gaussian",
                     vz(0.0)), sampled=False)) + stages
             legs.append(Leg(name=leg_name(f"retract_{k}" + (f"_{j}" if j else ""), p), fresh=fresh_retract,
+                            after=(approach.name,),       # from the end of its position's hold
                             define=leg_define(s, base + 100 + 10 * k + j), prepare=lambda d: ["reset_timestep 0"],
                             restart_head=restart_header_lines(s), stages=stages, columns=columns,
                             sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=n,
