@@ -397,3 +397,34 @@ def test_the_ots_result_adds_the_dispersion_tail_into_w_sl(md_smoke):
     assert w != pytest.approx(total - tail, rel=1e-6)
     assert any("beyond the 12 A cutoff" in n for n in r["notes"])
     assert "dispersion_tail_work_sl" not in md_smoke("wsl_silica").outcome.result["quantities"]
+
+
+
+@pytest.mark.md
+def test_the_window_length_check_leaves_the_tail_error_out_of_its_tolerance(md_smoke, tmp_path, monkeypatch):
+    """Both halves of the nodes' samples get the same tail (and tether) added, so the tail's error cancels in
+    their difference and must stay out of the check's tolerance, 2 x 2 x the nodes' statistical stderr. The smoke
+    OTS run is analysed again with its tail given a stderr three times the nodes' (at smoke the tail has none):
+    W_SL's stderr takes it in quadrature, the tolerance does not (with W_SL's whole stderr it would be 3.2 x
+    wider)."""
+    import md.workflows.wsl_ti as wsl
+    from md.engine.store import RunContext
+    from md.recipe import load_recipe
+    from md.workflows import get_workflow
+    from md.workflows.facade import job_for
+    out = md_smoke("wsl_ots").outcome
+    assert out.result["details"]["dispersion_tail"]["stderr"] == 0.0
+    nodes = out.result["quantities"]["work_of_adhesion_sl"]["stderr"]      # the nodes' own, with no tail error
+    job = job_for(load_recipe("wsl_ots"), "smoke")
+    wf = get_workflow(job.workflow)
+    plan = wf.plan(job.settings, tmp_path)                                  # the same build, written aside
+    real = wsl._dispersion_tail
+
+    def noisy_tail(ctx, info, s):
+        tail = dict(real(ctx, info, s))
+        tail["stderr"] = 3.0 * nodes
+        return tail
+    monkeypatch.setattr(wsl, "_dispersion_tail", noisy_tail)
+    an = wf.analyse(RunContext(out.run_dir, plan, job.settings))
+    assert an.quantities["work_of_adhesion_sl"]["stderr"] == pytest.approx(math.hypot(nodes, 3.0 * nodes), rel=1e-9)
+    assert an.details["window_halves_J_m2"]["difference_sigma"] == pytest.approx(4.0 * nodes, rel=1e-9)

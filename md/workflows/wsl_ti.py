@@ -227,6 +227,7 @@ class _WslAnalysis:
                                  info["area_A2"])
         w["value"] += tc["value"]
         w["tether_correction"] = tc
+        ti_stderr = w["stderr"]           # the nodes' statistical error alone: what the window-length check tests
         # OTS: the water-TraPPE dispersion beyond the cutoff, static, at full coupling (the film leg's framed half)
         tail = _dispersion_tail(self.ctx, info, self.s) if info.get("tail_site_ids") else None
         if tail is not None:
@@ -238,7 +239,9 @@ class _WslAnalysis:
         self.w_half = [A.ti_work_of_adhesion_sl(self.halves[h]["charge_film"], self.halves[h]["lj_film"],
                                                 self.halves[h]["charge_reference"], info["area_A2"])["value"]
                        + tc["value"] + self.dw_tail for h in (0, 1)]
-        self.half_sigma = w["stderr"] * 2.0             # each half has sqrt(2) x the stderr; their difference 2 x
+        # each half has sqrt(2) x the nodes' stderr, their difference 2 x. The tail and the tether enter both halves
+        # alike, so their errors cancel in the difference and stay out of its tolerance (as does the quadrature's)
+        self.half_sigma = ti_stderr * 2.0
         self.half_ok = bool(abs(self.w_half[1] - self.w_half[0]) <= 2.0 * self.half_sigma)
         self.w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
         ang = A.angle_from_work_of_adhesion_sl(w["value"], self.w_err, gamma)
