@@ -55,10 +55,16 @@ CONDITIONAL_KEYS: dict[str, dict[str, tuple[str, Any]]] = {
 #: {key: neutral value}. At that value the key stays out of the run's identity (`Recipe.canonical`), because the
 #: run it describes is the same run; any other value enters the hash. A protocol option added to a workflow is
 #: registered here with the value that reproduces the runs already committed.
+#: The builder's cubic lattice constant of beta-cristobalite (A; md.build.silica.CRISTOBALITE_A, Wyckoff 1925),
+#: the neutral value of ``silica_lattice_A``: every committed silica result was built with it.
+BUILDER_LATTICE_A = 7.16
+
 NEUTRAL_KEYS: dict[str, dict[str, Any]] = {
-    "pulloff": {"flat_thermostat": "mobile", "tip_positions": 1},
+    "pulloff": {"flat_thermostat": "mobile", "tip_positions": 1, "silica_lattice_A": BUILDER_LATTICE_A},
     "adhesion": {"registry_sampling": "rank1", "registry_contact_steps": 0, "sam_anneal_steps": 0,
-                 "pmf_return": False, "pmf_extra_windows_A": ()}}
+                 "pmf_return": False, "pmf_extra_windows_A": (), "silica_lattice_A": BUILDER_LATTICE_A},
+    "contact_angle": {"silica_lattice_A": BUILDER_LATTICE_A},
+    "wsl_ti": {"silica_lattice_A": BUILDER_LATTICE_A}}
 
 
 class RecipeError(InputError):
@@ -106,6 +112,11 @@ FIELDS: tuple[Field, ...] = (
     Field("silanol_density", "system", float, "OH/nm^2", "Silanol density requested on the (001) face "
           "(silica_face = '001'); the (111) face has 4.50 fixed.", 4.7, low=3.9, high=7.8,
           workflows=_SURF + _TI),
+    Field("silica_lattice_A", "system", float, "A", "Cubic lattice constant every silica slab, asperity and OTS "
+          "substrate is built with (beta-cristobalite, Fd-3m). 7.16 is the ideal cell (Wyckoff 1925) every committed "
+          "result used; under IFF a free (111) slab at 7.16 is stretched in plane by about 3 GPa and relaxed near "
+          "7.02 (benchmarks/md_lateral_stress.py). A protocol option: at 7.16 it stays out of the run hash.",
+          BUILDER_LATTICE_A, low=6.8, high=7.4, workflows=_SURF + _TI),
     Field("sam_coverage", "system", float, "chains/nm^2", "OTS grafting density (cristobalite (111) holds at "
           "most 4.50).", 4.5, low=0.5, high=4.5, workflows=_SURF + _TI),
     Field("chain_length", "system", int, "carbons", "OTS alkyl chain length (C18 for OTS).", 18, low=2, high=30,

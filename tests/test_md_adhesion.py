@@ -422,6 +422,37 @@ def test_degenerate_registries_are_named_in_the_notes():
     assert degenerate_note({**info, "degenerate_registries": []}) == []
 
 
+def _system(name, **override):
+    """The shipped recipe ``name`` with keys of its [system] table replaced."""
+    t = json.loads(json.dumps(dict(load_recipe(name).raw), default=dict))
+    t["system"].update(override)
+    return parse_recipe(t, name=name)
+
+
+def test_the_silica_lattice_key_is_neutral_at_the_builders_cell_and_builds_any_other(tmp_path):
+    """silica_lattice_A: its neutral value is the builder's own constant, so every shipped recipe of every
+    workflow that builds silica keeps its hash; another value enters the hash and builds both slabs (and an OTS
+    substrate) with that cell: the (111) surface cell is a/sqrt2 x a sqrt(3/2)."""
+    from md.build.silica import CRISTOBALITE_A
+    from md.recipe import BUILDER_LATTICE_A, NEUTRAL_KEYS, RECIPE_DIR
+    from md.workflows import get_workflow
+    assert BUILDER_LATTICE_A == CRISTOBALITE_A
+    for path in sorted(RECIPE_DIR.glob("*.toml")):
+        r = load_recipe(path.stem)
+        if r.workflow in NEUTRAL_KEYS and "silica_lattice_A" in NEUTRAL_KEYS[r.workflow]:
+            assert "silica_lattice_A" not in r.canonical("quick")["settings"], path.stem
+            assert _system(path.stem, silica_lattice_A=BUILDER_LATTICE_A).canonical_sha256("quick") == \
+                r.canonical_sha256("quick")
+    base = load_recipe("adhesion_silica_ots").canonical_sha256("smoke")
+    rec = _system("adhesion_silica_ots", silica_lattice_A=7.02)
+    assert rec.canonical_sha256("smoke") != base
+    s = rec.settings("smoke")
+    plan = get_workflow("adhesion").plan(s, tmp_path)
+    box = plan.system_info["box_A"]
+    assert box[0] == pytest.approx(s["nx"] * 7.02 / math.sqrt(2.0), rel=1e-9)
+    assert box[1] == pytest.approx(s["ny"] * 7.02 * math.sqrt(1.5), rel=1e-9)
+
+
 @pytest.mark.parametrize("name", ["adhesion_silica", "adhesion_ots", "adhesion_silica_ots"])
 def test_protocol_options_at_their_neutral_values_leave_the_run_hash_alone(name):
     """The shipped calibration recipes do not set the protocol options, so their canonical settings (hence the

@@ -303,10 +303,13 @@ def held_deep(system: System, group: str = "frozen") -> np.ndarray:
 
 def surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Settings, seed: int,
                   face: str) -> System:
+    a = settings.silica_lattice_A
     if kind == "silica":
         dens = settings.silanol_density if face == "001" else 4.5
-        return as_system(silica_slab(nx, ny, thickness=thickness, silanol_density=dens, face=face, seed=seed))
-    slab = as_system(silica_slab(nx, ny, thickness=thickness, face="111", silanol_density=4.5, seed=seed))
+        return as_system(silica_slab(nx, ny, thickness=thickness, silanol_density=dens, face=face, seed=seed,
+                                     lattice_a=a))
+    slab = as_system(silica_slab(nx, ny, thickness=thickness, face="111", silanol_density=4.5, seed=seed,
+                                 lattice_a=a))
     return as_system(ots_sam(slab, coverage=settings.sam_coverage, chain_length=settings.chain_length,
                              seed=seed + 1))
 

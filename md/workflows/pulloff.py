@@ -65,7 +65,8 @@ class PullOff(Workflow):
         face = silica_face_of((s.surface,), s.silica_face)
         dens = s.silanol_density if face == "001" else 4.5
         asp = as_system(silica_asperity(radius=R, holder_thickness=s.holder_thickness_A,
-                                        margin=s.asperity_margin_A, silanol_density=dens, face=face, seed=seed))
+                                        margin=s.asperity_margin_A, silanol_density=dens, face=face, seed=seed,
+                                        lattice_a=s.silica_lattice_A))
         nx, ny = asp.info["surface_cells"]
         fnx, fny = (s.flat_nx or nx), (s.flat_ny or ny)
         if (fnx, fny) != (nx, ny):
