@@ -359,7 +359,9 @@ def _leg_error_path(leg_dir: Path) -> Path:
 
 def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: Sequence[str]) -> None:
     """A forked child's whole life: run one leg; on any error write its message beside the leg directory for the
-    parent and exit 1 (os._exit: the parent's inherited buffers and exit handlers are not the child's)."""
+    parent and exit 1. os._exit: the parent's exit handlers and inherited stdio buffers are not the child's to
+    run or flush (a flush could wait on a lock another of the parent's threads held at the fork); what the child
+    reports goes to files and to logging, whose handlers flush every record."""
     code = 0
     try:
         _run_leg(leg, leg_dir, np_=np_, resume=resume, progress=None, chunk_counter=[0], stop_after_chunks=None,
@@ -369,10 +371,6 @@ def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: 
         with contextlib.suppress(OSError):
             atomic_write_text(_leg_error_path(leg_dir), f"{type(exc).__name__}: {msg}")
         code = 1
-    finally:
-        with contextlib.suppress(Exception):
-            sys.stdout.flush()
-            sys.stderr.flush()
     os._exit(code)
 
 
