@@ -48,10 +48,14 @@ def test_a_wait_for_a_later_or_unknown_leg_is_refused_naming_both(legs, word):
     assert word in str(info.value)
 
 
-def _stand_in(record: Path, seconds: dict[str, float], fail: str | None = None):
-    """A leg runner that sleeps, appends (name, start, end) to ``record`` and commits a done state."""
+def _stand_in(record: Path, seconds: dict[str, float], fail: str | None = None, spawn: str | None = None):
+    """A leg runner that sleeps, appends (name, start, end) to ``record`` and commits a done state; leg ``spawn``
+    first starts a long-lived subprocess (as an mpirun would) and writes its pid beside ``record``."""
     def run_leg(leg, leg_dir, **_):
         t0 = time.monotonic()
+        if leg.name == spawn:
+            child = subprocess.Popen(["sleep", "120"])
+            (record.parent / "grandchild.pid").write_text(str(child.pid))
         time.sleep(seconds.get(leg.name, 0.3))
         if leg.name == fail:
             raise RuntimeError(f"boom in {leg.name}")
@@ -86,9 +90,21 @@ def test_one_job_at_a_time_never_overlaps(tmp_path, monkeypatch):
     assert all(spans[k + 1][0] >= spans[k][1] for k in range(len(spans) - 1))
 
 
+def _gone(pid: int) -> bool:
+    """The process ``pid`` no longer runs (absent, or a zombie nobody has reaped yet)."""
+    try:
+        state = Path(f"/proc/{pid}/status").read_text()
+    except FileNotFoundError:
+        return True
+    return "\nState:\tZ" in state or "\nState:\tX" in state
+
+
 def test_a_failing_leg_stops_the_others_and_its_error_names_it(tmp_path, monkeypatch):
+    """The slow leg's own subprocess (an mpirun, in a real run) is stopped with it: the child leads a process
+    group of its own, and the parent stops the group."""
     record = tmp_path / "record.jsonl"
-    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"slow": 60.0, "bad": 0.2}, fail="bad"))
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"slow": 60.0, "bad": 1.0}, fail="bad",
+                                                      spawn="slow"))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     legs = [_leg("slow", ()), _leg("bad", ()), _leg("later", ("bad",))]
     t0 = time.monotonic()
@@ -98,6 +114,12 @@ def test_a_failing_leg_stops_the_others_and_its_error_names_it(tmp_path, monkeyp
     assert time.monotonic() - t0 < 20.0                     # the 60-s leg was stopped, not waited for
     assert not record.exists()                              # nothing finished; 'later' never started
     assert not (tmp_path / "later").exists()
+    pid = int((tmp_path / "grandchild.pid").read_text())
+    for _ in range(50):                                     # SIGTERM is delivered at once; allow it 5 s
+        if _gone(pid):
+            break
+        time.sleep(0.1)
+    assert _gone(pid), "the failed run left its leg's subprocess running"
 
 
 def test_legs_already_done_are_not_run_again(tmp_path, monkeypatch):

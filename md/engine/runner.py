@@ -364,6 +364,7 @@ def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: 
     reports goes to files and to logging, whose handlers flush every record."""
     code = 0
     try:
+        os.setpgrp()            # a group of its own: stopping it also stops its mpirun and the ranks
         _run_leg(leg, leg_dir, np_=np_, resume=resume, progress=None, chunk_counter=[0], stop_after_chunks=None,
                  extra_commands=extra_commands)
     except BaseException as exc:  # noqa: BLE001 -- everything a child meets must reach the parent
@@ -432,11 +433,29 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
                 log.info("leg %s done", leg_name)
             follow()
     finally:
-        for proc in running.values():           # an error or an interrupt: stop the others at once
-            proc.terminate()
-        for proc in running.values():
-            proc.join()
+        _stop_children(list(running.values()))      # an error or an interrupt: stop the others at once
     return {l.name: leg_state(legs_dir / l.name) for l in plan.legs}
+
+
+def _stop_children(procs, grace_s: float = 10.0) -> None:
+    """SIGTERM to every child's process group (the child, its mpirun, the ranks), SIGKILL to a group still there
+    after ``grace_s``. Their last committed restarts stay for ``--resume``."""
+    import signal   # noqa: PLC0415
+
+    def signal_group(proc, sig) -> None:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(proc.pid, sig)
+    for proc in procs:
+        signal_group(proc, signal.SIGTERM)
+        proc.terminate()                         # also a child stopped before its setpgrp
+    deadline = time.monotonic() + grace_s
+    for proc in procs:
+        proc.join(max(0.0, deadline - time.monotonic()))
+        if proc.exitcode is None:
+            signal_group(proc, signal.SIGKILL)
+            proc.kill()
+            proc.join()
+        signal_group(proc, signal.SIGKILL)       # descendants that outlived their child
 
 
 def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path, legs_state: Mapping[str, Any], *,
