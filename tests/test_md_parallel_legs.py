@@ -183,3 +183,42 @@ def test_every_leg_waits_for_exactly_the_legs_whose_files_it_reads(name, tmp_pat
         assert read == set(waits[leg.name]), (leg.name, read, waits[leg.name])
     assert any(len(w) == 0 for w in waits.values())
     assert sum(1 for w in waits.values() if len(w) <= 1) == len(plan.legs)
+
+
+def test_a_parent_killed_outright_leaves_no_leg_running(tmp_path):
+    """SIGKILL runs no clean-up in the parent; its children (process groups of their own, out of reach of the
+    terminal's signals) must still stop rather than run on holding the run's lock: they ask the kernel for a
+    SIGTERM when their parent dies."""
+    code = f"""
+import os, time
+from pathlib import Path
+from md.engine import runner
+from md.engine.plan import Leg, Plan, Stage
+
+def run_leg(leg, leg_dir, **_):
+    Path({str(tmp_path)!r}, "child.pid").write_text(str(os.getpid()))
+    time.sleep(120)
+
+runner._run_leg = run_leg
+leg = Leg(name="a", fresh=lambda d: [], define=lambda s: [], prepare=lambda d: [], restart_head=lambda p: [],
+          stages=[Stage("run", 10)], columns={{}}, sample_interval=1, chunk_steps=10, n_atoms=1, after=())
+runner._run_legs_parallel(Plan(legs=[leg], timestep_fs=1.0, n_atoms=1, seeds={{}}, forcefield_files=[]),
+                          Path({str(tmp_path)!r}), jobs=2, np_=1, resume=False, bar=None, extra_commands=())
+"""
+    parent = subprocess.Popen([sys.executable, "-c", code])
+    pid_file = tmp_path / "child.pid"
+    for _ in range(300):
+        if pid_file.exists() and pid_file.read_text():
+            break
+        time.sleep(0.1)
+    child = int(pid_file.read_text())
+    parent.kill()
+    parent.wait()
+    for _ in range(50):
+        if _gone(child):
+            break
+        time.sleep(0.1)
+    alive = not _gone(child)
+    if alive:
+        os.kill(child, 9)
+    assert not alive, "a leg ran on after its parent was killed"

@@ -37,7 +37,8 @@ Legs in parallel
     samples are the same as in one process. The children are forked, not spawned, because legs hold closures;
     the parent never loads LAMMPS before forking. The parent follows the children's committed ``state.json``
     for the progress bar; a failed child stops the others (their last restarts stay, for ``--resume``) and its
-    error is raised here. Independent legs are what a many-core machine gains from: the systems are small and
+    error is raised here. Each child leads a process group of its own (a stop reaches its ``mpirun`` and ranks)
+    and, on Linux, is sent SIGTERM when the parent dies, so no leg runs on after a parent killed outright. Independent legs are what a many-core machine gains from: the systems are small and
     MPI scales poorly on them.
 
 Errors
@@ -357,7 +358,19 @@ def _leg_error_path(leg_dir: Path) -> Path:
     return leg_dir.parent / f"{leg_dir.name}.error"
 
 
-def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: Sequence[str]) -> None:
+def _die_with_parent(parent: int) -> None:
+    """Linux: SIGTERM this process when its parent dies (prctl PR_SET_PDEATHSIG), so a parent killed outright
+    (SIGKILL, which runs no clean-up) leaves no leg running on, holding the run's lock; elsewhere a no-op."""
+    import ctypes     # noqa: PLC0415
+    import signal     # noqa: PLC0415
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))      # 1 = PR_SET_PDEATHSIG
+    if os.getppid() != parent:          # it died before the request took effect
+        os._exit(1)
+
+
+def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: Sequence[str],
+               parent: int) -> None:
     """A forked child's whole life: run one leg; on any error write its message beside the leg directory for the
     parent and exit 1. os._exit: the parent's exit handlers and inherited stdio buffers are not the child's to
     run or flush (a flush could wait on a lock another of the parent's threads held at the fork); what the child
@@ -365,6 +378,7 @@ def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: 
     code = 0
     try:
         os.setpgrp()            # a group of its own: stopping it also stops its mpirun and the ranks
+        _die_with_parent(parent)
         _run_leg(leg, leg_dir, np_=np_, resume=resume, progress=None, chunk_counter=[0], stop_after_chunks=None,
                  extra_commands=extra_commands)
     except BaseException as exc:  # noqa: BLE001 -- everything a child meets must reach the parent
@@ -389,14 +403,17 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
     running: dict[str, Any] = {}
     shown = [""]
 
+    def count(leg_name: str) -> None:
+        step = int(leg_state(legs_dir / leg_name).get("step", 0))
+        if bar is not None and step > counted[leg_name]:
+            bar.update(step - counted[leg_name])
+        counted[leg_name] = max(counted[leg_name], step)
+
     def follow() -> None:
         if bar is None:
             return
         for leg_name in running:
-            step = int(leg_state(legs_dir / leg_name).get("step", 0))
-            if step > counted[leg_name]:
-                bar.update(step - counted[leg_name])
-                counted[leg_name] = step
+            count(leg_name)
         desc = f"{name}:{','.join(running)}"[:70]
         if desc != shown[0]:            # a redraw only when the set of running legs changes
             bar.set_description(desc)
@@ -412,7 +429,8 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
                 leg_dir = legs_dir / leg.name
                 with contextlib.suppress(FileNotFoundError):
                     _leg_error_path(leg_dir).unlink()
-                proc = ctx.Process(target=_leg_child, args=(leg, leg_dir, np_, resume, tuple(extra_commands)),
+                proc = ctx.Process(target=_leg_child,
+                                   args=(leg, leg_dir, np_, resume, tuple(extra_commands), os.getpid()),
                                    name=f"md leg {leg.name}", daemon=False)
                 proc.start()
                 running[leg.name] = proc
@@ -430,6 +448,7 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
                     msg = err.read_text() if err.exists() else f"the leg's process ended with code {proc.exitcode}"
                     raise MDRunError(f"leg {leg_name!r} failed: {msg}", "", legs_dir / leg_name / "log.lammps")
                 done.add(leg_name)
+                count(leg_name)                  # its last chunks, committed since the previous look
                 log.info("leg %s done", leg_name)
             follow()
     finally:
