@@ -1,4 +1,4 @@
-"""``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N] [--jobs J]``.
+"""``nanoimpact md RECIPE --fidelity {smoke,quick,production} --out DIR [--resume] [--np N] [--jobs J [--fill-cores]]``.
 
 Runs one MD recipe (``inputs/md/*.toml``, or a recipe name such as ``adhesion_silica``) through
 :func:`md.workflows.run_recipe`, prints the quantities (SI) and copies ``result.json``, CSV curves and PNG figures
@@ -55,6 +55,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "starts when the legs it continues from are done (adhesion registries and window chains, "
                         "pull-off tip positions and retractions run side by side; other recipes' legs still follow "
                         "one another). Uses J x N cores")
+    p.add_argument("--fill-cores", dest="fill", action="store_true",
+                   help="with --jobs J: a leg that runs alone (an anneal, a contact, the last window chain: no "
+                        "other leg can start before it ends) gets all J x N cores as MPI ranks instead of idling "
+                        "them; faster, but its samples are no longer bit-identical to a one-process run's")
     p.add_argument("--cache", help="cache directory for run directories (overrides NANOIMPACT_CACHE)")
     p.add_argument("--force", action="store_true", help="run again even if a finished result is cached")
     p.add_argument("--no-wait", dest="wait", action="store_false",
@@ -96,12 +100,14 @@ def run(argv: list[str]) -> int:
 
     check_out_dir(args.out)
     check_out_dir(args.cache, "--cache")
+    if args.fill and args.jobs < 2:
+        raise UsageError(f"--fill-cores gives a lone leg the cores of --jobs J >= 2; got --jobs {args.jobs}")
     recipe = load_recipe(args.recipe)
     out = Path(args.out) if args.out else Path("out") / "md" / f"{recipe.name}-{args.fidelity}"
     try:
         outcome = run_recipe(recipe, args.fidelity, out=out, cache=args.cache, resume=args.resume, np_=args.np,
                              progress=log.isEnabledFor(logging.INFO),    # -q here or before `md`: no bar
-                             force=args.force, wait=args.wait, jobs=args.jobs)
+                             force=args.force, wait=args.wait, jobs=args.jobs, fill=args.fill)
     except MDRunError as exc:                 # the log tail is the point here: printed whole, not one line
         print(f"nanoimpact md: {exc}", file=sys.stderr)
         print("nanoimpact md: the run failed; no result.json was written", file=sys.stderr)

@@ -51,7 +51,7 @@ def test_a_wait_for_a_later_or_unknown_leg_is_refused_naming_both(legs, word):
 def _stand_in(record: Path, seconds: dict[str, float], fail: str | None = None, spawn: str | None = None):
     """A leg runner that sleeps, appends (name, start, end) to ``record`` and commits a done state; leg ``spawn``
     first starts a long-lived subprocess (as an mpirun would) and writes its pid beside ``record``."""
-    def run_leg(leg, leg_dir, **_):
+    def run_leg(leg, leg_dir, np_=1, **_):
         t0 = time.monotonic()
         if leg.name == spawn:
             child = subprocess.Popen(["sleep", "120"])
@@ -62,7 +62,7 @@ def _stand_in(record: Path, seconds: dict[str, float], fail: str | None = None, 
         leg_dir.mkdir(parents=True, exist_ok=True)
         (leg_dir / "state.json").write_text(json.dumps({"done": True, "step": leg.total_steps}))
         with open(record, "a") as fh:
-            fh.write(json.dumps([leg.name, t0, time.monotonic()]) + "\n")
+            fh.write(json.dumps([leg.name, t0, time.monotonic(), np_]) + "\n")
     return run_leg
 
 
@@ -74,10 +74,34 @@ def test_legs_start_when_what_they_read_is_done_and_independent_ones_overlap(tmp
     states = runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=False, bar=None,
                                        extra_commands=())
     assert all(states[n]["done"] for n in "abcd")
-    ran = {n: (t0, t1) for n, t0, t1 in map(json.loads, record.read_text().splitlines())}
+    ran = {n: (t0, t1) for n, t0, t1, _ in map(json.loads, record.read_text().splitlines())}
     assert ran["b"][0] >= ran["a"][1] and ran["c"][0] >= ran["a"][1]       # they read a's restart
     assert ran["b"][0] < ran["c"][1] and ran["c"][0] < ran["b"][1]         # b and c overlap: two jobs
     assert ran["d"][0] >= max(ran["b"][1], ran["c"][1])                     # after=None: waits for all
+
+
+@pytest.mark.parametrize("fill, expected", [
+    (True, {"a": 6, "b": 3, "c": 3, "d": 6, "e": 3, "f": 3}),     # a and d run alone; e ends alone but began beside f
+    (False, {n: 3 for n in "abcdef"}),
+])
+def test_fill_cores_gives_a_lone_leg_every_core_and_shared_legs_their_own(tmp_path, monkeypatch, fill, expected):
+    """jobs = 2 of np = 3 ranks: a leg that starts with nothing else running or able to start takes 2 x 3 ranks;
+    legs that start side by side keep 3 each, also the one left running alone when its neighbour ends."""
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"e": 0.8, "f": 0.2}))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    legs = [_leg("a", ()), _leg("b", ("a",)), _leg("c", ("a",)), _leg("d"), _leg("e", ("d",)), _leg("f", ("d",))]
+    runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=3, resume=False, bar=None, extra_commands=(),
+                              fill=fill)
+    ranks = {n: r for n, _, _, r in map(json.loads, record.read_text().splitlines())}
+    assert ranks == expected
+
+
+def test_fill_cores_without_jobs_is_refused_in_one_line_naming_both():
+    from md.cli import run
+    from nanoimpact.errors import UsageError
+    with pytest.raises(UsageError, match=r"--fill-cores .* --jobs J >= 2; got --jobs 1"):
+        run(["adhesion_ots_equilibrated", "--fidelity", "smoke", "--fill-cores"])
 
 
 def test_one_job_at_a_time_never_overlaps(tmp_path, monkeypatch):
@@ -86,7 +110,7 @@ def test_one_job_at_a_time_never_overlaps(tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     legs = [_leg("a", ()), _leg("b", ()), _leg("c", ())]
     runner._run_legs_parallel(_plan(legs), tmp_path, jobs=1, np_=1, resume=False, bar=None, extra_commands=())
-    spans = sorted((t0, t1) for _, t0, t1 in map(json.loads, record.read_text().splitlines()))
+    spans = sorted((t0, t1) for _, t0, t1, _ in map(json.loads, record.read_text().splitlines()))
     assert all(spans[k + 1][0] >= spans[k][1] for k in range(len(spans) - 1))
 
 
@@ -160,6 +184,7 @@ def test_two_jobs_give_the_samples_of_one_process_on_the_equilibrated_ots_recipe
         a = (one.run_dir / "legs" / leg / "samples.csv").read_bytes()
         b = (two_dir / "legs" / leg / "samples.csv").read_bytes()
         assert a == b, f"leg {leg}: samples differ between one process and two jobs"
+        assert two["legs"][leg]["ranks"] == [1], leg
     for name, q in one.result["quantities"].items():
         assert two["quantities"][name]["value"] == q["value"], name
 

@@ -39,7 +39,10 @@ Legs in parallel
     failed child stops the others (their last restarts stay, for ``--resume``) and its error is raised here. Each
     child leads a process group of its own (a stop reaches its ``mpirun`` and ranks) and, on Linux, is sent SIGTERM
     when the parent dies, so no leg runs on after a parent killed outright. Independent legs are what a many-core
-    machine gains from: the systems are small and MPI scales poorly on them.
+    machine gains from: the systems are small and MPI scales poorly on them. With ``fill`` (``--fill-cores``) a leg
+    that would run alone -- no other leg running or able to start -- gets all ``jobs`` x ``np`` cores as MPI ranks;
+    its samples then differ from a one-process run's by the rounding that another rank count brings (each leg's
+    ``ranks`` in ``result.json`` says what it ran on).
 
 Errors
     A LAMMPS error (lost atoms, bad parameters, ...) raises :class:`~md.engine.lammps.MDRunError`;
@@ -176,6 +179,7 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
     samples_csv = leg_dir / "samples.csv"
     if not samples_csv.exists():
         atomic_write_text(samples_csv, ",".join(["step", "stage"] + list(leg.columns)) + "\n")
+    state["ranks"] = sorted(set(state.get("ranks", [])) | {np_})     # a resumed leg may have run on other counts
     engine = InProcess(leg_dir) if np_ <= 1 else MpiRun(leg_dir, np_)
     try:
         t0 = time.perf_counter()
@@ -242,12 +246,13 @@ def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache
             resume: bool = False, np_: int = 1, progress: bool = True, force: bool = False,
             stop_after_chunks: int | None = None, extra_commands: Sequence[str] = (),
             echo: Callable[[str], None] | None = None, wait: bool = True,
-            wait_timeout: float | None = None, jobs: int = 1) -> RunOutcome:
+            wait_timeout: float | None = None, jobs: int = 1, fill: bool = False) -> RunOutcome:
     """Run ``job`` with ``workflow``'s plan and analysis (or reuse the cached result) and copy the result into
     ``out``.
 
     ``np_`` > 1 runs every chunk with ``mpirun -np np_``; ``jobs`` > 1 runs up to that many independent legs at
-    once (module docstring, "Legs in parallel"). ``force`` ignores a cached result. ``stop_after_chunks``
+    once (module docstring, "Legs in parallel"); with ``fill`` a leg that runs alone takes all ``jobs`` x ``np_``
+    cores as ranks. ``force`` ignores a cached result. ``stop_after_chunks``
     and ``extra_commands`` (LAMMPS commands issued after each leg's set-up) are for tests and debugging. What the
     run does (reused, discarded, resumed, written) is logged at INFO on ``md.engine.runner``; ``echo``, if given,
     receives the same lines.
@@ -271,12 +276,13 @@ def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache
                   hint="wait for it to finish and run again, or leave out --no-wait to wait for it"):
         return _run_locked(job, workflow, digest, hashed, run_dir, out=out, resume=resume, np_=np_,
                            progress=progress, force=force, stop_after_chunks=stop_after_chunks,
-                           extra_commands=extra_commands, say=say, jobs=jobs)
+                           extra_commands=extra_commands, say=say, jobs=jobs, fill=fill)
 
 
 def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], run_dir: Path, *, out,
                 resume: bool, np_: int, progress: bool, force: bool, stop_after_chunks: int | None,
-                extra_commands: Sequence[str], say: Callable[[str], None], jobs: int = 1) -> RunOutcome:
+                extra_commands: Sequence[str], say: Callable[[str], None], jobs: int = 1,
+                fill: bool = False) -> RunOutcome:
     """:func:`run_job`'s work on ``run_dir``; the caller holds its lock."""
     result_path = run_dir / "result.json"
     if result_path.exists() and not force and not extra_commands:
@@ -301,11 +307,12 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         if done:
             say(f"resuming {run_dir.name} at {done} of {total} steps")
     say(f"{job.name} [{job.fidelity}]: {len(plan.legs)} leg(s), {plan.n_atoms} atoms, {total} MD steps, "
-        f"run directory {run_dir}" + (f", up to {jobs} legs at a time" if jobs > 1 else ""))
+        f"run directory {run_dir}" + (f", up to {jobs} legs at a time" if jobs > 1 else "")
+        + (f", a leg alone on {jobs * np_} ranks" if fill and jobs > 1 else ""))
     t_start = time.perf_counter()
     legs_state = _run_legs(job, plan, run_dir, done=done, total=total, np_=np_, resume=resume, progress=progress,
-                           stop_after_chunks=stop_after_chunks, extra_commands=extra_commands, jobs=jobs)
-    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_, jobs=jobs,
+                           stop_after_chunks=stop_after_chunks, extra_commands=extra_commands, jobs=jobs, fill=fill)
+    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_, jobs=jobs, fill=fill,
                                  reanalysed=resume and done == total, t_start=t_start)
     atomic_write_text(result_path, json.dumps(clean_json(result), indent=1))
     say(f"wrote {result_path}")
@@ -313,7 +320,8 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
 
 
 def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int, resume: bool, progress: bool,
-              stop_after_chunks: int | None, extra_commands: Sequence[str], jobs: int = 1) -> dict[str, Any]:
+              stop_after_chunks: int | None, extra_commands: Sequence[str], jobs: int = 1,
+              fill: bool = False) -> dict[str, Any]:
     """Every leg of ``plan`` in order (:func:`_run_leg`), or up to ``jobs`` at once (:func:`_run_legs_parallel`),
     behind a progress bar if asked; their final states."""
     if jobs > 1 and stop_after_chunks is not None:
@@ -331,7 +339,7 @@ def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int,
     if jobs > 1:
         try:
             return _run_legs_parallel(plan, run_dir, jobs=jobs, np_=np_, resume=resume, bar=bar,
-                                      extra_commands=extra_commands, name=job.name)
+                                      extra_commands=extra_commands, name=job.name, fill=fill)
         finally:
             if bar is not None:
                 bar.close()
@@ -390,9 +398,14 @@ def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: 
 
 
 def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool, bar,
-                       extra_commands: Sequence[str], name: str = "md") -> dict[str, Any]:
+                       extra_commands: Sequence[str], name: str = "md", fill: bool = False) -> dict[str, Any]:
     """Up to ``jobs`` legs at once, each in a forked child, a leg started (in plan order) once every leg it waits
-    for (:func:`~md.engine.plan.leg_dependencies`) is done; the legs' final states."""
+    for (:func:`~md.engine.plan.leg_dependencies`) is done; the legs' final states.
+
+    ``fill``: a leg that starts while no other runs and no other can start gets ``jobs`` x ``np_`` ranks instead
+    of ``np_``. Nothing else can start before it ends (a leg waits only for done legs), so the cores it takes
+    would otherwise idle: an anneal, a contact, the last chain of windows. A leg keeps its rank count to its end,
+    so one that is left alone when a neighbour finishes runs on with ``np_``."""
     import multiprocessing as mp                           # noqa: PLC0415
     from multiprocessing.connection import wait as mp_wait   # noqa: PLC0415
     ctx = mp.get_context("fork")
@@ -421,20 +434,22 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
 
     try:
         while len(done) < len(plan.legs):
-            for leg in plan.legs:
+            startable = [l for l in plan.legs
+                         if l.name not in done and l.name not in running and waits[l.name] <= done]
+            ranks = jobs * np_ if fill and not running and len(startable) == 1 else np_
+            for leg in startable:
                 if len(running) >= jobs:
                     break
-                if leg.name in done or leg.name in running or not waits[leg.name] <= done:
-                    continue
                 leg_dir = legs_dir / leg.name
                 with contextlib.suppress(FileNotFoundError):
                     _leg_error_path(leg_dir).unlink()
                 proc = ctx.Process(target=_leg_child,
-                                   args=(leg, leg_dir, np_, resume, tuple(extra_commands), os.getpid()),
+                                   args=(leg, leg_dir, ranks, resume, tuple(extra_commands), os.getpid()),
                                    name=f"md leg {leg.name}", daemon=False)
                 proc.start()
                 running[leg.name] = proc
-                log.info("leg %s started (pid %d)", leg.name, proc.pid)
+                log.info("leg %s started (pid %d)%s", leg.name, proc.pid,
+                         f" alone, on {ranks} ranks" if ranks != np_ else "")
             if not running:     # cannot happen for a valid plan: leg_dependencies only allows earlier legs
                 raise RuntimeError(f"no leg can start; done: {sorted(done)}")
             mp_wait([p.sentinel for p in running.values()], timeout=POLL_S)
@@ -478,7 +493,8 @@ def _stop_children(procs, grace_s: float = 10.0) -> None:
 
 
 def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path, legs_state: Mapping[str, Any], *,
-                        np_: int, reanalysed: bool, t_start: float, jobs: int = 1) -> dict[str, Any]:
+                        np_: int, reanalysed: bool, t_start: float, jobs: int = 1,
+                        fill: bool = False) -> dict[str, Any]:
     """The workflow's analysis of the finished legs, its curves and figures exported (a figure that fails is
     named in the notes, never loses the run), and the run's ``result.json`` record."""
     analysis = wf.analyse(RunContext(run_dir, plan, job.settings))
@@ -520,11 +536,13 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
         "atom_steps_per_s": atom_steps / dyn_wall if dyn_wall > 0 else None,
         "np": np_,
         "jobs": jobs,
+        "fill_cores": fill,
         "seeds": plan.seeds,
         "settings": dict(job.settings),
         "system": plan.system_info,
         "legs": {name: {k: s.get(k) for k in ("total_steps", "n_atoms", "chunks", "dynamics_wall_s", "setup_wall_s",
-                                              "resumed_from", "dropped_on_resume")} for name, s in legs_state.items()},
+                                              "resumed_from", "dropped_on_resume", "ranks")}
+                 for name, s in legs_state.items()},
         "provenance": prov,
         "notes": notes,
         "details": analysis.details,
