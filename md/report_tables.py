@@ -104,8 +104,9 @@ def _flags(q: dict[str, Any]) -> str:
     if q.get("discretisation_error") is not None:
         grid = abs(q["discretisation_error"]) * factor
         flags.append(f"grid ± {grid:.{_decimals(grid)}f}" if grid > 0 else "grid ± 0")
-    if q.get("registries") is not None:
-        flags.append(f"{q['registries']} registries")
+    reg = q.get("registries")
+    if reg is not None:              # a count (W_F) or the registries averaged over (T dS)
+        flags.append(f"{len(reg) if isinstance(reg, (list, tuple)) else reg} registries")
     return "; ".join(flags)
 
 
