@@ -19,6 +19,11 @@ the set's origin and the report then name as "not a free energy". (The adhesion 
 2 started its windows outside the adhesive well and gave W_F 20x too small; those runs no longer match
 the run hash and are not read.)
 
+Which adhesion runs: bare silica from `adhesion_silica_registries` (six quasi-random lateral registries over the
+primitive cell, each with its own zero-load contact, windows denser over the force peak), not the three-registry
+`adhesion_silica`, whose z0 error was too wide to use (md-review-2). The spread over registries is part of W_F's
+stderr (md.analysis).
+
 Interaction range z0: from the flat-slab mean-force curve of the adhesion workflow (version 3):
 z0 = 1.026 W_F / sigma0 (Maugis 1992, the LJ 9-3 law), with sigma0 the curve's peak tensile traction, so that
 the continuum's Maugis-Dugdale stress 1.03 dgamma / z0 reproduces the measured sigma0 with the W_F used for
@@ -87,7 +92,8 @@ _DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this 
                 "docs/md.md)")
 
 MAPPING: tuple[Source, ...] = (
-    Source("surfaces.work_of_adhesion", "adhesion_silica", ("work_of_adhesion_free_energy", "work_of_adhesion")),
+    Source("surfaces.work_of_adhesion", "adhesion_silica_registries",
+           ("work_of_adhesion_free_energy", "work_of_adhesion")),
     Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion_free_energy", "work_of_adhesion")),
     Source("surfaces.body.contact_angle", "wsl_silica", ("contact_angle",),
            fallback=Source("surfaces.body.contact_angle", "contact_angle_silica", ("contact_angle",), note=_DROPLET)),
@@ -97,7 +103,7 @@ MAPPING: tuple[Source, ...] = (
     Source("surfaces.sam.contact_angle", "wsl_ots", ("contact_angle",),
            fallback=Source("surfaces.sam.contact_angle", "contact_angle_ots", ("contact_angle",), note=_DROPLET_OTS)),
     Source("menisci.surface_tension", "surface_tension_spce", ("surface_tension",)),
-    Source("surfaces.interaction_range", "adhesion_silica", ("interaction_range_z0",),
+    Source("surfaces.interaction_range", "adhesion_silica_registries", ("interaction_range_z0",),
            fallback=Source("surfaces.interaction_range", "pulloff_silica", ("interaction_range_z0",),
                            note=_PULLOFF_Z0)),
     Source("surfaces.sam.interaction_range", "adhesion_ots", ("interaction_range_z0",),
@@ -107,7 +113,7 @@ MAPPING: tuple[Source, ...] = (
 )
 
 #: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
-VALIDATION = (("pulloff_silica", "adhesion_silica"), ("pulloff_ots", "adhesion_ots"))
+VALIDATION = (("pulloff_silica", "adhesion_silica_registries"), ("pulloff_ots", "adhesion_ots"))
 
 
 def recipes_needed(mapping=MAPPING) -> list[str]:

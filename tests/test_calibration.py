@@ -10,12 +10,15 @@ import numpy as np
 import pytest
 
 from nanoimpact.executors import executor
-from calibration.mdset import build_parameter_set, recipes_needed, write_parameter_set
+from calibration.mdset import MAPPING, build_parameter_set, recipes_needed, write_parameter_set
 from calibration.pipeline import latin_hypercube, load_calibration, CalibrationError
 from calibration.sweep import parse_vary, run_sweep
 from continuum.scene import SceneError, resolve_scene
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: the bare-silica adhesion recipe the calibration reads (the mapping's choice, so these tests follow it)
+SILICA = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")
 
 
 def _result(recipe, quantities, run_hash=None):
@@ -25,7 +28,7 @@ def _result(recipe, quantities, run_hash=None):
 
 def _results(**changes):
     res = {
-        "adhesion_silica": _result("adhesion_silica", {"work_of_adhesion": (0.21, 0.02, "J/m^2"),
+        SILICA: _result(SILICA, {"work_of_adhesion": (0.21, 0.02, "J/m^2"),
                                                        "work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2")}),
         "adhesion_ots": _result("adhesion_ots", {"work_of_adhesion": (0.045, 0.004, "J/m^2"),
                                                  "work_of_adhesion_free_energy": (0.04, None, "J/m^2"),
@@ -42,7 +45,7 @@ def _results(**changes):
 
 def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
     results = _results()
-    results["adhesion_silica"]["quantities"]["work_of_adhesion_free_energy"]["discretisation_error"] = 0.04
+    results[SILICA]["quantities"]["work_of_adhesion_free_energy"]["discretisation_error"] = 0.04
     table, rows = build_parameter_set(results, "paper", "cal")
     s = table["surfaces"]
     assert s["work_of_adhesion"] == 0.18                       # the free energy (Dupre work), not dE/A = 0.21
@@ -57,7 +60,7 @@ def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
     assert w["discretisation_error"] == 0.04 and w["energy_estimate"]["value"] == 0.21
     origin = table["meta"]["origin"]
     assert origin["surfaces.work_of_adhesion"]["kind"] == "md" and "free energy" in origin["surfaces.work_of_adhesion"]["note"]
-    assert origin["surfaces.work_of_adhesion"]["run_hash"] == results["adhesion_silica"]["run_hash"]
+    assert origin["surfaces.work_of_adhesion"]["run_hash"] == results[SILICA]["run_hash"]
     assert cal["menisci.surface_tension"]["run_hash"] == _results()["surface_tension_spce"]["run_hash"]
     assert s["roughness"]["summit_radius"] == 0.2e-6            # from the base set, with its origin
     assert origin["surfaces.roughness.summit_radius"]["kind"] == "chosen"
@@ -76,7 +79,7 @@ def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
 
 
 def test_without_a_free_energy_the_energy_difference_is_used_and_named():
-    res = _results(adhesion_silica=_result("adhesion_silica", {"work_of_adhesion": (0.21, 0.02, "J/m^2")}))
+    res = _results(**{SILICA: _result(SILICA, {"work_of_adhesion": (0.21, 0.02, "J/m^2")})})
     table, _ = build_parameter_set(res, "paper", "cal")
     assert table["surfaces"]["work_of_adhesion"] == 0.21
     assert table["meta"]["calibration"]["surfaces.work_of_adhesion"]["quantity"] == "work_of_adhesion"
@@ -85,7 +88,7 @@ def test_without_a_free_energy_the_energy_difference_is_used_and_named():
 
 def test_unusable_md_values_keep_the_base_value_and_say_so():
     bad = _results(contact_angle_ots=_result("contact_angle_ots", {"contact_angle": (180.0, 0.0, "deg")}),
-                   adhesion_silica=_result("adhesion_silica", {"work_of_adhesion": (-0.3, 0.5, "J/m^2")}))
+                   **{SILICA: _result(SILICA, {"work_of_adhesion": (-0.3, 0.5, "J/m^2")})})
     del bad["pulloff_ots"]
     table, rows = build_parameter_set(bad, "paper", "cal")
     base = tomllib.loads((ROOT / "inputs" / "params" / "paper.toml").read_text())
@@ -167,7 +170,7 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     report = CalibrationReport(
         name="cal", set_path=tmp_path / "cal.toml", out=tmp_path / "out",
         calibration=recipe,
-        rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources={"adhesion_silica": {"source": "committed"}},
+        rows=tuple(ValueRow.from_dict(r) for r in rows), md_sources={SILICA: {"source": "committed"}},
         bands={"first_rebound_over_h0": band, "rebound_count": band, "escape_velocity_m_per_s": band,
                "covers": ["x"], "samples": 4, "failed_samples": 0, "seed": 0, "scene": "s", "max_bounces": 3},
         paper_checks=({"set": "cal", "name": "claim_a", "pass": True, "threshold": "t", "values": {}},
@@ -191,7 +194,7 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     assert f"- `surfaces.roughness.summit_radius`: {reason}" in text
     assert "- `surfaces.roughness.summit_modulus`: the base's 10000000000.0" in text
     assert '`claim_b`: needs t2; got {"v": 1}. **Why:** holds again when only W is put back.' in text
-    assert "| `surfaces.work_of_adhesion` | adhesion_silica | work_of_adhesion_free_energy | 0.18 J/m^2 | 0.03 | " \
+    assert f"| `surfaces.work_of_adhesion` | {SILICA} | work_of_adhesion_free_energy | 0.18 J/m^2 | 0.03 | " \
            "none quoted | - |" in text
     # the fixture's silica angle, 31 +- 3 deg: (31 - 20) / 3 = 3.7 stderr above the literature's 0-20 deg and beyond
     # the 0-30 deg acceptance window; OTS 108 deg inside Wasserman's 105-112 deg; z0 = 0.35 nm only inside the window
@@ -215,10 +218,10 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
 
 def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_needed():
     from calibration.mdset import fallbacks_needed, recipes_first
-    assert recipes_needed() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
+    assert recipes_needed() == [SILICA, "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
                                 "contact_angle_silica", "contact_angle_ots", "pulloff_silica", "pulloff_ots"]
     # every calibration runs the preferred recipes and the validation pull-offs; the droplets only as fallbacks
-    assert recipes_first() == ["adhesion_silica", "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
+    assert recipes_first() == [SILICA, "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
                                "pulloff_silica", "pulloff_ots"]
     ti = _ti(0.0, None, "wets", w=0.15, bound=0.0)
     both = {"wsl_silica": ti, "wsl_ots": ti, **{k: v for k, v in _results().items() if k in recipes_first()}}
@@ -480,7 +483,7 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
     assert v["pulloff_silica"]["ratio"] == pytest.approx(0.5, rel=1e-12)
     assert v["pulloff_silica"]["difference_in_stderr"] == pytest.approx(-0.09 / math.hypot(0.004, 0.03), rel=1e-12)
     text = "\n".join(_validation_lines(v))
-    assert "| pulloff_silica (vs adhesion_silica) | 0.09 +- 0.004 | 0.18 +- 0.03 | 0.50 | -3.0 sigma | +0.002 |" in text
+    assert f"| pulloff_silica (vs {SILICA}) | 0.09 +- 0.004 | 0.18 +- 0.03 | 0.50 | -3.0 sigma | +0.002 |" in text
     assert "| pulloff_ots (vs adhesion_ots) | 0.05 +- 0.01 | 0.04 +- - | 1.25 | +1.0 sigma | - |" in text
     assert "Beyond 2 combined stderrs: pulloff_silica." in text
     assert _validation_lines({}) == []
@@ -533,8 +536,8 @@ def test_pulloff_validation_carries_tabor_mu_of_the_current_results():
     res = _results()
     res["pulloff_silica"]["settings"] = {"asperity_radius_A": 15.0}
     res["pulloff_silica"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.096, "stderr": 0.004}
-    res["adhesion_silica"]["quantities"]["work_of_adhesion_free_energy"]["value"] = 0.196
-    res["adhesion_silica"]["quantities"]["interaction_range_z0"] = {"value": 0.2075e-9, "stderr": 0.1e-9}
+    res[SILICA]["quantities"]["work_of_adhesion_free_energy"]["value"] = 0.196
+    res[SILICA]["quantities"]["interaction_range_z0"] = {"value": 0.2075e-9, "stderr": 0.1e-9}
     v = pulloff_validation(res)["pulloff_silica"]
     mu = (1.5e-9 * 0.196 ** 2 / (SILICA_E_STAR_PA ** 2 * 0.2075e-9 ** 3)) ** (1 / 3)
     assert v["tabor_mu"] == pytest.approx(mu, rel=1e-12) and v["maugis_lambda"] == pytest.approx(1.157 * mu, rel=1e-3)

@@ -208,12 +208,13 @@ def test_production_ots_asperity_reaches_sam_density_with_leaning_chains():
 
 
 def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
-    from calibration.mdset import build_parameter_set, recipes_needed
+    from calibration.mdset import MAPPING, build_parameter_set, recipes_needed
+    silica = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")   # the mapping's choice
 
     def res(recipe, q):
         return {"recipe": recipe, "fidelity": "quick", "run_hash": f"{recipe:0<64}"[:64],
                 "quantities": {k: dict(v) for k, v in q.items()}}
-    adh_si = res("adhesion_silica", {
+    adh_si = res(silica, {
         "work_of_adhesion": {"value": 0.12, "stderr": 0.002, "units": "J/m^2"},
         "work_of_adhesion_free_energy": {"value": 0.075, "stderr": 0.002, "units": "J/m^2",
                                          "discretisation_error": 0.001},
@@ -225,11 +226,11 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
                        "work_of_adhesion_eff_dmt": {"value": w, "stderr": 0.01, "units": "J/m^2"},
                        "residual_drag_force": {"value": 1e-12, "stderr": 5e-11, "units": "N"}})
             for n, z, w in (("pulloff_silica", 0.49e-9, 0.054), ("pulloff_ots", 0.94e-9, 0.03))}
-    table, rows = build_parameter_set({"adhesion_silica": adh_si, "adhesion_ots": adh_ots, **pull}, "paper", "cal")
+    table, rows = build_parameter_set({silica: adh_si, "adhesion_ots": adh_ots, **pull}, "paper", "cal")
     s = table["surfaces"]
     assert s["interaction_range"] == 0.17e-9                   # flat slab, not the pull-off's 0.49 nm
     cal = table["meta"]["calibration"]["surfaces.interaction_range"]
-    assert cal["recipe"] == "adhesion_silica" and cal["stderr"] == 0.02e-9
+    assert cal["recipe"] == silica and cal["stderr"] == 0.02e-9
     assert cal["sigma0"]["value"] == 0.45e9 and cal["dugdale_range_h0"] == 0.16e-9
     # the OTS adhesion result predates the flat-slab z0: the pull-off's z0 is used and named as such
     assert s["sam"]["interaction_range"] == 0.94e-9
@@ -237,8 +238,8 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
     assert sam["recipe"] == "pulloff_ots" and "compliance" in sam["note"]
     assert "pull-off" in table["meta"]["origin"]["surfaces.sam.interaction_range"]["note"]
     val = table["meta"]["validation"]["pulloff_silica"]
-    assert val["ratio"] == pytest.approx(0.054 / 0.075) and val["adhesion_recipe"] == "adhesion_silica"
-    assert "pulloff_silica" in recipes_needed() and recipes_needed()[0] == "adhesion_silica"
+    assert val["ratio"] == pytest.approx(0.054 / 0.075) and val["adhesion_recipe"] == silica
+    assert "pulloff_silica" in recipes_needed() and recipes_needed()[0] == silica
 
 
 # ------------------------------------------------------------------------------------ LAMMPS (smoke)
