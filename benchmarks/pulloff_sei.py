@@ -5,7 +5,8 @@
 For each surface (bare silica, OTS): the asperity of the shipped ``pulloff_<surface>`` recipe is built at quick
 (the workflow's own builder, nothing runs), its atoms' heights binned into a lateral height map
 (:func:`md.analysis.pulloff.tip_height_map`); the flat-slab traction law is the registry-averaged mean force per
-area of the committed ``adhesion_<surface>-quick`` result (``details.pmf_windows``: ``mean_force_kcal_mol_A`` over
+area of the committed quick result of the adhesion recipe the calibration reads for that surface's W
+(``calibration.mdset.MAPPING``: ``adhesion_silica_registries``, ``adhesion_ots``) (``details.pmf_windows``: ``mean_force_kcal_mol_A`` over
 ``details.energy.area_A2`` against ``separation_A``; with the TraPPE tail force ``tail_force_kcal_mol_A`` added for
 the "full" law). The map's reach is the covering radius of the outermost sites (their hexagonal lattice, spacing
 a/sqrt 2 of cristobalite): the smallest at which a flat face of the same crystal maps flat, so the flat-slab law
@@ -40,7 +41,12 @@ from md.build.silica import CRISTOBALITE_A                                      
 from md.recipe import RECIPE_DIR, load_recipe                                    # noqa: E402
 from md.workflows import get_workflow                                            # noqa: E402
 
+from calibration.mdset import MAPPING                                           # noqa: E402
+
 RESULTS = RECIPE_DIR / "results"
+#: the adhesion recipe whose flat-slab law stands for each surface: the one the calibration reads its W from
+ADHESION = {surface: next(s.recipe for s in MAPPING if s.key == key)
+            for surface, key in (("silica", "surfaces.work_of_adhesion"), ("ots", "surfaces.sam.work_of_adhesion"))}
 
 
 def traction_law(adhesion: dict, with_tail: bool, registry: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -72,10 +78,11 @@ def tip_map(recipe: str, bin_A: float, reach_A: float) -> dict:
 
 
 def predict(surface: str, bins: list[float], reaches: list[float]) -> dict:
-    adhesion = json.loads((RESULTS / f"adhesion_{surface}-quick" / "result.json").read_text())
+    adhesion = json.loads((RESULTS / f"{ADHESION[surface]}-quick" / "result.json").read_text())
     pull = json.loads((RESULTS / f"pulloff_{surface}-quick" / "result.json").read_text())
     R = U.angstrom_to_m(pull["settings"]["asperity_radius_A"])
-    out = {"surface": surface, "radius_m": R, "adhesion_run_hash": adhesion["run_hash"],
+    out = {"surface": surface, "radius_m": R, "adhesion_recipe": ADHESION[surface],
+           "adhesion_run_hash": adhesion["run_hash"],
            "pulloff_run_hash": pull["run_hash"], "laws": {}}
     laws = {"cut": False} | ({"full": True} if any(adhesion["details"]["pmf_windows"]["tail_force_kcal_mol_A"])
                              else {})
