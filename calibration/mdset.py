@@ -113,7 +113,8 @@ MAPPING: tuple[Source, ...] = (
 )
 
 #: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
-VALIDATION = (("pulloff_silica", "adhesion_silica_registries"), ("pulloff_ots", "adhesion_ots"))
+#: (the silica pull-off over four tip positions, each its own contact, so its stderr holds the geometric spread)
+VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"), ("pulloff_ots", "adhesion_ots"))
 
 
 def recipes_needed(mapping=MAPPING) -> list[str]:
@@ -126,8 +127,9 @@ def recipes_needed(mapping=MAPPING) -> list[str]:
 def recipes_first(mapping=MAPPING, validation=VALIDATION) -> list[str]:
     """The recipes every calibration runs: the preferred recipe of every key and the validation runs (the
     pull-offs), in :func:`recipes_needed` order. A fallback recipe runs only when :func:`fallbacks_needed` asks."""
-    want = {s.recipe for s in mapping} | {pull for pull, _ in validation}
-    return [r for r in recipes_needed(mapping) if r in want]
+    want = {s.recipe for s in mapping}
+    first = [r for r in recipes_needed(mapping) if r in want]
+    return list(dict.fromkeys(first + [pull for pull, _ in validation]))
 
 
 def fallbacks_needed(results: dict[str, dict], mapping=MAPPING) -> list[str]:

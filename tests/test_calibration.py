@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from nanoimpact.executors import executor
-from calibration.mdset import MAPPING, build_parameter_set, recipes_needed, write_parameter_set
+from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_needed, write_parameter_set
 from calibration.pipeline import latin_hypercube, load_calibration, CalibrationError
 from calibration.sweep import parse_vary, run_sweep
 from continuum.scene import SceneError, resolve_scene
@@ -19,6 +19,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: the bare-silica adhesion recipe the calibration reads (the mapping's choice, so these tests follow it)
 SILICA = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")
+#: the pull-off the silica validation reads (calibration.mdset.VALIDATION)
+PULL_SI = next(pull for pull, adh in VALIDATION if adh == SILICA)
 
 
 def _result(recipe, quantities, run_hash=None):
@@ -37,6 +39,7 @@ def _results(**changes):
         "contact_angle_ots": _result("contact_angle_ots", {"contact_angle": (108.0, 4.0, "deg")}),
         "surface_tension_spce": _result("surface_tension_spce", {"surface_tension": (0.0615, 0.002, "N/m")}),
         "pulloff_silica": _result("pulloff_silica", {"interaction_range_z0": (0.35e-9, 0.05e-9, "m")}),
+        PULL_SI: _result(PULL_SI, {"interaction_range_z0": (0.35e-9, 0.05e-9, "m")}),
         "pulloff_ots": _result("pulloff_ots", {"interaction_range_z0": (0.42e-9, 0.06e-9, "m")}),
     }
     res.update(changes)
@@ -222,9 +225,11 @@ def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_nee
                                 "contact_angle_silica", "contact_angle_ots", "pulloff_silica", "pulloff_ots"]
     # every calibration runs the preferred recipes and the validation pull-offs; the droplets only as fallbacks
     assert recipes_first() == [SILICA, "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
-                               "pulloff_silica", "pulloff_ots"]
+                               PULL_SI, "pulloff_ots"]
     ti = _ti(0.0, None, "wets", w=0.15, bound=0.0)
     both = {"wsl_silica": ti, "wsl_ots": ti, **{k: v for k, v in _results().items() if k in recipes_first()}}
+    both[SILICA] = _result(SILICA, {"work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2"),
+                                    "interaction_range_z0": (0.2e-9, 0.05e-9, "m")})     # its own z0: no pull-off
     assert fallbacks_needed(both) == []
     no_angle = {**both, "wsl_ots": _result("wsl_ots", {"work_of_adhesion_sl": (0.04, 0.003, "J/m^2")})}
     assert fallbacks_needed(no_angle) == ["contact_angle_ots"]
@@ -475,17 +480,17 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
     from calibration.report import _validation_lines
 
     res = _results()
-    res["pulloff_silica"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.09, "stderr": 0.004,
+    res[PULL_SI]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.09, "stderr": 0.004,
                                                                        "units": "J/m^2"}
     res["pulloff_ots"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.05, "stderr": 0.01, "units": "J/m^2"}
-    res["pulloff_silica"]["quantities"]["residual_drag_force"] = {"value": 1.5e-12, "units": "N"}
+    res[PULL_SI]["quantities"]["residual_drag_force"] = {"value": 1.5e-12, "units": "N"}
     v = pulloff_validation(res)
-    assert v["pulloff_silica"]["ratio"] == pytest.approx(0.5, rel=1e-12)
-    assert v["pulloff_silica"]["difference_in_stderr"] == pytest.approx(-0.09 / math.hypot(0.004, 0.03), rel=1e-12)
+    assert v[PULL_SI]["ratio"] == pytest.approx(0.5, rel=1e-12)
+    assert v[PULL_SI]["difference_in_stderr"] == pytest.approx(-0.09 / math.hypot(0.004, 0.03), rel=1e-12)
     text = "\n".join(_validation_lines(v))
-    assert f"| pulloff_silica (vs {SILICA}) | 0.09 +- 0.004 | 0.18 +- 0.03 | 0.50 | -3.0 sigma | +0.002 |" in text
+    assert f"| {PULL_SI} (vs {SILICA}) | 0.09 +- 0.004 | 0.18 +- 0.03 | 0.50 | -3.0 sigma | +0.002 |" in text
     assert "| pulloff_ots (vs adhesion_ots) | 0.05 +- 0.01 | 0.04 +- - | 1.25 | +1.0 sigma | - |" in text
-    assert "Beyond 2 combined stderrs: pulloff_silica." in text
+    assert f"Beyond 2 combined stderrs: {PULL_SI}." in text
     assert _validation_lines({}) == []
     table, _ = build_parameter_set(res, "paper", "cal")
     assert table["meta"]["validation"] == v                 # the set records what the report shows
@@ -534,10 +539,10 @@ def test_pulloff_validation_carries_tabor_mu_of_the_current_results():
     from md.analysis.pulloff import SILICA_E_STAR_PA
 
     res = _results()
-    res["pulloff_silica"]["settings"] = {"asperity_radius_A": 15.0}
-    res["pulloff_silica"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.096, "stderr": 0.004}
+    res[PULL_SI]["settings"] = {"asperity_radius_A": 15.0}
+    res[PULL_SI]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.096, "stderr": 0.004}
     res[SILICA]["quantities"]["work_of_adhesion_free_energy"]["value"] = 0.196
     res[SILICA]["quantities"]["interaction_range_z0"] = {"value": 0.2075e-9, "stderr": 0.1e-9}
-    v = pulloff_validation(res)["pulloff_silica"]
+    v = pulloff_validation(res)[PULL_SI]
     mu = (1.5e-9 * 0.196 ** 2 / (SILICA_E_STAR_PA ** 2 * 0.2075e-9 ** 3)) ** (1 / 3)
     assert v["tabor_mu"] == pytest.approx(mu, rel=1e-12) and v["maugis_lambda"] == pytest.approx(1.157 * mu, rel=1e-3)

@@ -208,8 +208,9 @@ def test_production_ots_asperity_reaches_sam_density_with_leaning_chains():
 
 
 def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
-    from calibration.mdset import MAPPING, build_parameter_set, recipes_needed
+    from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_first, recipes_needed
     silica = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")   # the mapping's choice
+    pull_si = next(p for p, a in VALIDATION if a == silica)
 
     def res(recipe, q):
         return {"recipe": recipe, "fidelity": "quick", "run_hash": f"{recipe:0<64}"[:64],
@@ -225,7 +226,8 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
     pull = {n: res(n, {"interaction_range_z0": {"value": z, "stderr": None, "units": "m"},
                        "work_of_adhesion_eff_dmt": {"value": w, "stderr": 0.01, "units": "J/m^2"},
                        "residual_drag_force": {"value": 1e-12, "stderr": 5e-11, "units": "N"}})
-            for n, z, w in (("pulloff_silica", 0.49e-9, 0.054), ("pulloff_ots", 0.94e-9, 0.03))}
+            for n, z, w in (("pulloff_silica", 0.49e-9, 0.054), (pull_si, 0.49e-9, 0.054),
+                            ("pulloff_ots", 0.94e-9, 0.03))}
     table, rows = build_parameter_set({silica: adh_si, "adhesion_ots": adh_ots, **pull}, "paper", "cal")
     s = table["surfaces"]
     assert s["interaction_range"] == 0.17e-9                   # flat slab, not the pull-off's 0.49 nm
@@ -237,9 +239,9 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
     sam = table["meta"]["calibration"]["surfaces.sam.interaction_range"]
     assert sam["recipe"] == "pulloff_ots" and "compliance" in sam["note"]
     assert "pull-off" in table["meta"]["origin"]["surfaces.sam.interaction_range"]["note"]
-    val = table["meta"]["validation"]["pulloff_silica"]
+    val = table["meta"]["validation"][pull_si]
     assert val["ratio"] == pytest.approx(0.054 / 0.075) and val["adhesion_recipe"] == silica
-    assert "pulloff_silica" in recipes_needed() and recipes_needed()[0] == silica
+    assert "pulloff_silica" in recipes_needed() and recipes_needed()[0] == silica and pull_si in recipes_first()
 
 
 # ------------------------------------------------------------------------------------ LAMMPS (smoke)
