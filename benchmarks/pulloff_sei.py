@@ -2,8 +2,9 @@
 
     .venv/bin/python benchmarks/pulloff_sei.py [--json docs/figures/pulloff_sei.json] [--bins 1 2 3]
 
-For each surface (bare silica, OTS): the asperity of the shipped ``pulloff_<surface>`` recipe is built at quick
-(the workflow's own builder, nothing runs), its atoms' heights binned into a lateral height map
+For each surface (bare silica, OTS): the asperity of the pull-off recipe the calibration validates that surface
+with (``calibration.mdset.VALIDATION``: ``pulloff_silica_positions``, ``pulloff_ots``) is built at quick (the
+workflow's own builder, nothing runs), its atoms' heights binned into a lateral height map
 (:func:`md.analysis.pulloff.tip_height_map`); the flat-slab traction law is the registry-averaged mean force per
 area of the committed quick result of the adhesion recipe the calibration reads for that surface's W
 (``calibration.mdset.MAPPING``: ``adhesion_silica_registries``, ``adhesion_ots``) (``details.pmf_windows``:
@@ -42,12 +43,15 @@ from md.build.silica import CRISTOBALITE_A                                      
 from md.recipe import RECIPE_DIR, load_recipe                                    # noqa: E402
 from md.workflows import get_workflow                                            # noqa: E402
 
-from calibration.mdset import MAPPING                                           # noqa: E402
+from calibration.mdset import MAPPING, VALIDATION                               # noqa: E402
+from nanoimpact.fileio import atomic_write_text                                 # noqa: E402
 
 RESULTS = RECIPE_DIR / "results"
 #: the adhesion recipe whose flat-slab law stands for each surface: the one the calibration reads its W from
 ADHESION = {surface: next(s.recipe for s in MAPPING if s.key == key)
             for surface, key in (("silica", "surfaces.work_of_adhesion"), ("ots", "surfaces.sam.work_of_adhesion"))}
+#: the measured pull-off each prediction is held against: the validation pull of that adhesion recipe
+PULLOFF = {surface: next(pull for pull, adh in VALIDATION if adh == ADHESION[surface]) for surface in ADHESION}
 
 
 def traction_law(adhesion: dict, with_tail: bool, registry: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -80,14 +84,14 @@ def tip_map(recipe: str, bin_A: float, reach_A: float) -> dict:
 
 def predict(surface: str, bins: list[float], reaches: list[float]) -> dict:
     adhesion = json.loads((RESULTS / f"{ADHESION[surface]}-quick" / "result.json").read_text())
-    pull = json.loads((RESULTS / f"pulloff_{surface}-quick" / "result.json").read_text())
+    pull = json.loads((RESULTS / f"{PULLOFF[surface]}-quick" / "result.json").read_text())
     R = U.angstrom_to_m(pull["settings"]["asperity_radius_A"])
     out = {"surface": surface, "radius_m": R, "adhesion_recipe": ADHESION[surface],
-           "adhesion_run_hash": adhesion["run_hash"],
+           "adhesion_run_hash": adhesion["run_hash"], "pulloff_recipe": PULLOFF[surface],
            "pulloff_run_hash": pull["run_hash"], "laws": {}}
     laws = {"cut": False} | ({"full": True} if any(adhesion["details"]["pmf_windows"]["tail_force_kcal_mol_A"])
                              else {})
-    maps = {(b, r): tip_map(f"pulloff_{surface}", b, r * COVERING_RADIUS_A) for b in bins for r in reaches}
+    maps = {(b, r): tip_map(PULLOFF[surface], b, r * COVERING_RADIUS_A) for b in bins for r in reaches}
     for name, tail in laws.items():
         sep, sig = traction_law(adhesion, tail)
         law = tabulated_traction(sep, sig)
@@ -112,9 +116,11 @@ def predict(surface: str, bins: list[float], reaches: list[float]) -> dict:
     W = q["work_of_adhesion_free_energy"]["value"]
     out["dmt_2piRW_N"] = 2 * math.pi * R * W
     out["flat_slab_W_F_J_m2"] = W
-    out["measured"] = {"pull_off_force_N": pull["quantities"]["pull_off_force"]["value"],
-                       "stderr_N": pull["quantities"]["pull_off_force"]["stderr"],
-                       "kind": pull["quantities"]["pull_off_force"].get("kind", "")}
+    f = pull["quantities"]["pull_off_force"]
+    out["measured"] = {"pull_off_force_N": f["value"], "stderr_N": f["stderr"], "kind": f.get("kind", ""),
+                       # each tip position's own force at the reported speed (recipes with tip_positions)
+                       "per_position_N": [p["max_tensile_force_N"] for p in pull["details"].get("per_position", [])
+                                          if p["speed_m_s"] == f.get("speed_m_s")]}
     z0 = q["interaction_range_z0"]["value"]
     out["tabor_flat_slab"] = dict(tabor_parameter(R, W, SILICA_E_STAR_PA, z0), z0_m=z0, W_J_m2=W,
                                   e_star_Pa=SILICA_E_STAR_PA)
@@ -132,14 +138,16 @@ def main(argv=None) -> int:
     res = {s: predict(s, a.bins, a.reach) for s in ("silica", "ots")}
     for s, r in res.items():
         m = r["measured"]
-        print(f"{s}: measured {m['pull_off_force_N'] * 1e9:.3f} +- {m['stderr_N'] * 1e9:.3f} nN; "
+        per = ", ".join(f"{x * 1e9:.2f}" for x in m["per_position_N"])
+        print(f"{s}: measured ({r['pulloff_recipe']}) {m['pull_off_force_N'] * 1e9:.3f} +- "
+              f"{m['stderr_N'] * 1e9:.3f} nN" + (f" (per position {per})" if per else "") + "; "
               f"DMT 2 pi R W_F = {r['dmt_2piRW_N'] * 1e9:.3f} nN; Tabor mu (flat slab, silica E*) = "
               f"{r['tabor_flat_slab']['mu']:.3f}, lambda = {r['tabor_flat_slab']['lambda']:.3f}")
         for name, law in r["laws"].items():
             per = "; ".join(f"{b}: {v['pull_off_force_N'] * 1e9:.3f}" for b, v in law["maps"].items())
             print(f"   SEI ({name} law): {law['pull_off_force_N'] * 1e9:.3f} nN ({per}); per registry "
                   + ", ".join(f"{x * 1e9:.3f}" for x in law["per_registry_N"]) + " nN")
-    a.json.write_text(json.dumps(res, indent=1) + "\n")
+    atomic_write_text(a.json, json.dumps(res, indent=1) + "\n")
     print(f"wrote {a.json}")
     return 0
 

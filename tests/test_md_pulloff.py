@@ -282,16 +282,20 @@ def _sei_row(sei: dict) -> str:
 def test_the_sei_numbers_rest_on_the_committed_results_and_the_docs_quote_them():
     """docs/figures/pulloff_sei.json was computed from the committed adhesion and pull-off results (their run hashes
     match), and the docs' table quotes it: rerun benchmarks/pulloff_sei.py after a rerun of either. The adhesion
-    recipe is the one the calibration reads for the surface's W (the json names it)."""
-    from calibration.mdset import MAPPING
+    recipe is the one the calibration reads for the surface's W, the pull-off the one it validates that W with
+    (the json names both)."""
+    from calibration.mdset import MAPPING, VALIDATION
     reads = {s.recipe for s in MAPPING if s.key.endswith("work_of_adhesion")}
     sei = json.loads(SEI_JSON.read_text())
     doc = DOC.read_text()
     results = RECIPE_DIR / "results"
     for surface, r in sei.items():
         adh = json.loads((results / f"{r['adhesion_recipe']}-quick" / "result.json").read_text())
-        pull = json.loads((results / f"pulloff_{surface}-quick" / "result.json").read_text())
-        assert r["adhesion_recipe"] in reads
+        pull = json.loads((results / f"{r['pulloff_recipe']}-quick" / "result.json").read_text())
+        assert r["adhesion_recipe"] in reads and (r["pulloff_recipe"], r["adhesion_recipe"]) in VALIDATION
         assert (r["adhesion_run_hash"], r["pulloff_run_hash"]) == (adh["run_hash"], pull["run_hash"])
         assert r["measured"]["pull_off_force_N"] == pull["quantities"]["pull_off_force"]["value"]
+        per = [p["max_tensile_force_N"] for p in pull["details"].get("per_position", [])
+               if p["speed_m_s"] == pull["quantities"]["pull_off_force"].get("speed_m_s")]
+        assert r["measured"]["per_position_N"] == per
         assert _sei_row(r) in doc, _sei_row(r)
