@@ -21,6 +21,9 @@ ROOT = Path(__file__).resolve().parents[1]
 SILICA = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")
 #: the pull-off the silica validation reads (calibration.mdset.VALIDATION)
 PULL_SI = next(pull for pull, adh in VALIDATION if adh == SILICA)
+#: the OTS-OTS adhesion recipe the calibration reads (W, z0 and the layer modulus), and its validation pull-off
+OTS = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")
+PULL_OTS = next(pull for pull, adh in VALIDATION if adh == OTS)
 
 
 def _result(recipe, quantities, run_hash=None):
@@ -32,7 +35,7 @@ def _results(**changes):
     res = {
         SILICA: _result(SILICA, {"work_of_adhesion": (0.21, 0.02, "J/m^2"),
                                                        "work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2")}),
-        "adhesion_ots": _result("adhesion_ots", {"work_of_adhesion": (0.045, 0.004, "J/m^2"),
+        OTS: _result(OTS, {"work_of_adhesion": (0.045, 0.004, "J/m^2"),
                                                  "work_of_adhesion_free_energy": (0.04, None, "J/m^2"),
                                                  "sam_layer_modulus": (5.6e9, 0.6e9, "Pa")}),
         "contact_angle_silica": _result("contact_angle_silica", {"contact_angle": (31.0, 3.0, "deg")}),
@@ -41,6 +44,7 @@ def _results(**changes):
         "pulloff_silica": _result("pulloff_silica", {"interaction_range_z0": (0.35e-9, 0.05e-9, "m")}),
         PULL_SI: _result(PULL_SI, {"interaction_range_z0": (0.35e-9, 0.05e-9, "m")}),
         "pulloff_ots": _result("pulloff_ots", {"interaction_range_z0": (0.42e-9, 0.06e-9, "m")}),
+        PULL_OTS: _result(PULL_OTS, {"interaction_range_z0": (0.42e-9, 0.06e-9, "m")}),
     }
     res.update(changes)
     return res
@@ -92,7 +96,8 @@ def test_without_a_free_energy_the_energy_difference_is_used_and_named():
 def test_unusable_md_values_keep_the_base_value_and_say_so():
     bad = _results(contact_angle_ots=_result("contact_angle_ots", {"contact_angle": (180.0, 0.0, "deg")}),
                    **{SILICA: _result(SILICA, {"work_of_adhesion": (-0.3, 0.5, "J/m^2")})})
-    del bad["pulloff_ots"]
+    for pull in {"pulloff_ots", PULL_OTS}:                 # z0's fallback and the validation pull (one or two)
+        del bad[pull]
     table, rows = build_parameter_set(bad, "paper", "cal")
     base = tomllib.loads((ROOT / "inputs" / "params" / "paper.toml").read_text())
     assert table["surfaces"]["sam"]["contact_angle"] == base["surfaces"]["sam"]["contact_angle"]
@@ -221,11 +226,10 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
 
 def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_needed():
     from calibration.mdset import fallbacks_needed, recipes_first
-    assert recipes_needed() == [SILICA, "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
+    assert recipes_needed() == [SILICA, OTS, "wsl_silica", "wsl_ots", "surface_tension_spce",
                                 "contact_angle_silica", "contact_angle_ots", "pulloff_silica", "pulloff_ots"]
     # every calibration runs the preferred recipes and the validation pull-offs; the droplets only as fallbacks
-    assert recipes_first() == [SILICA, "adhesion_ots", "wsl_silica", "wsl_ots", "surface_tension_spce",
-                               PULL_SI, "pulloff_ots"]
+    assert recipes_first() == [SILICA, OTS, "wsl_silica", "wsl_ots", "surface_tension_spce", PULL_SI, PULL_OTS]
     ti = _ti(0.0, None, "wets", w=0.15, bound=0.0)
     both = {"wsl_silica": ti, "wsl_ots": ti, **{k: v for k, v in _results().items() if k in recipes_first()}}
     both[SILICA] = _result(SILICA, {"work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2"),
@@ -482,14 +486,14 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
     res = _results()
     res[PULL_SI]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.09, "stderr": 0.004,
                                                                        "units": "J/m^2"}
-    res["pulloff_ots"]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.05, "stderr": 0.01, "units": "J/m^2"}
+    res[PULL_OTS]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.05, "stderr": 0.01, "units": "J/m^2"}
     res[PULL_SI]["quantities"]["residual_drag_force"] = {"value": 1.5e-12, "units": "N"}
     v = pulloff_validation(res)
     assert v[PULL_SI]["ratio"] == pytest.approx(0.5, rel=1e-12)
     assert v[PULL_SI]["difference_in_stderr"] == pytest.approx(-0.09 / math.hypot(0.004, 0.03), rel=1e-12)
     text = "\n".join(_validation_lines(v))
     assert f"| {PULL_SI} (vs {SILICA}) | 0.09 +- 0.004 | 0.18 +- 0.03 | 0.50 | -3.0 sigma | +0.002 |" in text
-    assert "| pulloff_ots (vs adhesion_ots) | 0.05 +- 0.01 | 0.04 +- - | 1.25 | +1.0 sigma | - |" in text
+    assert f"| {PULL_OTS} (vs {OTS}) | 0.05 +- 0.01 | 0.04 +- - | 1.25 | +1.0 sigma | - |" in text
     assert f"Beyond 2 combined stderrs: {PULL_SI}." in text
     assert _validation_lines({}) == []
     table, _ = build_parameter_set(res, "paper", "cal")
@@ -497,8 +501,8 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
 
 
 def _ots_with_windows(separation_A, force, stderr, thickness_A=24.0, area_A2=530.0):
-    """An adhesion_ots result that predates sam_layer_modulus: its windows and system record only."""
-    res = _result("adhesion_ots", {"work_of_adhesion_free_energy": (0.05, 0.005, "J/m^2")}, run_hash="b" * 64)
+    """An OTS adhesion result that predates sam_layer_modulus: its windows and system record only."""
+    res = _result(OTS, {"work_of_adhesion_free_energy": (0.05, 0.005, "J/m^2")}, run_hash="b" * 64)
     sam = {"builder": "ots_sam", "thickness_A": thickness_A}
     res["system"] = {"area_A2": area_A2, "lower": sam, "upper": sam}
     res["details"] = {"pmf_windows": {"separation_A": list(separation_A), "mean_force_kcal_mol_A": list(force),
@@ -514,7 +518,7 @@ def test_the_sam_layer_modulus_is_derived_from_committed_windows_and_converted_t
     unchecked), the base value kept and the reason given."""
     d = [-4.0, -3.0, -2.0, -1.0, 0.5, 2.0]
     f = [80.0, 60.0, 40.0, 20.0, -5.0, -1.0]
-    table, rows = build_parameter_set(_results(adhesion_ots=_ots_with_windows(d, f, [1.0] * 6)), "paper", "cal")
+    table, rows = build_parameter_set(_results(**{OTS: _ots_with_windows(d, f, [1.0] * 6)}), "paper", "cal")
     nu = table["surfaces"]["sam"].get("layer_poisson_ratio", 0.3)
     m = 20.0 * 48.0 / 530.0 * 4184.0 / 6.02214076e23 / 1e-30
     e = table["surfaces"]["sam"]["layer_modulus"]
@@ -525,7 +529,7 @@ def test_the_sam_layer_modulus_is_derived_from_committed_windows_and_converted_t
     assert cal["confined_modulus"]["value"] == pytest.approx(m, rel=1e-9) and cal["confined_modulus"]["windows"] == 4
     assert "derived from the run's committed windows" in cal["note"] and cal["stderr"] >= 0
     few = _ots_with_windows(d[2:], f[2:], [1.0] * 4)
-    table2, rows2 = build_parameter_set(_results(adhesion_ots=few), "paper", "cal")
+    table2, rows2 = build_parameter_set(_results(**{OTS: few}), "paper", "cal")
     row = next(r for r in rows2 if r["key"] == "surfaces.sam.layer_modulus")
     assert row["status"] == "rejected" and "2 repulsive windows" in row["why"]
     assert table2["surfaces"]["sam"]["layer_modulus"] == row["base_value"]

@@ -211,6 +211,8 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
     from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_first, recipes_needed
     silica = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")   # the mapping's choice
     pull_si = next(p for p, a in VALIDATION if a == silica)
+    ots = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")
+    pull_ots = next(p for p, a in VALIDATION if a == ots)
 
     def res(recipe, q):
         return {"recipe": recipe, "fidelity": "quick", "run_hash": f"{recipe:0<64}"[:64],
@@ -221,14 +223,14 @@ def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
                                          "discretisation_error": 0.001},
         "interaction_range_z0": {"value": 0.17e-9, "stderr": 0.02e-9, "units": "m", "dugdale_range_h0_m": 0.16e-9},
         "peak_traction_sigma0": {"value": 0.45e9, "stderr": 0.04e9, "units": "Pa"}})
-    adh_ots = res("adhesion_ots", {"work_of_adhesion_free_energy": {"value": 0.04, "stderr": 0.004,
+    adh_ots = res(ots, {"work_of_adhesion_free_energy": {"value": 0.04, "stderr": 0.004,
                                                                      "units": "J/m^2"}})
     pull = {n: res(n, {"interaction_range_z0": {"value": z, "stderr": None, "units": "m"},
                        "work_of_adhesion_eff_dmt": {"value": w, "stderr": 0.01, "units": "J/m^2"},
                        "residual_drag_force": {"value": 1e-12, "stderr": 5e-11, "units": "N"}})
             for n, z, w in (("pulloff_silica", 0.49e-9, 0.054), (pull_si, 0.49e-9, 0.054),
-                            ("pulloff_ots", 0.94e-9, 0.03))}
-    table, rows = build_parameter_set({silica: adh_si, "adhesion_ots": adh_ots, **pull}, "paper", "cal")
+                            ("pulloff_ots", 0.94e-9, 0.03), (pull_ots, 0.94e-9, 0.03))}
+    table, rows = build_parameter_set({silica: adh_si, ots: adh_ots, **pull}, "paper", "cal")
     s = table["surfaces"]
     assert s["interaction_range"] == 0.17e-9                   # flat slab, not the pull-off's 0.49 nm
     cal = table["meta"]["calibration"]["surfaces.interaction_range"]
