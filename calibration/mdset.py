@@ -13,7 +13,9 @@ and, by thermodynamic integration of the mean force over separation windows, the
 separation (`work_of_adhesion_free_energy`, with its statistical stderr and the window grid's
 `discretisation_error`). The Dupre work of adhesion the JKR/GW summits need is a free energy
 (Israelachvili, Intermolecular and Surface Forces, 3rd ed., section 17.2), so the free energy is used when
-the result has it, with stderr = hypot(statistical, discretisation); dE/A is recorded beside it
+the result has it, with stderr = hypot(statistical, discretisation, systematic), the systematic being half the
+out-and-back hysteresis where the run pulled its windows back (the mean of the two directions is the estimate,
+md.analysis.hysteresis: the true reversible work lies between them); dE/A is recorded beside it
 ([meta.calibration] -> `energy_estimate`), and a result without the free energy falls back to dE/A, which
 the set's origin and the report then name as "not a free energy". (The adhesion workflow before version
 2 started its windows outside the adhesive well and gave W_F 20x too small; those runs no longer match
@@ -184,6 +186,9 @@ def _pick(result: dict, source: Source):
         disc = q[name].get("discretisation_error")
         if e is not None and disc is not None and math.isfinite(disc):
             e = math.hypot(e, float(disc))      # a quadrature's grid error counts like a statistical one
+        hyst = q[name].get("systematic_hysteresis")
+        if e is not None and hyst is not None and math.isfinite(hyst):
+            e = math.hypot(e, float(hyst))      # out-and-back: the reversible work lies between the two directions
         return name, float(v), e, q[name].get("units", "")
     return None, f"none of {source.quantities} is finite in the result"
 
@@ -419,6 +424,10 @@ def _calibration_entry(src: Source, res: dict, qname: str, value: float, stderr,
     if qname == "work_of_adhesion_free_energy":
         entry["stderr_statistical"] = qs[qname].get("stderr")
         entry["discretisation_error"] = qs[qname].get("discretisation_error")
+        if qs[qname].get("systematic_hysteresis") is not None:
+            entry["systematic_hysteresis"] = qs[qname]["systematic_hysteresis"]
+            entry["out_and_back"] = {k: qs[qname].get(k) for k in ("value_out", "stderr_out", "value_back",
+                                                                    "stderr_back")}
         de = qs.get("work_of_adhesion", {})
         if de.get("value") is not None:
             entry["energy_estimate"] = {"value": de["value"], "stderr": de.get("stderr"),

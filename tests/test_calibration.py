@@ -71,6 +71,7 @@ def test_md_values_land_on_their_scene_keys_with_stderr_and_run_hash(tmp_path):
     assert cal["menisci.surface_tension"]["run_hash"] == _results()["surface_tension_spce"]["run_hash"]
     assert s["roughness"]["summit_radius"] == 0.2e-6            # from the base set, with its origin
     assert origin["surfaces.roughness.summit_radius"]["kind"] == "chosen"
+    assert "systematic_hysteresis" not in w                      # one-way windows: no out-and-back systematic
     # the base's chosen summit modulus, adhesion law and additive wet adhesion give way to the materials' E*, the
     # Tabor parameter and the wet work of adhesion
     assert "summit_modulus" not in s["roughness"] and "physics" not in table
@@ -91,6 +92,23 @@ def test_without_a_free_energy_the_energy_difference_is_used_and_named():
     assert table["surfaces"]["work_of_adhesion"] == 0.21
     assert table["meta"]["calibration"]["surfaces.work_of_adhesion"]["quantity"] == "work_of_adhesion"
     assert "not a free energy" in table["meta"]["origin"]["surfaces.work_of_adhesion"]["note"]
+
+
+def test_an_out_and_back_work_of_adhesion_carries_half_its_hysteresis_as_a_systematic():
+    """W_F = mean of the outward 0.052 and the return 0.040 chains: 0.046, stat. 0.002, grid 0.003, half the
+    hysteresis 0.006 as a systematic; the set's stderr holds all three (hypot = 0.007), so the uncertainty bands
+    sample the range the reversible work can lie in, and the entry records both directions."""
+    res = _results()
+    res[OTS]["quantities"]["work_of_adhesion_free_energy"] = {
+        "value": 0.046, "stderr": 0.002, "units": "J/m^2", "discretisation_error": 0.003,
+        "systematic_hysteresis": 0.006, "value_out": 0.052, "stderr_out": 0.0025, "value_back": 0.040,
+        "stderr_back": 0.003}
+    table, _ = build_parameter_set(res, "paper", "cal")
+    w = table["meta"]["calibration"]["surfaces.sam.work_of_adhesion"]
+    assert table["surfaces"]["sam"]["work_of_adhesion"] == 0.046
+    assert w["stderr"] == pytest.approx(0.007, rel=1e-12) and w["stderr_statistical"] == 0.002
+    assert w["systematic_hysteresis"] == 0.006
+    assert w["out_and_back"] == {"value_out": 0.052, "stderr_out": 0.0025, "value_back": 0.040, "stderr_back": 0.003}
 
 
 def test_unusable_md_values_keep_the_base_value_and_say_so():
