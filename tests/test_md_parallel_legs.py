@@ -184,7 +184,7 @@ def test_two_jobs_give_the_samples_of_one_process_on_the_equilibrated_ots_recipe
         a = (one.run_dir / "legs" / leg / "samples.csv").read_bytes()
         b = (two_dir / "legs" / leg / "samples.csv").read_bytes()
         assert a == b, f"leg {leg}: samples differ between one process and two jobs"
-        assert two["legs"][leg]["ranks"] == [1], leg
+        assert two["legs"][leg]["ranks"] == [1] and two["legs"][leg]["hosts"] == [runner.leg_host()], leg
     for name, q in one.result["quantities"].items():
         assert two["quantities"][name]["value"] == q["value"], name
 
@@ -247,3 +247,22 @@ runner._run_legs_parallel(Plan(legs=[leg], timestep_fs=1.0, n_atoms=1, seeds={{}
     if alive:
         os.kill(child, 9)
     assert not alive, "a leg ran on after its parent was killed"
+
+
+def test_a_checkout_run_without_the_installed_package_hashes_like_the_installed_one(monkeypatch):
+    """A source checkout run with PYTHONPATH (no installed metadata) takes the version from the source tree (the
+    attribute pyproject.toml reads), so its run hash is the installed package's and a run started there resumes
+    here; before, such a run hashed with "unknown" and could not be resumed by the installed package."""
+    import importlib.metadata
+
+    import nanoimpact
+    from md.engine import hashing
+
+    installed = hashing.package_version()
+    key = hashing.run_hash({"name": "r"}, "quick", [])
+
+    def missing(name):
+        raise importlib.metadata.PackageNotFoundError(name)
+    monkeypatch.setattr(importlib.metadata, "version", missing)
+    assert hashing.package_version() == nanoimpact.__version__ == installed
+    assert hashing.run_hash({"name": "r"}, "quick", []) == key

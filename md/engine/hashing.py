@@ -13,10 +13,14 @@ __all__ = ["run_hash", "forcefield_hashes", "package_version", "lammps_version"]
 
 
 def package_version() -> str:
+    """nanoimpact's version: the installed distribution's, else the source tree's ``nanoimpact.__version__`` (the
+    attribute pyproject.toml reads it from), so a checkout run with ``PYTHONPATH`` (on a borrowed machine, say)
+    hashes like the installed package and a run started there resumes here."""
     try:
         return importlib.metadata.version("nanoimpact")
     except importlib.metadata.PackageNotFoundError:
-        return "unknown"
+        from nanoimpact import __version__   # noqa: PLC0415
+        return __version__
 
 
 def lammps_version() -> str:

@@ -168,6 +168,12 @@ def _commit_chunk(leg: Leg, leg_dir: Path, state: dict[str, Any], end: int) -> P
     return final
 
 
+def leg_host() -> str:
+    """The machine a leg (or a part of it) ran on, as its state records it: host name, architecture, cores (a
+    leg resumed elsewhere lists both, so a result whose legs ran on several machines says which ran where)."""
+    return f"{platform.node()} ({platform.machine()}, {os.cpu_count()} cores)"
+
+
 def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk_counter: list[int],
              stop_after_chunks: int | None, extra_commands: Sequence[str]) -> dict[str, Any]:
     """Run (or resume) one leg chunk by chunk: each chunk's samples and frames are stored, then its restart and
@@ -180,6 +186,7 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
     if not samples_csv.exists():
         atomic_write_text(samples_csv, ",".join(["step", "stage"] + list(leg.columns)) + "\n")
     state["ranks"] = sorted(set(state.get("ranks", [])) | {np_})     # a resumed leg may have run on other counts
+    state["hosts"] = sorted(set(state.get("hosts", [])) | {leg_host()})   # ... and on another machine
     engine = InProcess(leg_dir) if np_ <= 1 else MpiRun(leg_dir, np_)
     try:
         t0 = time.perf_counter()
@@ -541,7 +548,7 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
         "settings": dict(job.settings),
         "system": plan.system_info,
         "legs": {name: {k: s.get(k) for k in ("total_steps", "n_atoms", "chunks", "dynamics_wall_s", "setup_wall_s",
-                                              "resumed_from", "dropped_on_resume", "ranks")}
+                                              "resumed_from", "dropped_on_resume", "ranks", "hosts")}
                  for name, s in legs_state.items()},
         "provenance": prov,
         "notes": notes,
