@@ -104,6 +104,26 @@ def test_fill_cores_without_jobs_is_refused_in_one_line_naming_both():
         run(["adhesion_ots_equilibrated", "--fidelity", "smoke", "--fill-cores"])
 
 
+def test_the_leg_with_the_longest_chain_behind_it_starts_first(tmp_path, monkeypatch):
+    """x (100 steps) stands alone; y (10) starts a chain y -> z (1000). In plan order one job would run x, y, z,
+    leaving the long z to the end; by critical path it runs y (1010 behind it), z (1000), then x (100). Two jobs
+    start y beside x and z the moment y ends. Equal paths keep plan order."""
+    legs = [_leg("x", (), 100), _leg("y", (), 10), _leg("z", ("y",), 1000)]
+    waits = leg_dependencies(legs)
+    assert runner.critical_paths(legs, waits, {"x": 100, "y": 10, "z": 1000}) == {"x": 100, "y": 1010, "z": 1000}
+    assert runner.critical_paths(legs, waits, {"x": 100, "y": 0, "z": 400}) == {"x": 100, "y": 400, "z": 400}
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    runner._run_legs_parallel(_plan(legs), tmp_path, jobs=1, np_=1, resume=False, bar=None, extra_commands=())
+    assert [json.loads(l)[0] for l in record.read_text().splitlines()] == ["y", "z", "x"]
+    record.unlink()
+    same = [_leg("p", (), 10), _leg("q", (), 10), _leg("r", (), 10)]
+    runner._run_legs_parallel(_plan(same), tmp_path / "same", jobs=1, np_=1, resume=False, bar=None,
+                              extra_commands=())
+    assert [json.loads(l)[0] for l in record.read_text().splitlines()] == ["p", "q", "r"]
+
+
 def test_one_job_at_a_time_never_overlaps(tmp_path, monkeypatch):
     record = tmp_path / "record.jsonl"
     monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))

@@ -404,10 +404,27 @@ def _leg_child(leg: Leg, leg_dir: Path, np_: int, resume: bool, extra_commands: 
     os._exit(code)
 
 
+def critical_paths(legs: Sequence[Leg], waits: Mapping[str, frozenset[str]], remaining: Mapping[str, int]
+                   ) -> dict[str, int]:
+    """Leg name -> the MD steps from its start to the end of the longest chain of legs that waits on it, its own
+    remaining steps included: the run cannot end sooner than that after the leg starts. Starting the ready leg
+    with the longest such path first is list scheduling by level (Hu 1961; Adam, Chandy & Dickson, Commun. ACM
+    17 (1974) 685), which keeps a long chain of windows from being left to run alone at the end."""
+    later: dict[str, list[str]] = {l.name: [] for l in legs}
+    for name, before in waits.items():
+        for w in before:
+            later[w].append(name)
+    path: dict[str, int] = {}
+    for leg in reversed(legs):          # a leg waits only for earlier legs: every later one is known already
+        path[leg.name] = int(remaining[leg.name]) + max((path[m] for m in later[leg.name]), default=0)
+    return path
+
+
 def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool, bar,
                        extra_commands: Sequence[str], name: str = "md", fill: bool = False) -> dict[str, Any]:
-    """Up to ``jobs`` legs at once, each in a forked child, a leg started (in plan order) once every leg it waits
-    for (:func:`~md.engine.plan.leg_dependencies`) is done; the legs' final states.
+    """Up to ``jobs`` legs at once, each in a forked child, a leg started once every leg it waits for
+    (:func:`~md.engine.plan.leg_dependencies`) is done; among the legs that can start, the one with the longest
+    chain still behind it first (:func:`critical_paths`), plan order between equals; the legs' final states.
 
     ``fill``: a leg that starts while no other runs and no other can start gets ``jobs`` x ``np_`` ranks instead
     of ``np_``. Nothing else can start before it ends (a leg waits only for done legs), so the cores it takes
@@ -420,6 +437,9 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
     legs_dir = run_dir / "legs"
     done = {l.name for l in plan.legs if leg_state(legs_dir / l.name).get("done")}
     counted = {l.name: int(leg_state(legs_dir / l.name).get("step", 0)) for l in plan.legs}
+    remaining = {l.name: 0 if l.name in done else max(l.total_steps - counted[l.name], 0) for l in plan.legs}
+    priority = critical_paths(plan.legs, waits, remaining)
+    order = {l.name: k for k, l in enumerate(plan.legs)}
     running: dict[str, Any] = {}
     shown = [""]
 
@@ -441,8 +461,9 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
 
     try:
         while len(done) < len(plan.legs):
-            startable = [l for l in plan.legs
-                         if l.name not in done and l.name not in running and waits[l.name] <= done]
+            startable = sorted((l for l in plan.legs
+                                if l.name not in done and l.name not in running and waits[l.name] <= done),
+                               key=lambda l: (-priority[l.name], order[l.name]))
             ranks = jobs * np_ if fill and not running and len(startable) == 1 else np_
             for leg in startable:
                 if len(running) >= jobs:
