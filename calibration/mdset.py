@@ -24,7 +24,9 @@ the run hash and are not read.)
 Which adhesion runs: bare silica from `adhesion_silica_registries` (six quasi-random lateral registries over the
 primitive cell, each with its own zero-load contact, windows denser over the force peak), not the three-registry
 `adhesion_silica`, whose z0 error was too wide to use (md-review-2). The spread over registries is part of W_F's
-stderr (md.analysis).
+stderr (md.analysis). OTS from `adhesion_ots_equilibrated` (both SAMs annealed before contact, three quasi-random
+registries over the primitive cell, each with its own zero-load contact, the windows pulled out and back), not
+`adhesion_ots`, whose two registries were one and whose one-way windows went straight from the builder (md-review-2).
 
 Interaction range z0: from the flat-slab mean-force curve of the adhesion workflow (version 3):
 z0 = 1.026 W_F / sigma0 (Maugis 1992, the LJ 9-3 law), with sigma0 the curve's peak tensile traction, so that
@@ -96,7 +98,8 @@ _DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this 
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica_registries",
            ("work_of_adhesion_free_energy", "work_of_adhesion")),
-    Source("surfaces.sam.work_of_adhesion", "adhesion_ots", ("work_of_adhesion_free_energy", "work_of_adhesion")),
+    Source("surfaces.sam.work_of_adhesion", "adhesion_ots_equilibrated",
+           ("work_of_adhesion_free_energy", "work_of_adhesion")),
     Source("surfaces.body.contact_angle", "wsl_silica", ("contact_angle",),
            fallback=Source("surfaces.body.contact_angle", "contact_angle_silica", ("contact_angle",), note=_DROPLET)),
     Source("surfaces.substrate.contact_angle", "wsl_silica", ("contact_angle",),
@@ -108,15 +111,15 @@ MAPPING: tuple[Source, ...] = (
     Source("surfaces.interaction_range", "adhesion_silica_registries", ("interaction_range_z0",),
            fallback=Source("surfaces.interaction_range", "pulloff_silica", ("interaction_range_z0",),
                            note=_PULLOFF_Z0)),
-    Source("surfaces.sam.interaction_range", "adhesion_ots", ("interaction_range_z0",),
+    Source("surfaces.sam.interaction_range", "adhesion_ots_equilibrated", ("interaction_range_z0",),
            fallback=Source("surfaces.sam.interaction_range", "pulloff_ots", ("interaction_range_z0",),
                            note=_PULLOFF_Z0)),
-    Source("surfaces.sam.layer_modulus", "adhesion_ots", ("sam_layer_modulus",)),
+    Source("surfaces.sam.layer_modulus", "adhesion_ots_equilibrated", ("sam_layer_modulus",)),
 )
 
 #: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
 #: (the silica pull-off over four tip positions, each its own contact, so its stderr holds the geometric spread)
-VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"), ("pulloff_ots", "adhesion_ots"))
+VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"), ("pulloff_ots", "adhesion_ots_equilibrated"))
 
 
 def recipes_needed(mapping=MAPPING) -> list[str]:
@@ -508,7 +511,9 @@ def pulloff_validation(results: dict[str, dict]) -> dict:
         v1, v2 = dmt.get("value"), wf.get("value")
         if v1 is None or v2 is None or not (math.isfinite(v1) and math.isfinite(v2)) or v2 == 0:
             continue
-        e1, e2 = dmt.get("stderr") or 0.0, wf.get("stderr") or 0.0
+        # W_F's error as the set carries it (_pick): statistical, the window grid's and half the hysteresis
+        e1 = dmt.get("stderr") or 0.0
+        e2 = math.hypot(*(wf.get(k) or 0.0 for k in ("stderr", "discretisation_error", "systematic_hysteresis")))
         err = math.hypot(e1, e2)
         drag = qp.get("residual_drag_force", {})
         out[pull] = {"F_over_2piR": v1, "F_over_2piR_stderr": e1 or None, "W_F": v2, "W_F_stderr": e2 or None,

@@ -109,6 +109,12 @@ def test_an_out_and_back_work_of_adhesion_carries_half_its_hysteresis_as_a_syste
     assert w["stderr"] == pytest.approx(0.007, rel=1e-12) and w["stderr_statistical"] == 0.002
     assert w["systematic_hysteresis"] == 0.006
     assert w["out_and_back"] == {"value_out": 0.052, "stderr_out": 0.0025, "value_back": 0.040, "stderr_back": 0.003}
+    # the pull-off validation weighs the difference with the same W_F error the set carries
+    from calibration.mdset import pulloff_validation
+    res[PULL_OTS]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.060, "stderr": 0.024, "units": "J/m^2"}
+    v = pulloff_validation(res)[PULL_OTS]
+    assert v["W_F_stderr"] == pytest.approx(0.007, rel=1e-12)
+    assert v["difference_in_stderr"] == pytest.approx(0.014 / 0.025, rel=1e-12)      # hypot(0.024, 0.007) = 0.025
 
 
 def test_unusable_md_values_keep_the_base_value_and_say_so():
