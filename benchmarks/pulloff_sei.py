@@ -3,12 +3,11 @@
     .venv/bin/python benchmarks/pulloff_sei.py [--json docs/figures/pulloff_sei.json] [--bins 1 2 3]
 
 For each surface (bare silica, OTS): the asperity of the pull-off recipe the calibration validates that surface
-with (``calibration.mdset.VALIDATION``: ``pulloff_silica_positions``, ``pulloff_ots``) is built at quick (the
+with (``calibration.mdset.VALIDATION``; the json names it) is built at quick (the
 workflow's own builder, nothing runs), its atoms' heights binned into a lateral height map
 (:func:`md.analysis.pulloff.tip_height_map`); the flat-slab traction law is the registry-averaged mean force per
 area of the committed quick result of the adhesion recipe the calibration reads for that surface's W
-(``calibration.mdset.MAPPING``: ``adhesion_silica_registries``, ``adhesion_ots``) (``details.pmf_windows``:
-``mean_force_kcal_mol_A`` over
+(``calibration.mdset.MAPPING``; the json names it) (``details.pmf_windows``: ``mean_force_kcal_mol_A`` over
 ``details.energy.area_A2`` against ``separation_A``; with the TraPPE tail force ``tail_force_kcal_mol_A`` added for
 the "full" law). The map's reach is the covering radius of the outermost sites (their hexagonal lattice, spacing
 a/sqrt 2 of cristobalite): the smallest at which a flat face of the same crystal maps flat, so the flat-slab law

@@ -182,18 +182,23 @@ def _pick(result: dict, source: Source):
             return wets
         if name not in q:
             continue
-        v, e = q[name].get("value"), q[name].get("stderr")
+        v = q[name].get("value")
         if v is None or not math.isfinite(v):
             continue
-        e = float(e) if e is not None and math.isfinite(e) else None
-        disc = q[name].get("discretisation_error")
-        if e is not None and disc is not None and math.isfinite(disc):
-            e = math.hypot(e, float(disc))      # a quadrature's grid error counts like a statistical one
-        hyst = q[name].get("systematic_hysteresis")
-        if e is not None and hyst is not None and math.isfinite(hyst):
-            e = math.hypot(e, float(hyst))      # out-and-back: the reversible work lies between the two directions
-        return name, float(v), e, q[name].get("units", "")
+        return name, float(v), _combined_stderr(q[name]), q[name].get("units", "")
     return None, f"none of {source.quantities} is finite in the result"
+
+
+def _combined_stderr(rec: dict) -> float | None:
+    """The error a quantity enters the set with: its statistical stderr, in quadrature with a quadrature's grid
+    error (``discretisation_error``) and, for an out-and-back W_F, half the hysteresis (``systematic_hysteresis``:
+    the reversible work lies between the two directions); None without a finite statistical stderr."""
+    e = rec.get("stderr")
+    if e is None or not math.isfinite(e):
+        return None
+    extra = [float(rec[k]) for k in ("discretisation_error", "systematic_hysteresis")
+             if rec.get(k) is not None and math.isfinite(rec[k])]
+    return math.hypot(float(e), *extra)
 
 
 def _ti_wets(result: dict) -> bool:
@@ -511,9 +516,7 @@ def pulloff_validation(results: dict[str, dict]) -> dict:
         v1, v2 = dmt.get("value"), wf.get("value")
         if v1 is None or v2 is None or not (math.isfinite(v1) and math.isfinite(v2)) or v2 == 0:
             continue
-        # W_F's error as the set carries it (_pick): statistical, the window grid's and half the hysteresis
-        e1 = dmt.get("stderr") or 0.0
-        e2 = math.hypot(*(wf.get(k) or 0.0 for k in ("stderr", "discretisation_error", "systematic_hysteresis")))
+        e1, e2 = dmt.get("stderr") or 0.0, _combined_stderr(wf) or 0.0      # W_F's error as the set carries it
         err = math.hypot(e1, e2)
         drag = qp.get("residual_drag_force", {})
         out[pull] = {"F_over_2piR": v1, "F_over_2piR_stderr": e1 or None, "W_F": v2, "W_F_stderr": e2 or None,
