@@ -606,6 +606,32 @@ def test_linear_drift_flags_a_drifting_series_and_its_stderr_is_calibrated():
         linear_drift([0.0, 1.0], [1.0, 2.0])
 
 
+def test_anneal_figure_draws_the_drift_tests_line_and_says_what_it_concluded():
+    """The anneal figure plots energy and tilt with the second half's fitted line: the dashed energy line has the
+    drift test's slope, and the title names the drifting series (energy trends, tilt is flat) or says none."""
+    from matplotlib.figure import Figure
+    from md.analysis.drift import linear_drift
+    from md.workflows.adhesion_protocol import draw_anneal
+    rng = np.random.default_rng(3)
+    t, tt = np.linspace(0.0, 150.0, 1500), np.linspace(3.0, 150.0, 50)
+
+    def det(trend):
+        pe, tilt = -6e4 + _ar1(rng, 1500, 0.5) - trend * t, 25.0 + rng.normal(size=50)
+        h, k = len(t) // 2, len(tt) // 2
+        return {"time_ps": t, "potential_energy_kcal": pe, "tilt_time_ps": tt, "mean_tilt_deg": tilt,
+                "drift_second_half": {"potential_energy_kcal": linear_drift(t[h:], pe[h:]),
+                                      "mean_tilt_deg": linear_drift(tt[k:], tilt[k:])}}
+
+    for trend, title in ((0.5, "still drifting: potential_energy_kcal"), (0.0, "no drift")):
+        d = det(trend)
+        ax = Figure().subplots()
+        draw_anneal(ax, d)
+        assert title in ax.get_title()
+        x, y = ax.lines[1].get_data()
+        assert ax.lines[1].get_linestyle() == "--" and x[0] == pytest.approx(t[len(t) // 2])
+        assert np.polyfit(x, y, 1)[0] == pytest.approx(d["drift_second_half"]["potential_energy_kcal"]["slope"])
+
+
 def test_chain_tilt_follows_an_axis_that_reaches_further_sideways_than_half_the_box():
     """Two chains (one on the upper slab, pointing down) tilting from 15 to 40 deg over 26 frames in a 12 A box,
     positions wrapped: a 20 A axis at 40 deg reaches 12.9 A sideways, beyond the minimum image; the tilt is the

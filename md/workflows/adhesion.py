@@ -279,6 +279,7 @@ class _AdhesionAnalysis:
         if "anneal" in names:
             det, notes, curves = P.anneal_record(self.ctx, self.dt)
             self.details["anneal"], self.notes, self.curves = det, self.notes + notes, {**self.curves, **curves}
+            self.figures["anneal"] = figure_writer(lambda ax: P.draw_anneal(ax, det))
         if any(n.startswith("contact_r") for n in names):
             self.details["registry_contacts"] = P.registry_contacts_record(
                 self.ctx, self.ctx.samples("separated")["pe"], self.area, self.zc, self.w_tail_static)

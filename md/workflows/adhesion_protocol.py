@@ -72,6 +72,40 @@ def anneal_record(ctx, dt_fs: float) -> tuple[dict[str, Any], list[str], dict]:
     return det, notes, curves
 
 
+def draw_anneal(ax, det: dict[str, Any]) -> None:
+    """The anneal (``anneal_record``'s details) on one axes: potential energy against time, the mean chain tilt on
+    a second axis, and over each the least-squares line of the second half that the drift test fits (dashed), so
+    a reader sees whether the surfaces had settled before contact; the title says what the test concluded."""
+    t = np.asarray(det["time_ps"], float)
+    pe = np.asarray(det["potential_energy_kcal"], float)
+    checks = det["drift_second_half"]
+    ax.plot(t, pe, lw=0.6, color="C0", label="potential energy")
+    _draw_fit(ax, t, pe, checks["potential_energy_kcal"], "navy")
+    late = pe[len(pe) // 20:]                   # the range after the minimised start's first relaxation
+    pad = 0.1 * float(np.ptp(late)) if late.size else 0.0
+    if late.size:
+        ax.set_ylim(float(late.min()) - pad, float(late.max()) + pad)
+    ax.set_xlabel("anneal time (ps)")
+    ax.set_ylabel("potential energy (kcal/mol)", color="C0")
+    if "mean_tilt_deg" in det:
+        tt, tilt = np.asarray(det["tilt_time_ps"], float), np.asarray(det["mean_tilt_deg"], float)
+        ax2 = ax.twinx()
+        ax2.plot(tt, tilt, ".-", ms=2, lw=0.6, color="C1")
+        if "mean_tilt_deg" in checks:
+            _draw_fit(ax2, tt, tilt, checks["mean_tilt_deg"], "saddlebrown")
+        ax2.set_ylabel("mean chain tilt (deg)", color="C1")
+    drifting = [k for k, c in checks.items() if c["drifting"]]
+    ax.set_title("second half still drifting: " + ", ".join(drifting) if drifting
+                 else "second half: no drift beyond 2 stderr", fontsize=9)
+
+
+def _draw_fit(ax, t, y, check: dict, color: str) -> None:
+    """The drift test's line through the second half of (t, y): slope from ``check``, through the half's mean."""
+    h = len(t) // 2
+    th, yh = t[h:], y[h:]
+    ax.plot(th, yh.mean() + check["slope"] * (th - th.mean()), "--", lw=1.6, color=color)
+
+
 def registry_contacts_record(ctx, energy_separated, area_A2: float, zc: float, tail_J_m2: float) -> dict:
     """Every registry's own zero-load contact leg (``contact_rN``): dE/A against the separated leg (the static
     tail of registry 0's contact added) and the mean back height relative to registry 0's contact."""
