@@ -82,9 +82,8 @@ def draw_anneal(ax, det: dict[str, Any]) -> None:
     ax.plot(t, pe, lw=0.6, color="C0", label="potential energy")
     _draw_fit(ax, t, pe, checks["potential_energy_kcal"], "navy")
     late = pe[len(pe) // 20:]                   # the range after the minimised start's first relaxation
-    pad = 0.1 * float(np.ptp(late)) if late.size else 0.0
-    if late.size:
-        ax.set_ylim(float(late.min()) - pad, float(late.max()) + pad)
+    pad = 0.1 * float(np.ptp(late))
+    ax.set_ylim(float(late.min()) - pad, float(late.max()) + pad)
     ax.set_xlabel("anneal time (ps)")
     ax.set_ylabel("potential energy (kcal/mol)", color="C0")
     if "mean_tilt_deg" in det:
