@@ -34,9 +34,10 @@ from md.analysis.adhesion import (force_integration_work, registry_average, regi
 from md.analysis.layer_modulus import confined_layer_modulus, sam_layer_thickness_A, young_from_confined
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
-                                       block_drift, work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
+                                       work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
                                        shape_check,
                                        dispersion_tail_work, tail_antiderivative, cutoff_crossing_work)
+from md.analysis.drift import block_drift
 from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
                                      angle_from_work_of_adhesion_sl, tether_correction,
                                      film_lower_dividing_plane)

@@ -10,6 +10,7 @@ import numpy as np
 
 from md import units as _units
 
+from md.analysis.drift import block_drift
 from md.analysis.stats import timeseries_stats
 
 
@@ -287,33 +288,6 @@ def wetting_bound(density_map, u_edges, z_edges, bulk_density: float, reference_
             "film_thickness_A": area / width, "theta_max_deg": cap_angle_for_base(area, width),
             "theta_resolvable_deg": cap_angle_for_height(area, h_min) if area > 0 else float("nan"),
             "min_column_density": float(col.min()), "min_cap_height_A": h_min}
-
-
-def block_drift(values, times=None) -> dict:
-    """Linear trend of a block series (drift check): ordinary least squares of ``values`` against ``times``
-    (default 0, 1, 2, ...) with the slope's standard error from the residual scatter (n - 2 degrees of
-    freedom). ``drifting`` when |slope| > 2 stderr: the series has not levelled off, so its mean depends on
-    where the run stopped. ``change`` is slope x the time span covered. Non-finite values are left out;
-    fewer than 3 points give nan."""
-    from scipy import stats
-
-    y = np.asarray(values, float)
-    t = np.arange(len(y), dtype=float) if times is None else np.asarray(times, float)
-    ok = np.isfinite(y) & np.isfinite(t)
-    y, t = y[ok], t[ok]
-    nan = float("nan")
-    if len(y) < 3 or np.ptp(t) == 0:
-        return {"slope": nan, "stderr": nan, "t": nan, "p": nan, "change": nan, "drifting": False, "n": int(len(y))}
-    tm = t - t.mean()
-    sxx = float((tm * tm).sum())
-    slope = float((tm * (y - y.mean())).sum() / sxx)
-    resid = y - y.mean() - slope * tm
-    dof = len(y) - 2
-    se = math.sqrt(float((resid * resid).sum()) / dof / sxx)
-    tval = slope / se if se > 0 else (math.inf if slope else 0.0)
-    p = float(2 * stats.t.sf(abs(tval), dof)) if np.isfinite(tval) else 0.0
-    return {"slope": slope, "stderr": se, "t": float(tval), "p": p, "change": slope * float(np.ptp(t)),
-            "drifting": bool(abs(slope) > 2 * se), "n": int(len(y))}
 
 
 def work_of_adhesion_sl(gamma_lv, theta_deg, gamma_stderr=None, theta_stderr_deg=None) -> dict:

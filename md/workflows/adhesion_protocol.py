@@ -64,11 +64,12 @@ def anneal_record(ctx, dt_fs: float) -> tuple[dict[str, Any], list[str], dict]:
     det["drift_second_half"] = checks
     drifting = [k for k, c in checks.items() if c["drifting"]]
     span = f"{t_ps[-1] - t_ps[0]:.3g} ps" if len(t_ps) else "0 ps"
-    text = "; ".join(f"{k}: drift {c['drift']:+.3g} +/- {c['drift_stderr']:.2g} over the second half" for k, c in
-                     checks.items())
+    text = "; ".join(f"{k}: drift {c['drift']:+.3g} +/- {c['drift_stderr']:.2g} over the second half (a drift "
+                     f"beyond {c['drift_threshold']:.2g})" for k, c in checks.items())
     notes = [(f"ANNEAL STILL DRIFTING ({', '.join(drifting)}): the surfaces had not settled when the contact was "
-              f"formed; lengthen sam_anneal_steps. " if drifting else "SAM anneal: no linear drift beyond 2 stderr "
-              "in its second half. ") + f"Anneal of the separated pair ({span} at T): {text}."]
+              f"formed; lengthen sam_anneal_steps. " if drifting else "SAM anneal: no linear drift in its second half "
+              "beyond the drift test's threshold (md.analysis.drift). ")
+             + f"Anneal of the separated pair ({span} at T): {text}."]
     return det, notes, curves
 
 
@@ -95,7 +96,7 @@ def draw_anneal(ax, det: dict[str, Any]) -> None:
         ax2.set_ylabel("mean chain tilt (deg)", color="C1")
     drifting = [k for k, c in checks.items() if c["drifting"]]
     ax.set_title("second half still drifting: " + ", ".join(drifting) if drifting
-                 else "second half: no drift beyond 2 stderr", fontsize=9)
+                 else "second half: no drift beyond the test's threshold", fontsize=9)
 
 
 def _draw_fit(ax, t, y, check: dict, color: str) -> None:
