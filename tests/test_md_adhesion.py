@@ -609,11 +609,11 @@ def test_linear_drift_flags_a_drifting_series_and_its_stderr_is_calibrated():
 
 def test_linear_drift_is_not_fooled_by_a_fast_oscillation_over_a_slow_fluctuation():
     """An MD energy's shape: a fast oscillation (AR(2), period 8 samples, its autocorrelation negative within 3
-    samples) over a slow AR(1) (phi = 0.98, correlation time 50 samples, a quarter of a block). The ACF stderr stops
-    at the oscillation's first zero and is under half the slopes' true scatter over 300 seeds, so the ACF test
-    alone flags a third of these stationary series; the block-means stderr tracks the scatter (0.7-1.3) and the
-    combined test flags about its nominal 5 % (at most 12 %: binomial scatter over 300 seeds plus blocks that
-    are only four correlation times long). A trend of 5 block-stderrs is still caught on 9 seeds in 10."""
+    samples) over a slow AR(1) (phi = 0.98, correlation time 50 samples, a fifth of a 250-sample block). The ACF
+    stderr stops at the oscillation's first zero and is under half the slopes' true scatter over 300 seeds, so the
+    ACF test alone flags over a quarter of these stationary series; the block-means stderr tracks the scatter
+    (0.7-1.3) and the combined test flags about its nominal 5 % (at most 12 %: binomial scatter over 300 seeds
+    plus blocks that are only five correlation times long). A trend of 5 block-stderrs is still caught on 9 seeds in 10."""
     from scipy.signal import lfilter
     from md.analysis.drift import linear_drift
     rng = np.random.default_rng(11)

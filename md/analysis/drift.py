@@ -31,8 +31,8 @@ from md.analysis.stats import statistical_inefficiency, student_t_factor
 #: |slope| / stderr above which a series is reported as drifting (two-sided 95 %)
 DRIFT_Z_MAX = 2.0
 #: blocks of the block-means test: 6 degrees of freedom; on a fast oscillation plus an AR(1) whose correlation
-#: time is half a block the test keeps its nominal false-positive rate (tests/test_md_adhesion.py), and more
-#: blocks would be shorter than a SAM's slow fluctuations in a 250 ps half-anneal
+#: time is a fifth of a block the test keeps about its nominal false-positive rate (tests/test_md_adhesion.py),
+#: and more blocks would be shorter than a SAM's slow fluctuations in a 250 ps half-anneal
 DRIFT_BLOCKS = 8
 #: fewest blocks the block-means test runs on (2 degrees of freedom); shorter series get the ACF test alone
 MIN_DRIFT_BLOCKS = 4
@@ -40,19 +40,19 @@ MIN_DRIFT_BLOCKS = 4
 
 def ols_trend(t, y) -> dict:
     """Ordinary least-squares line of ``y`` against ``t``: ``slope``, its white-noise ``stderr`` (residual
-    variance over n - 2 degrees of freedom), ``dof``, the centred times' sum of squares ``sxx`` and the
-    ``residuals``. Needs at least 3 points at two distinct times."""
+    variance over n - 2 degrees of freedom), ``dof`` and the ``residuals``. Needs at least 3 points at two distinct times."""
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     tc = t - t.mean()
     sxx = float(np.sum(tc * tc))
     if t.size < 3 or sxx <= 0.0:
-        raise ValueError(f"a linear trend needs at least 3 points at two distinct times, got {t.size}")
+        raise ValueError(f"a linear trend needs at least 3 points at two distinct times, got {t.size} points "
+                         f"spanning {float(np.ptp(t)) if t.size else 0.0:g}")
     slope = float(np.sum(tc * (y - y.mean())) / sxx)
     resid = y - y.mean() - slope * tc
     dof = t.size - 2
     return {"slope": slope, "stderr": math.sqrt(float(np.sum(resid * resid)) / dof / sxx), "dof": dof,
-            "sxx": sxx, "residuals": resid}
+            "residuals": resid}
 
 
 def linear_drift(t, y, z_max: float = DRIFT_Z_MAX, blocks: int = DRIFT_BLOCKS) -> dict:
@@ -69,8 +69,6 @@ def linear_drift(t, y, z_max: float = DRIFT_Z_MAX, blocks: int = DRIFT_BLOCKS) -
     y = np.asarray(y, float)
     if t.shape != y.shape or t.size < 4:
         raise ValueError(f"linear_drift needs matching series of at least 4 points, got {t.size} and {y.size}")
-    if not float(np.ptp(t)) > 0.0:
-        raise ValueError("linear_drift needs at least two distinct times")
     fit = ols_trend(t, y)
     slope = fit["slope"]
     g = statistical_inefficiency(fit["residuals"]) if fit["stderr"] > 0 else 1.0
