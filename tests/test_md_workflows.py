@@ -266,6 +266,13 @@ def test_resume_after_an_interruption_loses_and_duplicates_no_sample(needs_lammp
     assert again.result["provenance"]["reanalysed_without_md"] is True
     assert again.result["quantities"] == outcome.result["quantities"]
     assert read_samples(leg / "samples.csv")["step"].tolist() == steps.tolist()
+    assert [i["from_step"] for i in again.result["provenance"]["md_invocations"]] == [0, 300]
+    # a run directory from before invocations.json: the reanalysis does not pass its own flags off as the MD's
+    (run_dir / "result.json").unlink()
+    (run_dir / "invocations.json").unlink()
+    legacy, _ = _run(name, tmp_path / "cache", None, resume=True, np_=1)
+    assert legacy.result["np"] is None and legacy.result["jobs"] is None and legacy.result["fill_cores"] is None
+    assert "predates" in legacy.result["provenance"]["md_flags_note"]
 
 
 @pytest.mark.md
@@ -298,4 +305,12 @@ def test_mpirun_two_ranks_runs_a_recipe(needs_lammps, tmp_path):
     grids = re.findall(r"(\d+) by (\d+) by (\d+) MPI processor grid", log)
     assert grids and all(g[2] == "1" and int(g[0]) * int(g[1]) == 2 for g in grids)
     assert r["legs"]["film"]["total_steps"] == 400
+    assert [(i["np"], i["jobs"], i["from_step"]) for i in r["provenance"]["md_invocations"]] == [(2, 1, 0)]
+    # a reanalysis from a one-rank invocation records the ranks the MD ran on, not its own
+    (outcome.run_dir / "result.json").unlink()
+    again, _ = _run(parse_recipe(t, name="surface_tension_spce_short"), tmp_path / "cache", None, resume=True)
+    a = again.result
+    assert a["provenance"]["reanalysed_without_md"] is True and a["provenance"]["md_invocations"] == \
+        r["provenance"]["md_invocations"]
+    assert a["np"] == 2 and a["provenance"]["engine"] == "mpirun -np 2 lmp" and a["quantities"] == r["quantities"]
     assert math.isfinite(r["quantities"]["surface_tension"]["value"])

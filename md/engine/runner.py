@@ -28,6 +28,9 @@ One writer per run directory
     process, and ``result.json``, ``state.json``, ``hash.json``, frame files and the files exported to
     ``--out`` atomically (unique temporary name, fsync, rename: :mod:`nanoimpact.fileio`); ``samples.csv`` is
     appended to, and ``--resume`` drops rows past the committed restart and a torn last row.
+    Each invocation that runs MD appends its ``np``, ``jobs``, ``fill_cores`` and host to ``invocations.json``;
+    ``result.json`` gives them under ``provenance.md_invocations`` and, at its top level, the last one's, so a
+    reanalysis (``--resume`` on a finished run, no MD) records how the legs ran, not how it was invoked.
 
 Legs in parallel
     ``jobs`` > 1 runs up to that many legs at once, each in a forked child process (``np`` ranks each), a leg
@@ -81,6 +84,8 @@ log = logging.getLogger(__name__)
 
 SCHEMA_VERSION = 1
 RESTARTS_KEPT = 2
+#: the run directory's record of the invocations that ran MD (their np, jobs, fill_cores, host, first step)
+INVOCATIONS = "invocations.json"
 
 
 class Interrupted(RuntimeError):
@@ -230,14 +235,14 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
 
 # ================================================================================================ the run
 
-def _provenance(job: Job, plan: Plan, legs_state: Mapping[str, Any], np_: int) -> dict[str, Any]:
+def _provenance(job: Job, plan: Plan, legs_state: Mapping[str, Any], np_: int | None) -> dict[str, Any]:
     from md.lammps_loader import mpich_version   # noqa: PLC0415
     versions = {s.get("lammps_version_string") for s in legs_state.values() if s.get("lammps_version_string")}
     return {
         "package": "nanoimpact", "package_version": package_version(), "git_commit": git_commit(),
         "lammps_version": lammps_version(), "lammps_version_string": sorted(versions)[0] if versions else None,
         "mpich_version": mpich_version(),
-        "engine": "in-process lammps module" if np_ <= 1 else f"mpirun -np {np_} lmp",
+        "engine": (None if np_ is None else "in-process lammps module" if np_ <= 1 else f"mpirun -np {np_} lmp"),
         "forcefields": [{"file": f"inputs/forcefields/{n}.toml", "sha256": h}
                         for n, h in forcefield_hashes(sorted(set(plan.forcefield_files))).items()],
         "recipe": job.source or job.name,
@@ -317,6 +322,8 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         f"run directory {run_dir}" + (f", up to {jobs} legs at a time" if jobs > 1 else "")
         + (f", a leg alone on {jobs * np_} ranks" if fill and jobs > 1 else ""))
     t_start = time.perf_counter()
+    if done < total:
+        _record_invocation(run_dir, np_=np_, jobs=jobs, fill=fill, from_step=done)
     legs_state = _run_legs(job, plan, run_dir, done=done, total=total, np_=np_, resume=resume, progress=progress,
                            stop_after_chunks=stop_after_chunks, extra_commands=extra_commands, jobs=jobs, fill=fill)
     result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_, jobs=jobs, fill=fill,
@@ -324,6 +331,30 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
     atomic_write_text(result_path, json.dumps(clean_json(result), indent=1))
     say(f"wrote {result_path}")
     return RunOutcome(json.loads(result_path.read_text()), run_dir, False, export(run_dir, out))
+
+
+def _record_invocation(run_dir: Path, *, np_: int, jobs: int, fill: bool, from_step: int) -> None:
+    """Append this invocation's parallel flags to ``invocations.json`` before it runs MD, so that a later
+    reanalysis (``--resume`` on a finished run) records how the legs ran, not how it was itself invoked."""
+    path = run_dir / INVOCATIONS
+    past = json.loads(path.read_text()) if path.exists() else []
+    past.append({"np": np_, "jobs": jobs, "fill_cores": fill, "from_step": from_step, "host": leg_host(),
+                 "started_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")})
+    atomic_write_text(path, json.dumps(past, indent=1))
+
+
+def _md_flags(run_dir: Path, *, np_: int, jobs: int, fill: bool, reanalysed: bool) -> tuple[dict[str, Any], list]:
+    """``np``, ``jobs`` and ``fill_cores`` of the run: this invocation's when it ran MD; after a reanalysis those of
+    the last invocation that did (``invocations.json``), or None for a run directory that predates that record
+    (each leg's ``ranks`` and ``hosts`` still say how it ran)."""
+    path = run_dir / INVOCATIONS
+    invocations = json.loads(path.read_text()) if path.exists() else []
+    if not reanalysed:
+        return {"np": np_, "jobs": jobs, "fill_cores": fill}, invocations
+    if not invocations:
+        return {"np": None, "jobs": None, "fill_cores": None}, invocations
+    last = invocations[-1]
+    return {k: last[k] for k in ("np", "jobs", "fill_cores")}, invocations
 
 
 def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int, resume: bool, progress: bool,
@@ -541,10 +572,15 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
     md_steps = sum(int(s.get("total_steps", 0)) for s in legs_state.values())
     dyn_wall = sum(float(s.get("dynamics_wall_s", 0.0)) for s in legs_state.values())
     atom_steps = sum(l.n_atoms * l.total_steps for l in plan.legs)
-    prov = _provenance(job, plan, legs_state, np_)
+    flags, invocations = _md_flags(run_dir, np_=np_, jobs=jobs, fill=fill, reanalysed=reanalysed)
+    prov = _provenance(job, plan, legs_state, flags["np"])
+    prov["md_invocations"] = invocations
     if reanalysed:
         # every leg had finished: this invocation only re-ran the analysis (e.g. after an analysis fix)
         prov["reanalysed_without_md"] = True
+        if not invocations:
+            prov["md_flags_note"] = ("np, jobs and fill_cores of the invocations that ran MD were not recorded (the "
+                                     "run predates invocations.json); each leg's ranks and hosts say how it ran")
     notes = list(analysis.notes)
     if figure_errors:
         notes.append(f"figures not drawn: {figure_errors}")
@@ -562,9 +598,7 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
         "ns_per_day": units.ns_per_day(md_steps, plan.timestep_fs, dyn_wall),
         "wall_s": {"dynamics": dyn_wall, "total_this_invocation": time.perf_counter() - t_start},
         "atom_steps_per_s": atom_steps / dyn_wall if dyn_wall > 0 else None,
-        "np": np_,
-        "jobs": jobs,
-        "fill_cores": fill,
+        **flags,
         "seeds": plan.seeds,
         "settings": dict(job.settings),
         "system": plan.system_info,
