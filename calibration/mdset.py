@@ -118,8 +118,10 @@ MAPPING: tuple[Source, ...] = (
 )
 
 #: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
-#: (the silica pull-off over four tip positions, each its own contact, so its stderr holds the geometric spread)
-VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"), ("pulloff_ots", "adhesion_ots_equilibrated"))
+#: (both pull-offs over four tip positions, each its own contact, so their stderr holds the geometric spread, with a
+#: thermostat on the flat's silica only, so nothing the tip drags feels a lab-frame friction)
+VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"),
+              ("pulloff_ots_positions", "adhesion_ots_equilibrated"))
 
 
 def recipes_needed(mapping=MAPPING) -> list[str]:

@@ -258,7 +258,12 @@ def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_nee
     both = {"wsl_silica": ti, "wsl_ots": ti, **{k: v for k, v in _results().items() if k in recipes_first()}}
     both[SILICA] = _result(SILICA, {"work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2"),
                                     "interaction_range_z0": (0.2e-9, 0.05e-9, "m")})     # its own z0: no pull-off
+    both[OTS] = _result(OTS, {"work_of_adhesion_free_energy": (0.04, 0.005, "J/m^2"),
+                              "interaction_range_z0": (0.4e-9, 0.05e-9, "m"), "sam_layer_modulus": (5.6e9, 0.6e9, "Pa")})
     assert fallbacks_needed(both) == []
+    # without its own z0 the OTS flat slab sends the calibration to z0's fallback, the one-position pull-off
+    no_z0 = {**both, OTS: _results()[OTS]}
+    assert fallbacks_needed(no_z0) == ["pulloff_ots"]
     no_angle = {**both, "wsl_ots": _result("wsl_ots", {"work_of_adhesion_sl": (0.04, 0.003, "J/m^2")})}
     assert fallbacks_needed(no_angle) == ["contact_angle_ots"]
     assert fallbacks_needed({**no_angle, "contact_angle_ots": _results()["contact_angle_ots"]}) == []
