@@ -259,7 +259,8 @@ def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_nee
     both[SILICA] = _result(SILICA, {"work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2"),
                                     "interaction_range_z0": (0.2e-9, 0.05e-9, "m")})     # its own z0: no pull-off
     both[OTS] = _result(OTS, {"work_of_adhesion_free_energy": (0.04, 0.005, "J/m^2"),
-                              "interaction_range_z0": (0.4e-9, 0.05e-9, "m"), "sam_layer_modulus": (5.6e9, 0.6e9, "Pa")})
+                              "interaction_range_z0": (0.4e-9, 0.05e-9, "m"),
+                              "sam_layer_modulus": (5.6e9, 0.6e9, "Pa")})
     assert fallbacks_needed(both) == []
     # without its own z0 the OTS flat slab sends the calibration to z0's fallback, the one-position pull-off
     no_z0 = {**both, OTS: _results()[OTS]}
