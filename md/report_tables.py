@@ -140,7 +140,8 @@ def cost_table(results: list[CommittedResult]) -> str:
         lines.append(_row([f"`{r.folder}`", "calibration input" if r.calibration_input else "study",
                            str(d["n_atoms"]), f"{d['steps']:,}", f"{d['steps'] * d['timestep_fs'] * 1e-6:.3g}",
                            f"{wall / 60:.1f}", f"{d['ns_per_day']:.3g}", f"{d['atom_steps_per_s'] * 1e-6:.3g}",
-                           "-" if d["np"] is None else str(d["np"]), d["provenance"]["created_utc"][:16].replace("T", " ")]))
+                           "-" if d["np"] is None else str(d["np"]),
+                           d["provenance"]["created_utc"][:16].replace("T", " ")]))
     return "\n".join(lines)
 
 

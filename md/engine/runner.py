@@ -326,8 +326,8 @@ def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], r
         _record_invocation(run_dir, np_=np_, jobs=jobs, fill=fill, from_step=done)
     legs_state = _run_legs(job, plan, run_dir, done=done, total=total, np_=np_, resume=resume, progress=progress,
                            stop_after_chunks=stop_after_chunks, extra_commands=extra_commands, jobs=jobs, fill=fill)
-    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, np_=np_, jobs=jobs, fill=fill,
-                                 reanalysed=resume and done == total, t_start=t_start)
+    result = _analyse_and_record(job, wf, digest, plan, run_dir, legs_state, reanalysed=resume and done == total,
+                                 t_start=t_start)
     atomic_write_text(result_path, json.dumps(clean_json(result), indent=1))
     say(f"wrote {result_path}")
     return RunOutcome(json.loads(result_path.read_text()), run_dir, False, export(run_dir, out))
@@ -343,18 +343,14 @@ def _record_invocation(run_dir: Path, *, np_: int, jobs: int, fill: bool, from_s
     atomic_write_text(path, json.dumps(past, indent=1))
 
 
-def _md_flags(run_dir: Path, *, np_: int, jobs: int, fill: bool, reanalysed: bool) -> tuple[dict[str, Any], list]:
-    """``np``, ``jobs`` and ``fill_cores`` of the run: this invocation's when it ran MD; after a reanalysis those of
-    the last invocation that did (``invocations.json``), or None for a run directory that predates that record
-    (each leg's ``ranks`` and ``hosts`` still say how it ran)."""
+def _md_flags(run_dir: Path) -> tuple[dict[str, Any], list]:
+    """``np``, ``jobs`` and ``fill_cores`` of the last invocation that ran MD (``invocations.json``: this one when it
+    ran MD, an earlier one after a reanalysis), with the whole record; None for a run directory that predates the
+    record (each leg's ``ranks`` and ``hosts`` still say how it ran)."""
     path = run_dir / INVOCATIONS
     invocations = json.loads(path.read_text()) if path.exists() else []
-    if not reanalysed:
-        return {"np": np_, "jobs": jobs, "fill_cores": fill}, invocations
-    if not invocations:
-        return {"np": None, "jobs": None, "fill_cores": None}, invocations
-    last = invocations[-1]
-    return {k: last[k] for k in ("np", "jobs", "fill_cores")}, invocations
+    last = invocations[-1] if invocations else {}
+    return {k: last.get(k) for k in ("np", "jobs", "fill_cores")}, invocations
 
 
 def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int, resume: bool, progress: bool,
@@ -552,8 +548,7 @@ def _stop_children(procs, grace_s: float = 10.0) -> None:
 
 
 def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path, legs_state: Mapping[str, Any], *,
-                        np_: int, reanalysed: bool, t_start: float, jobs: int = 1,
-                        fill: bool = False) -> dict[str, Any]:
+                        reanalysed: bool, t_start: float) -> dict[str, Any]:
     """The workflow's analysis of the finished legs, its curves and figures exported (a figure that fails is
     named in the notes, never loses the run), and the run's ``result.json`` record."""
     analysis = wf.analyse(RunContext(run_dir, plan, job.settings))
@@ -572,7 +567,7 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
     md_steps = sum(int(s.get("total_steps", 0)) for s in legs_state.values())
     dyn_wall = sum(float(s.get("dynamics_wall_s", 0.0)) for s in legs_state.values())
     atom_steps = sum(l.n_atoms * l.total_steps for l in plan.legs)
-    flags, invocations = _md_flags(run_dir, np_=np_, jobs=jobs, fill=fill, reanalysed=reanalysed)
+    flags, invocations = _md_flags(run_dir)
     prov = _provenance(job, plan, legs_state, flags["np"])
     prov["md_invocations"] = invocations
     if reanalysed:
