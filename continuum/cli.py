@@ -80,18 +80,31 @@ def scene_override(text: str) -> tuple[str, object]:
         return key.strip(), value.strip()
 
 
-def ensemble_summary(ens: dict) -> str:
-    """Two lines on an ensemble: stick probabilities, rebound counts and first rebounds (median, 5-95 %); a third
-    with the members' escape velocities where the scene asked for them."""
+def ensemble_summary(ens: dict, surface: dict | None = None) -> str:
+    """Lines on an ensemble: stick probabilities (count of members, Wilson 95 % interval, censored), rebound counts
+    and first rebounds (median, 5-95 %); the members' escape velocities where the scene asked for them; for a height
+    map the tail models and the cutoff band (`continuum.rough.cutoff_band`)."""
+    from continuum.rough.cutoff_band import band_summary, tails_summary
+
     p, r = ens["stick_probability"], ens["rebounds"]
     first = ens.get("first_rebound_over_h0") or ens["first_rebound_m"]
     unit = "h0" if "first_rebound_over_h0" in ens else "m"
     v = (ens.get("escape_velocity") or {}).get("m_per_s")
     escape = (f"\n  escape velocity median {v['p50']:.3g} m/s (5-95 %: {v['p5']:.3g}-{v['p95']:.3g})" if v else "")
-    return (f"ensemble of {ens['members']} realisations (master seed {ens['master_seed']}, {ens['wall_s']:.2f} s): "
-            f"stick probability {p['first_impact']['value']:.3f} at the first impact, {p['within_run']['value']:.3f} "
-            f"within the run\n  rebounds median {r['p50']:g} (5-95 %: {r['p5']:g}-{r['p95']:g}); first rebound median "
-            f"{first['p50']:.3g} {unit} (5-95 %: {first['p5']:.3g}-{first['p95']:.3g})" + escape)
+
+    def stick(q):
+        return (f"{q['count']}/{q['members']} ({q['interval'][0]:.3f}-{q['interval'][1]:.3f}, Wilson 95 %)"
+                if "interval" in q else f"{q['value']:.3f}")
+    censored = p["within_run"].get("censored")
+    tails = ens.get("tail_models")
+    band = (surface or {}).get("cutoff_band")
+    return (f"ensemble of {ens['members']} realisations (master seed {ens['master_seed']}, {ens['wall_s']:.2f} s"
+            f"{'; ' + ens['members_rule']['stopped'] if 'stopped' in ens.get('members_rule', {}) else ''}): stuck "
+            f"at the first impact {stick(p['first_impact'])}, within the run {stick(p['within_run'])}"
+            + (f" ({censored} censored by max_bounces/max_time)" if censored else "")
+            + f"\n  rebounds median {r['p50']:g} (5-95 %: {r['p5']:g}-{r['p95']:g}); first rebound median "
+            f"{first['p50']:.3g} {unit} (5-95 %: {first['p5']:.3g}-{first['p95']:.3g})" + escape
+            + (f"\n{tails_summary(tails)}" if tails else "") + (f"\n{band_summary(band)}" if band else ""))
 
 
 def cmd_impact(args) -> int:
@@ -135,7 +148,7 @@ def cmd_impact(args) -> int:
     print(f"status: {result['status']} after {result['n_bounces']} impacts; energy audit max error {audit:.2e}; "
           f"wall {result['timing']['wall_s']:.3f} s")
     if "ensemble" in result:
-        print(ensemble_summary(result["ensemble"]))
+        print(ensemble_summary(result["ensemble"], result.get("surface")))
     for w in result["warnings"]:
         print(f"warning: {w}")
     print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png"

@@ -66,8 +66,15 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         "timing": {"wall_s": wall},
     }
     if realisation is not None and realisation.mode == "ensemble":
-        result["ensemble"] = _ensemble_record(resolved, run, executor, workers)
+        result["ensemble"], extra = _ensemble_record(resolved, run, executor, workers)
+        if extra is not None:           # a height map: its cutoff band and the tail models (continuum.map_ensembles)
+            result["surface"] = {**result["surface"], "cutoff_band": extra["cutoff_band"]}
+            result["warnings"] += extra["warnings"]
         result["timing"]["wall_s"] = time.perf_counter() - start
+    elif (resolved.surface or {}).get("cutoff") is not None:
+        result["surface"] = {**result["surface"], "cutoff_band": None, "cutoff_band_why_not": (
+            f"the run is {realisation.mode if realisation else 'smooth'}: the cutoff band evaluates ensembles; set "
+            "surfaces.roughness.mode = 'ensemble' (or 'auto') for it")}
     return result, run.trace.arrays()
 
 
@@ -88,16 +95,23 @@ def _settle_realisation(resolved: ResolvedScene):
     return resolved, decision
 
 
-def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> dict:
-    """result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them."""
-    from .ensemble_run import run_ensemble
+def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> tuple[dict, dict | None]:
+    """(result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them; for a
+    scene with a height map, what `continuum.map_ensembles` adds: the tail models, the cutoff band, warnings)."""
+    from .ensemble_run import open_executor, run_ensemble
+    from .map_ensembles import map_ensembles
 
-    ens = run_ensemble(resolved, executor=executor, workers=workers)
+    with open_executor(executor, workers) as ex:
+        ens = run_ensemble(resolved, executor=ex)
+        extra = map_ensembles(resolved, ens, executor=ex)
     heights = [b.rebound_height for b in run.bounces if b.rebound_height is not None]
     mean_field = {"rebounds": len(heights), "first_rebound_m": heights[0] if heights else 0.0,
                   "status": run.status, "stuck": run.stuck,
                   "what": "the mean-field law of the trajectory (bounces, timeseries), same summit law"}
-    return ens.to_record(mean_field=mean_field)
+    record = ens.to_record(mean_field=mean_field)
+    if extra is not None:
+        record["tail_models"] = extra["tail_models"]
+    return record, extra
 
 
 def regime_numbers(scene, models: dict, run) -> dict:
@@ -163,6 +177,7 @@ def write_impact(out_dir: str | Path, result: dict, trace: dict) -> Path:
     figures = {"height.png": draw_height, "impacts.png": draw_force}
     if "ensemble" in result:
         def draw_ensemble(path):
-            plots.save(plots.ensemble_spread(result["ensemble"]), path, f"{name}: spread over summit realisations")
+            plots.save(plots.ensemble_spread(result["ensemble"], band=(result.get("surface") or {}).get("cutoff_band")),
+                       path, f"{name}: spread over summit realisations")
         figures["ensemble.png"] = draw_ensemble
     return write_run(out_dir, result, trace, figures)

@@ -47,15 +47,20 @@ def force_vs_time(trace: dict, bounces: list[dict], ax=None, max_impacts: int = 
     return ax
 
 
-def ensemble_spread(ensemble: dict, ax=None):
+def ensemble_spread(ensemble: dict, ax=None, band: list | None = None):
     """An ensemble's members: first rebound height / h0 against the member's number of rebounds (one dot per
     member, jittered sideways), with the mean-field run's point and the stick probabilities in the legend. Where
-    the ensemble has escape velocities (and no `ax` is given), a second panel shows their distribution
-    (`escape_velocity_spread`)."""
+    the ensemble has escape velocities (and no `ax` is given), a panel shows their distribution
+    (`escape_velocity_spread`); with a height map's cutoff `band` (result.json -> surface.cutoff_band), a panel
+    shows it (`cutoff_band_panel`)."""
     escape = ensemble.get("escape_velocity") or {}
-    if ax is None and escape.get("m_per_s"):
-        ax, right = Figure(figsize=(11, 3.5)).subplots(1, 2, gridspec_kw={"width_ratios": (3, 2), "wspace": 0.3})
-        escape_velocity_spread(ensemble, right)
+    if ax is None and (escape.get("m_per_s") or band):
+        extra = [f for f, on in ((escape_velocity_spread, escape.get("m_per_s")), (cutoff_band_panel, band)) if on]
+        axes = Figure(figsize=(7 + 4 * len(extra), 3.5)).subplots(
+            1, 1 + len(extra), gridspec_kw={"width_ratios": (3,) + (2,) * len(extra), "wspace": 0.3})
+        ax = axes[0]
+        for draw, right in zip(extra, axes[1:]):
+            draw(band if draw is cutoff_band_panel else ensemble, right)
     ax = ax or Figure(figsize=(7, 3.5)).subplots()
     runs = ensemble["member_runs"]
     h0 = ensemble.get("release_height_m") or 1.0
@@ -65,12 +70,39 @@ def ensemble_spread(ensemble: dict, ax=None):
     p = ensemble["stick_probability"]
     ax.plot(counts + jitter, first, "o", ms=3, alpha=0.6, color="C0",
             label=f"{len(runs)} members: stuck at 1st impact {p['first_impact']['value']:.2f}, "
-                  f"within the run {p['within_run']['value']:.2f}")
+                  f"within the run {p['within_run']['value']:.2f}"
+                  + (f" ({p['within_run']['censored']} censored)" if p["within_run"].get("censored") else ""))
     mf = ensemble.get("mean_field")
     if mf is not None:
         ax.plot([mf["rebounds"]], [mf["first_rebound_m"] / h0], "*", ms=12, color="C3", label="mean field")
     ax.set_xlabel("rebounds before the run ended")
     ax.set_ylabel("first rebound / release height" if ensemble.get("release_height_m") else "first rebound (m)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return ax
+
+
+def cutoff_band_panel(band: list, ax=None):
+    """The stick probability at the first impact (Wilson 95 % bars) against the summit cutoff of a height map's
+    band (result.json -> surface.cutoff_band), the run's own cutoff marked; each point labelled with beta."""
+    ax = ax or Figure(figsize=(5, 3.5)).subplots()
+    done = [e for e in band if e.get("evaluated")]
+    c = np.array([e["cutoff"] for e in done]) * 1e9
+    p = np.array([e["stick_probability"]["value"] for e in done])
+    lo = p - np.array([e["stick_probability"]["interval"][0] for e in done])
+    hi = np.array([e["stick_probability"]["interval"][1] for e in done]) - p
+    ax.errorbar(c, p, yerr=[lo, hi], fmt="o-", color="C0", capsize=3, label="stuck at the 1st impact")
+    for e, x, y in zip(done, c, p):
+        ax.annotate(f"beta {e['summit_radius'] * 1e9:.3g} nm", (x, y), textcoords="offset points", xytext=(4, 6),
+                    fontsize=7)
+    own = [e["cutoff"] * 1e9 for e in band if e["factor"] == 1.0]
+    if own:
+        ax.axvline(own[0], color="C3", lw=1, label="the run's cutoff")
+    ax.axhline(0.5, color="k", lw=0.5, ls=":")
+    ax.set_xscale("log")
+    ax.set_xlabel("summit cutoff (nm)")
+    ax.set_ylabel("stick probability")
+    ax.set_ylim(-0.02, 1.02)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     return ax

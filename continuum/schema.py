@@ -27,6 +27,32 @@ class Field(fields.Field):
         return self.key
 
 
+@dataclass(frozen=True)
+class NumberOrWord(Field):
+    """A number key that also takes one of a few words (`words`), e.g. surfaces.roughness.members = "auto"."""
+
+    words: tuple[str, ...] = ()
+
+    def allowed(self) -> str:
+        return super().allowed() + "".join(f" or {w!r}" for w in self.words)
+
+    def check(self, value, origin: str = "", *, error=fields.InputError, name: str | None = None):
+        if isinstance(value, str) and value in self.words:
+            return value
+        if isinstance(value, str):
+            raise error(name or self.key, value, f"must be {self.allowed()}", origin)
+        return super().check(value, origin, error=error, name=name)
+
+    def type_name(self) -> str:
+        return f"{self.kind.__name__} or " + " or ".join(repr(w) for w in self.words)
+
+    def json_schema(self) -> dict:
+        out = super().json_schema()
+        number = {k: out.pop(k) for k in ("type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+                  if k in out}
+        return {"anyOf": [number, {"enum": list(self.words)}], **out}
+
+
 _LEN = dict(kind=float, unit="m")
 _MODULUS = dict(kind=float, unit="Pa", low=1e6, high=1e13)
 _POISSON = dict(kind=float, unit="1", low=0.0, high=0.5, high_open=True)
@@ -122,8 +148,20 @@ FIELDS: tuple[Field, ...] = (
           "field.", "mean_field", choices=("auto", "mean_field", "discrete", "ensemble")),
     Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation; of an ensemble, "
           "the master seed its members' seeds are derived from (numpy SeedSequence).", 0, low=0, high=2**63 - 1),
-    Field("surfaces.roughness.members", int, "1", "Realisations in an ensemble (mode 'ensemble', or 'auto' where "
-          "it runs one).", 64, low=2, high=100000),
+    NumberOrWord("surfaces.roughness.members", int, "1", "Realisations in an ensemble (mode 'ensemble', or 'auto' "
+                 "where it runs one); 'auto' adds members in batches (continuum.ensemble_run.AUTO_BATCH) until the "
+                 "Wilson 95 % half-width of the stick probabilities (first impact and within the run) is below "
+                 "surfaces.roughness.target_half_width, or surfaces.roughness.max_members are run; result.json -> "
+                 "ensemble.members_rule records why it stopped.", 64, low=2, high=100000, words=("auto",)),
+    Field("surfaces.roughness.target_half_width", float, "1", "members = 'auto': the Wilson 95 % half-width of "
+          "the stick probabilities at which the ensemble stops growing.", 0.05, low=0.0, high=0.5, low_open=True),
+    Field("surfaces.roughness.max_members", int, "1", "members = 'auto': the most members run.", 512, low=2,
+          high=100000),
+    Field("surfaces.roughness.tail_model", str, "", "The summit-height distribution an ensemble's members draw "
+          "their strip from: 'gaussian' (of sigma, the Greenwood-Williamson surface of the mean field), or, for a "
+          "height map, 'empirical_gpd' (the map's own summit heights with a generalised Pareto tail fitted over a "
+          "threshold, continuum.rough.tail). With a map the ensemble is also run under the other model and both "
+          "are reported (result.json -> ensemble.tail_models).", "gaussian", choices=("gaussian", "empirical_gpd")),
     Field("surfaces.roughness.escape_velocities", bool, "", "Of an ensemble, also bisect each member's escape "
           "velocity (the smallest first-impact speed from which it rebounds, continuum.escape) and report their "
           "percentiles in result.json -> ensemble -> escape_velocity; each member then runs a dozen or more single "

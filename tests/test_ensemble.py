@@ -48,9 +48,13 @@ def test_stick_probabilities_are_the_members_fractions():
     assert ens.stick_probability_first_impact == sum(first) / 16
     assert 0.0 <= ens.stick_probability_first_impact <= ens.stick_probability <= 1.0
     rec = ens.to_record()
-    assert rec["stick_probability"]["within_run"]["count"] == sum(stuck)
-    p = rec["stick_probability"]["within_run"]["value"]
-    assert rec["stick_probability"]["within_run"]["standard_error"] == pytest.approx(math.sqrt(p * (1 - p) / 16))
+    within = rec["stick_probability"]["within_run"]
+    assert within["count"] == sum(stuck) and within["members"] == 16
+    lo, hi = within["interval"]
+    assert lo <= within["value"] <= hi and 0.0 <= lo < hi <= 1.0
+    censored = sum(o.status in ("max_bounces", "max_time") for o in ens.outcomes)
+    assert within["censored"] == censored
+    assert within["bounds"]["every_censored_member_sticks"] == (sum(stuck) + censored) / 16
     assert rec["rebounds"]["p50"] == pytest.approx(np.percentile([o.rebounds for o in ens.outcomes], 50))
 
 
@@ -210,49 +214,6 @@ def test_samples_inside_steps_do_not_change_a_members_rebounds(law):
                        settings=DriverSettings(rtol=scene.numerics.rtol, max_bounces=6, samples_per_step=per_step))
         runs.append([b.rebound_height for b in run.bounces])
     assert len(runs[0]) >= 2 and runs[0] == runs[1]
-
-
-def test_a_patch_holds_the_maps_summits_where_the_strip_puts_them():
-    """One summit at (1, 2) um, 3 nm high, on a 4 um x 4 um map; strip |x| <= 3 um, 0 <= y <= 10 um. From the map
-    origin the copies sit at x = 1 - 3 + 4i um (i = 0, 1) and y = 2 + 4j um (j = 0, 1, 2); from (1.5, 0) um the
-    summit lies at u = (1 - 1.5) mod 4 = 3.5 um, x = 0.5 um (the next copy, 4.5 um, is outside)."""
-    from continuum.rough.ensemble import SummitField, patch_summits, tiles
-
-    um = 1e-6
-    field = SummitField(np.array([1 * um]), np.array([2 * um]), np.array([3e-9]), (4 * um, 4 * um), True, {})
-    assert tiles(field, 3 * um, 10 * um) == (2, 3)
-    x, y, z = patch_summits(field, (0.0, 0.0), 3 * um, 10 * um)
-    got = sorted(zip(np.round(x / um, 12), np.round(y / um, 12)))
-    assert got == sorted((xi, yj) for xi in (-2.0, 2.0) for yj in (2.0, 6.0, 10.0)) and np.all(z == 3e-9)
-    x, y, _ = patch_summits(field, (1.5 * um, 0.0), 3 * um, 10 * um)
-    assert np.allclose(x / um, 0.5) and sorted(np.round(y / um, 12)) == [2.0, 6.0, 10.0]
-
-
-def test_members_of_a_scene_with_a_height_map_are_patches_of_its_summits():
-    """rough_synthetic names a synthetic map: the members are patches of its summits (found at the cutoff its
-    statistics used), every member's summits are the map's, and the record says so, with the tiling."""
-    from continuum.ensemble_run import summit_field
-    from continuum.model import factory
-    from continuum.rough.ensemble import patch_offset, patch_summits
-    from continuum.rough.gw import SummitStatistics
-
-    resolved = resolve_scene("rough_synthetic", params="paper", overrides={"numerics.max_bounces": 1})
-    field = summit_field(resolved)
-    assert field is not None and field.x.size >= 10 and field.source["cutoff_m"] == resolved.surface["cutoff"]
-    scene = resolved.scene
-    plan = member_plan(scene, first_impact_speed(scene))
-    rough = scene.surfaces.roughness
-    x, y, z = patch_summits(field, patch_offset(field, 7), plan.footprint_half_width, scene.body.length)
-    law = factory.discrete_roller(scene, SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius),
-                                  plan.work_of_adhesion, plan.summit_e_star, False, plan.footprint_half_width,
-                                  None, (x, y, z))
-    assert law.summits_in_strip == x.size and np.all(np.isin(law.sz, field.height))
-    ens = run_ensemble(resolved, members=2, seed=3)
-    rec = ens.to_record()
-    assert rec["source"] == "map_patches" and rec["patches"]["summits_on_map"] == field.x.size
-    ny = math.ceil(scene.body.length / field.size[1])
-    assert rec["patches"]["tiles"][1] == ny and rec["patches"]["tiled"] is True
-    assert len({tuple(m["patch_offset_m"]) for m in rec["member_runs"]}) == 2
 
 
 @pytest.mark.parametrize("law", ["jkr", "maugis_dugdale"])

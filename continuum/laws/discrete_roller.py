@@ -101,8 +101,11 @@ class DiscreteRoughRoller(RoughRollerBase):
         Maugis-Dugdale attraction before contact). JKR is the case delta_in = 0, delta_out = -Delta, reach 0.
     summits : (x, y, z) arrays, optional
         The summits of the strip (m: |x| <= footprint_half_width, 0 <= y <= length, heights) in place of a draw
-        from `stats` (a patch of a height map, `continuum.rough.ensemble.patch_summits`); the seed then draws
-        nothing.
+        from `stats` (e.g. a patch of a height map); the seed then draws nothing.
+    heights : optional
+        The summit-height distribution of the draw in place of Gaussian(0, sigma): an object whose
+        `sample(rng, m)` returns m heights (m) about the summits' mean plane (`continuum.rough.tail`, a map's
+        empirical distribution with a fitted extreme-value tail); positions and count are drawn as before.
     """
 
     name = "rough_roller_discrete_jkr"
@@ -112,7 +115,7 @@ class DiscreteRoughRoller(RoughRollerBase):
                  length: float, e_star: float, *, seed: int, detachment: str = "displacement",
                  half_space: bool = True, grid_points: int = 256, footprint_half_width: float | None = None,
                  depth_max: float | None = None, depth_safety: float = 1.5, coupling_tol: float = 1e-11,
-                 max_coupling_iterations: int = 20, summit_law=None, summits=None):
+                 max_coupling_iterations: int = 20, summit_law=None, summits=None, heights=None):
         if detachment not in ("displacement", "load"):
             raise ValueError(f"detachment = {detachment!r}: must be 'displacement' or 'load'")
         if not work_of_adhesion >= 0.0:
@@ -173,6 +176,7 @@ class DiscreteRoughRoller(RoughRollerBase):
         self.evaluations = 0
         self.deepened = 0
         self.grid_history: list[dict] = []
+        self.heights = heights
         self.given_summits = None if summits is None else tuple(np.asarray(a, float) for a in summits)
         self._realise(8.0 * self.sigma if depth_max is None else float(depth_max))
         self.design_depth = 4.0 * self.sigma
@@ -222,7 +226,7 @@ class DiscreteRoughRoller(RoughRollerBase):
             left -= m
             x = rng.uniform(-xf, xf, m)
             y = rng.uniform(0.0, l, m)
-            z = rng.normal(0.0, self.sigma, m)
+            z = rng.normal(0.0, self.sigma, m) if self.heights is None else self.heights.sample(rng, m)
             eff = z - x * x / two_r
             top = max(top, float(eff.max()))
             raw_top = max(raw_top, float(z.max()))

@@ -97,16 +97,17 @@ def grid_roller(surface, scene: Scene) -> ContactLaw:
 
 
 def discrete_roller(scene: Scene, stats, work_of_adhesion: float, summit_e_star: float, half_space: bool,
-                    footprint_half_width: float, summit_law=None, summits=None) -> ContactLaw:
+                    footprint_half_width: float, summit_law=None, summits=None, heights=None) -> ContactLaw:
     """A seeded realisation of individual summits (surfaces.roughness.seed) under the roller, or the given
     `summits` (x, y, z) of a map patch: closed-form JKR or Hertz summits, or `summit_law`'s tabulated branches
-    (Maugis-Dugdale, DMT, coated summits)."""
+    (Maugis-Dugdale, DMT, coated summits). `heights`: the summit-height distribution drawn from (None: Gaussian of
+    sigma; `continuum.rough.tail`)."""
     from ..laws.discrete_roller import DiscreteRoughRoller
     body, surf = scene.body, scene.surfaces
     return DiscreteRoughRoller(stats, work_of_adhesion, summit_e_star, body.radius, body.length, surf.e_star,
                                seed=surf.roughness.seed, detachment=scene.physics.detachment, half_space=half_space,
                                grid_points=scene.numerics.grid_points, footprint_half_width=footprint_half_width,
-                               summit_law=summit_law, summits=summits)
+                               summit_law=summit_law, summits=summits, heights=heights)
 
 
 def with_menisci(dry: ContactLaw, scene: Scene, stats, parameters: dict) -> ContactLaw:

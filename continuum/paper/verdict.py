@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import math
 
+from ..proportions import wilson_interval
+
 PASS, FAIL, NOT_EVALUABLE = "pass", "fail", "not_evaluable"
 VERIFICATION, REPRODUCTION = "verification", "reproduction"
 #: A reproduction claim passes when it holds on at least this fraction of its decided samples.
@@ -110,7 +112,4 @@ def proportion(flags) -> dict | None:
     n, k = len(f), sum(f)
     if n == 0:
         return None
-    z, p = 1.959964, k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return {"fraction": p, "k": k, "n": n, "wilson95": [max(0.0, centre - half), min(1.0, centre + half)]}
+    return {"fraction": k / n, "k": k, "n": n, "wilson95": list(wilson_interval(k, n))}

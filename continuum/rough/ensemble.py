@@ -21,6 +21,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..proportions import wilson_interval
+
 #: Percentiles reported for the rebound count, the first rebound height and the escape velocity.
 PERCENTILES = (5, 25, 50, 75, 95)
 #: numpy's percentile method for them ('linear': interpolated between order statistics, numpy's default).
@@ -33,47 +35,6 @@ def member_seeds(master: int, members: int) -> tuple[int, ...]:
         raise ValueError(f"members = {members!r}: must be >= 1")
     words = np.random.SeedSequence(int(master)).generate_state(int(members), dtype=np.uint64)
     return tuple(int(w) & (2**63 - 1) for w in words)
-
-
-@dataclass(frozen=True, eq=False)
-class SummitField:
-    """Summits of a height map taken as periodic (`continuum.rough.topography.identify_summits`): positions in
-    [0, Lx) x [0, Ly) (m), heights above the map's mean plane (m), the map's size (m) and where it came from."""
-
-    x: np.ndarray
-    y: np.ndarray
-    height: np.ndarray
-    size: tuple[float, float]
-    periodic: bool
-    source: dict
-
-
-def patch_offset(field: SummitField, seed: int) -> tuple[float, float]:
-    """A member's patch origin on the map (m), uniform over the map, from the member's seed (reproducible)."""
-    rng = np.random.default_rng(int(seed))
-    return float(rng.uniform(0.0, field.size[0])), float(rng.uniform(0.0, field.size[1]))
-
-
-def tiles(field: SummitField, half_width: float, length: float) -> tuple[int, int]:
-    """Copies of the map along x and y that cover the strip |x| <= half_width, 0 <= y <= length (1 where one
-    patch of the map covers it)."""
-    return (max(1, math.ceil(2.0 * half_width / field.size[0])), max(1, math.ceil(length / field.size[1])))
-
-
-def patch_summits(field: SummitField, offset: tuple[float, float], half_width: float,
-                  length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(x, y, z) of the summits under the strip |x| <= half_width, 0 <= y <= length (m) cut from the map at
-    `offset` = (ox, oy): the map point (ox, oy) lies at the strip's corner (-half_width, 0), and the map repeats
-    periodically where the strip runs past its edge (`tiles`)."""
-    lx, ly = field.size
-    u = np.mod(field.x - offset[0], lx)
-    v = np.mod(field.y - offset[1], ly)
-    nx, ny = tiles(field, half_width, length)
-    shape = (nx, ny, u.size)                                   # (copy along x, copy along y, summit)
-    x = np.broadcast_to(u[None, None, :] + lx * np.arange(nx)[:, None, None] - half_width, shape)
-    y = np.broadcast_to(v[None, None, :] + ly * np.arange(ny)[None, :, None], shape)
-    keep = (x <= half_width) & (y <= length)
-    return x[keep], y[keep], np.broadcast_to(field.height, shape)[keep]
 
 
 @dataclass(frozen=True)
@@ -92,8 +53,6 @@ class MemberOutcome:
     wall_s: float
     energy_error: float = 0.0
     """The run's energy audit: largest error of its energy books against the first impact's kinetic energy."""
-    patch_offset: tuple[float, float] | None = None
-    """Where a map-patch member's strip starts on the map (m); None for a draw from the statistics."""
     escape: Mapping[str, Any] | None = None
     """The member's escape velocity where the ensemble was asked for it (`continuum.escape.escape_velocity`:
     escape_velocity, lower, upper (m/s), runs), or {"escape_velocity": None, "reason": ...}; None: not asked."""
@@ -121,7 +80,6 @@ class MemberOutcome:
         return {"seed": self.seed, "status": self.status, "rebounds": self.rebounds,
                 "rebound_heights": list(self.rebound_heights), "max_contacts": self.max_contacts,
                 "energy_error": self.energy_error, "wall_s": self.wall_s,
-                **({"patch_offset_m": list(self.patch_offset)} if self.patch_offset is not None else {}),
                 **({"escape": dict(self.escape)} if self.escape is not None else {})}
 
     @classmethod
@@ -130,7 +88,6 @@ class MemberOutcome:
                    rebound_heights=tuple(float(h) for h in rec["rebound_heights"]), release_height=release_height,
                    max_contacts=int(rec["max_contacts"]), wall_s=float(rec["wall_s"]),
                    energy_error=float(rec["energy_error"]),
-                   patch_offset=tuple(rec["patch_offset_m"]) if "patch_offset_m" in rec else None,
                    escape=rec.get("escape"))
 
 
@@ -139,11 +96,54 @@ def _percentiles(values: Sequence[float]) -> dict[str, float]:
     return {f"p{p}": float(v) for p, v in zip(PERCENTILES, q)}
 
 
-def _fraction(flags: Sequence[bool]) -> dict[str, float]:
-    """A fraction of members with its binomial standard error sqrt(p (1 - p) / n)."""
-    n = len(flags)
-    p = sum(bool(f) for f in flags) / n
-    return {"value": p, "standard_error": math.sqrt(p * (1.0 - p) / n), "count": int(sum(bool(f) for f in flags))}
+#: How a run ended without the body held or rebounding clear: its run was cut by a numerical limit.
+CENSORING_STATUSES = ("max_bounces", "max_time")
+
+
+def _proportion(count: int, members: int) -> dict:
+    """count of members, the fraction and its Wilson 95 % interval (`continuum.proportions`)."""
+    lo, hi = wilson_interval(count, members)
+    return {"count": int(count), "members": int(members), "value": count / members, "interval": [lo, hi],
+            "interval_rule": "Wilson score 95 % (Wilson 1927)"}
+
+
+def first_impact_record(outcomes: Sequence["MemberOutcome"]) -> dict:
+    """Stuck at the first impact (held by adhesion, no rebound): count, members, Wilson interval; apart from it the
+    members that rebounded clear of the first impact, those whose first contact ended at rest under gravity, and
+    those `censored` (the run's max_time ended it inside the first contact)."""
+    n = len(outcomes)
+    stuck = sum(o.stuck_at_first_impact for o in outcomes)
+    rebounded = sum(o.rebounds > 0 for o in outcomes)
+    censored = sum(o.rebounds == 0 and o.status in CENSORING_STATUSES for o in outcomes)
+    return {**_proportion(stuck, n), "rebounded": rebounded, "censored": censored,
+            "rest": n - stuck - rebounded - censored}
+
+
+def within_run_record(outcomes: Sequence["MemberOutcome"]) -> dict:
+    """Stuck by the end of the run: count, members, Wilson interval, and apart from them the members `censored`
+    (still bouncing when numerics.max_bounces or max_time ended the run: their fate is not known) and those that
+    came to rest, rebounded clear (gravity off) or otherwise did not stick. `bounds`: the fraction if no censored
+    member would have stuck and if every one would."""
+    n = len(outcomes)
+    stuck = sum(o.stuck for o in outcomes)
+    censored = sum(o.status in CENSORING_STATUSES for o in outcomes)
+    return {**_proportion(stuck, n), "censored": censored,
+            "censored_by": {s: sum(o.status == s for o in outcomes) for s in CENSORING_STATUSES},
+            "not_stuck": {s: sum(o.status == s for o in outcomes) for s in ("rest", "escaped")},
+            "bounds": {"no_censored_member_sticks": stuck / n, "every_censored_member_sticks": (stuck + censored) / n},
+            "means": "held by adhesion ('stuck') before numerics.max_bounces or max_time ended the run"}
+
+
+def first_impact_summary(outcomes: Sequence["MemberOutcome"]) -> dict:
+    """What a first-impact ensemble (a tail model's, a cutoff's) reports: the stick probability at the first impact
+    and the first rebound's percentiles (m and, with a release height, over it; 0 for a member held)."""
+    first = np.array([o.first_rebound for o in outcomes], float)
+    rec = {"members": len(outcomes), "stick_probability_first_impact": first_impact_record(outcomes),
+           "first_rebound_m": _percentiles(first)}
+    h0 = outcomes[0].release_height if outcomes else None
+    if h0:
+        rec["first_rebound_over_h0"] = {k: v / h0 for k, v in rec["first_rebound_m"].items()}
+    return rec
 
 
 @dataclass(frozen=True)
@@ -155,8 +155,12 @@ class EnsembleResult:
     executor: str
     wall_s: float
     source: Mapping[str, Any] = field(default_factory=lambda: {"source": "statistics"})
-    """What the members realise: {"source": "statistics"} (draws from sigma, summit_density, summit_radius) or
-    {"source": "map_patches", ...} (patches of the scene's height map, with the map and its tiling)."""
+    """What the members realise: {"source": "statistics"} (draws from sigma, summit_density, summit_radius given as
+    numbers) or {"source": "map_statistics", "tail_model": ...} (draws from a height map's measured distributions,
+    `continuum.rough.tail`); never copies of a map."""
+    members_rule: Mapping[str, Any] = field(default_factory=lambda: {"rule": "fixed"})
+    """How the member count was set: {"rule": "fixed"} (surfaces.roughness.members), or the 'auto' rule's target,
+    cap, batch and why it stopped (`continuum.ensemble_run`)."""
     escape_rel_tol: float | None = None
     """Relative bracket width of each member's escape velocity; None where the scene did not ask for them."""
 
@@ -193,10 +197,9 @@ class EnsembleResult:
             "members": self.members, "master_seed": self.master_seed, "seeds": list(self.seeds), **self.source,
             "release_height_m": h0,
             "seed_rule": "numpy SeedSequence(master_seed).generate_state(members, uint64), top bit cleared",
-            "stick_probability": {
-                "first_impact": _fraction([o.stuck_at_first_impact for o in self.outcomes]),
-                "within_run": _fraction([o.stuck for o in self.outcomes]),
-                "within_run_means": "held by adhesion ('stuck') before numerics.max_bounces or max_time ended the run"},
+            "members_rule": dict(self.members_rule),
+            "stick_probability": {"first_impact": first_impact_record(self.outcomes),
+                                  "within_run": within_run_record(self.outcomes)},
             "percentiles": list(PERCENTILES), "percentile_method": PERCENTILE_METHOD,
             "rebounds": {**_percentiles(self.rebound_counts()), "mean": float(np.mean(self.rebound_counts()))},
             "first_rebound_m": {**_percentiles(first), "mean": float(np.mean(first)), "std": float(np.std(first)),
@@ -240,8 +243,8 @@ class EnsembleResult:
     @classmethod
     def from_record(cls, rec: Mapping[str, Any], release_height: float | None) -> "EnsembleResult":
         outcomes = tuple(MemberOutcome.from_record(m, release_height) for m in rec["member_runs"])
-        source = {k: rec[k] for k in ("source", "patches") if k in rec} or {"source": "statistics"}
+        source = {k: rec[k] for k in ("source", "tail_model", "map_summits") if k in rec} or {"source": "statistics"}
         escape = rec.get("escape_velocity") or {}
         return cls(master_seed=int(rec["master_seed"]), outcomes=outcomes, executor=str(rec["executor"]),
-                   wall_s=float(rec["wall_s"]), source=source,
+                   wall_s=float(rec["wall_s"]), source=source, members_rule=rec.get("members_rule", {"rule": "fixed"}),
                    escape_rel_tol=escape.get("rel_tol") if escape.get("requested") else None)

@@ -8,8 +8,8 @@ scene file itself or as an override next to a map is an error, since two sources
 reader guessing which one ran. `surfaces.roughness.sigma` holds the summits' height standard deviation (the GW
 sigma), so a map fills it with sigma_s, not with the surface's rms height.
 
-The map supplies statistics for the mean-field (Greenwood-Williamson) model only: the roller's footprint may be
-far larger than the map, and nothing here tiles the map under it.
+The map supplies statistics (to the mean-field law and to the draws of an ensemble's members,
+`continuum.ensemble_run`): the roller's footprint may be far larger than the map, and nothing tiles the map under it.
 """
 from __future__ import annotations
 
@@ -122,8 +122,8 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
                                       values.get(KEY_UNIT), cutoff, tip, values.get(KEY_ROUTE, "direct"), stamp)
     block = {**stats.to_json(), "cutoff_from": origin, "source": dict(hmap.source), "replaced": replaced,
              "fills": {key: attr for key, attr in MAP_KEYS.items()},
-             "note": "the map supplies summit statistics to the mean-field (GW) law and to discrete draws; the "
-                     "members of an ensemble are patches of the map's own summits (result.json -> ensemble.patches)"}
+             "note": "the map supplies summit statistics to the mean-field (GW) law and the distributions an "
+                     "ensemble's members draw their strip from (never copies of the map; result.json -> ensemble)"}
     return MapStatistics(values={key: getattr(stats, attr) for key, attr in MAP_KEYS.items()}, block=block)
 
 

@@ -1,0 +1,134 @@
+"""What a height map adds to an ensemble: the run under the other tail model and the cutoff band.
+
+A map's summit statistics at one cutoff, extrapolated with one tail model, are two choices the scan cannot fix
+(`continuum.rough.tail`, `continuum.rough.cutoff_band`). Beside the scene's own ensemble this runs, to the first
+rebound (the physical statistic no numerical cap censors):
+
+- the ensemble under the other tail model of the map's summit heights (result.json -> ensemble.tail_models);
+- ensembles at the cutoffs of `BAND_FACTORS` other than the run's own, with the statistics SurfaceTopography's map
+  gives there (`continuum.rough.topography.summit_statistics`, the scene's route) and the scene's tail model
+  (result.json -> surface.cutoff_band).
+
+The scene's own ensemble supplies the entries at its own tail model and cutoff (a member's first impact does not
+depend on how many bounces follow). Each extra ensemble follows the scene's members rule ('auto': until the first
+impact's Wilson half-width is below the target).
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from .ensemble_run import open_executor, run_ensemble
+from .rough.cutoff_band import BAND_FACTORS, band_entry, band_warning, tail_warning
+from .rough.ensemble import EnsembleResult, first_impact_summary
+from .rough.tail import TAIL_MODELS, TailFitError, fit_empirical_gpd, map_summit_record
+from .scene import ResolvedScene, Scene
+
+log = logging.getLogger(__name__)
+
+
+def _map(resolved: ResolvedScene):
+    """(height map, cutoff (m), summit route) of the scene, or None without a map."""
+    from .rough.surface_map import height_map
+
+    scene_dir = Path(resolved.scene_file).parent if resolved.scene_file else None
+    found = height_map(resolved.values, scene_dir)
+    if found is None:
+        return None
+    return found[0], found[1], resolved.values.get("surfaces.roughness.summit_route", "direct")
+
+
+def _summits(hmap, cutoff: float):
+    from .rough.topography import identify_summits
+    return identify_summits(hmap.heights, hmap.pixel_size, cutoff, periodic=hmap.periodic)
+
+
+def map_tail(resolved: ResolvedScene, cutoff: float | None = None) -> tuple[Any, dict]:
+    """(the `empirical_gpd` model of the map's summit heights at `cutoff` (default: the run's) or None where the map
+    cannot carry the fit, its record with the map's summit distributions)."""
+    from .rough.datum import tallest_summit
+
+    hmap, own, _ = _map(resolved)
+    rough, body = resolved.scene.surfaces.roughness, resolved.scene.body
+    summits = _summits(hmap, own if cutoff is None else cutoff)
+    sigma_s = float(summits.height.std())
+    rec = {"map_summits": map_summit_record(summits, sigma_s)}
+    try:
+        model = fit_empirical_gpd(summits.height)
+    except TailFitError as exc:
+        return None, {**rec, "fitted": False, "why": str(exc)}
+    strip = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)["summits_in_footprint"]
+    return model, {**rec, "fitted": True, **model.record(sigma_s, strip)}
+
+
+def _with_rough(scene: Scene, **values) -> Scene:
+    rough = replace(scene.surfaces.roughness, **values)
+    return replace(scene, surfaces=replace(scene.surfaces, roughness=rough))
+
+
+def map_ensembles(resolved: ResolvedScene, main: EnsembleResult, executor: Any = None,
+                  workers: int | None = None) -> dict | None:
+    """{'tail_models': ..., 'cutoff_band': [...], 'warnings': [...]} for a scene with a height map whose ensemble
+    `main` ran; None for a scene without a map."""
+    found = _map(resolved)
+    if found is None:
+        return None
+    hmap, cutoff, route = found
+    sc = resolved.scene
+    headline = sc.surfaces.roughness.tail_model
+    model, tail_record = map_tail(resolved)
+    tails: dict = {headline: {**first_impact_summary(main.outcomes), "from": "the scene's ensemble (first impacts)"}}
+    band = [band_entry(1.0, cutoff, _stats_of(sc), {**first_impact_summary(main.outcomes)})]
+    with open_executor(executor, workers) as ex:
+        for other in TAIL_MODELS:
+            if other == headline:
+                continue
+            if other == "empirical_gpd" and model is None:
+                tails[other] = {"run": False, "why": tail_record["why"]}
+                continue
+            ens = run_ensemble(_with_rough(sc, tail_model=other), heights=model if other == "empirical_gpd" else None,
+                               first_impact=True, executor=ex)
+            tails[other] = {**first_impact_summary(ens.outcomes), "members_rule": dict(ens.members_rule),
+                            "from": "an ensemble run to the first rebound", "wall_s": ens.wall_s}
+        tails["empirical_gpd"] = {**tails.get("empirical_gpd", {}), "fit": tail_record}
+        for factor in BAND_FACTORS:
+            if factor != 1.0:
+                band.append(_band_point(sc, hmap, factor * cutoff, factor, route, headline, ex))
+    band.sort(key=lambda e: e["cutoff"])
+    warnings = [w for w in (band_warning(sc.name, band), tail_warning(sc.name, tails)) if w]
+    return {"tail_models": tails, "cutoff_band": band, "warnings": warnings}
+
+
+def _stats_of(scene: Scene) -> dict:
+    rough = scene.surfaces.roughness
+    return {"summit_radius": rough.summit_radius, "summit_density": rough.summit_density,
+            "summit_height_std": rough.sigma}
+
+
+def _band_point(sc: Scene, hmap, cutoff: float, factor: float, route: str, tail_model: str, ex) -> dict:
+    """One cutoff of the band: the map's statistics there and an ensemble of them, or why it was not evaluated."""
+    from .rough.topography import TopographyError, summit_statistics
+
+    try:
+        stats = summit_statistics(hmap, cutoff, route)
+    except TopographyError as exc:
+        return band_entry(factor, cutoff, {"summit_radius": None, "summit_density": None, "summit_height_std": None},
+                          None, str(exc))
+    scene = _with_rough(sc, sigma=stats.summit_height_std, summit_density=stats.summit_density,
+                        summit_radius=stats.summit_radius)
+    values = _stats_of(scene)
+    heights = None
+    if tail_model == "empirical_gpd":
+        try:
+            heights = fit_empirical_gpd(_summits(hmap, cutoff).height)
+        except TailFitError as exc:
+            return band_entry(factor, cutoff, values, None, str(exc))
+    try:
+        ens = run_ensemble(scene, heights=heights, first_impact=True, executor=ex)
+    except ValueError as exc:           # e.g. too few summits in the footprint at this cutoff's density
+        return band_entry(factor, cutoff, values, None, str(exc))
+    log.info("cutoff band: %.3g m (x%g) in %.2f s", cutoff, factor, ens.wall_s)
+    return {**band_entry(factor, cutoff, values, first_impact_summary(ens.outcomes)),
+            "members_rule": dict(ens.members_rule)}
