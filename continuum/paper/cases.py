@@ -55,7 +55,7 @@ def sigma_case(sigma_nm: float) -> Case:
 
 def dry_cases() -> list[Case]:
     cases = [Case("hertz", "hertz_roller.toml", {}, ("5a", "5b")),
-             Case("rough_ots", "rough_ots.toml", {}, ("4", "5a", "5b")),
+             Case("rough_ots", "rough_ots.toml", {**MEAN_FIELD}, ("4", "5a", "5b")),
              # Fig 6: the first impact of rough silica with the elastic half-space under the summits
              Case("fig6_halfspace", "rough_silica.toml",
                   {"numerics.max_bounces": 1, "physics.half_space": "on", **MEAN_FIELD}, ("6",))]
