@@ -194,3 +194,12 @@ def test_the_shipped_topography_scene_runs_the_calibrated_set_with_the_law_the_t
     d = adhesion_decision(scene, regime_of(scene, first_impact_speed(scene)))
     assert d.record()["decided_by"] == "tabor_parameter"
     assert resolve_scene("rough_ots").scene.surfaces.roughness.mode == "auto"
+
+
+def test_a_mean_field_run_on_a_map_says_why_it_has_no_cutoff_band():
+    from continuum import run_scene
+
+    r = run_scene("rough_synthetic", overrides={**SMALL, "surfaces.roughness.mode": "mean_field",
+                                                "numerics.max_bounces": 1})
+    assert r.record["surface"]["cutoff_band"] is None and "mean_field" in r.record["surface"]["cutoff_band_why_not"]
+    assert "ensemble" not in r.record

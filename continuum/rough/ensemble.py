@@ -6,7 +6,9 @@ sqrt(N_c), and each summit's hysteresis loop is a sizeable part of the impact en
 distribution over realisations of the same summit statistics (docs/model.md, "Few summits: ensembles"). Each
 member is one seeded realisation (`continuum.laws.discrete_roller`, surfaces.roughness.mode = 'discrete'); this
 module holds what is pure about an ensemble: how member seeds follow from one master seed, what a member's
-run reduces to (`MemberOutcome`), and the statistics reported in result.json -> ensemble (`EnsembleResult`).
+run reduces to (`MemberOutcome`), and the statistics reported in result.json -> ensemble (`EnsembleResult`):
+stick probabilities as counts of members with their Wilson 95 % interval (`continuum.proportions`), with the
+members whose run a numerical cap ended (`censored`) apart from those stuck or at rest.
 
 Seeds: numpy's `SeedSequence(master).generate_state(members, uint64)`, each word's top bit cleared (the scene's
 seed range is 0 .. 2^63 - 1). SeedSequence hashes the master seed into well-mixed, independent streams
