@@ -147,12 +147,16 @@ def cmd_impact(args) -> int:
     audit = result["energy_audit"]["max_relative_error"]
     print(f"status: {result['status']} after {result['n_bounces']} impacts; energy audit max error {audit:.2e}; "
           f"wall {result['timing']['wall_s']:.3f} s")
+    band = (result.get("surface") or {}).get("cutoff_band")
     if "ensemble" in result:
         print(ensemble_summary(result["ensemble"], result.get("surface")))
+    elif band:
+        from continuum.rough.cutoff_band import band_summary
+        print("cutoff band (mean field, first impact):\n" + band_summary(band))
     for w in result["warnings"]:
         print(f"warning: {w}")
     print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png"
-          + (", ensemble.png" if "ensemble" in result else ""))
+          + (", ensemble.png" if "ensemble" in result else ", cutoff_band.png" if band else ""))
     return 0
 
 

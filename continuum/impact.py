@@ -71,10 +71,11 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
             result["surface"] = {**result["surface"], "cutoff_band": extra["cutoff_band"]}
             result["warnings"] += extra["warnings"]
         result["timing"]["wall_s"] = time.perf_counter() - start
-    elif (resolved.surface or {}).get("cutoff") is not None:
-        result["surface"] = {**result["surface"], "cutoff_band": None, "cutoff_band_why_not": (
-            f"the run is {realisation.mode if realisation else 'smooth'}: the cutoff band evaluates ensembles; set "
-            "surfaces.roughness.mode = 'ensemble' (or 'auto') for it")}
+    elif realisation is not None and realisation.mode == "mean_field" and (resolved.surface or {}).get("cutoff"):
+        from .map_ensembles import mean_field_band     # a map under the mean field: its first impact at each cutoff
+        band = mean_field_band(resolved)
+        result["surface"] = {**result["surface"], "cutoff_band": band["cutoff_band"]}
+        result["warnings"] += band["warnings"]
     return result, run.trace.arrays()
 
 
@@ -175,6 +176,11 @@ def write_impact(out_dir: str | Path, result: dict, trace: dict) -> Path:
         plots.save(plots.force_vs_time(trace, result["bounces"]), path, f"{name}: force during each impact")
 
     figures = {"height.png": draw_height, "impacts.png": draw_force}
+    band = (result.get("surface") or {}).get("cutoff_band")
+    if band and "ensemble" not in result:
+        def draw_band(path):
+            plots.save(plots.cutoff_band_panel(band), path, f"{name}: first impact against the summit cutoff")
+        figures["cutoff_band.png"] = draw_band
     if "ensemble" in result:
         def draw_ensemble(path):
             plots.save(plots.ensemble_spread(result["ensemble"], band=(result.get("surface") or {}).get("cutoff_band")),

@@ -132,3 +132,71 @@ def _band_point(sc: Scene, hmap, cutoff: float, factor: float, route: str, tail_
     log.info("cutoff band: %.3g m (x%g) in %.2f s", cutoff, factor, ens.wall_s)
     return {**band_entry(factor, cutoff, values, first_impact_summary(ens.outcomes)),
             "members_rule": dict(ens.members_rule)}
+
+
+def _mean_field_first_impact(scene: Scene) -> dict:
+    """The mean-field law's first impact of `scene` (to its first rebound): a summary shaped as an ensemble's of
+    one deterministic member (no interval: nothing random is sampled), with the law that ran."""
+    from .driver import DriverSettings, simulate
+    from .model import dry_run_verdict, select_law
+    from .model.regime import first_impact_speed
+
+    speed = first_impact_speed(scene)
+    law, models = select_law(scene, speed)
+    n = scene.numerics
+    settings = DriverSettings(rtol=n.rtol, max_bounces=1, max_time=n.max_time, rest_fraction=n.rest_fraction,
+                              samples_per_flight=2, samples_per_step=0)
+
+    def run(law):
+        release = scene.release_height
+        if release is not None and scene.surfaces.roughness.datum == "mean_plane":
+            release -= float(law.z_top)
+        return simulate(law, scene.body.mass, scene.environment.gravity, release_height=release,
+                        impact_velocity=scene.impact_velocity, settings=settings)
+    out = run(law)
+    if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
+        if dry_run_verdict(scene, [b.duration for b in out.bounces], out.status).rerun:
+            law, models = select_law(scene, speed, menisci=True)
+            out = run(law)
+    first = next((b.rebound_height for b in out.bounces if b.rebound_height is not None), None)
+    stuck = out.status == "stuck" and first is None
+    h0 = scene.release_height
+    value = (first or 0.0) / h0 if h0 else (first or 0.0)
+    return {"members": 1, "stick_probability_first_impact": {
+                "count": int(stuck), "members": 1, "value": float(stuck), "interval": None, "censored": 0,
+                "what": "the mean-field law (deterministic): stuck or not, no interval"},
+            "first_rebound_m": {"p50": first or 0.0}, **({"first_rebound_over_h0": {"p50": value}} if h0 else {}),
+            "law": models["adhesion"].get("law") if "adhesion" in models else None}
+
+
+def mean_field_band(resolved: ResolvedScene) -> dict | None:
+    """{'cutoff_band': [...], 'warnings': [...]} of a mean-field run on a height map: the mean-field law's first
+    impact at each cutoff of BAND_FACTORS with the map's statistics there; None for a scene without a map."""
+    from .rough.topography import TopographyError, summit_statistics
+
+    found = _map(resolved)
+    if found is None:
+        return None
+    hmap, cutoff, route = found
+    sc = resolved.scene
+    band = []
+    for factor in BAND_FACTORS:
+        c = factor * cutoff
+        try:
+            stats = summit_statistics(hmap, c, route) if factor != 1.0 else None
+        except TopographyError as exc:
+            band.append(band_entry(factor, c, {"summit_radius": None, "summit_density": None,
+                                               "summit_height_std": None}, None, str(exc)))
+            continue
+        scene = sc if stats is None else _with_rough(sc, sigma=stats.summit_height_std,
+                                                     summit_density=stats.summit_density,
+                                                     summit_radius=stats.summit_radius)
+        try:
+            summary = _mean_field_first_impact(scene)
+        except ValueError as exc:       # e.g. too few summits in the footprint at this cutoff's density
+            band.append(band_entry(factor, c, _stats_of(scene), None, str(exc)))
+            continue
+        band.append({**band_entry(factor, c, _stats_of(scene), summary), "model": "mean_field",
+                     "law": summary["law"]})
+    warning = band_warning(sc.name, band)
+    return {"cutoff_band": band, "warnings": [warning] if warning else []}

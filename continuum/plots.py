@@ -89,12 +89,13 @@ def cutoff_band_panel(band: list, ax=None):
     done = [e for e in band if e.get("evaluated")]
     c = np.array([e["cutoff"] for e in done]) * 1e9
     p = np.array([e["stick_probability"]["value"] for e in done])
-    lo = p - np.array([e["stick_probability"]["interval"][0] for e in done])
-    hi = np.array([e["stick_probability"]["interval"][1] for e in done]) - p
+    lo = p - np.array([(e["stick_probability"]["interval"] or [v])[0] for e, v in zip(done, p)])
+    hi = np.array([(e["stick_probability"]["interval"] or [v, v])[1] for e, v in zip(done, p)]) - p
     ax.errorbar(c, p, yerr=[lo, hi], fmt="o-", color="C0", capsize=3, label="stuck at the 1st impact")
     for e, x, y in zip(done, c, p):
-        ax.annotate(f"beta {e['summit_radius'] * 1e9:.3g} nm", (x, y), textcoords="offset points", xytext=(4, 6),
-                    fontsize=7)
+        beta = e["summit_radius"]
+        ax.annotate(f"beta {beta * 1e9:.3g} nm" if beta < 1e-6 else f"beta {beta * 1e6:.3g} um", (x, y),
+                    textcoords="offset points", xytext=(-20, -14 if y > 0.5 else 8), fontsize=7)
     own = [e["cutoff"] * 1e9 for e in band if e["factor"] == 1.0]
     if own:
         ax.axvline(own[0], color="C3", lw=1, label="the run's cutoff")
@@ -102,7 +103,8 @@ def cutoff_band_panel(band: list, ax=None):
     ax.set_xscale("log")
     ax.set_xlabel("summit cutoff (nm)")
     ax.set_ylabel("stick probability")
-    ax.set_ylim(-0.02, 1.02)
+    ax.set_ylim(-0.05, 1.08)
+    ax.margins(x=0.15)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     return ax

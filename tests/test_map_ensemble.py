@@ -196,10 +196,19 @@ def test_the_shipped_topography_scene_runs_the_calibrated_set_with_the_law_the_t
     assert resolve_scene("rough_ots").scene.surfaces.roughness.mode == "auto"
 
 
-def test_a_mean_field_run_on_a_map_says_why_it_has_no_cutoff_band():
+def test_a_mean_field_run_on_a_map_reports_the_band_of_its_first_impact(tmp_path):
+    """Under the mean field the band is the mean-field law's first impact at each cutoff: at the run's own cutoff it
+    is the run's own first bounce; the others run on the map's statistics there, and the figure is drawn."""
     from continuum import run_scene
 
     r = run_scene("rough_synthetic", overrides={**SMALL, "surfaces.roughness.mode": "mean_field",
                                                 "numerics.max_bounces": 1})
-    assert r.record["surface"]["cutoff_band"] is None and "mean_field" in r.record["surface"]["cutoff_band_why_not"]
-    assert "ensemble" not in r.record
+    band = r.record["surface"]["cutoff_band"]
+    assert "ensemble" not in r.record and [e["factor"] for e in band] == [0.5, 1.0, 2.0]
+    own = band[1]
+    h0 = r.record["scene"]["si"]["release_height"]
+    first = r.record["bounces"][0]["rebound_height"] or 0.0
+    assert own["model"] == "mean_field" and own["first_rebound_median"] == pytest.approx(first / h0, rel=1e-9)
+    assert own["stick_probability"]["value"] == float(r.record["stuck"] and first == 0.0)
+    assert band[2]["summit_density"] < own["summit_density"]     # (the map holds no wavelength below 1x: 1/2x = 1x)
+    assert (r.write(tmp_path / "run") / "cutoff_band.png").is_file()

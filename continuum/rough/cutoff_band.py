@@ -86,8 +86,9 @@ def band_summary(band: Sequence[Mapping]) -> str:
             lines.append(f"{head}: not evaluated ({e['why']})")
             continue
         p = e["stick_probability"]
-        lines.append(f"{head}: stick at 1st impact {p['count']}/{p['members']} ({p['interval'][0]:.3f}-"
-                     f"{p['interval'][1]:.3f}), first rebound median {e['first_rebound_median']:.3g} "
+        stick = (f"{p['count']}/{p['members']} ({p['interval'][0]:.3f}-{p['interval'][1]:.3f})"
+                 if p.get("interval") else ("stuck" if p["count"] else "rebounds") + " (mean field)")
+        lines.append(f"{head}: stick at 1st impact {stick}, first rebound median {e['first_rebound_median']:.3g} "
                      f"{e['first_rebound_unit']}")
     return "\n".join(lines)
 
