@@ -212,3 +212,15 @@ def test_a_mean_field_run_on_a_map_reports_the_band_of_its_first_impact(tmp_path
     assert own["stick_probability"]["value"] == float(r.record["stuck"] and first == 0.0)
     assert band[2]["summit_density"] < own["summit_density"]     # (the map holds no wavelength below 1x: 1/2x = 1x)
     assert (r.write(tmp_path / "run") / "cutoff_band.png").is_file()
+
+
+def test_a_members_first_impact_does_not_depend_on_the_bounces_that_follow():
+    """The tail models' and the band's ensembles run to the first rebound only and take the scene's own ensemble's
+    first impacts for its own entries: a member's first impact (stuck or not, first rebound) is the same whether
+    its run stops there or goes on."""
+    scene = resolve_scene("rough_silica", params="paper", overrides={**SMALL, "numerics.max_bounces": 4}).scene
+    full = run_ensemble(scene, members=6, seed=5)
+    first = run_ensemble(scene, members=6, seed=5, first_impact=True)
+    assert [o.stuck_at_first_impact for o in full.outcomes] == [o.stuck_at_first_impact for o in first.outcomes]
+    assert [o.first_rebound for o in full.outcomes] == [o.first_rebound for o in first.outcomes]
+    assert any(o.rebounds > 1 for o in full.outcomes) and all(o.rebounds <= 1 for o in first.outcomes)
