@@ -136,11 +136,15 @@ def test_auto_keeps_the_mean_field_where_menisci_may_form():
     ("surfaces.roughness.members", 1, ">= 2"),
     ("surfaces.roughness.members", 2.5, "int"),
     ("surfaces.roughness.seed", -1, ">= 0"),
+    ("surfaces.roughness.members", "many", "or 'auto'"),
+    ("surfaces.roughness.target_half_width", 0.0, "> 0"),
+    ("surfaces.roughness.max_members", 1, ">= 2"),
+    ("surfaces.roughness.tail_model", "pareto", "one of"),
 ])
 def test_bad_ensemble_keys_are_one_line_errors(key, value, words):
     with pytest.raises(SceneError) as err:
         _scene(**{key: value})
-    assert err.value.key == key and "\n" not in str(err.value)
+    assert err.value.key == key and "\n" not in str(err.value) and words in str(err.value)
 
 
 def test_an_ensemble_of_maugis_dugdale_summits_runs_them():
