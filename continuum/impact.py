@@ -50,7 +50,8 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     diagnostics = law.diagnostics()
     if diagnostics:
         models["diagnostics"] = diagnostics
-    warnings = result_warnings(scene, law, run.bounces) + model_warnings(models)
+    warnings = (list((resolved.surface or {}).get("warnings", ())) + result_warnings(scene, law, run.bounces)
+                + model_warnings(models))
     result = {
         "schema_version": SCHEMA_VERSION,
         "scene": resolved.to_json(),
