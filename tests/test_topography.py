@@ -18,6 +18,7 @@ from continuum.rough.map_scans import FEW_SUMMITS, data_depth, pooled_statistics
 from continuum.rough.summit_stats import spectral_summits
 from continuum.rough.topography import (MIN_SUMMITS, HeightMap, Synthesis, TopographyError, identify_summits,
                                         load_height_map, map_summits, summit_statistics)
+from continuum.rough.surface_map import scene_scans
 from continuum.scene import SceneError, resolve_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -417,17 +418,25 @@ def _two_scans(tmp_path: Path) -> tuple[Path, Path]:
 
 
 def test_several_scans_take_part_where_they_resolve_the_cutoff_and_their_summits_pool(tmp_path):
+    """At 8 nm only the fine scan resolves the cutoff (the coarse one's 3.9 nm pixel would need 15.6 nm): the
+    statistics are the fine scan's alone. At 31 nm both take part and their summits pool: count and area add up,
+    the density is their ratio. At 200 nm the 250 nm scan spans too few cutoffs and sits out."""
     small, large = _two_scans(tmp_path)
     rough = {"topography": [str(small), str(large)], "summit_cutoff": 8e-9}
     fine = resolve_scene(table={**SCENE, "surfaces": {"roughness": rough}}).surface
     alone = resolve_scene(table={**SCENE, "surfaces": {"roughness": {**rough, "topography": str(small)}}}).surface
     assert [s["used"] for s in fine["scans"]] == [True, False] and "does not resolve" in fine["scans"][1]["why_not"]
     assert fine["summit_density"] == alone["summit_density"] and fine["summit_radius"] == alone["summit_radius"]
-    both = resolve_scene(table={**SCENE, "surfaces": {"roughness": {**rough, "summit_cutoff": 3.125e-8}}}).surface
+    resolved = resolve_scene(table={**SCENE, "surfaces": {"roughness": {**rough, "summit_cutoff": 3.125e-8}}})
+    both = resolved.surface
+    pooled = scene_scans(resolved.values, None)
+    assert len(pooled.used) == 2 and pooled.summits.count == both["routes"]["direct"]["count"]
     assert [s["used"] for s in both["scans"]] == [True, True]
     n = sum(s["summits"] for s in both["scans"])
     area = sum(s["area"] for s in [both["routes"]["direct"]])
     assert both["routes"]["direct"]["count"] == n and both["summit_density"] == pytest.approx(n / area, rel=1e-12)
+    # pooled, the scans of one Gaussian surface still meet Nayak's density from their (area-weighted) moments
+    assert both["summit_density"] == pytest.approx(both["routes"]["spectral"]["summit_density"], rel=3 / math.sqrt(n))
     margin = [math.ceil(0.5 * 3.125e-8 / px) * px for px in (0.25e-6 / 256, 1e-6 / 256)]
     assert area == pytest.approx((0.25e-6 - 2 * margin[0]) ** 2 + (1e-6 - 2 * margin[1]) ** 2, rel=1e-9)
     used, record = scan_record(load_height_map(small), 2e-7)            # 250 nm spans 1.25 such cutoffs

@@ -33,7 +33,7 @@ __all__ = ["NOT_HEIGHT", "DETREND_MODES", "MAX_LINE_OFFSET_SHARE", "is_height_ch
 
 #: Words in a channel's name that mark data other than heights.
 NOT_HEIGHT = ("phase", "amplitude", "deflection", "error", "friction", "lateral", "current", "force", "voltage",
-              "potential", "adhesion", "dissipation", "stiffness", "modulus", "frequency", "peakforce")
+              "potential", "adhesion", "dissipation", "deformation", "stiffness", "modulus", "frequency", "peakforce")
 #: Words that mark a closed-loop (sensor) height channel, preferred among several height channels.
 SENSOR = ("sensor",)
 DETREND_MODES = ("plane", "line", "none")

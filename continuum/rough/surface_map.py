@@ -26,7 +26,7 @@ from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_DETREND, KEY_FILE, KEY_SIZ
                          HeightMap, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map)
 
 __all__ = ["MapStatistics", "map_statistics", "statistics_block", "find_topography", "height_map", "height_maps",
-           "MAP_KEYS"]
+           "scene_scans", "MAP_KEYS"]
 
 KEY_ROUTE = "surfaces.roughness.summit_route"
 #: The scene keys a map fills, and the statistic each takes.
@@ -173,6 +173,15 @@ def statistics_block(values: dict, sources: dict) -> dict:
             "summit_density": values.get("surfaces.roughness.summit_density"),
             "summit_radius": values.get("surfaces.roughness.summit_radius"), "route": None, "cutoff": None,
             "source": {"kind": "statistics", "keys": {key: sources.get(key) for key in MAP_KEYS}}}
+
+
+def scene_scans(values: dict, scene_dir: Path | None) -> PooledScans | None:
+    """The scene's scans at its cutoff: pooled statistics, the pooled summits (`summits`), the maps that take part
+    (`used`) and one record per scan (`scans`), or None when the scene names no map. For a scene
+    `map_statistics` has already accepted (the same cached load)."""
+    if values.get(KEY_FILE) is None and _synthesis(values) is None:
+        return None
+    return _load(values, scene_dir)[1]
 
 
 def height_maps(values: dict, scene_dir: Path | None) -> tuple[tuple[HeightMap, ...], float] | None:
