@@ -125,6 +125,9 @@ def test_identify_summits_on_a_non_periodic_map_keeps_off_the_edges():
     half_pixel = 0.5e-6 / 128                              # the fitted summit may sit half a pixel off its grid point
     assert s.x.min() >= margin - half_pixel and s.x.max() <= 1e-6 - margin + half_pixel
     assert s.area == pytest.approx((1e-6 - 2 * margin) ** 2, rel=1e-12)
+    wide = identify_summits(h, 1e-6 / 128, cutoff=8e-6 / 128, edge_band=2 * margin)      # a wider band, by keyword
+    assert wide.area == pytest.approx((1e-6 - 4 * margin) ** 2, rel=1e-12)
+    assert wide.x.min() >= 2 * margin - half_pixel and set(zip(wide.x, wide.y)) <= set(zip(s.x, s.y))
 
 
 # ----------------------------------------------------------------------------- maps and scenes
