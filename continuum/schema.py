@@ -300,6 +300,10 @@ FIELDS: tuple[Field, ...] = (
           low_open=True),
     Field("numerics.rest_fraction", float, "1", "A rebound lower than this fraction of the release height "
           "counts as coming to rest (the notes' 1e-3 h0).", 1e-3, low=0.0, high=1.0, low_open=True, high_open=True),
+    Field("numerics.audit_tolerance", float, "1", "Largest energy-audit error (energy_audit.max_relative_error: "
+          "max |E(t) - E(0)| over the first impact's kinetic energy) the run accepts without a warning in "
+          "result.json -> warnings. Not set: no check (the audit is recorded either way).", None, low=0.0, high=1.0,
+          low_open=True),
     Field("numerics.samples_per_flight", int, "1", "Time-series samples written per free flight.", 64,
           low=2, high=100000),
 )

@@ -503,6 +503,25 @@ def test_validity_checks_carry_their_numbers_and_warn_where_the_model_is_stretch
     assert f"{1 / math.sqrt(n):.0%}" in text
 
 
+def test_an_energy_audit_above_the_scene_s_tolerance_warns_with_its_numbers():
+    """numerics.audit_tolerance: a run whose audit error exceeds it carries a warning with the error; one below
+    it (the same audit against a looser tolerance) carries none; unset, nothing is checked."""
+    from dataclasses import replace
+
+    from continuum import run_scene
+    from continuum.warnings import audit_warnings
+
+    r = run_scene("rough_afm_scan", overrides={"numerics.max_bounces": 1, "numerics.fidelity": "fast",
+                                               "numerics.audit_tolerance": 1e-15})
+    error = r.record["energy_audit"]["max_relative_error"]
+    assert 1e-15 < error < 1.0
+    assert [w for w in r.record["warnings"] if w.startswith(f"energy audit error {error:.3g} ")]
+    scene = resolve_scene("rough_afm_scan").scene
+    assert scene.numerics.audit_tolerance is None and audit_warnings(scene, r.record["energy_audit"]) == []
+    loose = replace(scene, numerics=replace(scene.numerics, audit_tolerance=min(1.0, 2 * error)))
+    assert audit_warnings(loose, r.record["energy_audit"]) == []
+
+
 def test_the_shipped_afm_scene_runs_and_result_json_carries_the_reading_warnings():
     """rough_afm_scan runs (one impact) on the real scan; without its channel named, the run's result.json
     warnings hold the channel warning from the surface block."""
