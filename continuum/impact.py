@@ -12,7 +12,7 @@ from .model import dry_run_verdict, select_law
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
 from .scene import ResolvedScene, SceneError
-from .warnings import model_warnings, result_warnings
+from .warnings import audit_warnings, model_warnings, result_warnings
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:
@@ -50,7 +50,8 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     diagnostics = law.diagnostics()
     if diagnostics:
         models["diagnostics"] = diagnostics
-    warnings = result_warnings(scene, law, run.bounces) + model_warnings(models)
+    warnings = (list((resolved.surface or {}).get("warnings", ())) + result_warnings(scene, law, run.bounces)
+                + model_warnings(models) + audit_warnings(scene, run.audit))
     result = {
         "schema_version": SCHEMA_VERSION,
         "scene": resolved.to_json(),

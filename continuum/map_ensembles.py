@@ -30,19 +30,25 @@ log = logging.getLogger(__name__)
 
 
 def _map(resolved: ResolvedScene):
-    """(height map, cutoff (m), summit route) of the scene, or None without a map."""
-    from .rough.surface_map import height_map
+    """(the scene's height maps (every scan that takes part), cutoff (m), summit route), or None without a map."""
+    from .rough.surface_map import height_maps
 
     scene_dir = Path(resolved.scene_file).parent if resolved.scene_file else None
-    found = height_map(resolved.values, scene_dir)
+    found = height_maps(resolved.values, scene_dir)
     if found is None:
         return None
     return found[0], found[1], resolved.values.get("surfaces.roughness.summit_route", "direct")
 
 
-def _summits(hmap, cutoff: float):
-    from .rough.topography import identify_summits
-    return identify_summits(hmap.heights, hmap.pixel_size, cutoff, periodic=hmap.periodic)
+def _pooled(hmaps, cutoff: float, route: str = "direct"):
+    """The scans' pooled summits and statistics at `cutoff` (`continuum.rough.map_scans`: each scan that resolves
+    it contributes; a non-periodic scan is mirror-stitched, never wrapped)."""
+    from .rough.map_scans import pooled_statistics
+    return pooled_statistics(hmaps, cutoff, route)
+
+
+def _summits(hmaps, cutoff: float):
+    return _pooled(hmaps, cutoff).summits
 
 
 def map_tail(resolved: ResolvedScene, cutoff: float | None = None) -> tuple[Any, dict]:
@@ -109,10 +115,10 @@ def _stats_of(scene: Scene) -> dict:
 
 def _band_point(sc: Scene, hmap, cutoff: float, factor: float, route: str, tail_model: str, ex) -> dict:
     """One cutoff of the band: the map's statistics there and an ensemble of them, or why it was not evaluated."""
-    from .rough.topography import TopographyError, summit_statistics
+    from .rough.topography import TopographyError
 
     try:
-        stats = summit_statistics(hmap, cutoff, route)
+        stats = _pooled(hmap, cutoff, route).statistics
     except TopographyError as exc:
         return band_entry(factor, cutoff, {"summit_radius": None, "summit_density": None, "summit_height_std": None},
                           None, str(exc))
@@ -172,7 +178,7 @@ def _mean_field_first_impact(scene: Scene) -> dict:
 def mean_field_band(resolved: ResolvedScene) -> dict | None:
     """{'cutoff_band': [...], 'warnings': [...]} of a mean-field run on a height map: the mean-field law's first
     impact at each cutoff of BAND_FACTORS with the map's statistics there; None for a scene without a map."""
-    from .rough.topography import TopographyError, summit_statistics
+    from .rough.topography import TopographyError
 
     found = _map(resolved)
     if found is None:
@@ -183,7 +189,7 @@ def mean_field_band(resolved: ResolvedScene) -> dict | None:
     for factor in BAND_FACTORS:
         c = factor * cutoff
         try:
-            stats = summit_statistics(hmap, c, route) if factor != 1.0 else None
+            stats = _pooled(hmap, c, route).statistics if factor != 1.0 else None
         except TopographyError as exc:
             band.append(band_entry(factor, c, {"summit_radius": None, "summit_density": None,
                                                "summit_height_std": None}, None, str(exc)))

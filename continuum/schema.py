@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass
 
 from nanoimpact import fields
+from nanoimpact.errors import InputError
 from nanoimpact.fields import REQUIRED
 
 
@@ -51,6 +52,61 @@ class NumberOrWord(Field):
         number = {k: out.pop(k) for k in ("type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
                   if k in out}
         return {"anyOf": [number, {"enum": list(self.words)}], **out}
+
+
+@dataclass(frozen=True)
+class _OneOrList(Field):
+    """A string key that also takes a list of one or more strings (`topography = "a.di"` or `["a.di", "b.di"]`);
+    the value is kept as given."""
+
+    def _list(self) -> Field:
+        return Field(self.key, list, self.unit, "", item=str)
+
+    def check(self, value, origin="", *, error=None, name=None):
+        kw = {} if error is None else {"error": error}
+        if isinstance(value, list):
+            try:
+                return self._list().check(value, origin, name=name, **kw)
+            except InputError as exc:
+                raise type(exc)(exc.key, exc.value, f"must be {self.allowed()}", origin) from None
+        return super().check(value, origin, name=name, **kw)
+
+    def allowed(self) -> str:
+        return f"a string, or {self._list().allowed()}"
+
+    def json_schema(self) -> dict:
+        out = super().json_schema()
+        out.pop("type")
+        listed = {k: v for k, v in self._list().json_schema().items() if k in ("type", "items", "minItems")}
+        return {"anyOf": [{"type": "string"}, listed], **out}
+
+
+@dataclass(frozen=True)
+class _IndexOrName(Field):
+    """A string key that also takes an index (an integer from `low` to `high`): a channel by name or by index."""
+
+    def _index(self) -> Field:
+        return Field(self.key, int, "1", "", low=self.low, high=self.high)
+
+    def check(self, value, origin="", *, error=None, name=None):
+        kw = {} if error is None else {"error": error}
+        if isinstance(value, int) and not isinstance(value, bool):
+            try:
+                return self._index().check(value, origin, name=name, **kw)
+            except InputError as exc:
+                raise type(exc)(exc.key, value, f"must be {self.allowed()}", origin) from None
+        if isinstance(value, str) and not value:
+            raise (error or InputError)(name or self.key, value, f"must be {self.allowed()}", origin)
+        return super().check(value, origin, name=name, **kw)
+
+    def allowed(self) -> str:
+        return f"a name (a non-empty string), or an index: {self._index().allowed()}"
+
+    def json_schema(self) -> dict:
+        out = super().json_schema()
+        index = {k: v for k, v in self._index().json_schema().items() if k in ("type", "minimum", "maximum")}
+        out.pop("type")
+        return {"anyOf": [{"type": "string", "minLength": 1}, index], **out}
 
 
 _LEN = dict(kind=float, unit="m")
@@ -166,12 +222,21 @@ FIELDS: tuple[Field, ...] = (
           "velocity (the smallest first-impact speed from which it rebounds, continuum.escape) and report their "
           "percentiles in result.json -> ensemble -> escape_velocity; each member then runs a dozen or more single "
           "impacts besides its drop.", False),
-    Field("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography reads: "
-          "NanoScope .di, Gwyddion .gwy, Nanosurf .nid, Asylum .ibw, matrix text, .npy); a relative path is looked "
-          "up beside the scene file, then in the data folders. Its summit statistics fill sigma, summit_density and "
-          "summit_radius (replacing the parameter set's; giving them in the scene too is an error).", None),
-    Field("surfaces.roughness.topography_channel", int, "1", "Channel of the topography file (index; default 0).",
-          None, low=0, high=1000),
+    _OneOrList("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography "
+               "reads: NanoScope .di, Gwyddion .gwy, Nanosurf .nid, Asylum .ibw, matrix text, .npy), or a list of "
+               "scans of one surface at different sizes (each takes part at the cutoff where it resolves it; their "
+               "summits are pooled); a relative path is looked up beside the scene file, then in the data folders. "
+               "The summit statistics fill sigma, summit_density and summit_radius (replacing the parameter set's; "
+               "giving them in the scene too is an error).", None),
+    _IndexOrName("surfaces.roughness.topography_channel", str, "", "Channel of the topography file: its index, "
+                 "or its name as the file spells it ('Height', 'ZSensor'). Must hold heights (never phase, "
+                 "amplitude, deflection, error). Not set: the file's only height channel, or among several the "
+                 "closed-loop sensor channel (else the first), with a warning naming the others.", None, low=0,
+                 high=1000),
+    Field("surfaces.roughness.topography_detrend", str, "", "Levelling of a measured map: 'plane' (least-squares "
+          "plane), 'line' (each scan line's offset and tilt, SurfaceTopography scan_line_align) or 'none' (mean "
+          "only). Recorded in result.json (surface.source.detrend) with the variance removed; 'plane' warns where "
+          "scan-line offsets carry more than a quarter of the variance.", "plane", choices=("plane", "line", "none")),
     Field("surfaces.roughness.topography_size", list, "m", "Physical size [L] or [Lx, Ly] of a topography file "
           "that has none (refused where the file has its own).", None, item=float, length=(1, 2), low=1e-9,
           high=1.0),
@@ -273,6 +338,10 @@ FIELDS: tuple[Field, ...] = (
           low_open=True),
     Field("numerics.rest_fraction", float, "1", "A rebound lower than this fraction of the release height "
           "counts as coming to rest (the notes' 1e-3 h0).", 1e-3, low=0.0, high=1.0, low_open=True, high_open=True),
+    Field("numerics.audit_tolerance", float, "1", "Largest energy-audit error (energy_audit.max_relative_error: "
+          "max |E(t) - E(0)| over the first impact's kinetic energy) the run accepts without a warning in "
+          "result.json -> warnings. Not set: no check (the audit is recorded either way).", None, low=0.0, high=1.0,
+          low_open=True),
     Field("numerics.samples_per_flight", int, "1", "Time-series samples written per free flight.", 64,
           low=2, high=100000),
 )
@@ -308,7 +377,7 @@ def to_internal(f: Field, value):
 def schema_markdown() -> str:
     """The schema as a markdown table, for docs/scenes.md (generated, so it cannot drift)."""
     return fields.markdown_table(FIELDS, [("key", lambda f: f"`{f.path}`"), ("type", lambda f: f.kind.__name__),
-                                          ("unit", lambda f: f.unit or ""), ("allowed", Field.allowed),
+                                          ("unit", lambda f: f.unit or ""), ("allowed", lambda f: f.allowed()),
                                           ("default", Field.default_text), ("meaning", lambda f: f.doc)])
 
 

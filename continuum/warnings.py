@@ -80,3 +80,15 @@ def model_warnings(models: dict) -> list[str]:
     if adhesion.get("decided_by") == "geometry" and not adhesion.get("used", True) and adhesion.get("work_of_adhesion"):
         out.append("work of adhesion given but a smooth roller has no adhesive law here: adhesion left out")
     return out
+
+
+def audit_warnings(scene, audit: dict) -> list[str]:
+    """A warning where the run's energy audit exceeds the scene's `numerics.audit_tolerance` (none if unset)."""
+    tolerance = scene.numerics.audit_tolerance
+    error = audit.get("max_relative_error", 0.0)
+    if tolerance is None or not error > tolerance:
+        return []
+    return [f"energy audit error {error:.3g} of the first impact's kinetic energy exceeds numerics.audit_tolerance "
+            f"= {tolerance:g} (relative to the run's turnover: {audit.get('max_error_over_turnover', 0.0):.3g}): "
+            "the integration or the contact tables are not accurate enough for this scene (try numerics.fidelity = "
+            "'reference'), or the model is outside its range (see the surface block's validity checks)"]

@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SpectralSummits", "DirectSummits", "spectral_summits", "direct_summary", "profile_moments"]
+__all__ = ["SpectralSummits", "DirectSummits", "spectral_summits", "spectral_from_moments", "areal_moments",
+           "direct_summary", "profile_moments"]
 
 _NAYAK = 6.0 * math.pi * math.sqrt(3.0)
 
@@ -75,9 +76,17 @@ def _filtered_periodic(topography, cutoff: float):
 
 def spectral_summits(topography, cutoff: float) -> SpectralSummits:
     """Nayak/McCool statistics of a SurfaceTopography map (metres) filtered at wavelength `cutoff` (m)."""
+    return spectral_from_moments(*profile_moments(*areal_moments(topography, cutoff)))
+
+
+def areal_moments(topography, cutoff: float) -> tuple[float, float, float]:
+    """Areal moments <h^2>, <|grad h|^2>, <(lap h)^2> of a SurfaceTopography map filtered at `cutoff` (m)."""
     filtered = _filtered_periodic(topography, cutoff)
-    areal = [float(filtered.moment_power_spectrum(order, window=None, reliable=False)) for order in (0, 2, 4)]
-    m0, m2, m4 = profile_moments(*areal)
+    return tuple(float(filtered.moment_power_spectrum(order, window=None, reliable=False)) for order in (0, 2, 4))
+
+
+def spectral_from_moments(m0: float, m2: float, m4: float) -> SpectralSummits:
+    """Nayak/McCool summit statistics from the profile moments (m0, m2, m4) (SI)."""
     alpha = m0 * m4 / m2**2
     kappa = 8.0 / 3.0 * math.sqrt(m4 / math.pi)
     return SpectralSummits(m0=m0, m2=m2, m4=m4, alpha=alpha, summit_density=m4 / (_NAYAK * m2),

@@ -10,6 +10,9 @@ sigma), so a map fills it with sigma_s, not with the surface's rms height.
 
 The map supplies statistics (to the mean-field law and to the draws of an ensemble's members,
 `continuum.ensemble_run`): the roller's footprint may be far larger than the map, and nothing tiles the map under it.
+`topography` may list several scans of one surface (`continuum.rough.map_scans`: each takes part at the cutoff where
+it resolves it, and their summits are pooled); the block records each scan, how deep the data reach against the
+impact (`data_depth`), and the range-of-validity checks (`validity`, `warnings`).
 """
 from __future__ import annotations
 
@@ -19,11 +22,12 @@ from pathlib import Path
 
 from nanoimpact import data
 
-from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_FILE, KEY_SIZE, KEY_SYNTH, KEY_TIP, KEY_UNIT, HeightMap,
-                         SurfaceStatistics, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map,
-                         summit_statistics)
+from .map_scans import PooledScans, data_depth, pooled_statistics, validity
+from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_DETREND, KEY_FILE, KEY_SIZE, KEY_SYNTH, KEY_TIP, KEY_UNIT,
+                         HeightMap, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map)
 
-__all__ = ["MapStatistics", "map_statistics", "statistics_block", "find_topography", "MAP_KEYS"]
+__all__ = ["MapStatistics", "map_statistics", "statistics_block", "find_topography", "height_map", "height_maps",
+           "scene_scans", "MAP_KEYS"]
 
 KEY_ROUTE = "surfaces.roughness.summit_route"
 #: The scene keys a map fills, and the statistic each takes.
@@ -70,33 +74,42 @@ def _synthesis(values: dict) -> Synthesis | None:
 
 
 @functools.lru_cache(maxsize=8)
-def _statistics(spec, channel, size, unit, cutoff, tip_radius, route, stamp) -> tuple[HeightMap, SurfaceStatistics,
-                                                                                          str]:
-    """(map, statistics, what set the cutoff); cached on the inputs and the file's size and mtime (`stamp`), as
-    sweeps resolve one scene many times."""
-    if isinstance(spec, Synthesis):
-        hmap = load_height_map(synthesis=spec)
+def _statistics(specs, channel, size, unit, cutoff, tip_radius, route, stamp,
+                detrend="plane") -> tuple[tuple[HeightMap, ...], PooledScans, str]:
+    """(maps, pooled statistics, what set the cutoff); cached on the inputs and the files' sizes and mtimes
+    (`stamp`), as sweeps resolve one scene many times."""
+    if isinstance(specs, Synthesis):
+        hmaps = (load_height_map(synthesis=specs),)
     else:
-        hmap = load_height_map(spec, channel=channel, size=None if size is None else list(size), unit=unit)
+        hmaps = tuple(load_height_map(spec, channel=channel, size=None if size is None else list(size), unit=unit,
+                                      detrend=detrend) for spec in specs)
     if cutoff is not None:
         wavelength, origin = cutoff, "summit_cutoff"
     elif tip_radius is not None:
-        wavelength = cutoff_from_tip_radius(hmap, tip_radius)
-        origin = f"tip_radius {tip_radius:g} m (SurfaceTopography scanning_probe_reliability_cutoff)"
+        wavelength = max(cutoff_from_tip_radius(hmap, tip_radius) for hmap in hmaps)
+        origin = (f"tip_radius {tip_radius:g} m (SurfaceTopography scanning_probe_reliability_cutoff" +
+                  (", the longest of the scans')" if len(hmaps) > 1 else ")"))
     else:
-        wavelength, origin = spec.short_cutoff, "synthetic.short_cutoff (the spectrum holds no shorter wavelength)"
-    return hmap, summit_statistics(hmap, wavelength, route), origin
+        wavelength, origin = specs.short_cutoff, "synthetic.short_cutoff (the spectrum holds no shorter wavelength)"
+    key_value = ((f"{KEY_SYNTH}.size", specs.size) if isinstance(specs, Synthesis)
+                 else (KEY_FILE, str(specs[0]) if len(specs) == 1 else [str(s) for s in specs]))
+    return hmaps, pooled_statistics(hmaps, wavelength, route, key_value), origin
 
 
 def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapStatistics | None:
     """The statistics of the scene's height map, or None when it names none (see the module docstring for the
     precedence). Raises TopographyError naming the key."""
     file_spec, synthesis = values.get(KEY_FILE), _synthesis(values)
+    if file_spec is not None and not file_spec:
+        raise TopographyError(KEY_FILE, file_spec, "must name a file or a list of one or more files")
     if file_spec is None and synthesis is None:
-        for key in (KEY_CHANNEL, KEY_SIZE, KEY_UNIT, KEY_CUTOFF, KEY_TIP):
-            if values.get(key) is not None:
+        for key in (KEY_CHANNEL, KEY_SIZE, KEY_UNIT, KEY_CUTOFF, KEY_TIP, KEY_DETREND):
+            if values.get(key) is not None and sources.get(key) != "default":
                 raise TopographyError(key, values[key], f"is for a height map: set {KEY_FILE} or [{KEY_SYNTH}]")
         return None
+    if synthesis is not None and values.get(KEY_DETREND) is not None and sources.get(KEY_DETREND) != "default":
+        raise TopographyError(KEY_DETREND, values[KEY_DETREND], "is for a measured map (a synthetic map is periodic "
+                                                                "and only loses its mean)")
     if file_spec is not None and synthesis is not None:
         raise TopographyError(KEY_FILE, file_spec, f"give a measured map or a synthetic one ([{KEY_SYNTH}]), not both")
     if values.get("contact") != "rough":
@@ -116,26 +129,45 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
                 raise TopographyError(key, values[key], f"is derived from the height map; remove it from the "
                                                         f"{source}, or remove the map")
             replaced[key] = {"value": values[key], "source": source}
-    spec, stamp = _map_spec(file_spec, synthesis, scene_dir)
-    size = values.get(KEY_SIZE)
-    hmap, stats, origin = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
-                                      values.get(KEY_UNIT), cutoff, tip, values.get(KEY_ROUTE, "direct"), stamp)
-    block = {**stats.to_json(), "cutoff_from": origin, "source": dict(hmap.source), "replaced": replaced,
-             "fills": {key: attr for key, attr in MAP_KEYS.items()},
+    hmaps, pooled, origin = _load(values, scene_dir)
+    stats = pooled.statistics
+    radius, length = values.get("body.radius"), values.get("body.length")
+    block = {**stats.to_json(), "cutoff_from": origin, "source": dict(pooled.used[0].source), "scans": pooled.scans,
+             "replaced": replaced, "fills": {key: attr for key, attr in MAP_KEYS.items()},
              "note": "the map supplies summit statistics to the mean-field (GW) law and the distributions an "
-                     "ensemble's members draw their strip from (never copies of the map; result.json -> ensemble)"}
+                     "ensemble's members draw their strip from (never copies of the map; result.json -> ensemble); "
+                     "data_depth says how far its summits reach against the impact"}
+    warnings = [w for hmap in hmaps for w in hmap.warnings]
+    if radius is not None:
+        depth = data_depth(pooled, stats.summit_height_std, stats.summit_density, float(radius),
+                           None if length is None else float(length))
+        checks, more = validity(pooled, depth, float(radius), stats.cutoff)
+        block.update(data_depth=depth, validity=checks)
+        warnings += more
+    block["warnings"] = warnings
     return MapStatistics(values={key: getattr(stats, attr) for key, attr in MAP_KEYS.items()}, block=block)
+
+
+def _load(values: dict, scene_dir: Path | None) -> tuple[tuple[HeightMap, ...], PooledScans, str]:
+    """The scene's maps, their pooled statistics and what set the cutoff (one cached load)."""
+    spec, stamp = _map_spec(values.get(KEY_FILE), _synthesis(values), scene_dir)
+    size = values.get(KEY_SIZE)
+    channel = values.get(KEY_CHANNEL)
+    return _statistics(spec, channel, None if size is None else tuple(size), values.get(KEY_UNIT),
+                       values.get(KEY_CUTOFF), values.get(KEY_TIP), values.get(KEY_ROUTE, "direct"), stamp,
+                       values.get(KEY_DETREND) or "plane")
 
 
 
 def _map_spec(file_spec, synthesis, scene_dir: Path | None):
-    """(what to load, cache stamp): the synthesis parameters (no stamp), or the map file's resolved path with its
-    size and modification time, so that the cached load is redone when the file changes."""
+    """(what to load, cache stamp): the synthesis parameters (no stamp), or the map files' resolved paths (a
+    tuple) with their sizes and modification times, so that the cached load is redone when a file changes."""
     if synthesis is not None:
         return synthesis, None
-    path = find_topography(file_spec, scene_dir)
-    stat = path.stat()
-    return path.resolve(), (stat.st_size, stat.st_mtime_ns)
+    paths = tuple(find_topography(spec, scene_dir) for spec in ([file_spec] if isinstance(file_spec, str)
+                                                                 else file_spec))
+    stats = [path.stat() for path in paths]
+    return tuple(p.resolve() for p in paths), tuple((st.st_size, st.st_mtime_ns) for st in stats)
 
 def statistics_block(values: dict, sources: dict) -> dict:
     """result.json's `surface` block of a rough scene given by its statistics (no map)."""
@@ -145,15 +177,28 @@ def statistics_block(values: dict, sources: dict) -> dict:
             "source": {"kind": "statistics", "keys": {key: sources.get(key) for key in MAP_KEYS}}}
 
 
-def height_map(values: dict, scene_dir: Path | None) -> tuple[HeightMap, float] | None:
-    """The scene's height map and the cutoff wavelength (m) its statistics were taken at (the same cached load as
-    `map_statistics`), or None when the scene names none. For a scene `map_statistics` has already accepted."""
-    file_spec, synthesis = values.get(KEY_FILE), _synthesis(values)
-    if file_spec is None and synthesis is None:
+def scene_scans(values: dict, scene_dir: Path | None) -> PooledScans | None:
+    """The scene's scans at its cutoff: pooled statistics, the pooled summits (`summits`), the maps that take part
+    (`used`) and one record per scan (`scans`), or None when the scene names no map. For a scene
+    `map_statistics` has already accepted (the same cached load)."""
+    if values.get(KEY_FILE) is None and _synthesis(values) is None:
         return None
-    spec, stamp = _map_spec(file_spec, synthesis, scene_dir)
-    size = values.get(KEY_SIZE)
-    hmap, stats, _ = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
-                                 values.get(KEY_UNIT), values.get(KEY_CUTOFF), values.get(KEY_TIP),
-                                 values.get(KEY_ROUTE, "direct"), stamp)
-    return hmap, float(stats.cutoff)
+    return _load(values, scene_dir)[1]
+
+
+def height_maps(values: dict, scene_dir: Path | None) -> tuple[tuple[HeightMap, ...], float] | None:
+    """The scene's height maps that take part at the cutoff (largest first) and the cutoff wavelength (m) their
+    statistics were taken at (the same cached load as `map_statistics`), or None when the scene names none. For a
+    scene `map_statistics` has already accepted."""
+    if values.get(KEY_FILE) is None and _synthesis(values) is None:
+        return None
+    _, pooled, _ = _load(values, scene_dir)
+    used = sorted(pooled.used, key=lambda h: -h.physical_size[0] * h.physical_size[1])
+    return tuple(used), float(pooled.statistics.cutoff)
+
+
+def height_map(values: dict, scene_dir: Path | None) -> tuple[HeightMap, float] | None:
+    """The scene's (largest used) height map and the cutoff wavelength (m) its statistics were taken at, or None
+    when the scene names none (`height_maps` gives every scan that takes part)."""
+    found = height_maps(values, scene_dir)
+    return None if found is None else (found[0][0], found[1])
