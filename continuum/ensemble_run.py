@@ -128,8 +128,8 @@ def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any, t
         summits = patch_summits(plan.field, offset, plan.footprint_half_width, member.body.length)
     law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
                                   plan.footprint_half_width, plan.summit_law, summits)
-    from .model.select import plastic_member     # Thornton-Ning summits where the scene's summits yield
-    return member, plastic_member(member, law, plan.speed), offset
+    from .model.select import member_summit_law  # plastic summits where they yield, bridges where humid
+    return member, member_summit_law(member, law, plan.speed), offset
 
 
 def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:
@@ -167,11 +167,13 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan, escape_rel_tol: float 
     run = simulate(law, member.body.mass, member.environment.gravity, release_height=release,
                    impact_velocity=member.impact_velocity, settings=settings)
     heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)
-    contacts = int(law.diagnostics()["max_contacts"])
+    diagnostics = law.diagnostics()
+    contacts = int(diagnostics["max_contacts"])
     escape = member_escape(law, member, plan.speed, escape_rel_tol) if escape_rel_tol is not None else None
     return MemberOutcome(seed=int(seed), status=run.status, rebound_heights=heights, release_height=release,
                          max_contacts=contacts, wall_s=time.perf_counter() - start,
-                         energy_error=float(run.audit["max_relative_error"]), patch_offset=offset, escape=escape)
+                         energy_error=float(run.audit["max_relative_error"]), patch_offset=offset, escape=escape,
+                         menisci=diagnostics.get("menisci"))
 
 
 def _member_job(job: tuple) -> MemberOutcome:

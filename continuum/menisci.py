@@ -114,21 +114,34 @@ def bridge_pull_off(radius: float, surface_tension: float, theta1: float, theta2
     return 2.0 * math.pi * radius * surface_tension * max(wetting_sum(theta1, theta2), 0.0)
 
 
-def wet_work_of_adhesion(work_of_adhesion: float, surface_tension: float, theta1: float, theta2: float) -> float:
-    """W_wet = dgamma - gamma_lv (cos theta1 + cos theta2) (J/m^2): the solids' work of adhesion under the liquid
-    (Dupre in a medium with Young's law; Israelachvili 2011 §17.7). Negative: the liquid separates them."""
-    return work_of_adhesion - surface_tension * wetting_sum(theta1, theta2)
+def solid_liquid_work(surface_tension: float, theta: float, measured: float | None = None) -> float:
+    """W_SL = gamma_S + gamma_L - gamma_SL (J/m^2) of one face: `measured` where given (MD thermodynamic
+    integration), else Young-Dupre gamma_lv (1 + cos theta). Only the measured value can exceed 2 gamma_lv
+    (complete wetting, where Young's angle is 0 and the excess is the spreading coefficient S = W_SL - 2 gamma_lv)."""
+    return float(measured) if measured is not None else surface_tension * (1.0 + math.cos(theta))
+
+
+def wet_work_of_adhesion(work_of_adhesion: float, surface_tension: float, theta1: float, theta2: float,
+                         solid_liquid: tuple[float | None, float | None] = (None, None)) -> float:
+    """W_wet = gamma_1L + gamma_2L - gamma_12 = dgamma + 2 gamma_lv - W_1L - W_2L (J/m^2): the solids' work of
+    adhesion under the liquid (Dupre in a medium; Israelachvili 2011 §17.7, Butt & Kappl 2009 §2.6), with each face's
+    W_iL from `solid_liquid` where measured, else from its angle (then W_wet = dgamma - gamma_lv (cos t1 + cos t2)).
+    Two different solids take one W_iL each. Negative: the liquid separates them."""
+    w1 = solid_liquid_work(surface_tension, theta1, solid_liquid[0])
+    w2 = solid_liquid_work(surface_tension, theta2, solid_liquid[1])
+    return work_of_adhesion + 2.0 * surface_tension - w1 - w2
 
 
 def solid_pull_inside_bridge(radius: float, work_of_adhesion: float, surface_tension: float, theta1: float,
-                             theta2: float, choice: str) -> float:
+                             theta2: float, choice: str,
+                             solid_liquid: tuple[float | None, float | None] = (None, None)) -> float:
     """Solid-solid pull (N, >= 0) a bridge takes from each compressed summit it wets: 2 pi beta (dgamma - max(W_wet, 0))
     for choice 'wet', 0 for 'additive' (the paper's eq 14: the bridge adds to the dry adhesion)."""
     if choice == "additive":
         return 0.0
     if choice != "wet":
         raise ValueError(f"menisci.solid_adhesion = {choice!r}: 'wet' or 'additive'")
-    w_wet = wet_work_of_adhesion(work_of_adhesion, surface_tension, theta1, theta2)
+    w_wet = wet_work_of_adhesion(work_of_adhesion, surface_tension, theta1, theta2, solid_liquid)
     return 2.0 * math.pi * radius * (work_of_adhesion - max(w_wet, 0.0))
 
 

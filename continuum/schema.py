@@ -62,6 +62,10 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.body.poisson_ratio", doc="Poisson's ratio of the body.", default=REQUIRED, **_POISSON),
     Field("surfaces.body.contact_angle", doc="Water contact angle on the body (menisci).",
           default=None, **_ANGLE),
+    Field("surfaces.body.work_of_adhesion_sl", float, "J/m^2", "Solid-water work of adhesion W_SL of the body "
+          "(MD thermodynamic integration): inside a bridge the solids adhere with W_wet = dgamma + 2 gamma_lv "
+          "- W_1L - W_2L (docs/model.md, Menisci). Not given: gamma_lv (1 + cos theta) from the contact angle.",
+          None, low=0.0, high=10.0),
     Field("surfaces.body.yield_strength", float, "Pa", "Tensile yield strength Y of the body: a smooth sphere's "
           "limiting contact pressure 2.8 Y (Tabor) in the Thornton-Ning elastic-plastic law (physics.plasticity; "
           "the softer partner's counts). Optional.", None, low=1e6, high=1e12),
@@ -74,6 +78,11 @@ FIELDS: tuple[Field, ...] = (
           **_POISSON),
     Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci).",
           default=None, **_ANGLE),
+    Field("surfaces.substrate.work_of_adhesion_sl", float, "J/m^2", "Solid-water work of adhesion W_SL of the "
+          "substrate "
+          "(MD thermodynamic integration): inside a bridge the solids adhere with W_wet = dgamma + 2 gamma_lv "
+          "- W_1L - W_2L (docs/model.md, Menisci). Not given: gamma_lv (1 + cos theta) from the contact angle.",
+          None, low=0.0, high=10.0),
     Field("surfaces.substrate.yield_strength", float, "Pa", "Tensile yield strength of the substrate: a smooth "
           "sphere's limiting contact pressure 2.8 Y (as surfaces.body.yield_strength); rough and line contact warn "
           "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
@@ -88,6 +97,10 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.sam.work_of_adhesion", float, "J/m^2", "Work of adhesion between the two SAM-covered "
           "surfaces.", None, low=0.0, high=10.0),
     Field("surfaces.sam.contact_angle", doc="Water contact angle on the SAM.", default=None, **_ANGLE),
+    Field("surfaces.sam.work_of_adhesion_sl", float, "J/m^2", "Solid-water work of adhesion W_SL of the SAM "
+          "(MD thermodynamic integration): inside a bridge the solids adhere with W_wet = dgamma + 2 gamma_lv "
+          "- W_1L - W_2L (docs/model.md, Menisci). Not given: gamma_lv (1 + cos theta) from the contact angle.",
+          None, low=0.0, high=10.0),
     Field("surfaces.sam.layer_modulus", float, "Pa", "Young's modulus of the SAM as a compliant layer on every "
           "summit (rough contact; needs surfaces.sam.thickness): the summits' contact modulus becomes the coated "
           "pair's equivalent modulus (Perriot & Barthel 2004; docs/model.md, Coated summits). Not set: the layer is "

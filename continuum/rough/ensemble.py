@@ -94,6 +94,9 @@ class MemberOutcome:
     """The run's energy audit: largest error of its energy books against the first impact's kinetic energy."""
     patch_offset: tuple[float, float] | None = None
     """Where a map-patch member's strip starts on the map (m); None for a draw from the statistics."""
+    menisci: Mapping[str, Any] | None = None
+    """The member's capillary bridges where its summits carry them (`continuum.laws.wet.WetRoughRoller.diagnostics`:
+    longest contact, t_a, contacts with bridges, most summits bridged at once); None: a dry member."""
     escape: Mapping[str, Any] | None = None
     """The member's escape velocity where the ensemble was asked for it (`continuum.escape.escape_velocity`:
     escape_velocity, lower, upper (m/s), runs), or {"escape_velocity": None, "reason": ...}; None: not asked."""
@@ -122,6 +125,7 @@ class MemberOutcome:
                 "rebound_heights": list(self.rebound_heights), "max_contacts": self.max_contacts,
                 "energy_error": self.energy_error, "wall_s": self.wall_s,
                 **({"patch_offset_m": list(self.patch_offset)} if self.patch_offset is not None else {}),
+                **({"menisci": dict(self.menisci)} if self.menisci is not None else {}),
                 **({"escape": dict(self.escape)} if self.escape is not None else {})}
 
     @classmethod
@@ -131,7 +135,7 @@ class MemberOutcome:
                    max_contacts=int(rec["max_contacts"]), wall_s=float(rec["wall_s"]),
                    energy_error=float(rec["energy_error"]),
                    patch_offset=tuple(rec["patch_offset_m"]) if "patch_offset_m" in rec else None,
-                   escape=rec.get("escape"))
+                   menisci=rec.get("menisci"), escape=rec.get("escape"))
 
 
 def _percentiles(values: Sequence[float]) -> dict[str, float]:
@@ -144,6 +148,17 @@ def _fraction(flags: Sequence[bool]) -> dict[str, float]:
     n = len(flags)
     p = sum(bool(f) for f in flags) / n
     return {"value": p, "standard_error": math.sqrt(p * (1.0 - p) / n), "count": int(sum(bool(f) for f in flags))}
+
+
+def _menisci_summary(outcomes: Sequence[MemberOutcome]) -> dict:
+    """result.json -> ensemble -> menisci: whether the members carry bridges and how many formed."""
+    wet = [o.menisci for o in outcomes if o.menisci is not None]
+    if not wet:
+        return {"carried": False, "why": "the members' summits carry no bridges (dry, hydrophobic or menisci off)"}
+    return {"carried": True, "members": len(wet), "condensation_time_s": float(wet[0]["condensation_time_s"]),
+            "members_with_bridges": sum(m["contacts_with_bridges"] > 0 for m in wet),
+            "max_bridged_summits": _percentiles([m["max_bridges"] for m in wet]),
+            "law": "a bridge on each summit, the mean field's law and clock (continuum.laws.discrete_bridges)"}
 
 
 @dataclass(frozen=True)
@@ -205,6 +220,7 @@ class EnsembleResult:
                               for s in sorted({o.status for o in self.outcomes})},
             "max_contacts": _percentiles([o.max_contacts for o in self.outcomes]),
             "energy_audit_max_relative_error": max(o.energy_error for o in self.outcomes),
+            "menisci": _menisci_summary(self.outcomes),
             "escape_velocity": self.escape_record(),
             "executor": self.executor, "wall_s": self.wall_s,
             "member_runs": [o.to_record() for o in self.outcomes]}
