@@ -136,6 +136,8 @@ def cmd_impact(args) -> int:
           f"wall {result['timing']['wall_s']:.3f} s")
     if "ensemble" in result:
         print(ensemble_summary(result["ensemble"]))
+    if "menisci_condensation_time" in result:
+        print(result["menisci_condensation_time"]["summary"])
     for w in result["warnings"]:
         print(f"warning: {w}")
     print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png"

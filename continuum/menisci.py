@@ -84,6 +84,11 @@ NUCLEATION_BARRIER_40 = 7.8e-20
 NUCLEATION_TIME_299K = 4.2e-3
 NUCLEATION_REFERENCE_RH = 0.4
 NUCLEATION_REFERENCE_T = 299.0
+#: Szoszkiewicz & Riedo (2005): the attempt frequencies their Arrhenius fit allows (Hz), 4-250 GHz. The estimate's
+#: prefactor tau0 is known only within 1/250 GHz .. 1/4 GHz: the range of t_a its inputs allow at given RH and T.
+NUCLEATION_ATTEMPT_FREQUENCIES = (4e9, 250e9)
+#: Their measured nucleation times at 40 % RH (K -> s), the ends of their temperature range.
+NUCLEATION_MEASURED = {299.0: 4.2e-3, 332.0: 0.7e-3}
 #: One water molecule's diameter d_w = n_w^(-1/3) (m, 0.31 nm): the default smallest Kelvin radius a smooth
 #: sphere's bridge is given (``menisci.min_kelvin_radius``). The Kelvin and Laplace equations describe a
 #: continuum liquid; Israelachvili (2011, §17.7) finds them holding down to menisci of a few molecular
@@ -185,6 +190,15 @@ def nucleation_condensation_time(relative_humidity: float, temperature: float) -
     barrier = NUCLEATION_BARRIER_40 * math.log(1.0 / relative_humidity) / math.log(1.0 / NUCLEATION_REFERENCE_RH)
     tau0 = NUCLEATION_TIME_299K * math.exp(-NUCLEATION_BARRIER_40 / (K_BOLTZMANN * NUCLEATION_REFERENCE_T))
     return tau0 * math.exp(barrier / (K_BOLTZMANN * temperature))
+
+
+def nucleation_time_range(relative_humidity: float, temperature: float) -> tuple[float, float]:
+    """(shortest, longest) t_a (s) the nucleation estimate allows at (RH, T): its barrier dE(RH) with the attempt time
+    tau0 anywhere in Szoszkiewicz & Riedo's 1/250 GHz .. 1/4 GHz (`NUCLEATION_ATTEMPT_FREQUENCIES`)."""
+    barrier = NUCLEATION_BARRIER_40 * math.log(1.0 / relative_humidity) / math.log(1.0 / NUCLEATION_REFERENCE_RH)
+    boltzmann = math.exp(barrier / (K_BOLTZMANN * temperature))
+    lo, hi = NUCLEATION_ATTEMPT_FREQUENCIES
+    return boltzmann / hi, boltzmann / lo
 
 
 def bridgeable_gap(t_contact: float, t_a: float, growth_length: float, d_k: float) -> float:
