@@ -96,9 +96,10 @@ def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, wor
             rows.append({"condensation_time_s": t, **point, "how": "run again at this t_a"})
     values = [r["stick_probability_within_run"] for r in rows]
     lo, hi = rng["range_s"]
+    spread = (f"{min(values):.3g}-{max(values):.3g}" if max(values) > min(values)
+              else f"{values[0]:.3g} at every t_a (no contact lasts t_a: humidity changes nothing here)")
     summary = (f"menisci: t_a = {t_scene:.3g} s ({rng['source']}); over the estimate's range {lo:.3g}-{hi:.3g} s "
-               f"the stick probability within the run is {min(values):.3g}-{max(values):.3g}"
-               + ("" if max(values) > min(values) else " (t_a changes nothing here)"))
+               f"the stick probability within the run is {spread}")
     return {**rng, "grid_points": GRID_POINTS, "longest_contact_s": longest, "bridges_formed": bridged,
             "stick_probability": "fraction of ensemble members held (an ensemble), or 1/0 (a single run)",
             "points": rows, "summary": summary}

@@ -156,3 +156,64 @@ def test_a_discrete_run_with_bridges_keeps_its_energy_books():
                    settings=DriverSettings(rtol=1e-8, max_bounces=3))
     assert law.diagnostics()["menisci"]["contacts_with_bridges"] >= 1
     assert run.audit["max_relative_error"] < 1e-4
+
+
+def _wet_summit_pair(w_dry: float = 0.192, w_wet: float = 0.028, e_star: float = 2e10):
+    """One JKR summit under a roller, dry at w_dry, inside its bridge at w_wet (continuum.laws.wet_summits)."""
+    from continuum.laws.wet_summits import wet_summit_roller
+
+    stats = SummitStatistics(1e-9, 1e13, BETA)
+    one = (np.array([0.0]), np.array([0.0]), np.array([0.0]))
+    kw = dict(seed=0, half_space=False, summits=one)
+    dry = DiscreteRoughRoller(stats, w_dry, e_star, 5e-6, 1e-3, 1e11, **kw)
+    wet = DiscreteRoughRoller(stats, w_wet, e_star, 5e-6, 1e-3, 1e11, **kw)
+    params = {"bridge_pull_off": F0, "kelvin_gap": D_K, "condensation_time": T_A, "growth_length": H1}
+    return wet_summit_roller(dry, wet, params), dry, wet
+
+
+def test_a_summit_inside_its_bridge_lets_go_with_the_wet_loop_and_the_books_close():
+    """Quasi-static cycle of one JKR summit: pressed before t_a (dry), held past t_a (its bridge forms, the summit
+    switches to W_wet where it stands), pulled off. It lets go at the wet release point and books one wet loop (the
+    JKR closed form at W_wet, continuum.reference.jkr), no dry one; the work the roller does, -int F dgap, equals the
+    change of stored + booked energy (trapezoid on a fine path; the force jumps only where a summit lets go)."""
+    from continuum.reference import jkr as ref
+
+    law, dry, wet = _wet_summit_pair()
+    law.reset()
+    books = lambda g: law.stored_energy(g) + law.dissipated(g)          # noqa: E731
+    depth = 3.0 * dry.delta_c
+    path = [(g, 0.0) for g in np.linspace(0.5 * D_K, -depth, 400)]                  # press, dry (t < t_a)
+    path += [(-depth, t) for t in np.linspace(0.5 * T_A, 3.0 * T_A, 20)]            # hold: the bridge forms
+    path += [(g, 3.0 * T_A) for g in np.linspace(-depth, 1.5 * D_K, 4000)]          # pull off, wet
+    work, e0, prev = 0.0, None, None
+    for g, t in path:
+        law.set_time(t)
+        f = law.force(g)
+        if prev is not None:
+            work += -0.5 * (f + prev[1]) * (g - prev[0]) if abs(f - prev[1]) < 0.05 * dry.pull_off_force else \
+                -(prev[1] if g > prev[0] else f) * (g - prev[0])
+            if prev[2] != t:                      # at a fixed gap the bridge's formation leaves the books unchanged
+                assert books(g) == pytest.approx(prev[3], abs=1e-9 * dry.loop_energy)
+        e = books(g)
+        e0 = e if e0 is None else e0
+        law.accept(g)
+        prev = (g, f, t, e)
+    d = law.dry
+    assert d.detached_wet == 1 and d.detached == 0
+    assert wet.loop_energy == pytest.approx(float(ref.loop_area(BETA, 0.028, 2e10)), rel=1e-9)
+    assert wet.loop_energy < 0.1 * dry.loop_energy
+    scale = max(wet.loop_energy, abs(d.switched), law.bridges.formed)
+    assert prev[3] - e0 == pytest.approx(work, abs=2e-3 * scale)
+
+
+def test_a_humid_member_runs_its_summits_at_the_wet_work_of_adhesion():
+    """wet_silica (calibrated: measured W_SL, 'wet' solid adhesion) members: Maugis-Dugdale summits rebuilt at W_wet
+    inside bridges, the bridges without the DMT pull (the summit law carries the solids' adhesion)."""
+    from continuum.ensemble_run import member_law, member_plan
+    from continuum.model.regime import first_impact_speed
+
+    scene = resolve_scene("wet_silica", params="calibrated", overrides={"surfaces.roughness.mode": "ensemble"}).scene
+    _, law, _ = member_law(scene, 7, member_plan(scene, first_impact_speed(scene)))
+    inside = law.describe()["inside_bridges"]
+    assert inside["work_of_adhesion"] == pytest.approx(meniscus_parameters(scene)["work_of_adhesion_wet"])
+    assert law.bridges.solid_pull == 0.0 and "maugis_dugdale" in inside["summit_law"]

@@ -87,6 +87,15 @@ class DiscreteBridges(MeniscusBridges):
             total += a0 + x * (a1 + x * a2)
         return scale * total
 
+    def prefix(self, gap: float, t: float) -> int:
+        """Number of kept summits, in the source's order, that carry a bridge at a trial state (they are a prefix:
+        u_i >= s; every one within D_K since s >= gap - D_K)."""
+        s = self.offset(gap, t)
+        if not math.isfinite(s):
+            return 0
+        self._summits(s, math.inf)                           # refresh the cached heights if the kept set changed
+        return int(np.searchsorted(self._neg, -s, side="right"))
+
     def bridged(self, gap: float, t: float) -> int:
         """Number of summits carrying a bridge at a trial state (gap m, contact time t s)."""
         s = self.offset(gap, t)

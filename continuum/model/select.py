@@ -137,7 +137,7 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
         table=table, fast_min_sigma_over_delta_c=FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, law=law,
         summit_law_record=(slaw.describe() if slaw is not None else adhesion) if generic else None)
     if with_menisci and rough.mode == "discrete":
-        law = wet_discrete(law, law, meniscus_parameters(scene))       # a bridge on each summit of the realisation
+        law = discrete_menisci(scene, law, law)                     # a bridge on each summit of the realisation
     elif with_menisci:
         law = factory.with_menisci(law, scene, stats, meniscus_parameters(scene))
     return law, record
@@ -204,7 +204,30 @@ def member_menisci(member: Scene, law: ContactLaw, elastic: ContactLaw) -> Conta
     `continuum.laws.wet.WetRoughRoller.compiled`), so a member whose contacts all end sooner runs exactly dry."""
     if member.contact != "rough" or menisci_decision(member).choice == "off":
         return law
-    return wet_discrete(law, elastic, meniscus_parameters(member))
+    return discrete_menisci(member, law, elastic)
+
+
+def discrete_menisci(scene: Scene, law: ContactLaw, elastic) -> ContactLaw:
+    """`law` (summits on the realisation of the elastic `DiscreteRoughRoller` `elastic`) with a bridge on each summit.
+
+    menisci.solid_adhesion = 'wet' with elastic summits on a rigid substrate: the bridged summits adhere by their
+    summit law rebuilt at the wet work of adhesion max(W_wet, 0), force and loop (`continuum.laws.wet_summits`; Hertz
+    where W_wet <= 0). Otherwise (the additive choice, plastic summits, the half-space) the bridges carry the mean
+    field's DMT solid pull and the summits keep their dry loop (`continuum.laws.discrete_bridges.wet_discrete`);
+    the record says which."""
+    params = meniscus_parameters(scene)
+    if params["solid_adhesion"] != "wet" or law is not elastic or elastic.use_half_space:
+        why = ("menisci.solid_adhesion = 'additive'" if params["solid_adhesion"] != "wet" else
+               "plastic summits" if law is not elastic else "the half-space couples the summits")
+        return wet_discrete(law, elastic, {**params, "solids_inside_bridges": f"dry summit law, DMT solid pull "
+                                                                               f"(loop dry: {why})"})
+    from ..laws.wet_summits import wet_summit_roller
+    w_wet = max(params["work_of_adhesion_wet"], 0.0)
+    wet_scene = _with_work_of_adhesion(scene, w_wet)
+    slaw = summit_law(elastic.slaw.name, wet_scene) if elastic.slaw is not None and w_wet > 0 else None
+    wet = factory.discrete_roller(wet_scene, elastic.stats, w_wet, elastic.summit_e_star, False,
+                                  elastic.footprint_half_width, slaw, (elastic.sx, elastic.sy, elastic.sz))
+    return wet_summit_roller(elastic, wet, params)
 
 
 def member_summit_law(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
