@@ -36,7 +36,8 @@ def _one_summit(u: float = 0.0, solid_pull: float = 0.0) -> DiscreteBridges:
 def test_a_single_bridged_summit_is_the_kelvin_laplace_bridge_on_a_sphere(g_over_dk):
     """One summit at gap g, bridged after t_a: F = 2 pi beta gamma (cos t1 + cos t2)(1 - g/D_K) stretched (the Laplace
     pressure -gamma/r_K over the wetted disc pi x^2 = 2 pi beta (D_K - g)), F0 (1 - g/(2 D_K)) compressed (the Hertz
-    disc pi beta (-g) dry); U(g) = -int_g^{D_K} F, zero at rupture. Closed forms written here, not read from the code."""
+    disc pi beta (-g) dry); U(g) = -int_g^{D_K} F, zero at rupture. Closed forms written here, not read from the
+    code."""
     b = _one_summit()
     g = g_over_dk * D_K
     t = 2.0 * T_A                                 # after t_a every summit in contact is bridged; at g > 0 it bridges

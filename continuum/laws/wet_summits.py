@@ -253,7 +253,6 @@ def wet_summit_roller(dry: DiscreteRoughRoller, wet: DiscreteRoughRoller, parame
     law = WetSummitRoller.from_dry(dry, wet)
     p = {**parameters, "solid_pull": 0.0}
     bridges = DiscreteBridges(law, p["bridge_pull_off"], p["kelvin_gap"], p["condensation_time"], p["growth_length"])
+    inside = f"summit law at W_wet = {wet.work_of_adhesion:.4g} J/m^2: force and loop (continuum.laws.wet_summits)"
     return WetDiscreteRoller(law, bridges, {**p, "bridges_on": "each summit of the realisation "
-                                            "(continuum.laws.discrete_bridges)",
-                                            "solids_inside_bridges": f"summit law at W_wet = {wet.work_of_adhesion:.4g} "
-                                                                      "J/m^2: force and loop (continuum.laws.wet_summits)"})
+                                            "(continuum.laws.discrete_bridges)", "solids_inside_bridges": inside})
