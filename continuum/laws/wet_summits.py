@@ -70,43 +70,40 @@ class WetSummitRoller(DiscreteRoughRoller):
         return state
 
     # ------------------------------------------------------------------ the trial state, two classes of summits
-    def _class_rules(self, k: int, kw: int):
-        """Per-summit (delta_in, release stretch, reach) of the first k summits, the first kw wet."""
-        def arr(dry_v, wet_v):
-            out = np.full(k, float(dry_v))
-            out[:kw] = wet_v
-            return out
-        w = self.wet
-        return (arr(self._delta_in, w._delta_in), arr(self.release_stretch, w.release_stretch),
-                arr(self._reach, w._reach))
-
     def _summits_at(self, gap: float, de_lo: float, de_of=None):
+        """Trial state over the summits attached or within reach: the first kw (bridged) by the wet law, the rest by
+        the dry one (each slice with its class's jump-in, release and reach); the history rule applied, not
+        committed."""
         base = self.z_top + gap
-        reach = max(self._reach, self.wet._reach)
+        w = self.wet
         if base < self.z_top - self.depth_keep:
             self._deepen(2.0 * (self.z_top - base))
-            self.wet.given_summits = (self.sx, self.sy, self.sz)
-            self.wet._realise(self.depth_keep)
-        k = max(self.k_att, self._count_above(base - reach), min(self.k_trial, self.eff.size))
+            w.given_summits = (self.sx, self.sy, self.sz)
+            w._realise(self.depth_keep)
+        k = max(self.k_att, self._count_above(base - max(self._reach, w._reach)), min(self.k_trial, self.eff.size))
         kw = min(self.k_trial, k)
         delta = self.eff[:k] - base
-        d_in, release, reach_i = self._class_rules(k, kw)
+        att = np.empty(k, bool)
+        force = np.zeros(k)
+        free = np.zeros(k, bool)
+        q = {}
+        for cls, law, sl in (("wet", w, slice(0, kw)), ("dry", self, slice(kw, k))):
+            d = delta[sl]
+            a = (self.attached[sl] | (d >= law._delta_in)) & (d >= -law.release_stretch)
+            att[sl] = a
+            q[cls] = law._laws(d[a])
+            f = np.zeros(d.size)
+            f[a] = q[cls]["force"]
+            if law.slaw is not None:
+                fr = ~a & (d >= -law._reach)
+                if fr.any():
+                    f[fr] = law.slaw.force(d[fr], "approach")
+                free[sl] = fr
+            force[sl] = f
         wet = np.zeros(k, bool)
         wet[:kw] = True
-        att = (self.attached[:k] | (delta >= d_in)) & (delta >= -release)
-        q_d = self._laws(delta[att & ~wet])
-        q_w = self.wet._laws(delta[att & wet])
-        force = np.zeros(k)
-        force[att & ~wet] = q_d["force"]
-        force[att & wet] = q_w["force"]
-        free = ~att & (delta >= -reach_i)
-        free_d, free_w = free & ~wet, free & wet
-        if self.slaw is not None and np.any(free_d):
-            force[free_d] = self.slaw.force(delta[free_d], "approach")
-        if self.wet.slaw is not None and np.any(free_w):
-            force[free_w] = self.wet.slaw.force(delta[free_w], "approach")
-        q = {"dry": q_d, "wet": q_w, "att_dry": att & ~wet, "att_wet": att & wet, "free_dry": free_d,
-             "free_wet": free_w, "delta": delta, "force": force[att]}
+        q.update({"att_dry": att & ~wet, "att_wet": att & wet, "free_dry": free & ~wet, "free_wet": free & wet,
+                  "delta": delta})
         return k, delta, att, q, force, None
 
     def _energies(self, s) -> np.ndarray:
