@@ -211,7 +211,8 @@ FIELDS: tuple[Field, ...] = (
           "'auto': on unless its estimated deflection across the footprint is below 1e-3 sigma.",
           "auto", choices=("auto", "on", "off")),
     Field("physics.menisci", str, "", "Capillary bridges after the condensation time (section 'menisci'): at "
-          "the summits of mean-field rough contact, or one bridge at a smooth sphere's contact. 'auto': left out "
+          "the summits of rough contact (mean field, or each summit of a discrete realisation and of every ensemble "
+          "member), or one bridge at a smooth sphere's contact. 'auto': left out "
           "when dry, hydrophobic (cos t1 + cos t2 <= 0), for a sphere when the Kelvin radius is below "
           "menisci.min_kelvin_radius, or when no contact of the dry run lasts the condensation time.", "auto",
           choices=("auto", "on", "off")),
@@ -223,8 +224,8 @@ FIELDS: tuple[Field, ...] = (
           "activated: t_a = tau0 exp(dE(RH)/kT), dE = 7.8e-20 J ln(1/RH)/ln(1/0.4), tau0 = 2.6e-11 s, fitted to "
           "Szoszkiewicz & Riedo 2005: 4.2 ms at 40% RH, 299 K).", "fixed", choices=("fixed", "nucleation")),
     Field("menisci.solid_adhesion", str, "", "Solid-solid adhesion of a summit inside a bridge: 'wet' (the work "
-          "of adhesion under the liquid, dgamma - gamma_lv (cos t1 + cos t2), Israelachvili 2011 §17.7: the bridge "
-          "replaces part of the dry pull) or 'additive' (the paper's eq 14: bridges add to the dry dgamma).", "wet",
+          "of adhesion under the liquid, dgamma + 2 gamma_lv - W_1L - W_2L, Israelachvili 2011 §17.7: the bridge "
+          "replaces part of the dry pull; discrete summits take their whole law, loop included, at it) or 'additive' (the paper's eq 14: bridges add to the dry dgamma).", "wet",
           choices=("wet", "additive")),
     Field("menisci.growth_length", float, "m", "h1 in h_mw(t) = h1 ln(t/t_a), the growth of the bridgeable gap "
           "(Riedo et al. 2002). Not set: 1/(n_w d_w^2 ln(1/RH)), one water molecule's cross-section d_w^2 as the "
