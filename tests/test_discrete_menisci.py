@@ -218,3 +218,60 @@ def test_a_humid_member_runs_its_summits_at_the_wet_work_of_adhesion():
     inside = law.describe()["inside_bridges"]
     assert inside["work_of_adhesion"] == pytest.approx(meniscus_parameters(scene)["work_of_adhesion_wet"])
     assert law.bridges.solid_pull == 0.0 and "maugis_dugdale" in inside["summit_law"]
+
+
+def test_a_humid_scene_reports_its_sticking_against_t_a():
+    """result.json -> menisci_condensation_time: the scene's t_a and the estimate's range at its humidity and
+    temperature, the stick probability at each t_a; at the paper's 40 % RH the range (ms) lies beyond every contact
+    and no bridge formed, so every point is the scene's run, reused."""
+    from continuum.impact import run_impact
+
+    over = {"surfaces.roughness.mode": "ensemble", "surfaces.roughness.members": 2, "numerics.max_bounces": 2}
+    result, _ = run_impact(resolve_scene("wet_silica", params="paper", overrides=over))
+    block = result["menisci_condensation_time"]
+    scene = resolve_scene("wet_silica", params="paper").scene
+    lo, hi = block["range_s"]
+    assert (lo, hi) == pytest.approx(men.nucleation_time_range(scene.environment.relative_humidity,
+                                                               scene.environment.temperature), rel=1e-12)
+    times = [p["condensation_time_s"] for p in block["points"]]
+    assert times == sorted(times) and times[0] == 25e-6 and times[-1] == pytest.approx(hi) and len(times) == 6
+    assert not block["bridges_formed"] and block["longest_contact_s"] < lo
+    here = result["ensemble"]["stick_probability"]["within_run"]["value"]
+    assert all(p["stick_probability_within_run"] == here and p["how"] != "run again at this t_a"
+               for p in block["points"])
+
+
+def test_the_t_a_sweep_runs_again_exactly_the_points_that_can_differ(monkeypatch):
+    """Points at or below the longest contact, or any point once a bridge formed, are run again; the others reuse the
+    scene's run (bridges cannot form before t_a: the run is the same step for step)."""
+    from continuum import ensemble_run, wet_sweep
+
+    resolved = resolve_scene("wet_silica", params="paper")
+    asked = []
+
+    class Fake:
+        def __init__(self, t):
+            self.t = t
+
+        def to_record(self):
+            return {"stick_probability": {"first_impact": {"value": 0.5}, "within_run": {"value": 0.75,
+                                                                                       "standard_error": 0.1}}}
+
+    monkeypatch.setattr(ensemble_run, "run_ensemble",
+                        lambda r, **kw: (asked.append(r.scene.menisci.condensation_time), Fake(0))[1])
+    lo, hi = men.nucleation_time_range(0.4, resolved.scene.environment.temperature)
+    longest = math.sqrt(lo * hi)                      # between the range's ends
+    member = {"menisci": {"longest_contact_s": longest, "contacts_with_bridges": 0}}
+    ens = {"stick_probability": {"first_impact": {"value": 0.0}, "within_run": {"value": 0.0, "standard_error": 0.0}},
+           "member_runs": [member, member]}
+    block = wet_sweep.condensation_sweep(resolved, {"ensemble": ens})
+    expect = [t for t in wet_sweep.t_a_grid(25e-6, lo, hi) if t != 25e-6 and t <= longest]
+    assert asked == expect and len(expect) >= 2
+    for p in block["points"]:
+        rerun = p["condensation_time_s"] in expect
+        assert (p["how"] == "run again at this t_a") == rerun
+        assert p["stick_probability_within_run"] == (0.75 if rerun else 0.0)
+    asked.clear()
+    member["menisci"]["contacts_with_bridges"] = 1    # a bridge formed: every other point can differ
+    wet_sweep.condensation_sweep(resolved, {"ensemble": ens})
+    assert len(asked) == len(wet_sweep.t_a_grid(25e-6, lo, hi)) - 1
