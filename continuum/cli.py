@@ -153,6 +153,8 @@ def cmd_impact(args) -> int:
     elif band:
         from continuum.rough.cutoff_band import band_summary
         print("cutoff band (mean field, first impact):\n" + band_summary(band))
+    if "menisci_condensation_time" in result:
+        print(result["menisci_condensation_time"]["summary"])
     for w in result["warnings"]:
         print(f"warning: {w}")
     print(f"wrote {out}/result.json, timeseries.csv, height.png, impacts.png"

@@ -106,7 +106,7 @@ def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any]:
     """(the member's scene, its discrete law) for realisation `seed`: the strip's summits drawn from the plan's
     height distribution."""
     from .model import factory
-    from .model.select import plastic_member     # Thornton-Ning summits where the scene's summits yield
+    from .model.select import member_summit_law  # plastic summits where they yield, bridges where humid
     from .rough.gw import SummitStatistics
 
     member = with_realisation(scene, "discrete", seed)
@@ -114,7 +114,7 @@ def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any]:
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
     law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
                                   plan.footprint_half_width, plan.summit_law, heights=plan.heights)
-    return member, plastic_member(member, law, plan.speed)
+    return member, member_summit_law(member, law, plan.speed)
 
 
 def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:
@@ -152,11 +152,13 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan, escape_rel_tol: float 
     run = simulate(law, member.body.mass, member.environment.gravity, release_height=release,
                    impact_velocity=member.impact_velocity, settings=settings)
     heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)
-    contacts = int(law.diagnostics()["max_contacts"])
+    diagnostics = law.diagnostics()
+    contacts = int(diagnostics["max_contacts"])
     escape = member_escape(law, member, plan.speed, escape_rel_tol) if escape_rel_tol is not None else None
     return MemberOutcome(seed=int(seed), status=run.status, rebound_heights=heights, release_height=release,
                          max_contacts=contacts, wall_s=time.perf_counter() - start,
-                         energy_error=float(run.audit["max_relative_error"]), escape=escape)
+                         energy_error=float(run.audit["max_relative_error"]), escape=escape,
+                         menisci=diagnostics.get("menisci"))
 
 
 def _member_job(job: tuple) -> MemberOutcome:

@@ -9,6 +9,7 @@ from typing import Callable
 from . import plots
 from .driver import Bounce, DriverSettings, simulate
 from .model import dry_run_verdict, select_law
+from .model.decisions import menisci_decision
 from .provenance import provenance
 from .results import SCHEMA_VERSION, write_run
 from .scene import ResolvedScene, SceneError
@@ -24,13 +25,15 @@ def first_impact_speed(resolved: ResolvedScene) -> float:
 
 
 def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | None = None,
-               executor=None, workers: int | None = None) -> tuple[dict, dict]:
+               executor=None, workers: int | None = None, condensation_sweep: bool = True) -> tuple[dict, dict]:
     """Simulate a resolved scene; returns (result record for result.json, time-series arrays).
 
     Rough contact: surfaces.roughness.mode is settled first (`realisation_decision`; 'auto' by the expected
     summits in contact). An ensemble runs its members on `executor` (a `nanoimpact.executors` name or an open
     executor; None: in this process) and adds result.json -> ensemble; the trajectory (bounces, time series) is
-    then the mean-field law's, with the members' summit law, for comparison."""
+    then the mean-field law's, with the members' summit law, for comparison. A humid scene (menisci not 'off')
+    adds result.json -> menisci_condensation_time, its sticking against t_a over the range the estimate allows
+    (`continuum.wet_sweep`; `condensation_sweep` False leaves it out)."""
     start = time.perf_counter()
     resolved, realisation = _settle_realisation(resolved)
     scene = resolved.scene
@@ -77,6 +80,10 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         band = mean_field_band(resolved)
         result["surface"] = {**result["surface"], "cutoff_band": band["cutoff_band"]}
         result["warnings"] += band["warnings"]
+    if condensation_sweep and menisci_decision(scene).choice != "off":
+        from .wet_sweep import condensation_sweep as sweep
+        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers)
+        result["timing"]["wall_s"] = time.perf_counter() - start
     return result, run.trace.arrays()
 
 

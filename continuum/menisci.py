@@ -84,6 +84,11 @@ NUCLEATION_BARRIER_40 = 7.8e-20
 NUCLEATION_TIME_299K = 4.2e-3
 NUCLEATION_REFERENCE_RH = 0.4
 NUCLEATION_REFERENCE_T = 299.0
+#: Szoszkiewicz & Riedo (2005): the attempt frequencies their Arrhenius fit allows (Hz), 4-250 GHz. The estimate's
+#: prefactor tau0 is known only within 1/250 GHz .. 1/4 GHz: the range of t_a its inputs allow at given RH and T.
+NUCLEATION_ATTEMPT_FREQUENCIES = (4e9, 250e9)
+#: Their measured nucleation times at 40 % RH (K -> s), the ends of their temperature range.
+NUCLEATION_MEASURED = {299.0: 4.2e-3, 332.0: 0.7e-3}
 #: One water molecule's diameter d_w = n_w^(-1/3) (m, 0.31 nm): the default smallest Kelvin radius a smooth
 #: sphere's bridge is given (``menisci.min_kelvin_radius``). The Kelvin and Laplace equations describe a
 #: continuum liquid; Israelachvili (2011, §17.7) finds them holding down to menisci of a few molecular
@@ -114,21 +119,34 @@ def bridge_pull_off(radius: float, surface_tension: float, theta1: float, theta2
     return 2.0 * math.pi * radius * surface_tension * max(wetting_sum(theta1, theta2), 0.0)
 
 
-def wet_work_of_adhesion(work_of_adhesion: float, surface_tension: float, theta1: float, theta2: float) -> float:
-    """W_wet = dgamma - gamma_lv (cos theta1 + cos theta2) (J/m^2): the solids' work of adhesion under the liquid
-    (Dupre in a medium with Young's law; Israelachvili 2011 §17.7). Negative: the liquid separates them."""
-    return work_of_adhesion - surface_tension * wetting_sum(theta1, theta2)
+def solid_liquid_work(surface_tension: float, theta: float, measured: float | None = None) -> float:
+    """W_SL = gamma_S + gamma_L - gamma_SL (J/m^2) of one face: `measured` where given (MD thermodynamic
+    integration), else Young-Dupre gamma_lv (1 + cos theta). Only the measured value can exceed 2 gamma_lv
+    (complete wetting, where Young's angle is 0 and the excess is the spreading coefficient S = W_SL - 2 gamma_lv)."""
+    return float(measured) if measured is not None else surface_tension * (1.0 + math.cos(theta))
+
+
+def wet_work_of_adhesion(work_of_adhesion: float, surface_tension: float, theta1: float, theta2: float,
+                         solid_liquid: tuple[float | None, float | None] = (None, None)) -> float:
+    """W_wet = gamma_1L + gamma_2L - gamma_12 = dgamma + 2 gamma_lv - W_1L - W_2L (J/m^2): the solids' work of
+    adhesion under the liquid (Dupre in a medium; Israelachvili 2011 §17.7, Butt & Kappl 2009 §2.6), with each face's
+    W_iL from `solid_liquid` where measured, else from its angle (then W_wet = dgamma - gamma_lv (cos t1 + cos t2)).
+    Two different solids take one W_iL each. Negative: the liquid separates them."""
+    w1 = solid_liquid_work(surface_tension, theta1, solid_liquid[0])
+    w2 = solid_liquid_work(surface_tension, theta2, solid_liquid[1])
+    return work_of_adhesion + 2.0 * surface_tension - w1 - w2
 
 
 def solid_pull_inside_bridge(radius: float, work_of_adhesion: float, surface_tension: float, theta1: float,
-                             theta2: float, choice: str) -> float:
+                             theta2: float, choice: str,
+                             solid_liquid: tuple[float | None, float | None] = (None, None)) -> float:
     """Solid-solid pull (N, >= 0) a bridge takes from each compressed summit it wets: 2 pi beta (dgamma - max(W_wet, 0))
     for choice 'wet', 0 for 'additive' (the paper's eq 14: the bridge adds to the dry adhesion)."""
     if choice == "additive":
         return 0.0
     if choice != "wet":
         raise ValueError(f"menisci.solid_adhesion = {choice!r}: 'wet' or 'additive'")
-    w_wet = wet_work_of_adhesion(work_of_adhesion, surface_tension, theta1, theta2)
+    w_wet = wet_work_of_adhesion(work_of_adhesion, surface_tension, theta1, theta2, solid_liquid)
     return 2.0 * math.pi * radius * (work_of_adhesion - max(w_wet, 0.0))
 
 
@@ -172,6 +190,15 @@ def nucleation_condensation_time(relative_humidity: float, temperature: float) -
     barrier = NUCLEATION_BARRIER_40 * math.log(1.0 / relative_humidity) / math.log(1.0 / NUCLEATION_REFERENCE_RH)
     tau0 = NUCLEATION_TIME_299K * math.exp(-NUCLEATION_BARRIER_40 / (K_BOLTZMANN * NUCLEATION_REFERENCE_T))
     return tau0 * math.exp(barrier / (K_BOLTZMANN * temperature))
+
+
+def nucleation_time_range(relative_humidity: float, temperature: float) -> tuple[float, float]:
+    """(shortest, longest) t_a (s) the nucleation estimate allows at (RH, T): its barrier dE(RH) with the attempt time
+    tau0 anywhere in Szoszkiewicz & Riedo's 1/250 GHz .. 1/4 GHz (`NUCLEATION_ATTEMPT_FREQUENCIES`)."""
+    barrier = NUCLEATION_BARRIER_40 * math.log(1.0 / relative_humidity) / math.log(1.0 / NUCLEATION_REFERENCE_RH)
+    boltzmann = math.exp(barrier / (K_BOLTZMANN * temperature))
+    lo, hi = NUCLEATION_ATTEMPT_FREQUENCIES
+    return boltzmann / hi, boltzmann / lo
 
 
 def bridgeable_gap(t_contact: float, t_a: float, growth_length: float, d_k: float) -> float:

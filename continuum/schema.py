@@ -144,6 +144,10 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.body.poisson_ratio", doc="Poisson's ratio of the body.", default=REQUIRED, **_POISSON),
     Field("surfaces.body.contact_angle", doc="Water contact angle on the body (menisci).",
           default=None, **_ANGLE),
+    Field("surfaces.body.work_of_adhesion_sl", float, "J/m^2", "Solid-water work of adhesion W_SL of the body "
+          "(MD thermodynamic integration): inside a bridge the solids adhere with W_wet = dgamma + 2 gamma_lv "
+          "- W_1L - W_2L (docs/model.md, Menisci). Not given: gamma_lv (1 + cos theta) from the contact angle.",
+          None, low=0.0, high=10.0),
     Field("surfaces.body.yield_strength", float, "Pa", "Tensile yield strength Y of the body: a smooth sphere's "
           "limiting contact pressure 2.8 Y (Tabor) in the Thornton-Ning elastic-plastic law (physics.plasticity; "
           "the softer partner's counts). Optional.", None, low=1e6, high=1e12),
@@ -156,6 +160,11 @@ FIELDS: tuple[Field, ...] = (
           **_POISSON),
     Field("surfaces.substrate.contact_angle", doc="Water contact angle on the substrate (menisci).",
           default=None, **_ANGLE),
+    Field("surfaces.substrate.work_of_adhesion_sl", float, "J/m^2", "Solid-water work of adhesion W_SL of the "
+          "substrate "
+          "(MD thermodynamic integration): inside a bridge the solids adhere with W_wet = dgamma + 2 gamma_lv "
+          "- W_1L - W_2L (docs/model.md, Menisci). Not given: gamma_lv (1 + cos theta) from the contact angle.",
+          None, low=0.0, high=10.0),
     Field("surfaces.substrate.yield_strength", float, "Pa", "Tensile yield strength of the substrate: a smooth "
           "sphere's limiting contact pressure 2.8 Y (as surfaces.body.yield_strength); rough and line contact warn "
           "when the contact pressure passes the Tresca/von Mises onset (optional).", None, low=1e6, high=1e12),
@@ -170,6 +179,10 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.sam.work_of_adhesion", float, "J/m^2", "Work of adhesion between the two SAM-covered "
           "surfaces.", None, low=0.0, high=10.0),
     Field("surfaces.sam.contact_angle", doc="Water contact angle on the SAM.", default=None, **_ANGLE),
+    Field("surfaces.sam.work_of_adhesion_sl", float, "J/m^2", "Solid-water work of adhesion W_SL of the SAM "
+          "(MD thermodynamic integration): inside a bridge the solids adhere with W_wet = dgamma + 2 gamma_lv "
+          "- W_1L - W_2L (docs/model.md, Menisci). Not given: gamma_lv (1 + cos theta) from the contact angle.",
+          None, low=0.0, high=10.0),
     Field("surfaces.sam.layer_modulus", float, "Pa", "Young's modulus of the SAM as a compliant layer on every "
           "summit (rough contact; needs surfaces.sam.thickness): the summits' contact modulus becomes the coated "
           "pair's equivalent modulus (Perriot & Barthel 2004; docs/model.md, Coated summits). Not set: the layer is "
@@ -301,7 +314,8 @@ FIELDS: tuple[Field, ...] = (
           "'auto': on unless its estimated deflection across the footprint is below 1e-3 sigma.",
           "auto", choices=("auto", "on", "off")),
     Field("physics.menisci", str, "", "Capillary bridges after the condensation time (section 'menisci'): at "
-          "the summits of mean-field rough contact, or one bridge at a smooth sphere's contact. 'auto': left out "
+          "the summits of rough contact (mean field, or each summit of a discrete realisation and of every ensemble "
+          "member), or one bridge at a smooth sphere's contact. 'auto': left out "
           "when dry, hydrophobic (cos t1 + cos t2 <= 0), for a sphere when the Kelvin radius is below "
           "menisci.min_kelvin_radius, or when no contact of the dry run lasts the condensation time.", "auto",
           choices=("auto", "on", "off")),
@@ -313,8 +327,8 @@ FIELDS: tuple[Field, ...] = (
           "activated: t_a = tau0 exp(dE(RH)/kT), dE = 7.8e-20 J ln(1/RH)/ln(1/0.4), tau0 = 2.6e-11 s, fitted to "
           "Szoszkiewicz & Riedo 2005: 4.2 ms at 40% RH, 299 K).", "fixed", choices=("fixed", "nucleation")),
     Field("menisci.solid_adhesion", str, "", "Solid-solid adhesion of a summit inside a bridge: 'wet' (the work "
-          "of adhesion under the liquid, dgamma - gamma_lv (cos t1 + cos t2), Israelachvili 2011 §17.7: the bridge "
-          "replaces part of the dry pull) or 'additive' (the paper's eq 14: bridges add to the dry dgamma).", "wet",
+          "of adhesion under the liquid, dgamma + 2 gamma_lv - W_1L - W_2L, Israelachvili 2011 §17.7: the bridge "
+          "replaces part of the dry pull; discrete summits take their whole law, loop included, at it) or 'additive' (the paper's eq 14: bridges add to the dry dgamma).", "wet",
           choices=("wet", "additive")),
     Field("menisci.growth_length", float, "m", "h1 in h_mw(t) = h1 ln(t/t_a), the growth of the bridgeable gap "
           "(Riedo et al. 2002). Not set: 1/(n_w d_w^2 ln(1/RH)), one water molecule's cross-section d_w^2 as the "

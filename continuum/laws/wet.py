@@ -242,11 +242,19 @@ class WetRoughRoller(ContactLaw):
         Bridges can pull the roller deeper than the dry estimate; their force at twice the dry
         quasi-static depth with every summit within D_K bridged bounds the pull over the contact.
         """
+        if not hasattr(self.dry, "quasi_static_depth"):
+            # a summit law without a rigid approach branch (plastic summits keep every summit they may reach)
+            self.design_pull = 0.0
+            self.dry.prepare(mass, speed, gravity)
+            return
         depth = self.dry.quasi_static_depth(0.5 * mass * speed * speed, mass * gravity)
         deep = -2.0 * depth
         pull = self.bridges.full_force(deep)
         self.design_pull = pull
         self.dry.prepare(mass, speed, gravity + pull / mass)
+
+    def forget_history(self):
+        self.dry.forget_history()
 
     def reset(self):
         if self.bridges.ever:

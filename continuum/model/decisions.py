@@ -22,7 +22,7 @@ form before t_a, so if no contact of the dry run lasts t_a, the wet run is ident
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from .. import menisci as men
 from ..reference import jkr as jkr_ref
@@ -242,11 +242,8 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
         return MenisciDecision("off", "scene", "physics.menisci = 'off' set in the scene", rh)
     sphere = scene.contact == "smooth" and scene.body.shape == "sphere"
     if scene.contact != "rough" and not sphere:
-        return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact and the smooth "
-                               "sphere only", rh)
-    if not sphere and surf.roughness.mode != "mean_field":
-        return MenisciDecision("off", "geometry", "menisci are modelled for mean-field rough contact only (surfaces."
-                               f"roughness.mode = '{surf.roughness.mode}')", rh)
+        return MenisciDecision("off", "geometry", "menisci are modelled for rough contact (every summit, mean field "
+                               "or discrete) and the smooth sphere only", rh)
     if rh <= 0.0:
         return MenisciDecision("off", "relative_humidity", "dry: environment.relative_humidity = 0", rh)
     t1, t2 = surf.contact_angles
@@ -356,11 +353,7 @@ def realisation_decision(scene: Scene, regime: Regime) -> RealisationDecision:
                                    f"auto: {n_c:.3g} summits expected in contact >= {ENSEMBLE_BELOW_CONTACTS:g}: the "
                                    "mean field agrees with the ensemble mean within the measured tolerance", n_c)
     few = f"auto: {n_c:.3g} summits expected in contact < {ENSEMBLE_BELOW_CONTACTS:g}"
-    mean_field = replace(scene, surfaces=replace(scene.surfaces, roughness=replace(rough, mode="mean_field")))
-    if menisci_decision(mean_field).choice != "off":
-        return RealisationDecision("mean_field", "menisci",
-                                   f"{few}, but menisci may form and discrete members carry none: the mean field "
-                                   "runs with them, and no spread is computed", n_c)
+    # menisci do not change this: each member's summits grow their own bridges (continuum.laws.discrete_bridges)
     return RealisationDecision("ensemble", "expected_contacts",
                                f"{few}: the mean field describes no single impact; an ensemble of {rough.members} "
                                "discrete realisations gives the distribution", n_c, **ens)

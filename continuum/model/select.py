@@ -9,13 +9,15 @@ import functools
 
 from ..estimates import check_table_cost
 from ..laws.base import ContactLaw
+from ..laws.discrete_bridges import wet_discrete
 from ..reference import jkr as jkr_ref
 from ..scene import Scene, SceneError
 from . import factory
 from . import record as rec
 from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, half_space_decision,
                         menisci_decision, plasticity_decision, summit_law)
-from .regime import Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of, summit_e_star
+from .regime import (Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of, solid_liquid_works,
+                     summit_e_star)
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
@@ -134,7 +136,9 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
         scene, datum=datum, regime=rec.rough_regime_record(scene, regime, w, delta_c), surface=surface, cost=cost,
         table=table, fast_min_sigma_over_delta_c=FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, law=law,
         summit_law_record=(slaw.describe() if slaw is not None else adhesion) if generic else None)
-    if with_menisci:
+    if with_menisci and rough.mode == "discrete":
+        law = discrete_menisci(scene, law, law)                     # a bridge on each summit of the realisation
+    elif with_menisci:
         law = factory.with_menisci(law, scene, stats, meniscus_parameters(scene))
     return law, record
 
@@ -147,7 +151,7 @@ def _wet_solids_record(scene: Scene, plastic: bool) -> dict:
     surf, m = scene.surfaces, scene.menisci
     t1, t2 = surf.contact_angles
     w = surf.interface_work_of_adhesion
-    w_wet = max(men.wet_work_of_adhesion(w, m.surface_tension, t1, t2), 0.0)
+    w_wet = max(men.wet_work_of_adhesion(w, m.surface_tension, t1, t2, solid_liquid_works(scene)), 0.0)
     if m.solid_adhesion == "wet" and plastic:
         raise SceneError("menisci.solid_adhesion", "wet", "the wet solid adhesion rebuilds the sphere's law when "
                          "the bridge condenses, which would drop the Thornton-Ning flattening: set "
@@ -189,6 +193,48 @@ def plastic_member(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
     if not decision.used:
         return law
     return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure)
+
+
+def member_menisci(member: Scene, law: ContactLaw, elastic: ContactLaw) -> ContactLaw:
+    """An ensemble member's summit law `law` (elastic or plastic summits on the realisation of the elastic discrete
+    roller `elastic`) with a capillary bridge growing on each summit where the member's humidity and contact angles
+    let bridges pull (`menisci_decision` not 'off'), else `law` itself.
+
+    'auto' needs no dry run here: before t_a no bridge exists and the wet law is its dry law (compiled up to t_a,
+    `continuum.laws.wet.WetRoughRoller.compiled`), so a member whose contacts all end sooner runs exactly dry."""
+    if member.contact != "rough" or menisci_decision(member).choice == "off":
+        return law
+    return discrete_menisci(member, law, elastic)
+
+
+def discrete_menisci(scene: Scene, law: ContactLaw, elastic) -> ContactLaw:
+    """`law` (summits on the realisation of the elastic `DiscreteRoughRoller` `elastic`) with a bridge on each summit.
+
+    menisci.solid_adhesion = 'wet' with elastic summits on a rigid substrate: the bridged summits adhere by their
+    summit law rebuilt at the wet work of adhesion max(W_wet, 0), force and loop (`continuum.laws.wet_summits`; Hertz
+    where W_wet <= 0). Otherwise (the additive choice, plastic summits, the half-space) the bridges carry the mean
+    field's DMT solid pull and the summits keep their dry loop (`continuum.laws.discrete_bridges.wet_discrete`);
+    the record says which."""
+    params = meniscus_parameters(scene)
+    if params["solid_adhesion"] != "wet" or law is not elastic or elastic.use_half_space:
+        why = ("menisci.solid_adhesion = 'additive'" if params["solid_adhesion"] != "wet" else
+               "plastic summits" if law is not elastic else "the half-space couples the summits")
+        return wet_discrete(law, elastic, {**params, "solids_inside_bridges": f"dry summit law, DMT solid pull "
+                                                                               f"(loop dry: {why})"})
+    from ..laws.wet_summits import wet_summit_roller
+    w_wet = max(params["work_of_adhesion_wet"], 0.0)
+    wet_scene = _with_work_of_adhesion(scene, w_wet)
+    slaw = summit_law(elastic.slaw.name, wet_scene) if elastic.slaw is not None and w_wet > 0 else None
+    wet = factory.discrete_roller(wet_scene, elastic.stats, w_wet, elastic.summit_e_star, False,
+                                  elastic.footprint_half_width, slaw, (elastic.sx, elastic.sy, elastic.sz))
+    return wet_summit_roller(elastic, wet, params)
+
+
+def member_summit_law(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
+    """An ensemble member's summits as every member runs them, whoever builds its realisation `law` (an elastic
+    `DiscreteRoughRoller`): plastic where the scene's summits yield (`plastic_member`), with a bridge on each summit
+    where the scene is humid (`member_menisci`)."""
+    return member_menisci(member, plastic_member(member, law, speed), law)
 
 
 def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None) -> tuple[ContactLaw, dict]:

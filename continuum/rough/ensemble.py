@@ -55,6 +55,9 @@ class MemberOutcome:
     wall_s: float
     energy_error: float = 0.0
     """The run's energy audit: largest error of its energy books against the first impact's kinetic energy."""
+    menisci: Mapping[str, Any] | None = None
+    """The member's capillary bridges where its summits carry them (`continuum.laws.wet.WetRoughRoller.diagnostics`:
+    longest contact, t_a, contacts with bridges, most summits bridged at once); None: a dry member."""
     escape: Mapping[str, Any] | None = None
     """The member's escape velocity where the ensemble was asked for it (`continuum.escape.escape_velocity`:
     escape_velocity, lower, upper (m/s), runs), or {"escape_velocity": None, "reason": ...}; None: not asked."""
@@ -82,6 +85,7 @@ class MemberOutcome:
         return {"seed": self.seed, "status": self.status, "rebounds": self.rebounds,
                 "rebound_heights": list(self.rebound_heights), "max_contacts": self.max_contacts,
                 "energy_error": self.energy_error, "wall_s": self.wall_s,
+                **({"menisci": dict(self.menisci)} if self.menisci is not None else {}),
                 **({"escape": dict(self.escape)} if self.escape is not None else {})}
 
     @classmethod
@@ -90,7 +94,7 @@ class MemberOutcome:
                    rebound_heights=tuple(float(h) for h in rec["rebound_heights"]), release_height=release_height,
                    max_contacts=int(rec["max_contacts"]), wall_s=float(rec["wall_s"]),
                    energy_error=float(rec["energy_error"]),
-                   escape=rec.get("escape"))
+                   menisci=rec.get("menisci"), escape=rec.get("escape"))
 
 
 def _percentiles(values: Sequence[float]) -> dict[str, float]:
@@ -146,6 +150,17 @@ def first_impact_summary(outcomes: Sequence["MemberOutcome"]) -> dict:
     if h0:
         rec["first_rebound_over_h0"] = {k: v / h0 for k, v in rec["first_rebound_m"].items()}
     return rec
+
+
+def _menisci_summary(outcomes: Sequence[MemberOutcome]) -> dict:
+    """result.json -> ensemble -> menisci: whether the members carry bridges and how many formed."""
+    wet = [o.menisci for o in outcomes if o.menisci is not None]
+    if not wet:
+        return {"carried": False, "why": "the members' summits carry no bridges (dry, hydrophobic or menisci off)"}
+    return {"carried": True, "members": len(wet), "condensation_time_s": float(wet[0]["condensation_time_s"]),
+            "members_with_bridges": sum(m["contacts_with_bridges"] > 0 for m in wet),
+            "max_bridged_summits": _percentiles([m["max_bridges"] for m in wet]),
+            "law": "a bridge on each summit, the mean field's law and clock (continuum.laws.discrete_bridges)"}
 
 
 @dataclass(frozen=True)
@@ -210,6 +225,7 @@ class EnsembleResult:
                               for s in sorted({o.status for o in self.outcomes})},
             "max_contacts": _percentiles([o.max_contacts for o in self.outcomes]),
             "energy_audit_max_relative_error": max(o.energy_error for o in self.outcomes),
+            "menisci": _menisci_summary(self.outcomes),
             "escape_velocity": self.escape_record(),
             "executor": self.executor, "wall_s": self.wall_s,
             "member_runs": [o.to_record() for o in self.outcomes]}
