@@ -188,7 +188,8 @@ def plastic_member(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
     decision = _members_plasticity(shared, float(speed))
     if not decision.used:
         return law
-    return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure)
+    return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure,
+                                           decision.summit_law)
 
 
 def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None) -> tuple[ContactLaw, dict]:
@@ -210,8 +211,9 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet,
                                       depth=estimate.depth if estimate is not None else None)
         if plastic.used and scene.surfaces.roughness.mode == "discrete":
-            law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure)
-        elif plastic.used:
+            law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure,
+                                                  plastic.summit_law)
+        elif plastic.used and plastic.summit_law == "jkr":
             law = factory.plastic_rigid_roller(scene, regime.e_star, plastic.limiting_pressure,
                                                record["datum"]["z_max"])
             record["table"] = {"used": False, "why": "plastic summits: the mean field is summed state by state "

@@ -1,0 +1,72 @@
+"""Cost of plastic summits in an ensemble against the elastic dry ensemble, measured in one run.
+
+    .venv/bin/python benchmarks/bench_plastic_summits.py [--members N] [--bounces N] [--params calibrated]
+                                                         [--json FILE]
+
+The `rough_silica` scene on the given parameter set (its hardness makes psi say the summits yield): the same N
+ensemble members (seeds 1..N, the scene's first-impact plan) run each with `physics.plasticity = 'off'` (the
+elastic dry members: the compiled discrete roller of the set's summit law) and with `'auto'` (each member's
+realisation with Thornton-Ning summits on that law, `continuum.laws.plastic_rough`), `--bounces` impacts each,
+in this process, one after the other. Reports the wall time of each and the ratio plastic/elastic. The issue's budget: ratio <= 2.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import platform
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from continuum.ensemble_run import member_law, member_plan, run_member  # noqa: E402
+from continuum.model.regime import first_impact_speed  # noqa: E402
+from continuum.scene import resolve_scene  # noqa: E402
+
+log = logging.getLogger("bench_plastic_summits")
+
+
+def _scene(params: str, plasticity: str, bounces: int):
+    return resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params=params,
+                         overrides={"physics.plasticity": plasticity, "numerics.max_bounces": bounces}).scene
+
+
+def measure(params: str, members: int, bounces: int) -> dict:
+    out: dict = {"params": params, "members": members, "bounces": bounces}
+    for label, choice in (("elastic", "off"), ("plastic", "auto")):
+        scene = _scene(params, choice, bounces)
+        plan = member_plan(scene, first_impact_speed(scene))
+        _, law, _ = member_law(scene, 1, plan)          # build shared tables outside the timing
+        start = time.perf_counter()
+        runs = [run_member(scene, seed, plan) for seed in range(1, members + 1)]
+        wall = time.perf_counter() - start
+        out[label] = {"wall_s": wall, "law": law.name, "statuses": [r.status for r in runs],
+                      "rebounds": [len(r.rebound_heights) for r in runs],
+                      "max_energy_error": max(r.energy_error for r in runs)}
+        log.info("%s: %s, %d members x %d bounces in %.2f s", label, law.name, members, bounces, wall)
+    out["ratio_plastic_over_elastic"] = out["plastic"]["wall_s"] / out["elastic"]["wall_s"]
+    out["machine"] = {"python": platform.python_version(), "platform": platform.platform()}
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--params", default="calibrated")
+    ap.add_argument("--members", type=int, default=2)
+    ap.add_argument("--bounces", type=int, default=3)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    res = measure(args.params, args.members, args.bounces)
+    text = json.dumps(res, indent=1)
+    if args.json:
+        args.json.write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
