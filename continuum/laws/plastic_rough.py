@@ -206,6 +206,12 @@ class PlasticSummitsPunch(ContactLaw):
         return self._w_total + dw - self._w0 + self._loops + jumps
 
     def release_gap(self):
+        stretch = getattr(self.law, "max_stretch", None)
+        if stretch is not None and not self._met.any():
+            # before any summit is met in this contact: a bound for the whole contact (R_p may still grow), where
+            # every summit has let go and is out of reach (the compiled form runs to it)
+            r_p, d_p = self.law.flattening(self.delta_max)
+            return float(np.max(self.heights - d_p)) - self.z_top + stretch
         met = self._met if self._met.any() else np.ones_like(self._met)
         r_p, d_p = self.law.flattening(self.delta_max[met])
         held = float(np.max(self.heights[met] - d_p - self.law.jump_out(r_p))) - self.z_top
@@ -229,6 +235,44 @@ class PlasticSummitsPunch(ContactLaw):
 
     def length_scale(self, mass, speed):
         return max(self._reach, self._approach_reach)
+
+    #: effective heights below which summits were not kept (m below the datum; the punch keeps all)
+    _lowest = -math.inf
+
+    def compiled(self, t0: float):
+        """The contact's compiled form (`continuum.rough.plastic_kernel`, `LAW_PLASTIC`) for summits of a
+        `PlasticBranchSummitLaw`; None for the closed-form JKR law (the Python stepper runs it)."""
+        if not hasattr(self.law, "max_stretch"):
+            return None
+        from .. import contact_kernel as ck
+        from ..compiled_contact import CompiledLaw
+        from ..rough.plastic_kernel import compiled_tables
+        P, T = compiled_tables(self.law, self.heights - self.z_top, self.delta_max, self.release_gap(),
+                               self.law.max_stretch, self._lowest)
+        return CompiledLaw(ck.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        """Take back a compiled contact: its deepest gap h_min fixes which summits jumped in and how deep each went
+        (`continuum.rough.plastic_kernel`); their plastic work and jump-in terms are booked as `accept` would."""
+        h_min = float(state[0])
+        self.max_contacts = max(self.max_contacts, int(state[2]))
+        if not math.isfinite(h_min):
+            return
+        law = self.law
+        # the summits the contact could reach (delta_p >= 0 and delta_in >= -reach): a prefix of the sorted heights
+        k = int(np.searchsorted(self._neg, -(self.z_top + h_min - law.max_stretch), side="right"))
+        dm0 = self.delta_max[:k]
+        deep = self.heights[:k] - self.z_top - h_min
+        r0, dp0 = law.flattening(dm0)
+        jumped = deep - dp0 >= law.jump_in(r0)
+        dm = np.where(jumped, np.maximum(dm0, deep), dm0)
+        self._w_total += float(np.sum(law.plastic_work(dm[jumped])) - np.sum(law.plastic_work(dm0[jumped])))
+        self._loops += float(np.sum(law.in_switch(r0[jumped])))
+        self.delta_max[:k] = dm
+        self._met[:k] |= jumped
+        self._attached[:] = False
+        self._attached[:k] = jumped
+        self._memo = None
 
     def diagnostics(self):
         yielded = self.delta_max > self.law.yield_approach
@@ -258,6 +302,7 @@ class PlasticDiscreteRoller(PlasticSummitsPunch):
     def __init__(self, law: PlasticSummitLaw, effective_heights, sigma: float, depth_keep: float):
         super().__init__(law, effective_heights)
         self.sigma, self.depth_keep = float(sigma), float(depth_keep)
+        self._lowest = -self.depth_keep
 
     def accept(self, gap):
         if -gap > self.depth_keep:

@@ -449,9 +449,9 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     member: `continuum.model.select.plastic_member`) or on the GW mean field (JKR summits; under another law the
     mean-field trajectory keeps elastic summits and says so, while the ensemble members yield). They sit on a rigid
     substrate without bridges, so under the half-space or menisci the summits stay elastic and the record says why.
-    Plastic Maugis-Dugdale and DMT summits have no compiled form yet and cost about two orders of magnitude more
-    than the compiled elastic members (benchmarks/bench_plastic_summits.py, docs/benchmarks.md): `choice` 'auto'
-    records that they yield and runs them elastic, saying so; 'on' (physics.plasticity) runs them.
+    Plastic Maugis-Dugdale and DMT summits run compiled (`continuum.rough.plastic_kernel`; their cost against the
+    elastic members: benchmarks/bench_plastic_summits.py, docs/benchmarks.md). `choice` is physics.plasticity
+    ('on' and 'auto' decide alike for rough contact; 'off' is handled by `plasticity_decision`).
     A p_y below the summits' adhesive stress scale (they would yield on snap-in, outside Thornton-Ning) is refused
     naming its key."""
     from ..limiting_pressure import partner_limits, softer_partner
@@ -476,9 +476,7 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     blockers = [text for cond, text in (
         (adhesion == "none", "the summits are not adhesive (the plastic summit laws are adhesive)"),
         (half_space, "the half-space roller carries elastic summits only"),
-        (adhesion in ("maugis_dugdale", "dmt") and choice != "on",
-         f"plastic {adhesion} summits run in Python, about two orders of magnitude slower than the compiled elastic "
-         "summits (benchmarks/bench_plastic_summits.py): set physics.plasticity = 'on' to run them"),
+
         (menisci, "the bridges' law wraps elastic summits")) if cond]
     used = yields and not blockers
     if used:

@@ -84,6 +84,7 @@ class PlasticBranchSummitLaw:
         self.delta_max = float(delta_max)
         self.sigma0 = DUGDALE_FACTOR * self.work_of_adhesion / self.z0
         self.self_similar = name in ("jkr", "dmt")
+        self.node_ratio = NODE_RATIO
         self._laws = [self._law(self.radius)]
         base = self._laws[0]
         #: stretch (m) at which the approach branch starts to pull (Maugis-Dugdale: h0; JKR, DMT: 0)
@@ -92,6 +93,7 @@ class PlasticBranchSummitLaw:
         if math.isinf(self.limiting_pressure):
             self.yield_radius = self.yield_force = self.yield_approach = math.inf
             self._d = np.zeros(1)
+            self.max_stretch = max(self.approach_reach, -float(base.delta_out))
             return
         a_y = self._yield_radius()
         f_y, d_y = self.force_approach(a_y, self.radius)
@@ -112,6 +114,7 @@ class PlasticBranchSummitLaw:
         self._r_p, self._d_p = r_p, d_p
         while not self.self_similar and self._laws[-1].radius_tip < r_p[-1]:
             self._laws.append(self._law(self.radius * NODE_RATIO ** len(self._laws)))
+        self.max_stretch = max(self.approach_reach, float(np.max(-self.jump_out(r_p))))
 
     # ------------------------------------------------------------------ the elastic law on radius R
     def _law(self, radius):
@@ -179,6 +182,8 @@ class PlasticBranchSummitLaw:
         """Weighted mean over the bracketing nodes of law_k's `fn`(delta, ...) at eps (m) scaled from R_p to R_k:
         delta_k = eps (R_k/R_p)^{1/3}; forces scale as R, energies as R^{4/3} (returned per `fn`'s kind)."""
         eps, r_p = np.broadcast_arrays(np.asarray(eps, float), np.asarray(r_p, float))
+        if np.all(r_p == self.radius):       # unflattened summits: node 0's own curve, scale 1
+            return np.asarray(fn(self._laws[0], eps, np.ones(eps.shape)), float) * np.ones(eps.shape)
         k, t = self._nodes(r_p)
         out = np.zeros(eps.shape)
         for kk in np.unique(k):
@@ -228,8 +233,12 @@ class PlasticBranchSummitLaw:
         if np.any(over > self._d[-1] * (1.0 + 1e-12)):
             raise ValueError(f"plastic summit: approach {float(np.max(dm)):.3g} m beyond the law's table "
                              f"({self.delta_max:.3g} m)")
-        r_p = np.where(over > 0.0, np.interp(over, self._d, self._r_p), self.radius)
-        return r_p, np.where(over > 0.0, np.interp(over, self._d, self._d_p), 0.0)
+        r_p, d_p = np.full(dm.shape, self.radius), np.zeros(dm.shape)
+        yielded = over > 0.0
+        if np.any(yielded):
+            r_p[yielded] = np.interp(over[yielded], self._d, self._r_p)
+            d_p[yielded] = np.interp(over[yielded], self._d, self._d_p)
+        return r_p, d_p
 
     def range_radius_ratio(self, delta_max):
         """a*/R_p (yielded) or a/beta (elastic) at the deepest state delta_max (m): the strain the law is used at."""
