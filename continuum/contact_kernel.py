@@ -184,17 +184,7 @@ def _jkr_root(d):
     return d, s
 
 
-@njit(cache=True)
-def _count_at_least(e, level):
-    """Number of entries of the descending array `e` that are >= level."""
-    lo, hi = 0, e.size
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if e[mid] >= level:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+_count_at_least = pk.count_at_least     # entries of a descending array >= a level (binary search)
 
 
 @njit(cache=True)

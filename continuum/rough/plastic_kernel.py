@@ -38,7 +38,8 @@ _S_H_MIN, _S_MAX_CONTACTS, _S_BEYOND_FLAG = 0, 2, 4
 
 
 @njit(cache=True)
-def _count_at_least(e, level):
+def count_at_least(e, level):
+    """Number of entries of the descending array `e` that are >= level (the compiled laws share it)."""
     lo, hi = 0, e.size
     while lo < hi:
         mid = (lo + hi) // 2
@@ -137,7 +138,7 @@ def plastic_value(gap, S, P, T, what):
     if hm - P[P_P_REACH] < P[P_P_LOWEST]:
         S[_S_BEYOND_FLAG] = 1.0
     # force, energy and count: the summits within reach of gap; the loss: every summit reached this contact
-    k = _count_at_least(e, (hm if what == 2 else gap) - P[P_P_REACH])
+    k = count_at_least(e, (hm if what == 2 else gap) - P[P_P_REACH])
     total = 0.0
     for i in range(k):
         r0, dp0, wp0, din0, dout = per[i], per[n + i], per[2 * n + i], per[3 * n + i], per[4 * n + i]
