@@ -155,3 +155,28 @@ def test_the_compiled_contact_is_the_python_law(md):
         assert booked_c == pytest.approx(booked_p, rel=1e-5)
         assert w_c == pytest.approx(w_p, rel=1e-6)
     assert out[True][0][2] > 0.0
+
+
+def test_calibrated_rough_silica_members_run_plastic_maugis_dugdale_summits_and_off_still_records_psi():
+    """The calibrated set (silicon hardness, MD-measured range: Maugis-Dugdale summits, psi > 1): auto gives each
+    ensemble member plastic Maugis-Dugdale summits; physics.plasticity = 'off' keeps them elastic and still
+    records psi = (E*/H) sqrt(sigma/beta)."""
+    from pathlib import Path
+
+    from continuum.ensemble_run import member_law, member_plan
+    from continuum.model import plasticity_decision
+    from continuum.model.regime import first_impact_speed, summit_e_star
+    from continuum.scene import resolve_scene
+
+    path = Path(__file__).resolve().parents[1] / "inputs" / "scenes" / "rough_silica.toml"
+    scene = resolve_scene(path, params="calibrated").scene
+    plan = member_plan(scene, first_impact_speed(scene))
+    _, law, _ = member_law(scene, 3, plan)
+    assert law.name == "rough_roller_discrete_plastic"
+    assert isinstance(law.law, PlasticBranchSummitLaw) and law.law.name == "maugis_dugdale"
+    off = resolve_scene(path, params="calibrated", overrides={"physics.plasticity": "off"}).scene
+    rec = plasticity_decision(off, "maugis_dugdale", 0.001).record()
+    rough = off.surfaces.roughness
+    psi = summit_e_star(off) / off.surfaces.substrate.hardness * math.sqrt(rough.sigma / rough.summit_radius)
+    assert not rec["used"] and rec["decided_by"] == "scene"
+    assert rec["plasticity_index"] == pytest.approx(psi, rel=1e-12) and rec["plasticity_index"] > 1.0
