@@ -138,7 +138,7 @@ class PlasticSummitsPunch(ContactLaw):
         self.heights = np.sort(np.asarray(heights, float))[::-1].copy()      # descending
         self._neg = -self.heights                                            # ascending, for searchsorted
         self.z_top = float(self.heights[0])
-        self._approach_reach = float(getattr(law, "approach_reach", 0.0))
+        self._approach_reach = float(law.approach_reach)
         self.touch_gap = self._approach_reach    # the tallest summit's attraction starts here
         self.forget_history()
 
@@ -206,7 +206,7 @@ class PlasticSummitsPunch(ContactLaw):
         return self._w_total + dw - self._w0 + self._loops + jumps
 
     def release_gap(self):
-        stretch = getattr(self.law, "max_stretch", None)
+        stretch = self.law.max_stretch
         if stretch is not None and not self._met.any():
             # before any summit is met in this contact: a bound for the whole contact (R_p may still grow), where
             # every summit has let go and is out of reach (the compiled form runs to it)
@@ -242,7 +242,7 @@ class PlasticSummitsPunch(ContactLaw):
     def compiled(self, t0: float):
         """The contact's compiled form (`continuum.rough.plastic_kernel`, `LAW_PLASTIC`) for summits of a
         `PlasticBranchSummitLaw`; None for the closed-form JKR law (the Python stepper runs it)."""
-        if not hasattr(self.law, "max_stretch"):
+        if not self.law.compiled_form:
             return None
         from .. import contact_kernel as ck
         from ..compiled_contact import CompiledLaw
@@ -279,9 +279,8 @@ class PlasticSummitsPunch(ContactLaw):
         r_p, d_p = self.law.flattening(self.delta_max[yielded])
         out = {"summits_yielded": int(np.sum(yielded)), "max_contacts": self.max_contacts, "plastic_summits": True,
                "plastic_work": self._w_total, "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
-        ratio = getattr(self.law, "range_radius_ratio", None)
-        if ratio is not None and yielded.any():
-            out["max_contact_radius_ratio"] = float(np.max(ratio(self.delta_max[yielded])))
+        if yielded.any():
+            out["max_contact_radius_ratio"] = float(np.max(self.law.range_radius_ratio(self.delta_max[yielded])))
         return out
 
     def describe(self):

@@ -75,6 +75,9 @@ class PlasticBranchSummitLaw:
     (m), work of adhesion w > 0 (J/m^2), contact modulus E* (Pa), limiting contact pressure p_y (Pa; inf:
     elastic), interaction range z0 (m, Maugis-Dugdale), table range delta_max (m). Vectorised over summits."""
 
+    #: the law has a compiled form (`continuum.rough.plastic_kernel`)
+    compiled_form = True
+
     def __init__(self, name: str, radius: float, work_of_adhesion: float, e_star: float, limiting_pressure: float,
                  *, z0: float = 0.3e-9, delta_max: float):
         if not work_of_adhesion > 0.0:

@@ -147,6 +147,20 @@ class PlasticSummitLaw:
                                                    self.e_star), float)
 
     # ---- the interface every plastic summit law offers (`continuum.rough.plastic_branches`): JKR's closed forms
+    #: no attraction before contact (zero-range adhesion); no bound on the release stretch over a contact (the
+    #: law is not compiled: the Python stepper asks for the release gap at every step)
+    approach_reach = 0.0
+    max_stretch = None
+    compiled_form = False
+
+    def range_radius_ratio(self, delta_max):
+        """a*/R_p at the deepest state delta_max (m) of yielded summits (a^2 = a_y^2 + beta (delta_max - delta_y))."""
+        dm = np.asarray(delta_max, float)
+        r_p, _ = self.flattening(dm)
+        over = np.maximum(dm - self.yield_approach, 0.0) if math.isfinite(self.yield_approach) else np.zeros(dm.shape)
+        a2 = np.where(over > 0.0, self.yield_radius**2 + self.radius * over, 0.0)
+        return np.sqrt(a2) / r_p
+
     @property
     def reach(self) -> float:
         """Stretch (m) below delta_p at which a virgin summit still pulls: its fold delta_c(beta)."""
