@@ -22,7 +22,7 @@ tolerance; `tests/test_contact_kernel.py` checks both):
   history from before it (Hairer, Norsett & Wanner, section II.6 on discontinuities).
 
 Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid rough roller's footprint tables, `continuum.laws.rough_rigid`;
-`LAW_DISCRETE`: a realisation of closed-form JKR or Hertz summits on a rigid substrate, `continuum.laws.discrete_roller`,
+`LAW_DISCRETE`: a realisation of closed-form JKR or Hertz summits on a rigid base (`continuum.laws.discrete_roller`)
 or, `LAW_DISCRETE_BRANCH`, of tabulated branches of any summit law; `LAW_PLASTIC`: elastic-plastic summits,
 `continuum.rough.plastic_kernel`; `LAW_POWER`: F = k (-h)^n, Hertz, to validate the integrator against closed forms)
 give parameters `P`, tables `T` (a tuple of arrays) and a history `S` that the kernel updates in place.
