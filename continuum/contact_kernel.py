@@ -21,12 +21,11 @@ tolerance; `tests/test_contact_kernel.py` checks both):
 * History laws are restarted at every extremum of the motion, so no stage after it uses the
   history from before it (Hairer, Norsett & Wanner, section II.6 on discontinuities).
 
-Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid-substrate rough roller's bicubic footprint
-tables, `continuum.laws.rough_rigid`; `LAW_DISCRETE`: a seeded realisation of JKR or Hertz summits on a
-rigid substrate, `continuum.laws.discrete_roller`, with closed-form JKR or Hertz summits or, `LAW_DISCRETE_BRANCH`,
-tabulated branches of any summit law; `LAW_POWER`: F = k (-h)^n, Hertz, used to validate the
-integrator against closed forms) give their parameters as a float array `P`, their tables as a
-tuple of arrays `T` and their history as a float array `S` that the kernel updates in place.
+Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid rough roller's footprint tables, `continuum.laws.rough_rigid`;
+`LAW_DISCRETE`: a realisation of closed-form JKR or Hertz summits on a rigid base (`continuum.laws.discrete_roller`)
+or, `LAW_DISCRETE_BRANCH`, of tabulated branches of any summit law; `LAW_PLASTIC`: elastic-plastic summits,
+`continuum.rough.plastic_kernel`; `LAW_POWER`: F = k (-h)^n, Hertz, to validate the integrator against closed forms)
+give parameters `P`, tables `T` (a tuple of arrays) and a history `S` that the kernel updates in place.
 
 Where the compiled law cannot evaluate a state (deeper than its tables, where the Python law
 evaluates its integral directly) or a buffer is full, the kernel returns a status saying so, and
@@ -41,12 +40,14 @@ import numpy as np
 from numba import njit
 
 from .dop853_tableau import A, B, C, D, E3, E5
+from .rough import plastic_kernel as pk
 
 #: Law kinds.
 LAW_RIGID_TABLE = 0
 LAW_POWER = 1
 LAW_DISCRETE = 2
 LAW_DISCRETE_BRANCH = 3
+LAW_PLASTIC = 4
 
 #: Ends of a kernel call (info[END]).
 END_RELEASE, END_STUCK, END_REST, END_MAX_TIME, END_STOP_TIME = 0, 1, 2, 3, 4
@@ -183,17 +184,7 @@ def _jkr_root(d):
     return d, s
 
 
-@njit(cache=True)
-def _count_at_least(e, level):
-    """Number of entries of the descending array `e` that are >= level."""
-    lo, hi = 0, e.size
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if e[mid] >= level:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+_count_at_least = pk.count_at_least     # entries of a descending array >= a level (binary search)
 
 
 @njit(cache=True)
@@ -351,6 +342,8 @@ def law_force(kind, gap, S, P, T):
         return _discrete_sum(gap, S, P, T, False)
     if kind == LAW_DISCRETE_BRANCH:
         return _branch_sum(gap, S, P, T, False) if gap < P[P_B_END_GAP] else 0.0
+    if kind == LAW_PLASTIC:
+        return pk.plastic_value(gap, S, P, T, 0)
     if gap >= P[P_END_GAP]:
         return 0.0
     if gap < P[P_H_LO]:
@@ -368,6 +361,8 @@ def law_stored(kind, gap, S, P, T):
         return _discrete_sum(gap, S, P, T, True) if gap < P[P_D_END_GAP] else 0.0
     if kind == LAW_DISCRETE_BRANCH:
         return _branch_sum(gap, S, P, T, True) if gap < P[P_B_END_GAP] else 0.0
+    if kind == LAW_PLASTIC:
+        return pk.plastic_value(gap, S, P, T, 1)
     if gap >= P[P_END_GAP] or (S[S_H_MIN] == math.inf and gap >= P[P_REACH]):
         return 0.0
     if gap < P[P_H_LO]:
@@ -383,6 +378,8 @@ def law_dissipated(kind, gap, S, P, T):
         return _discrete_dissipated(gap, S, P, T)
     if kind == LAW_DISCRETE_BRANCH:
         return _branch_dissipated(gap, S, P, T)
+    if kind == LAW_PLASTIC:
+        return pk.plastic_value(gap, S, P, T, 2)
     if kind == LAW_POWER or S[S_H_MIN] == math.inf:
         return 0.0
     return P[P_LOOP] * max(S[S_COUNT_MIN] - _rigid_attached(gap, S, P, T), 0.0)
@@ -395,6 +392,9 @@ def law_accept(kind, gap, S, P, T):
         return
     if kind == LAW_DISCRETE:
         _discrete_accept(gap, S, P, T)
+        return
+    if kind == LAW_PLASTIC:
+        pk.plastic_accept(gap, S, P, T)
         return
     if kind == LAW_DISCRETE_BRANCH:
         if gap < S[S_H_MIN]:

@@ -264,7 +264,7 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | str | None = None,
             raise SceneError("surfaces.roughness.tail_model", tail_model, "needs a height map (topography or "
                              "[surfaces.roughness.synthetic]); a scene given by its statistics has the 'gaussian' "
                              "tail", getattr(scene, "scene_file", "") or "")
-        from .map_ensembles import map_tail
+        from .map_tail import map_tail
         heights = map_tail(scene)[0]
     if first_impact:
         sc = first_impact_only(sc)

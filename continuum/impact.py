@@ -82,7 +82,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         result["warnings"] += band["warnings"]
     if condensation_sweep and menisci_decision(scene).choice != "off":
         from .wet_sweep import condensation_sweep as sweep
-        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers)
+        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers, rerun=run_impact)
         result["timing"]["wall_s"] = time.perf_counter() - start
     return result, run.trace.arrays()
 

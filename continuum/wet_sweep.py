@@ -18,6 +18,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import replace
+from typing import Any, Callable
 
 import numpy as np
 
@@ -68,11 +69,13 @@ def _single_contacts(result: dict) -> tuple[float, bool]:
     return longest, bool(wet.get("contacts_with_bridges", 0))
 
 
-def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, workers: int | None = None) -> dict:
+def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, workers: int | None = None, *,
+                       rerun: Callable[..., tuple[dict, Any]]) -> dict:
     """result.json -> menisci_condensation_time for the humid scene `resolved` whose run gave `result`: the scene's
-    t_a, the range the estimate allows, and the stick probability at each t_a of the grid (`t_a_grid`)."""
+    t_a, the range the estimate allows, and the stick probability at each t_a of the grid (`t_a_grid`). `rerun`
+    runs a single (non-ensemble) scene again (`continuum.impact.run_impact`, passed in by its caller)."""
     from .ensemble_run import run_ensemble
-    from .impact import run_impact
+    run_impact = rerun
 
     scene = resolved.scene
     rng = condensation_time_range(scene)

@@ -11,6 +11,7 @@ from scipy import integrate
 
 from continuum import menisci as men
 from continuum.ensemble_run import run_ensemble
+from continuum.impact import run_impact
 from continuum.laws.discrete_bridges import DiscreteBridges, wet_discrete
 from continuum.laws.discrete_roller import DiscreteRoughRoller
 from continuum.model.regime import condensation_time, meniscus_parameters
@@ -213,11 +214,27 @@ def test_a_humid_member_runs_its_summits_at_the_wet_work_of_adhesion():
     from continuum.ensemble_run import member_law, member_plan
     from continuum.model.regime import first_impact_speed
 
-    scene = resolve_scene("wet_silica", params="calibrated", overrides={"surfaces.roughness.mode": "ensemble"}).scene
+    # elastic summits (plasticity off): the calibrated silicon's hardness makes psi > 0.6, and plastic summits keep
+    # the dry loop inside a bridge (the next test)
+    scene = resolve_scene("wet_silica", params="calibrated", overrides={"surfaces.roughness.mode": "ensemble",
+                                                                        "physics.plasticity": "off"}).scene
     _, law = member_law(scene, 7, member_plan(scene, first_impact_speed(scene)))
     inside = law.describe()["inside_bridges"]
     assert inside["work_of_adhesion"] == pytest.approx(meniscus_parameters(scene)["work_of_adhesion_wet"])
     assert law.bridges.solid_pull == 0.0 and "maugis_dugdale" in inside["summit_law"]
+
+
+def test_a_humid_plastic_member_keeps_its_bridges_with_the_dry_loop_and_says_so():
+    """Where the summits yield (calibrated silicon, psi > 0.6) a member carries its bridges on plastic summits; the
+    solids inside a bridge keep the dry summit law with the mean field's DMT correction, and the record says why."""
+    from continuum.ensemble_run import member_law, member_plan
+    from continuum.model.regime import first_impact_speed
+
+    scene = resolve_scene("wet_silica", params="calibrated", overrides={"surfaces.roughness.mode": "ensemble"}).scene
+    _, law = member_law(scene, 7, member_plan(scene, first_impact_speed(scene)))
+    text = str(law.describe())
+    assert "plastic summits" in text and "inside_bridges" not in law.describe()
+    assert law.bridges.solid_pull > 0.0
 
 
 def test_a_humid_scene_reports_its_sticking_against_t_a():
@@ -265,7 +282,7 @@ def test_the_t_a_sweep_runs_again_exactly_the_points_that_can_differ(monkeypatch
     ens = {"stick_probability": {"first_impact": {"value": 0.0, "interval": [0.0, 0.06]},
                                  "within_run": {"value": 0.0, "interval": [0.0, 0.06], "censored": 0}},
            "member_runs": [member, member]}
-    block = wet_sweep.condensation_sweep(resolved, {"ensemble": ens})
+    block = wet_sweep.condensation_sweep(resolved, {"ensemble": ens}, rerun=run_impact)
     expect = [t for t in wet_sweep.t_a_grid(25e-6, lo, hi) if t != 25e-6 and t <= longest]
     assert asked == expect and len(expect) >= 2
     for p in block["points"]:
@@ -274,5 +291,5 @@ def test_the_t_a_sweep_runs_again_exactly_the_points_that_can_differ(monkeypatch
         assert p["stick_probability_within_run"] == (0.75 if rerun else 0.0)
     asked.clear()
     member["menisci"]["contacts_with_bridges"] = 1    # a bridge formed: every other point can differ
-    wet_sweep.condensation_sweep(resolved, {"ensemble": ens})
+    wet_sweep.condensation_sweep(resolved, {"ensemble": ens}, rerun=run_impact)
     assert len(asked) == len(wet_sweep.t_a_grid(25e-6, lo, hi)) - 1

@@ -53,6 +53,18 @@ def test_the_calibrated_set_measures_what_the_project_can_and_declares_the_rest(
     assert meta["replaced"]["surfaces.roughness.summit_modulus"]["base_value"] == 10e9
 
 
+@pytest.mark.parametrize("path", SETS, ids=lambda p: p.stem)
+def test_every_shipped_set_gives_each_materials_hardness_with_its_source(path):
+    """The summits' plasticity index needs a hardness (issue 42): each partner's, a material value with its
+    source, in the range nanoindentation measures for silicon and fused silica (8-13 GPa)."""
+    meta, flat = _set(path)
+    for side in ("body", "substrate"):
+        key = f"surfaces.{side}.hardness"
+        assert 8e9 <= flat[key] <= 13e9, key
+        entry = meta["origin"][key]
+        assert entry["kind"] == "material" and entry["source"].strip(), key
+
+
 def _write(tmp_path, origin_lines: str, body: str = "[surfaces]\nwork_of_adhesion = 0.3\n") -> Path:
     path = tmp_path / "mine.toml"
     path.write_text("[meta.origin]\n" + origin_lines + body if origin_lines is not None else body)

@@ -218,3 +218,15 @@ def test_bounces_under_gravity_meet_the_flattened_spot():
         assert b.restitution == pytest.approx(math.sqrt(1.0 - loop / (0.5 * MASS * b.v_impact**2)), rel=1e-6)
     assert law.diagnostics()["impacts_yielded"] == 1
     assert run.audit["max_relative_error"] < 1e-6
+
+
+@pytest.mark.parametrize("speed,beyond", [(2.0, False), (50.0, True)])
+def test_the_sphere_reports_its_contact_radius_against_the_laws_range(speed, beyond):
+    """a*/R at the deepest state is the closed form's (the law's own flattening) and is flagged beyond the
+    small-strain bound: 2 m/s stays inside it, 50 m/s (a*/R ~ 0.6) does not."""
+    law = _law()
+    single_impact(law, MASS, 0.0, speed, RTOL)
+    diag = law.diagnostics()
+    assert diag["max_contact_radius_ratio"] == pytest.approx(
+        tn.contact_radius_ratio(speed, R, W, E_STAR, RHO, P_Y), rel=1e-6)
+    assert diag["beyond_law_range"] is beyond

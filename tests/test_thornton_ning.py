@@ -4,6 +4,8 @@ elastic capture when the contact does not yield, e ~ v^(-1/4) at high speed, and
 bookkeeping checked by quadrature of the force law itself."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy.integrate import quad
@@ -183,3 +185,16 @@ def test_vectorised_impact_equals_scalar_calls():
     for i, vi in enumerate(v):
         one = tn.impact(vi, R, W, E_STAR, RHO, PY)
         assert one.restitution[0] == r.restitution[i] and one.plastic_radius[0] == r.plastic_radius[i]
+
+
+def test_contact_radius_ratio_is_hertz_without_adhesion_and_flags_the_fast_acceptance_points():
+    """a*/R: without adhesion and yield it is Hertz's sqrt(delta*/R), delta* = (15 m v^2/(16 E* sqrt R))^(2/5);
+    the acceptance case (R 2.45 um, E* 1.309 GPa, rho 1350, w 0.2, p_y 35.3 MPa) passes the law's small-strain
+    bound by 20 m/s, so the validation page flags 50-100 m/s."""
+    r, e, rho = 2.45e-6, 1.309e9, 1350.0
+    m = tn.sphere_mass(r, rho)
+    for v in (0.5, 5.0):
+        d = (15.0 * m * v * v / (16.0 * e * math.sqrt(r))) ** 0.4
+        assert tn.contact_radius_ratio(v, r, 0.0, e, rho, math.inf) == pytest.approx(math.sqrt(d / r), rel=1e-9)
+    ratio = [float(tn.contact_radius_ratio(v, r, 0.2, e, rho, 35.3e6)) for v in (2.0, 50.0, 100.0)]
+    assert ratio[0] < tn.LAW_RANGE_RADIUS_RATIO < ratio[1] < ratio[2]

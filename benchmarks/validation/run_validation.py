@@ -211,6 +211,10 @@ def restitution_case(name, ds, simulate):
         point = {"velocity": v, "measured_floor": e_floor, "elastic_band": el,
                  "tn_band": [min(tnb), max(tnb)] if tnb else None,
                  "tn_inapplicable_w": [w for w, x in tn_w.items() if x is None]}
+        ratios = [float(tn.contact_radius_ratio(v, r, w, e_star, rho, p_y)) for w, x in tn_w.items() if x is not None]
+        point["tn_radius_ratio"] = max(ratios) if ratios else None
+        point["tn_beyond_range"] = bool(ratios) and max(ratios) > tn.LAW_RANGE_RADIUS_RATIO
+        point["tn_range"] = tn.LAW_RANGE_RADIUS_RATIO
         if simulate:
             point["simulator_work_of_adhesion"] = w_mid
             point["simulator"], point["simulator_error"] = _try_simulator(

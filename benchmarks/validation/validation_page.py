@@ -92,7 +92,9 @@ def _restitution(res, ds, simulate):
         na = p["tn_inapplicable_w"]
         tn_txt = f"{_band(p['tn_band'], 3)} ({_lost(p['tn_band'])})" + (
             f"; not applicable at w = {', '.join(f'{w:g}' for w in na)} J/m^2 (p_y below the adhesive stress "
-            "scale)" if na else "")
+            "scale)" if na else "") + (
+            f"; **beyond the law's range**: a*/R = {p['tn_radius_ratio']:.2f} > {p['tn_range']:g} (small-strain "
+            "Hertz/JKR relations)" if p.get("tn_beyond_range") else "")
         lines.append(f"| {p['velocity']:g} | {_band(p['elastic_band'], 4)} ({_lost(p['elastic_band'])}) | "
                      f"{tn_txt} | {sim_txt} | {plastic_txt} |")
     if agree:

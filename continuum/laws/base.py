@@ -33,6 +33,9 @@ class ContactLaw(ABC):
     time_dependent : bool
         True if the force also depends on the time since touch (capillary bridges condensing);
         the driver then calls `set_time` before every evaluation and cuts steps at `time_events`.
+    has_rigid_approach : bool
+        True if the law has a rigid approach branch and so a `quasi_static_depth(energy, weight)` (the rough
+        rollers); the wet law sizes the bridges' extra pull with it.
     """
 
     name: str = "law"
@@ -40,6 +43,7 @@ class ContactLaw(ABC):
     bound_is_final: bool = True
     has_history: bool = False
     time_dependent: bool = False
+    has_rigid_approach: bool = False
 
     def set_time(self, t_contact: float) -> None:
         """Time-dependent laws (`time_dependent`): the contact time (s since this impact's touch) of the

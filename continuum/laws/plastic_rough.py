@@ -117,30 +117,35 @@ class PlasticGWRoller(PlasticGWPunch):
 
 
 class PlasticSummitsPunch(ContactLaw):
-    """Rigid flat on discrete `PlasticSummitLaw` summits of heights z (m); gap = d - max(z) (m).
+    """Rigid flat on discrete adhesive elastic-plastic summits of heights z (m); gap = d - max(z) (m).
 
-    Each summit carries its deepest approach (hence R_p and delta_p) into later contacts; `forget_history` returns
-    them to virgin summits. A summit is met at delta = delta_p (its force jumps onto the JKR curve of R_p there, at
-    no cost in energy) and lets go at the fold delta_p - delta_c(R_p), booking that branch's loop.
+    The summit law is `PlasticSummitLaw` (JKR, closed form) or `PlasticBranchSummitLaw` (Thornton-Ning's
+    construction on any law of the Tabor range). Each summit carries its deepest approach (hence R_p and delta_p)
+    into later contacts; `forget_history` returns them to virgin summits. A summit jumps onto its retreat branch at
+    delta_p + delta_in(R_p), lets go at delta_p + delta_out(R_p), and otherwise exerts its approach branch's force
+    (the Maugis-Dugdale attraction before contact; none for JKR). The jumps book U_A - U_R (in) and U_R - U_A (out),
+    whose sum is the loop of the R_p curve.
 
-    Cost: the summits are kept sorted by height, and a state is evaluated on the prefix that can be attached
-    (delta_i >= -max delta_c(R_p), since delta_p >= 0), so a call costs O(summits within reach)."""
+    Cost: the summits are kept sorted by height, and a state is evaluated on the prefix that can pull or be
+    attached (delta_i >= -max(reach, stretch), since delta_p >= 0), so a call costs O(summits within reach)."""
 
     name = "plastic_summits_punch"
     has_history = True
     bound_is_final = True
 
-    def __init__(self, law: PlasticSummitLaw, heights):
+    def __init__(self, law, heights):
         self.law = law
         self.heights = np.sort(np.asarray(heights, float))[::-1].copy()      # descending
         self._neg = -self.heights                                            # ascending, for searchsorted
         self.z_top = float(self.heights[0])
+        self._approach_reach = float(law.approach_reach)
+        self.touch_gap = self._approach_reach    # the tallest summit's attraction starts here
         self.forget_history()
 
     def forget_history(self) -> None:
         self.delta_max = np.zeros_like(self.heights)      # 0 < delta_y: virgin summits
         self.max_contacts = 0
-        self._reach = float(self.law.release_stretch(self.law.radius))
+        self._reach = max(self._approach_reach, float(-self.law.jump_out(np.array([self.law.radius]))[0]))
         self._w_total = 0.0                               # plastic work of the accepted state (J)
         self.reset()
 
@@ -152,35 +157,39 @@ class PlasticSummitsPunch(ContactLaw):
         self._memo = None
 
     def _prefix(self, gap) -> int:
-        """Summits that can be attached at gap: delta_i = z_i - z_top - gap >= -reach."""
+        """Summits that can pull or be attached at gap: delta_i = z_i - z_top - gap >= -reach."""
         return int(np.searchsorted(self._neg, -(self.z_top + gap - self._reach), side="right"))
 
     def _trial(self, gap):
-        """(k, delta, attached, deepest approach, loops letting go now, plastic work change) on the first k summits;
+        """(k, delta, attached, deepest approach, jumps booked now, plastic work change) on the first k summits;
         summits beyond k keep their accepted state and are free."""
         if self._memo is not None and self._memo[0] == gap:
             return self._memo[1]
+        law = self.law
         k = max(self._prefix(gap), int(np.flatnonzero(self._attached)[-1]) + 1 if self._attached.any() else 0)
         delta = self.heights[:k] - self.z_top - gap
         dm0, held = self.delta_max[:k], self._attached[:k]
-        r_p, d_p = self.law.flattening(dm0)
-        attached = (delta >= d_p) | (held & (delta > d_p - self.law.release_stretch(r_p)))
-        lost = held & ~attached
+        r_p, d_p = law.flattening(dm0)
+        eps = delta - d_p
+        attached = (eps >= law.jump_in(r_p)) | (held & (eps > law.jump_out(r_p)))
+        lost, gained = held & ~attached, attached & ~held
         dm = np.where(attached, np.maximum(dm0, delta), dm0)
         grew = dm > dm0
-        loops = float(np.sum(self.law.loop_energy(dm0[lost]))) if lost.any() else 0.0
-        dw = (float(np.sum(self.law.plastic_work(dm[grew])) - np.sum(self.law.plastic_work(dm0[grew])))
+        jumps = float(np.sum(law.out_switch(r_p[lost]))) if lost.any() else 0.0
+        if gained.any():
+            jumps += float(np.sum(law.in_switch(r_p[gained])))
+        dw = (float(np.sum(law.plastic_work(dm[grew])) - np.sum(law.plastic_work(dm0[grew])))
               if grew.any() else 0.0)
-        out = (k, delta, attached, dm, loops, dw)
+        out = (k, delta, attached, dm, jumps, dw)
         self._memo = (gap, out)
         return out
 
     def _values(self, gap):
-        k, delta, att, dm, loops, dw = self._trial(gap)
-        if not att.any():
-            return 0.0, 0.0, loops, dw
-        f, en = self.law.branch(delta[att], dm[att])
-        return float(np.sum(f)), float(np.sum(en)), loops, dw
+        k, delta, att, dm, jumps, dw = self._trial(gap)
+        if k == 0:
+            return 0.0, 0.0, jumps, dw
+        f, en = self.law.state(delta, dm, att)
+        return float(np.sum(f)), float(np.sum(en)), jumps, dw
 
     def force(self, gap):
         return self._values(gap)[0]
@@ -193,38 +202,86 @@ class PlasticSummitsPunch(ContactLaw):
         return self._values(gap)[1]
 
     def dissipated(self, gap):
-        _, _, loops, dw = self._values(gap)
-        return self._w_total + dw - self._w0 + self._loops + loops
+        _, _, jumps, dw = self._values(gap)
+        return self._w_total + dw - self._w0 + self._loops + jumps
 
     def release_gap(self):
+        stretch = self.law.max_stretch
+        if stretch is not None and not self._met.any():
+            # before any summit is met in this contact: a bound for the whole contact (R_p may still grow), where
+            # every summit has let go and is out of reach (the compiled form runs to it)
+            r_p, d_p = self.law.flattening(self.delta_max)
+            return float(np.max(self.heights - d_p)) - self.z_top + stretch
         met = self._met if self._met.any() else np.ones_like(self._met)
         r_p, d_p = self.law.flattening(self.delta_max[met])
-        return float(np.max(self.heights[met] - d_p + self.law.release_stretch(r_p))) - self.z_top
+        held = float(np.max(self.heights[met] - d_p - self.law.jump_out(r_p))) - self.z_top
+        return max(held, self._approach_reach) if self._approach_reach > 0.0 else held
 
     def on_release(self):
         held = self._attached
-        return (self._w_total - self._w0 + self._loops
-                + float(np.sum(self.law.loop_energy(self.delta_max[held]))))
+        r_p = self.law.flattening(self.delta_max[held])[0]
+        return self._w_total - self._w0 + self._loops + float(np.sum(self.law.out_switch(r_p)))
 
     def accept(self, gap):
-        k, _, att, dm, loops, dw = self._trial(gap)
-        self._loops += loops
+        k, _, att, dm, jumps, dw = self._trial(gap)
+        self._loops += jumps
         self._w_total += dw
         self._attached[:k], self.delta_max[:k] = att, dm
         self._met[:k] |= att
         self._memo = None
         self.max_contacts = max(self.max_contacts, int(att.sum()))
         if att.any():
-            self._reach = max(self._reach, float(np.max(self.law.release_stretch(self.law.flattening(dm[att])[0]))))
+            self._reach = max(self._reach, float(np.max(-self.law.jump_out(self.law.flattening(dm[att])[0]))))
 
     def length_scale(self, mass, speed):
-        return float(self.law.release_stretch(self.law.radius))
+        return max(self._reach, self._approach_reach)
+
+    #: effective heights below which summits were not kept (m below the datum; the punch keeps all)
+    _lowest = -math.inf
+
+    def compiled(self, t0: float):
+        """The contact's compiled form (`continuum.rough.plastic_kernel`, `LAW_PLASTIC`) for summits of a
+        `PlasticBranchSummitLaw`; None for the closed-form JKR law (the Python stepper runs it)."""
+        if not self.law.compiled_form:
+            return None
+        from .. import contact_kernel as ck
+        from ..compiled_contact import CompiledLaw
+        from ..rough.plastic_kernel import compiled_tables
+        P, T = compiled_tables(self.law, self.heights - self.z_top, self.delta_max, self.release_gap(),
+                               self.law.max_stretch, self._lowest)
+        return CompiledLaw(ck.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        """Take back a compiled contact: its deepest gap h_min fixes which summits jumped in and how deep each went
+        (`continuum.rough.plastic_kernel`); their plastic work and jump-in terms are booked as `accept` would."""
+        h_min = float(state[0])
+        self.max_contacts = max(self.max_contacts, int(state[2]))
+        if not math.isfinite(h_min):
+            return
+        law = self.law
+        # the summits the contact could reach (delta_p >= 0 and delta_in >= -reach): a prefix of the sorted heights
+        k = int(np.searchsorted(self._neg, -(self.z_top + h_min - law.max_stretch), side="right"))
+        dm0 = self.delta_max[:k]
+        deep = self.heights[:k] - self.z_top - h_min
+        r0, dp0 = law.flattening(dm0)
+        jumped = deep - dp0 >= law.jump_in(r0)
+        dm = np.where(jumped, np.maximum(dm0, deep), dm0)
+        self._w_total += float(np.sum(law.plastic_work(dm[jumped])) - np.sum(law.plastic_work(dm0[jumped])))
+        self._loops += float(np.sum(law.in_switch(r0[jumped])))
+        self.delta_max[:k] = dm
+        self._met[:k] |= jumped
+        self._attached[:] = False
+        self._attached[:k] = jumped
+        self._memo = None
 
     def diagnostics(self):
         yielded = self.delta_max > self.law.yield_approach
         r_p, d_p = self.law.flattening(self.delta_max[yielded])
-        return {"summits_yielded": int(np.sum(yielded)), "max_contacts": self.max_contacts, "plastic_summits": True,
-                "plastic_work": self._w_total, "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
+        out = {"summits_yielded": int(np.sum(yielded)), "max_contacts": self.max_contacts, "plastic_summits": True,
+               "plastic_work": self._w_total, "plastic_radius": r_p.tolist(), "plastic_approach": d_p.tolist()}
+        if yielded.any():
+            out["max_contact_radius_ratio"] = float(np.max(self.law.range_radius_ratio(self.delta_max[yielded])))
+        return out
 
     def describe(self):
         return {"name": self.name, "summits": int(self.heights.size), "summit_law": self.law.describe(),
@@ -244,6 +301,7 @@ class PlasticDiscreteRoller(PlasticSummitsPunch):
     def __init__(self, law: PlasticSummitLaw, effective_heights, sigma: float, depth_keep: float):
         super().__init__(law, effective_heights)
         self.sigma, self.depth_keep = float(sigma), float(depth_keep)
+        self._lowest = -self.depth_keep
 
     def accept(self, gap):
         if -gap > self.depth_keep:

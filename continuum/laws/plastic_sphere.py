@@ -173,8 +173,15 @@ class PlasticJKRSphere(ContactLaw):
         return max(min(hertz, plastic), self._branch.delta_c, self.yield_approach)
 
     def diagnostics(self):
-        return {"impacts_yielded": self._impacts_yielded, "plastic_radius": self._branch.radius,
-                "plastic_approach": self._offset, "max_plastic_approach": max(self._limit, self.yield_approach)}
+        """The flattening, and a*/R at the deepest plastic state against the law's small-strain bound
+        (`thornton_ning.LAW_RANGE_RADIUS_RATIO`): beyond it the law is used outside the range it was derived for."""
+        out = {"impacts_yielded": self._impacts_yielded, "plastic_radius": self._branch.radius,
+               "plastic_approach": self._offset, "max_plastic_approach": max(self._limit, self.yield_approach)}
+        if self._impacts_yielded:
+            a = math.sqrt(self.yield_radius**2 + self.radius * (self._limit - self.yield_approach))
+            out.update(max_contact_radius_ratio=a / self.radius, law_range_radius_ratio=tn.LAW_RANGE_RADIUS_RATIO,
+                       beyond_law_range=a / self.radius > tn.LAW_RANGE_RADIUS_RATIO)
+        return out
 
     def describe(self):
         return {"name": self.name, "source": "Thornton & Ning (1998): JKR loading to yield, plastic line "

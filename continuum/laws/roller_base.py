@@ -46,6 +46,7 @@ class RoughRollerBase(ContactLaw):
     touch_gap = 0.0
     bound_is_final = True
     has_history = True
+    has_rigid_approach = True
 
     #: the name a refused depth search gives the contact
     depth_search_name = "rough contact"

@@ -242,7 +242,7 @@ class WetRoughRoller(ContactLaw):
         Bridges can pull the roller deeper than the dry estimate; their force at twice the dry
         quasi-static depth with every summit within D_K bridged bounds the pull over the contact.
         """
-        if not hasattr(self.dry, "quasi_static_depth"):
+        if not self.dry.has_rigid_approach:
             # a summit law without a rigid approach branch (plastic summits keep every summit they may reach)
             self.design_pull = 0.0
             self.dry.prepare(mass, speed, gravity)

@@ -384,6 +384,8 @@ class PlasticityDecision:
     """Rough contact: the approach (m) at which a summit yields (JKR centre pressure = p_y)."""
     estimated_depth: float | None = None
     """Rough contact: the first impact's estimated depth below the tallest summit (m), where estimated."""
+    summit_law: str | None = None
+    """Rough contact: the elastic summit law the plastic summits are built on ('jkr', 'maugis_dugdale', 'dmt')."""
 
     def record(self) -> dict:
         rec: dict = {}
@@ -393,7 +395,7 @@ class PlasticityDecision:
         if self.plasticity_index is not None:
             rec.update(plasticity_index=self.plasticity_index, summits_yield=self.summits_yield,
                        summit_yield_approach=self.summit_yield_approach, estimated_depth=self.estimated_depth,
-                       limiting_pressure=self.limiting_pressure, from_key=self.from_key,
+                       limiting_pressure=self.limiting_pressure, from_key=self.from_key, summit_law=self.summit_law,
                        thresholds={"elastic_below": PSI_ELASTIC, "plastic_above": PSI_PLASTIC},
                        source="Greenwood & Williamson, Proc. R. Soc. Lond. A 295 (1966) 300")
         if self.yield_velocity is not None:
@@ -427,19 +429,24 @@ def _summit_yield_approach(scene: Scene, limiting_pressure: float, e_s: float) -
 
 
 def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = False, menisci: bool = False,
-                      depth: float | None = None) -> PlasticityDecision:
+                      depth: float | None = None, choice: str = "auto") -> PlasticityDecision:
     """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
     (the summits' E*, `summit_e_star`; the softer partner's limiting pressure p_y, H or 2.8 Y) decides for the
     surface under any practical load; the first impact's estimated depth below the tallest summit (`depth`, m,
     `continuum.estimates`) beyond a summit's yield approach delta_y decides for an impact hard enough to yield
     the tallest summits of an otherwise elastic surface.
 
-    Where they yield, Thornton-Ning summits under a rigid roller run (`continuum.laws.plastic_rough`: the GW mean
-    field, or the discrete realisation in mode 'discrete'); they are JKR summits over a rigid substrate without
-    bridges, so under another summit law (`adhesion`), the half-space or menisci the summits stay elastic and the
-    record says why; ensemble members take the same decision (`continuum.model.select.plastic_member`). A p_y below
-    the summits' adhesive stress scale (they would yield on snap-in, outside Thornton-Ning) is refused naming its
-    key."""
+    Where they yield, adhesive elastic-plastic summits under a rigid roller run (`continuum.laws.plastic_rough`):
+    Thornton-Ning's construction on the summit law that runs (`adhesion`: JKR, Maugis-Dugdale or DMT,
+    `continuum.rough.plastic_branches`), on each summit of the realisation (mode 'discrete', and every ensemble
+    member: `continuum.model.select.plastic_member`) or on the GW mean field (JKR summits; under another law the
+    mean-field trajectory keeps elastic summits and says so, while the ensemble members yield). They sit on a rigid
+    substrate without bridges, so under the half-space or menisci the summits stay elastic and the record says why.
+    Plastic Maugis-Dugdale and DMT summits run compiled (`continuum.rough.plastic_kernel`; their cost against the
+    elastic members: benchmarks/bench_plastic_summits.py, docs/benchmarks.md). `choice` is physics.plasticity
+    ('on' and 'auto' decide alike for rough contact; 'off' is handled by `plasticity_decision`).
+    A p_y below the summits' adhesive stress scale (they would yield on snap-in, outside Thornton-Ning) is refused
+    naming its key."""
     from ..limiting_pressure import partner_limits, softer_partner
 
     limits = tuple(partner_limits(_yield_values(scene)))
@@ -460,22 +467,26 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
         why += (f"; the first impact's estimated depth {depth:.3g} m " + (">" if by_depth else "<=")
                 + f" the summits' yield approach {d_y:.3g} m")
     blockers = [text for cond, text in (
-        (adhesion != "jkr", f"the summit law is '{adhesion}' (Thornton-Ning summits are JKR summits)"),
+        (adhesion == "none", "the summits are not adhesive (the plastic summit laws are adhesive)"),
         (half_space, "the half-space roller carries elastic summits only"),
+
         (menisci, "the bridges' law wraps elastic summits")) if cond]
     used = yields and not blockers
     if used:
         _check_summit_limit(scene, soft, e_s)
-        why += (": Thornton-Ning summits under a rigid roller, " + ("each summit of the realisation"
-                if rough.mode == "discrete" else "their GW mean field"))
-        if rough.mode in ("auto", "ensemble"):
+        why += (f": Thornton-Ning's construction on the {adhesion} summits under a rigid roller, "
+                + ("each summit of the realisation" if rough.mode == "discrete" else
+                   "their GW mean field" if adhesion == "jkr" else
+                   "each ensemble member's realisation (the mean field of plastic summits is summed for JKR summits "
+                   "only: the mean-field trajectory keeps elastic summits)"))
+        if rough.mode in ("auto", "ensemble") and adhesion == "jkr":
             why += " (and each ensemble member's realisation, where an ensemble runs)"
     elif yields:
         why += "; " + "; ".join(blockers) + ": this run is elastic and overestimates the rebound"
     return PlasticityDecision(used, "plasticity_index" if by_psi or not by_depth else "estimated_depth", why,
                               limiting_pressure=soft.limiting_pressure, from_key=soft.key, partners=limits,
                               plasticity_index=psi, summits_yield=yields, summit_yield_approach=d_y,
-                              estimated_depth=depth)
+                              estimated_depth=depth, summit_law=adhesion)
 
 
 def _check_summit_limit(scene: Scene, soft, e_s: float) -> None:
@@ -503,9 +514,20 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
 
     choice = scene.physics.plasticity
     if choice == "off":
-        return PlasticityDecision(False, "scene", "physics.plasticity = 'off' set in the scene")
+        off = PlasticityDecision(False, "scene", "physics.plasticity = 'off' set in the scene")
+        if scene.contact == "rough":     # psi is still evaluated and recorded, for the reader
+            from nanoimpact.errors import InputError
+            try:
+                rough = summit_plasticity(scene, adhesion, half_space, menisci, depth, "auto")
+            except InputError:
+                return off
+            if rough.plasticity_index is not None:
+                state = "summits would yield" if rough.summits_yield else "summits stay elastic"
+                return replace(rough, used=False, decided_by="scene", why=off.why + f" (plasticity index psi = "
+                               f"{rough.plasticity_index:.3g}: {state})")
+        return off
     if scene.contact == "rough":
-        return summit_plasticity(scene, adhesion, half_space, menisci, depth)
+        return summit_plasticity(scene, adhesion, half_space, menisci, depth, choice)
     if scene.body.shape != "sphere":
         return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; a smooth "
                                   "roller stays elastic (the line-contact yield warning says where it would yield)")

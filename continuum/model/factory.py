@@ -7,6 +7,8 @@ numbers, and returns the built object; nothing here decides or records.
 """
 from __future__ import annotations
 
+import functools
+
 from ..laws.base import ContactLaw
 from ..scene import Scene
 
@@ -65,26 +67,42 @@ def rigid_roller(surface, radius: float, length: float, resolution: str = "stand
     return RigidRoughRoller(surface, radius, length, resolution=resolution)
 
 
+@functools.lru_cache(maxsize=16)
+def _plastic_summit_law(name: str, radius: float, work_of_adhesion: float, summit_e_star: float,
+                        limiting_pressure: float, z0: float, delta_max: float):
+    from ..rough.plastic_branches import PlasticBranchSummitLaw
+    from ..rough.plastic_summits import PlasticSummitLaw
+    if name == "jkr":
+        return PlasticSummitLaw(radius, work_of_adhesion, summit_e_star, limiting_pressure)
+    return PlasticBranchSummitLaw(name, radius, work_of_adhesion, summit_e_star, limiting_pressure, z0=z0,
+                                  delta_max=delta_max)
+
+
+def plastic_summit_law(scene: Scene, name: str, summit_e_star: float, limiting_pressure: float):
+    """One summit's adhesive elastic-plastic law on the summit law `name`: JKR's Thornton-Ning closed forms, or
+    Thornton-Ning's construction on the tabulated Maugis-Dugdale / DMT law (tabulated to 30 sigma, as the elastic
+    summit law). Built once per process for a set of numbers (an ensemble's members share it)."""
+    surf = scene.surfaces
+    return _plastic_summit_law(name, surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star,
+                               limiting_pressure, surf.interface_interaction_range, 30.0 * surf.roughness.sigma)
+
+
 def plastic_rigid_roller(scene: Scene, summit_e_star: float, limiting_pressure: float, z_max: float) -> ContactLaw:
-    """Rigid roller on the GW mean field of Thornton-Ning summits over a rigid substrate (summits of the scene's
+    """Rigid roller on the GW mean field of Thornton-Ning JKR summits over a rigid substrate (summits of the scene's
     roughness, the summits' E*, limiting contact pressure p_y in Pa, truncation z_max in units of sigma)."""
     from ..laws.plastic_rough import PlasticGWRoller
-    from ..rough.plastic_summits import PlasticSummitLaw
     rough, body = scene.surfaces.roughness, scene.body
-    law = PlasticSummitLaw(rough.summit_radius, scene.surfaces.interface_work_of_adhesion, summit_e_star,
-                           limiting_pressure)
+    law = plastic_summit_law(scene, "jkr", summit_e_star, limiting_pressure)
     return PlasticGWRoller(law, rough.sigma, rough.summit_density, z_max, body.radius, body.length)
 
 
 def plastic_discrete_roller(elastic: ContactLaw, scene: Scene, summit_e_star: float,
-                            limiting_pressure: float) -> ContactLaw:
+                            limiting_pressure: float, summit_law: str = "jkr") -> ContactLaw:
     """The realisation of the elastic discrete roller `elastic` (a rigid-substrate `DiscreteRoughRoller`: its kept
-    effective heights) with Thornton-Ning summits of limiting contact pressure p_y (Pa)."""
+    effective heights) with adhesive elastic-plastic summits on `summit_law`, limiting contact pressure p_y (Pa)."""
     from ..laws.plastic_rough import PlasticDiscreteRoller
-    from ..rough.plastic_summits import PlasticSummitLaw
     rough = scene.surfaces.roughness
-    law = PlasticSummitLaw(rough.summit_radius, scene.surfaces.interface_work_of_adhesion, summit_e_star,
-                           limiting_pressure)
+    law = plastic_summit_law(scene, summit_law, summit_e_star, limiting_pressure)
     return PlasticDiscreteRoller(law, elastic.eff, rough.sigma, elastic.depth_keep)
 
 
@@ -126,3 +144,10 @@ def with_sphere_meniscus(dry: ContactLaw, wet: ContactLaw, parameters: dict) -> 
     p = parameters
     bridge = SphereBridge(p["bridge_pull_off"], p["kelvin_gap"], p["condensation_time"], p["growth_length"])
     return WetSphere(dry, wet, bridge, p)
+
+
+def wet_summit_roller(elastic: ContactLaw, wet: ContactLaw, parameters: dict) -> ContactLaw:
+    """A discrete roller whose summits inside a bridge run `wet` (the summit law rebuilt at the wet work of
+    adhesion) and outside it `elastic` (`continuum.laws.wet_summits`)."""
+    from ..laws.wet_summits import wet_summit_roller as build
+    return build(elastic, wet, parameters)

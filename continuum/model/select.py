@@ -192,7 +192,8 @@ def plastic_member(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
     decision = _members_plasticity(shared, float(speed))
     if not decision.used:
         return law
-    return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure)
+    return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure,
+                                           decision.summit_law)
 
 
 def member_menisci(member: Scene, law: ContactLaw, elastic: ContactLaw) -> ContactLaw:
@@ -221,13 +222,12 @@ def discrete_menisci(scene: Scene, law: ContactLaw, elastic) -> ContactLaw:
                "plastic summits" if law is not elastic else "the half-space couples the summits")
         return wet_discrete(law, elastic, {**params, "solids_inside_bridges": f"dry summit law, DMT solid pull "
                                                                                f"(loop dry: {why})"})
-    from ..laws.wet_summits import wet_summit_roller
     w_wet = max(params["work_of_adhesion_wet"], 0.0)
     wet_scene = _with_work_of_adhesion(scene, w_wet)
     slaw = summit_law(elastic.slaw.name, wet_scene) if elastic.slaw is not None and w_wet > 0 else None
     wet = factory.discrete_roller(wet_scene, elastic.stats, w_wet, elastic.summit_e_star, False,
                                   elastic.footprint_half_width, slaw, (elastic.sx, elastic.sy, elastic.sz))
-    return wet_summit_roller(elastic, wet, params)
+    return factory.wet_summit_roller(elastic, wet, params)
 
 
 def member_summit_law(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
@@ -256,8 +256,9 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet,
                                       depth=estimate.depth if estimate is not None else None)
         if plastic.used and scene.surfaces.roughness.mode == "discrete":
-            law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure)
-        elif plastic.used:
+            law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure,
+                                                  plastic.summit_law)
+        elif plastic.used and plastic.summit_law == "jkr":
             law = factory.plastic_rigid_roller(scene, regime.e_star, plastic.limiting_pressure,
                                                record["datum"]["z_max"])
             record["table"] = {"used": False, "why": "plastic summits: the mean field is summed state by state "

@@ -77,7 +77,9 @@ __all__ = [
     "ELASTIC_CAPTURE_COEFFICIENT",
     "TABOR_CONSTRAINT_FACTOR",
     "ImpactEnergy",
+    "LAW_RANGE_RADIUS_RATIO",
     "adhesive_stress_scale",
+    "contact_radius_ratio",
     "capture_velocity",
     "capture_velocity_elastic",
     "check_limiting_pressure",
@@ -123,6 +125,21 @@ def capture_velocity_elastic(radius, work_of_adhesion, e_star, density, detachme
 
 #: V_s / (w^5/(rho^3 E*^2 R^5))^{1/6} for displacement-controlled detachment: Thornton & Ning's 1.84.
 ELASTIC_CAPTURE_COEFFICIENT = float(capture_velocity_elastic(1.0, 1.0, 1.0, 1.0))
+
+
+#: Largest a*/R at which the law is used as derived: its Hertz/JKR relations are exact for the paraboloid
+#: z = r^2/2R, and a sphere departs from its paraboloid by (a/R)^2/4 of the height at the contact edge (2.3 % at
+#: a/R = 0.3, 9 % at 0.6): beyond 0.3 (a declared bound, the small-strain range of Hertz theory, Johnson 1985 §4.2)
+#: a point is flagged as outside the range the law was derived for (a_y < R/2 is `check_limiting_pressure`'s).
+LAW_RANGE_RADIUS_RATIO = 0.3
+
+
+def contact_radius_ratio(velocity, radius, work_of_adhesion, e_star, density, limiting_pressure,
+                         detachment="displacement"):
+    """a*/R at the deepest state of an impact at `velocity` (m/s): compare with LAW_RANGE_RADIUS_RATIO."""
+    res = impact(velocity, radius, work_of_adhesion, e_star, density, limiting_pressure, detachment)
+    out = np.asarray(res.max_contact_radius, float) / float(radius)
+    return float(out.ravel()[0]) if np.ndim(velocity) == 0 else out
 
 
 def adhesive_stress_scale(radius, work_of_adhesion, e_star):

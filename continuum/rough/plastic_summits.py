@@ -146,6 +146,53 @@ class PlasticSummitLaw:
         return np.asarray(jkr.energy_from_approach(-self.release_stretch(r_p), r_p, self.work_of_adhesion,
                                                    self.e_star), float)
 
+    # ---- the interface every plastic summit law offers (`continuum.rough.plastic_branches`): JKR's closed forms
+    #: no attraction before contact (zero-range adhesion); no bound on the release stretch over a contact (the
+    #: law is not compiled: the Python stepper asks for the release gap at every step)
+    approach_reach = 0.0
+    max_stretch = None
+    compiled_form = False
+
+    def range_radius_ratio(self, delta_max):
+        """a*/R_p at the deepest state delta_max (m) of yielded summits (a^2 = a_y^2 + beta (delta_max - delta_y))."""
+        dm = np.asarray(delta_max, float)
+        r_p, _ = self.flattening(dm)
+        over = np.maximum(dm - self.yield_approach, 0.0) if math.isfinite(self.yield_approach) else np.zeros(dm.shape)
+        a2 = np.where(over > 0.0, self.yield_radius**2 + self.radius * over, 0.0)
+        return np.sqrt(a2) / r_p
+
+    @property
+    def reach(self) -> float:
+        """Stretch (m) below delta_p at which a virgin summit still pulls: its fold delta_c(beta)."""
+        return float(self.release_stretch(self.radius))
+
+    def jump_in(self, r_p):
+        """delta_in (m, relative to delta_p): a JKR summit snaps in on touching (zero-range adhesion)."""
+        return np.zeros_like(np.asarray(r_p, float))
+
+    def jump_out(self, r_p):
+        """delta_out (m, relative to delta_p): the fold -delta_c(R_p)."""
+        return -self.release_stretch(r_p)
+
+    def in_switch(self, r_p):
+        """U_A - U_R at the jump in: 0 (the JKR branch starts from its touch point with U = 0)."""
+        return np.zeros_like(np.asarray(r_p, float))
+
+    def out_switch(self, r_p):
+        """U_R - U_A at the fold: the R_p branch's Fuller-Tabor loop."""
+        r_p = np.asarray(r_p, float)
+        return np.asarray(jkr.energy_from_approach(-self.release_stretch(r_p), r_p, self.work_of_adhesion,
+                                                   self.e_star), float)
+
+    def state(self, delta, delta_max, attached):
+        """(force N, stored energy J): `branch` where attached, free (0, 0) otherwise (no force out of contact)."""
+        delta, dm, att = np.broadcast_arrays(np.asarray(delta, float), np.asarray(delta_max, float),
+                                             np.asarray(attached, bool))
+        f, u = np.zeros(delta.shape), np.zeros(delta.shape)
+        if np.any(att):
+            f[att], u[att] = self.branch(delta[att], dm[att])
+        return f, u
+
     def describe(self) -> dict:
         return {"name": "thornton_ning_summit", "radius": self.radius, "work_of_adhesion": self.work_of_adhesion,
                 "e_star": self.e_star, "limiting_pressure": self.limiting_pressure,
