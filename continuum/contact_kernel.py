@@ -1,6 +1,6 @@
 """Compiled contact phase: DOP853 with dense output and event location, for laws with a compiled form.
 
-One contact of the event-driven driver (`continuum.driver._contact`) is a 1-D ODE, h' = v,
+One contact of the event-driven driver (`continuum.driver._ContactRun`) is a 1-D ODE, h' = v,
 v' = F(h)/M - g, integrated until the body leaves (release), turns back while attached (stuck or
 at rest), reaches a time the law asks to stop at (capillary bridges condense at t_a), or the run's
 time limit. Stepped in Python through `scipy.integrate.DOP853`, a rough impact costs ~0.05-0.2 s,
