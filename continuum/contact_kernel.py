@@ -65,7 +65,6 @@ SAMPLE_COLUMNS = 7
 #: Rigid-table law: P slots and S slots.
 (P_END_GAP, P_REACH, P_ATTACH, P_RELEASE, P_R_IN, P_H_LO, P_LOOP) = range(7)
 (S_H_MIN, S_COUNT_MIN, S_MAX_CONTACTS, S_BEYOND_ACCEPTED, S_BEYOND_FLAG) = range(5)
-RIGID_STATE_SIZE = 5
 #: Power law: P = (k, n).
 P_K, P_N = 0, 1
 #: Discrete law: P slots (its S slots are the rigid-table law's); T[0] holds the kept summits' effective heights

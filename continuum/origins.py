@@ -74,8 +74,3 @@ def describe(entry: Mapping[str, Any]) -> str:
         what = what[:16]
     extra = f" ({entry['note']})" if entry.get("note") else ""
     return f"{kind}: {what}{extra}"
-
-
-def chosen_keys(origin: Mapping[str, Any]) -> list[str]:
-    """The keys whose origin is `chosen`, in table order."""
-    return [k for k, e in origin.items() if isinstance(e, Mapping) and e.get("kind") == "chosen"]
