@@ -4,7 +4,7 @@ A parameter set (inputs/params/NAME.toml) gives scene keys. Every one of them ca
 input a prediction rests on is silently chosen:
 
     [meta.origin]
-    "surfaces.work_of_adhesion" = { kind = "md", run_hash = "578d...", recipe = "adhesion_silica" }
+    "surfaces.work_of_adhesion" = { kind = "md", run_hash = "4346...", recipe = "adhesion_silica" }
     "surfaces.body.youngs_modulus" = { kind = "material", source = "Hopcroft et al., J. MEMS 19 (2010) 229" }
     "surfaces.roughness.summit_radius" = { kind = "chosen", reason = "no topography measured; ..." }
 
