@@ -21,7 +21,7 @@ def package_version() -> str:
     try:
         return importlib.metadata.version("nanoimpact")
     except importlib.metadata.PackageNotFoundError:
-        from nanoimpact import __version__   # noqa: PLC0415 -- the package's own root, read when asked
+        from nanoimpact import __version__  # noqa: PLC0415 -- the package's own root, read when asked
         return __version__
 
 

@@ -16,9 +16,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from md import lammps_loader
 from md.engine.hashing import forcefield_hashes
 from md.engine.plan import Job, Plan
-from md import lammps_loader
 from nanoimpact.provenance import git_commit, package_version
 
 __all__ = ["lammps_version", "versions_now", "version_differences", "describe_differences", "run_provenance"]

@@ -73,10 +73,19 @@ import numpy as np
 from md import units
 from md.engine.hashing import run_hash
 from md.engine.lammps import InProcess, MDRunError, MpiRun
-from md.engine.plan import Job, Leg, Plan, Planner, leg_dependencies
+from md.engine.plan import Job, Leg, Planner, leg_dependencies
 from md.engine.provenance import describe_differences, run_provenance, version_differences
-from md.engine.store import (RunContext, RunOutcome, run_dir_for, export, leg_state, parse_ave_time,
-                             parse_dump, truncate_samples, write_csv)
+from md.engine.store import (
+    RunContext,
+    RunOutcome,
+    export,
+    leg_state,
+    parse_ave_time,
+    parse_dump,
+    run_dir_for,
+    truncate_samples,
+    write_csv,
+)
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, clean_json
 from nanoimpact.lock import run_lock
 
@@ -359,7 +368,7 @@ def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int,
     bar = None
     if progress:
         try:
-            from tqdm import tqdm   # noqa: PLC0415
+            from tqdm import tqdm  # noqa: PLC0415
             if jobs > 1:
                 tqdm.monitor_interval = 0        # no monitor thread in a process that forks
             bar = tqdm(total=total, initial=done, unit="step", desc=job.name, file=sys.stderr,
@@ -399,8 +408,8 @@ def _leg_error_path(leg_dir: Path) -> Path:
 def _die_with_parent(parent: int) -> None:
     """Linux: SIGTERM this process when its parent dies (prctl PR_SET_PDEATHSIG), so a parent killed outright
     (SIGKILL, which runs no clean-up) leaves no leg running on, holding the run's lock; elsewhere a no-op."""
-    import ctypes     # noqa: PLC0415
-    import signal     # noqa: PLC0415
+    import ctypes  # noqa: PLC0415
+    import signal  # noqa: PLC0415
     with contextlib.suppress(OSError, AttributeError):
         ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))      # 1 = PR_SET_PDEATHSIG
     if os.getppid() != parent:          # it died before the request took effect
@@ -453,8 +462,8 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
     of ``np_``. Nothing else can start before it ends (a leg waits only for done legs), so the cores it takes
     would otherwise idle: an anneal, a contact, the last chain of windows. A leg keeps its rank count to its end,
     so one that is left alone when a neighbour finishes runs on with ``np_``."""
-    import multiprocessing as mp                           # noqa: PLC0415
-    from multiprocessing.connection import wait as mp_wait   # noqa: PLC0415
+    import multiprocessing as mp  # noqa: PLC0415
+    from multiprocessing.connection import wait as mp_wait  # noqa: PLC0415
     ctx = mp.get_context("fork")
     waits = leg_dependencies(plan.legs)
     legs_dir = run_dir / "legs"
@@ -525,7 +534,7 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
 def _stop_children(procs, grace_s: float = 10.0) -> None:
     """SIGTERM to every child's process group (the child, its mpirun, the ranks), SIGKILL to a group still there
     after ``grace_s``. Their last committed restarts stay for ``--resume``."""
-    import signal   # noqa: PLC0415
+    import signal  # noqa: PLC0415
 
     def signal_group(proc, sig) -> None:
         with contextlib.suppress(ProcessLookupError, PermissionError):
