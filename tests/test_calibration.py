@@ -402,8 +402,9 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     into this test's md cache and found there by their hash ('md cache'): smoke MD proves plumbing, so running it
     again here would prove nothing more. The paper's case lists are cut to the three impacts its figures read, one
     bounce each at the fast preset, and one sweep (as test_executors cuts them; the cases themselves are
-    test_paper's), the sampled claims to one discrete-summit seed, and the smoke recipe's uncertainty to two samples
-    at the fast preset."""
+    test_paper's), the sampled claims to one discrete-summit seed and, in each set's sample bundle, three impacts
+    per drop and two sigmas for the escape velocity, and the smoke recipe's uncertainty to two samples at the fast
+    preset."""
     import shutil
     from dataclasses import replace
 
@@ -430,6 +431,23 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     monkeypatch.setattr(run, "wet_cases", lambda: [])
     monkeypatch.setattr(run, "fig8_cases", lambda: cheap[:1])
     monkeypatch.setattr(samples, "DEFAULT_SEEDS", 1)
+    # each set's sample bundle (the attribution runs seven sets) cut to 3 impacts per drop and the escape velocity
+    # over two sigmas: here and, through a setup callback, on every Dask worker (a worker imports its own modules)
+    from calibration import pipeline
+
+    def small_bundles(dask_worker=None):
+        from continuum.paper import samples as on_worker
+        on_worker.SAMPLE_MAX_BOUNCES, on_worker.FIG8_SIGMAS_NM = 3, (3.0, 6.0)
+
+    def executor(*args, **kwargs):
+        ex = make_executor(*args, **kwargs)
+        ex.client.register_worker_callbacks(small_bundles)
+        return ex
+
+    make_executor = pipeline.executor
+    monkeypatch.setattr(pipeline, "executor", executor)
+    monkeypatch.setattr(samples, "SAMPLE_MAX_BOUNCES", 3)
+    monkeypatch.setattr(samples, "FIG8_SIGMAS_NM", (3.0, 6.0))
     recipe = tmp_path / "smoke.toml"
     text = (ROOT / "inputs" / "calibration" / "smoke.toml").read_text()
     overrides = 'overrides = { "physics.half_space" = "auto" }'
