@@ -43,7 +43,7 @@ def cmd_calibrate(args) -> int:
     # calibrate checks the whole recipe (pipeline.load_calibration) before any MD or paper run starts
     calibrate(args.recipe, args.out, md_fidelity=args.md_fidelity, executor_name=args.executor,
               workers=args.workers, scheduler=args.scheduler, params_out=args.params_out, md_cache=args.md_cache,
-              progress=log.info)
+              progress=log.info, same_versions=args.same_versions)
     return 0
 
 
@@ -74,6 +74,9 @@ def configure_calibrate(c: argparse.ArgumentParser) -> None:
     c.add_argument("--out", default="out/calibration", help="output folder (default: out/calibration)")
     c.add_argument("--params-out", help="write the set here instead of <data folder>/params/<name>.toml")
     c.add_argument("--md-cache", help="MD cache directory (default: $NANOIMPACT_CACHE or ~/.cache/nanoimpact/md)")
+    c.add_argument("--require-same-versions", dest="same_versions", action="store_true",
+                   help="run again every committed or cached MD result made under another nanoimpact or LAMMPS "
+                        "version (by default it is used and the report names its versions)")
 
 
 def configure_sweep(w: argparse.ArgumentParser) -> None:

@@ -4,7 +4,9 @@ Steps (each timed in the report):
 1. MD jobs: every recipe the mapping needs (calibration.mdset.MAPPING) at --md-fidelity, as
    independent jobs on the executor. A committed result (inputs/md/results/<recipe>-<fidelity>/) is
    used only if its run_hash equals the hash md would compute now (same recipe content, force-field
-   files, package and LAMMPS versions); otherwise md's own engine runs it, reusing its hashed cache.
+   files and workflow protocol version); otherwise md's own engine runs it, reusing its hashed cache. One made
+   under other nanoimpact or LAMMPS versions is used, its versions named in the report, or refused (run again)
+   with `same_versions` (--require-same-versions).
 2. The set: calibration.mdset.build_parameter_set on the recipe's base set, written atomically to
    inputs/params/<name>.toml (or --params-out), every value with its MD run hash in [meta].
 3. The paper's dry, wet and SAM cases for the base set, the recipe's `compare_sets` (default: the literature
@@ -366,19 +368,31 @@ def current_hash(recipe_name: str, fidelity: str) -> str:
     return run_hash(recipe, fidelity, wf.forcefield_files(recipe.settings(fidelity)))[0]
 
 
-def md_plan(recipes, fidelity: str, cache: str | None = None, results_dir: str | Path | None = None) -> dict[str, str]:
+def committed_if_usable(recipe_name: str, fidelity: str, results_dir, same_versions: bool) -> tuple[dict | None, str]:
+    """(the committed result of `recipe_name` if its hash is current and, with `same_versions`, it was made under
+    the running nanoimpact and LAMMPS versions, else None; what its versions say: 'made with ...' or '')."""
+    from md.engine import describe_differences, version_differences
+
+    committed = committed_result(recipe_name, fidelity, None if results_dir is None else Path(results_dir))
+    if committed is None or committed.get("run_hash") != current_hash(recipe_name, fidelity):
+        return None, ""
+    made = describe_differences(version_differences(committed.get("provenance", {})))
+    return (None if made and same_versions else committed), made
+
+
+def md_plan(recipes, fidelity: str, cache: str | None = None, results_dir: str | Path | None = None,
+            same_versions: bool = False) -> dict[str, str]:
     """Where each recipe's result will come from, decided before anything runs (hashes and files only): 'committed'
-    (a committed result at the current hash), 'md cache' (a finished run in the cache), 'resumes' (an unfinished
-    run of the current hash in the cache: it goes on from its last restart) or 'runs' (from the start)."""
+    (a committed result at the current hash, made under the running versions if `same_versions`), 'md cache'
+    (a finished run in the cache), 'resumes' (an unfinished run of the current hash in the cache: it goes on from
+    its last restart) or 'runs' (from the start)."""
     from md.engine.store import run_dir_for
     from md.recipe import load_recipe
 
     out = {}
     for name in recipes:
-        digest = current_hash(name, fidelity)
-        committed = committed_result(name, fidelity, None if results_dir is None else Path(results_dir))
-        run_dir = run_dir_for(load_recipe(name).name, fidelity, digest, cache)
-        if committed is not None and committed.get("run_hash") == digest:
+        run_dir = run_dir_for(load_recipe(name).name, fidelity, current_hash(name, fidelity), cache)
+        if committed_if_usable(name, fidelity, results_dir, same_versions)[0] is not None:
             out[name] = "committed"
         elif (run_dir / "result.json").is_file():
             out[name] = "md cache"
@@ -390,21 +404,29 @@ def md_plan(recipes, fidelity: str, cache: str | None = None, results_dir: str |
 
 
 def md_job(task: tuple) -> dict:
-    """One MD recipe: the committed result if its hash is current, else md's engine (cached). Picklable."""
-    recipe_name, fidelity, cache, results_dir = task
+    """One MD recipe, `(recipe, fidelity, cache, results_dir, same_versions)`: the committed result if its hash is
+    current (and its versions the running ones, with same_versions), else md's engine (cached). Picklable."""
+    recipe_name, fidelity, cache, results_dir, same_versions = task
     start = time.perf_counter()
     digest = current_hash(recipe_name, fidelity)
+    usable, made = committed_if_usable(recipe_name, fidelity, results_dir, same_versions)
+    if usable is not None:
+        return {"recipe": recipe_name, "result": usable, "source": "committed" + (f" ({made})" if made else ""),
+                "wall_s": time.perf_counter() - start}
     committed = committed_result(recipe_name, fidelity, None if results_dir is None else Path(results_dir))
-    if committed is not None and committed.get("run_hash") == digest:
-        return {"recipe": recipe_name, "result": committed, "source": "committed", "wall_s": time.perf_counter() - start}
+    from md.engine import describe_differences, version_differences
     from md.recipe import load_recipe
     from md.workflows import run_recipe
 
     # resume: a run this job (or a worker that died, or an earlier calibration) left unfinished goes on from its
     # last restart instead of starting again; with nothing to resume it is a fresh run
-    outcome = run_recipe(load_recipe(recipe_name), fidelity, cache=cache, resume=True, progress=False, echo=None)
-    note = "md cache" if outcome.reused else "ran"
-    if committed is not None:
+    outcome = run_recipe(load_recipe(recipe_name), fidelity, cache=cache, resume=True, progress=False, echo=None,
+                         same_versions=same_versions)
+    cached = describe_differences(version_differences(outcome.result.get("provenance", {}))) if outcome.reused else ""
+    note = ("md cache" + (f" ({cached})" if cached else "")) if outcome.reused else "ran"
+    if made:
+        note += f" (the committed result was {made}; the same versions are required)"
+    elif committed is not None:
         note += f" (committed result's hash {str(committed.get('run_hash'))[:16]} is not current {digest[:16]})"
     return {"recipe": recipe_name, "result": outcome.result, "source": note, "wall_s": time.perf_counter() - start}
 
@@ -536,12 +558,13 @@ def _band(values) -> dict:
 def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "quick", executor_name: str = "local",
               workers: int | None = None, scheduler: str | None = None, params_out: str | Path | None = None,
               md_cache: str | None = None, results_dir: str | Path | None = None,
-              paper_sets: tuple | None = None, progress=None) -> CalibrationReport:
+              paper_sets: tuple | None = None, progress=None, same_versions: bool = False) -> CalibrationReport:
     """Run the whole pipeline; returns the typed CalibrationReport (also written to OUT/calibration.json and
     OUT/report.md).
 
     `paper_sets`: the sets whose paper cases run beside the base and the new set (default: the recipe's
-    `compare_sets`)."""
+    `compare_sets`). `same_versions`: refuse committed and cached MD results made under other nanoimpact or LAMMPS
+    versions (they are run again); by default they are used and the report names their versions."""
     progress = progress or log.info                 # library code logs; the CLI decides what is shown
     t_all = time.perf_counter()
     cal = load_calibration(recipe_path)             # the whole recipe and the options, before anything runs
@@ -554,7 +577,8 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
     try:
         # 1. MD jobs
         t = time.perf_counter()
-        results, sources = _run_md_jobs(ex, cal.name, md_fidelity, executor_name, md_cache, results_dir, progress)
+        results, sources = _run_md_jobs(ex, cal.name, md_fidelity, executor_name, md_cache, results_dir, progress,
+                                        same_versions)
         timings["md_s"] = time.perf_counter() - t
         # 2. the set
         machine = {"cores": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}
@@ -599,13 +623,13 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
 
 
 def _run_md_jobs(ex, name: str, md_fidelity: str, executor_name: str, md_cache, results_dir,
-                 progress) -> tuple[dict, dict]:
+                 progress, same_versions: bool = False) -> tuple[dict, dict]:
     """Every MD recipe the calibration needs, committed, cached or run on `ex`; then the fallbacks whose
     preferred result lacks the key's quantity. Returns (results by recipe, where each came from)."""
     recipes = recipes_first()
     progress(f"calibrate {name}: {len(recipes)} MD recipes at {md_fidelity} on '{executor_name}' (a fallback "
              f"recipe runs only where its preferred result lacks the quantity)")
-    plan = md_plan(recipes, md_fidelity, md_cache, results_dir)
+    plan = md_plan(recipes, md_fidelity, md_cache, results_dir, same_versions)
     todo = [r for r, how in plan.items() if how in ("runs", "resumes")]
     progress("  MD plan: " + "; ".join(f"{how}: {', '.join(r for r, h in plan.items() if h == how)}"
                                        for how in ("committed", "md cache", "resumes", "runs")
@@ -615,7 +639,8 @@ def _run_md_jobs(ex, name: str, md_fidelity: str, executor_name: str, md_cache, 
     results, sources = {}, {}
 
     def run_md(names):
-        tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir)) for r in names]
+        tasks = [(r, md_fidelity, md_cache, None if results_dir is None else str(results_dir), same_versions)
+                 for r in names]
         for _, job in ex.map(md_job, tasks):
             results[job["recipe"]] = job["result"]
             sources[job["recipe"]] = {"source": job["source"], "wall_s": job["wall_s"],

@@ -1,6 +1,6 @@
 """Compiled contact phase: DOP853 with dense output and event location, for laws with a compiled form.
 
-One contact of the event-driven driver (`continuum.driver._contact`) is a 1-D ODE, h' = v,
+One contact of the event-driven driver (`continuum.driver._ContactRun`) is a 1-D ODE, h' = v,
 v' = F(h)/M - g, integrated until the body leaves (release), turns back while attached (stuck or
 at rest), reaches a time the law asks to stop at (capillary bridges condense at t_a), or the run's
 time limit. Stepped in Python through `scipy.integrate.DOP853`, a rough impact costs ~0.05-0.2 s,
@@ -66,7 +66,6 @@ SAMPLE_COLUMNS = 7
 #: Rigid-table law: P slots and S slots.
 (P_END_GAP, P_REACH, P_ATTACH, P_RELEASE, P_R_IN, P_H_LO, P_LOOP) = range(7)
 (S_H_MIN, S_COUNT_MIN, S_MAX_CONTACTS, S_BEYOND_ACCEPTED, S_BEYOND_FLAG) = range(5)
-RIGID_STATE_SIZE = 5
 #: Power law: P = (k, n).
 P_K, P_N = 0, 1
 #: Discrete law: P slots (its S slots are the rigid-table law's); T[0] holds the kept summits' effective heights

@@ -94,7 +94,6 @@ class ImpactRun:
     status: str
     trace: Trace
     audit: dict
-    reference_energy: float
 
     @property
     def stuck(self) -> bool:
@@ -178,7 +177,7 @@ def simulate(law: ContactLaw, mass: float, gravity: float, *, release_height: fl
             status = "rest"
             ledger(t, gap, v, 0.0, -1, 0.0)
             break
-    return ImpactRun(bounces, status, ledger.trace, ledger.audit(), ledger.ek_ref or 0.0)
+    return ImpactRun(bounces, status, ledger.trace, ledger.audit())
 
 
 class _Ledger:

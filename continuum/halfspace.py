@@ -488,10 +488,10 @@ def solve_coupled(halfspace: LineHalfSpace, gap_rigid, pressure_law: PressureLaw
         start = p0 if stage != "fixed_point" or best is None else best[0]
         if stage == "newton":
             out = _newton(hs, D, evaluate, start, tol, max_iter, pressure_scale, gmres_restart,
-                          gmres_maxiter, history, ptc=False, max_iter_ptc=0)
+                          gmres_maxiter, history, ptc=False)
         elif stage == "ptc":
             out = _newton(hs, D, evaluate, start, tol, max_ptc_iter, pressure_scale, gmres_restart,
-                          gmres_maxiter, history, ptc=True, max_iter_ptc=max_ptc_iter)
+                          gmres_maxiter, history, ptc=True)
         else:
             out = _fixed_point(hs, evaluate, start, tol, max_fixed_point_iter, pressure_scale, history)
         p, delta, h, P, it, res, ok = out
@@ -504,7 +504,7 @@ def solve_coupled(halfspace: LineHalfSpace, gap_rigid, pressure_law: PressureLaw
     return CoupledSolution(p, delta, h, total, res, False, stage, D.n, float(np.sum(p) * hs.dx), history)
 
 
-def _newton(hs, D, evaluate, p, tol, max_iter, pressure_scale, restart, maxiter, history, ptc, max_iter_ptc):
+def _newton(hs, D, evaluate, p, tol, max_iter, pressure_scale, restart, maxiter, history, ptc):
     """Newton-Krylov with line search (ptc=False) or pseudo-transient continuation (ptc=True)."""
     name = "ptc" if ptc else "newton"
     d0 = hs.self_compliance

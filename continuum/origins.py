@@ -4,7 +4,7 @@ A parameter set (inputs/params/NAME.toml) gives scene keys. Every one of them ca
 input a prediction rests on is silently chosen:
 
     [meta.origin]
-    "surfaces.work_of_adhesion" = { kind = "md", run_hash = "578d...", recipe = "adhesion_silica" }
+    "surfaces.work_of_adhesion" = { kind = "md", run_hash = "4346...", recipe = "adhesion_silica" }
     "surfaces.body.youngs_modulus" = { kind = "material", source = "Hopcroft et al., J. MEMS 19 (2010) 229" }
     "surfaces.roughness.summit_radius" = { kind = "chosen", reason = "no topography measured; ..." }
 
@@ -74,8 +74,3 @@ def describe(entry: Mapping[str, Any]) -> str:
         what = what[:16]
     extra = f" ({entry['note']})" if entry.get("note") else ""
     return f"{kind}: {what}{extra}"
-
-
-def chosen_keys(origin: Mapping[str, Any]) -> list[str]:
-    """The keys whose origin is `chosen`, in table order."""
-    return [k for k, e in origin.items() if isinstance(e, Mapping) and e.get("kind") == "chosen"]

@@ -27,10 +27,6 @@ from .rough.surface_map import map_statistics, statistics_block
 from .rough.topography import KEY_FILE, KEY_SYNTH, TopographyError
 from .schema import FIDELITY, FIELD_BY_PATH, FIELDS, REQUIRED, Field, is_section, to_internal
 
-#: The shipped parameter sets (inputs/params, installed as package data); names are looked up in
-#: the user data folder first (nanoimpact.data).
-PARAMS_DIR = data.shipped_root() / "params"
-
 
 class SceneError(InputError):
     """An invalid scene: names the key, the value and what is allowed."""

@@ -36,8 +36,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "surface tension) and write result.json (SI units), curves (CSV) and figures (PNG).",
         epilog="Recipes: inputs/md/*.toml (give a path or a name; names are also looked up in the user data "
                "folder, --data or $NANOIMPACT_DATA). Results are cached by a hash of the recipe, "
-               "fidelity, force-field files, package and LAMMPS versions under --cache (default "
-               "$NANOIMPACT_CACHE or ~/.cache/nanoimpact/md); a finished run is reused, not repeated. "
+               "fidelity, force-field files and the workflow's protocol version under --cache (default "
+               "$NANOIMPACT_CACHE or ~/.cache/nanoimpact/md); a finished run is reused, not repeated (with a note "
+               "when it was made under other nanoimpact or LAMMPS versions). "
                "Exit codes: 0 done, 1 LAMMPS failed, 2 invalid input, 3 LAMMPS missing, 75 run busy (--no-wait), "
                "130 interrupted.")
     p.add_argument("recipe", help="recipe file (inputs/md/adhesion_silica.toml) or name (adhesion_silica)")
@@ -61,6 +62,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "them; faster, but its samples are no longer bit-identical to a one-process run's")
     p.add_argument("--cache", help="cache directory for run directories (overrides NANOIMPACT_CACHE)")
     p.add_argument("--force", action="store_true", help="run again even if a finished result is cached")
+    p.add_argument("--require-same-versions", dest="same_versions", action="store_true",
+                   help="run again, instead of reusing, a cached result made under another nanoimpact or LAMMPS "
+                        "version (by default it is reused and its versions are printed)")
     p.add_argument("--no-wait", dest="wait", action="store_false",
                    help="if another process is running the same run (same recipe, fidelity and hash), stop at "
                         "once with exit code 75 (the message names its PID) instead of waiting for it and then "
@@ -93,6 +97,7 @@ def run(argv: list[str]) -> int:
         setup_logging(verbosity)
     import md.workflows                          # run_recipe looked up at call time (tests replace it)
     from md.engine.lammps import MDRunError
+    from md.engine.provenance import describe_differences, version_differences
     from md.engine.runner import Interrupted
     from md.recipe import load_recipe
 
@@ -107,7 +112,8 @@ def run(argv: list[str]) -> int:
     try:
         outcome = run_recipe(recipe, args.fidelity, out=out, cache=args.cache, resume=args.resume, np_=args.np,
                              progress=log.isEnabledFor(logging.INFO),    # -q here or before `md`: no bar
-                             force=args.force, wait=args.wait, jobs=args.jobs, fill=args.fill)
+                             force=args.force, wait=args.wait, jobs=args.jobs, fill=args.fill,
+                             same_versions=args.same_versions)
     except MDRunError as exc:                 # the log tail is the point here: printed whole, not one line
         print(f"nanoimpact md: {exc}", file=sys.stderr)
         print("nanoimpact md: the run failed; no result.json was written", file=sys.stderr)
@@ -122,7 +128,8 @@ def run(argv: list[str]) -> int:
     print(format_quantities(r["quantities"]))
     print(f"{r['n_atoms']} atoms, {r['steps']} steps of {r['timestep_fs']:g} fs, "
           f"{(r['ns_per_day'] or float('nan')):.3g} ns/day" + (" (cached)" if outcome.reused else ""))
-    for note in r.get("notes", []):
+    made = describe_differences(version_differences(r.get("provenance", {})))
+    for note in r.get("notes", []) + ([f"this result was {made}"] if made else []):
         print(f"note: {note}")
     print(f"result: {outcome.out_dir}/result.json (run directory {outcome.run_dir})")
     return EXIT_OK

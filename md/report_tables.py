@@ -41,8 +41,6 @@ DISPLAY_UNITS: dict[str, tuple[str, float]] = {
     "deg": ("°", 1.0), "deg/ns": ("°/ns", 1.0), "kg/m^3": ("kg/m³", 1.0),
 }
 
-BLOCKS = ("md-results", "md-studies", "md-cost")
-
 
 @dataclass(frozen=True)
 class CommittedResult:

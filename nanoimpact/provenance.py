@@ -1,4 +1,4 @@
-"""Where the running code came from: the source checkout (if this is one) and its git commit.
+"""Where the running code came from: its version, the source checkout (if this is one) and its git commit.
 
 An installed package that happens to sit inside some other git checkout (a venv inside a
 repository) must not record that repository's commit, so git is asked only when the folder above
@@ -7,10 +7,22 @@ the packages is nanoimpact's own source tree (its pyproject.toml and inputs/ bes
 from __future__ import annotations
 
 import functools
+import importlib.metadata
 import subprocess
 from pathlib import Path
 
 _ROOT = Path(__file__).resolve().parent.parent
+
+
+def package_version() -> str:
+    """nanoimpact's version: the installed distribution's, else the source tree's ``nanoimpact.__version__`` (the
+    attribute pyproject.toml reads it from), so a checkout run with ``PYTHONPATH`` records what the installed
+    package would."""
+    try:
+        return importlib.metadata.version("nanoimpact")
+    except importlib.metadata.PackageNotFoundError:
+        from nanoimpact import __version__  # noqa: PLC0415 -- the package's own root, read when asked
+        return __version__
 
 
 def source_checkout() -> Path | None:

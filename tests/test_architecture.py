@@ -154,7 +154,7 @@ def test_no_module_imports_another_in_a_circle():
 
 
 def test_the_cycle_scan_sees_a_lazy_cycle():
-    """Two modules that import each other, one of them inside a function (how md.runner and md.workflows did)."""
+    """Two modules that import each other, one of them inside a function."""
     assert _cycles({"md.a": {"md.b"}, "md.b": {"md.a"}, "md.c": {"md.a"}}) == [["md.a", "md.b"]]
     assert _cycles({"md.a": {"md.b"}, "md.b": set()}) == []
 

@@ -385,51 +385,83 @@ def test_sweep_validates_first_then_resumes_without_rerunning(tmp_path):
     assert (tmp_path / "sw" / "sweep.png").stat().st_size > 0
 
 
-#: the recipe whose smoke MD runs on a Dask worker in the pipeline test (the others come from the session's shared
-#: smoke runs or, surface_tension_spce, from its committed result)
-RUN_ON_WORKER = "wsl_silica"
+#: the recipe whose smoke MD runs on a Dask worker in the pipeline test: the cheapest smoke run
+#: (docs/figures/md_cost.json); the others come from the session's shared smoke runs, AS_COMMITTED as a committed
+#: result, the rest from the md cache
+RUN_ON_WORKER = "surface_tension_spce"
+AS_COMMITTED = "wsl_silica"
 
 
 @pytest.mark.md
 @pytest.mark.filterwarnings("ignore:No artists with labels found:UserWarning")     # Fig 8b without its wet cases
 def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
-    """The whole pipeline on executor 'dask' with two workers: the MD jobs, the paper's cases and the
-    uncertainty samples are Dask tasks. Each MD source is exercised once: one recipe's LAMMPS runs on a worker
-    ('ran'), surface_tension_spce is the committed result ('committed'), and the other five are the smoke runs
-    other md tests made this session (md_smoke), copied into this test's md cache and found there by their hash
-    ('md cache'): smoke MD proves plumbing, so running it again here would prove nothing more. The paper's case
-    lists are cut to the three impacts its figures read, one bounce each, and one sweep (as test_executors cuts
-    them; the cases themselves are test_paper's), and the smoke recipe's uncertainty to two samples."""
+    """The whole pipeline on executor 'dask' with two workers: the MD jobs, the paper's cases, the claim
+    attribution and the uncertainty samples are Dask tasks. Each MD source is exercised once: the cheapest recipe's
+    LAMMPS runs on a worker ('ran'), one session smoke run is handed over as a committed result ('committed',
+    through results_dir), and the other five are the smoke runs other md tests made this session (md_smoke), copied
+    into this test's md cache and found there by their hash ('md cache'): smoke MD proves plumbing, so running it
+    again here would prove nothing more. The paper's case lists are cut to the three impacts its figures read, one
+    bounce each at the fast preset, and one sweep (as test_executors cuts them; the cases themselves are
+    test_paper's), the sampled claims to one discrete-summit seed and, in each set's sample bundle, three impacts
+    per drop and two sigmas for the escape velocity, and the smoke recipe's uncertainty to two samples at the fast
+    preset."""
     import shutil
     from dataclasses import replace
 
     from calibration import CalibrationReport, calibrate
     from calibration.mdset import recipes_first
-    from continuum.paper import run
+    from continuum.paper import run, samples
 
-    cache = tmp_path / "md"
+    cache, committed = tmp_path / "md", tmp_path / "committed"
     cache.mkdir()
-    shared = [r for r in recipes_first() if r not in (RUN_ON_WORKER, "surface_tension_spce")]
+    shared = [r for r in recipes_first() if r != RUN_ON_WORKER]
     for name in shared:
         run_dir = md_smoke(name).outcome.run_dir
-        shutil.copytree(run_dir, cache / run_dir.name)
-    # the cases the figures read (hertz, rough silica, rough OTS), one bounce each; one sweep; no wet case
-    cheap = [replace(c, overrides={**c.overrides, "numerics.max_bounces": 1}) for c in run.dry_cases()
+        if name == AS_COMMITTED:
+            (committed / f"{name}-smoke").mkdir(parents=True)
+            shutil.copy(run_dir / "result.json", committed / f"{name}-smoke" / "result.json")
+        else:
+            shutil.copytree(run_dir, cache / run_dir.name)
+    # the cases the figures read (hertz, rough silica, rough OTS), one bounce each at the fast preset (the runs take
+    # it as an argument, so it reaches the Dask workers); one sweep; no wet case; one discrete-summit seed
+    fast = {"numerics.max_bounces": 1, "numerics.fidelity": "fast"}
+    cheap = [replace(c, overrides={**c.overrides, **fast}) for c in run.dry_cases()
              if c.name in ("hertz", "rough_silica", "rough_ots")]
     monkeypatch.setattr(run, "dry_cases", lambda: cheap)
     monkeypatch.setattr(run, "wet_cases", lambda: [])
     monkeypatch.setattr(run, "fig8_cases", lambda: cheap[:1])
+    monkeypatch.setattr(samples, "DEFAULT_SEEDS", 1)
+    # each set's sample bundle (the attribution runs seven sets) cut to 3 impacts per drop and the escape velocity
+    # over two sigmas: here and, through a setup callback, on every Dask worker (a worker imports its own modules)
+    from calibration import pipeline
+
+    def small_bundles(dask_worker=None):
+        from continuum.paper import samples as on_worker
+        on_worker.SAMPLE_MAX_BOUNCES, on_worker.FIG8_SIGMAS_NM = 3, (3.0, 6.0)
+
+    def executor(*args, **kwargs):
+        ex = make_executor(*args, **kwargs)
+        ex.client.register_worker_callbacks(small_bundles)
+        return ex
+
+    make_executor = pipeline.executor
+    monkeypatch.setattr(pipeline, "executor", executor)
+    monkeypatch.setattr(samples, "SAMPLE_MAX_BOUNCES", 3)
+    monkeypatch.setattr(samples, "FIG8_SIGMAS_NM", (3.0, 6.0))
     recipe = tmp_path / "smoke.toml"
     text = (ROOT / "inputs" / "calibration" / "smoke.toml").read_text()
-    assert "\nsamples = 4\n" in text
-    recipe.write_text(text.replace("\nsamples = 4\n", "\nsamples = 2\n"))
+    overrides = 'overrides = { "physics.half_space" = "auto" }'
+    assert "\nsamples = 4\n" in text and overrides in text
+    recipe.write_text(text.replace("\nsamples = 4\n", "\nsamples = 2\n").replace(
+        overrides, overrides[:-2] + ', "numerics.fidelity" = "fast" }'))
 
     out = tmp_path / "cal"
     report = calibrate(recipe, out, md_fidelity="smoke", executor_name="dask", workers=2,
-                       params_out=tmp_path / "calibrated_smoke.toml", md_cache=str(cache), progress=lambda m: None)
+                       params_out=tmp_path / "calibrated_smoke.toml", md_cache=str(cache), results_dir=committed,
+                       progress=lambda m: None)
     assert isinstance(report, CalibrationReport) and report.name == "calibrated_smoke"
     sources = {r: v["source"] for r, v in report.md_sources.items()}
-    assert sources == {**{r: "md cache" for r in shared}, RUN_ON_WORKER: "ran", "surface_tension_spce": "committed"}
+    assert sources == {**{r: "md cache" for r in shared}, RUN_ON_WORKER: "ran", AS_COMMITTED: "committed"}
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
     assert sorted(p.name for p in (out / "paper" / "cases").iterdir()) == ["hertz", "rough_ots", "rough_silica"]

@@ -2,8 +2,9 @@
 the scheduler's order and overlap, a failing leg stopping the run, and -- with LAMMPS -- the same samples as the
 one-process run on the adhesion recipe with the richest dependency graph (anneal, contacts, chains out and back).
 
-The scheduler tests replace the leg runner with a stand-in that sleeps and records when it ran (the forked
-children inherit it), so they need no LAMMPS and take about a second each.
+The scheduler tests replace the leg runner with a stand-in that logs its start and end to a file and, where a test
+needs an order, waits for another leg's event there (the forked children inherit it): the order they assert is
+forced by events, not by sleeps, so a loaded machine cannot reorder it. They need no LAMMPS.
 """
 from __future__ import annotations
 
@@ -48,36 +49,84 @@ def test_a_wait_for_a_later_or_unknown_leg_is_refused_naming_both(legs, word):
     assert word in str(info.value)
 
 
-def _stand_in(record: Path, seconds: dict[str, float], fail: str | None = None, spawn: str | None = None):
-    """A leg runner that sleeps, appends (name, start, end) to ``record`` and commits a done state; leg ``spawn``
-    first starts a long-lived subprocess (as an mpirun would) and writes its pid beside ``record``."""
+#: How long a stand-in leg waits for an event before it fails the run (a scheduler that never lets the event happen
+#: fails the test instead of hanging it); reached only on failure.
+EVENT_TIMEOUT_S = 60.0
+
+
+def _events(record: Path) -> list[str]:
+    return record.read_text().splitlines() if record.exists() else []
+
+
+def _log(record: Path, event: str) -> None:
+    """Append one event line; O_APPEND writes of a short line are atomic across the forked legs."""
+    fd = os.open(record, os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+    try:
+        os.write(fd, (event + "\n").encode())
+    finally:
+        os.close(fd)
+
+
+def _await(record: Path, events) -> None:
+    """Block until every event in ``events`` is in ``record`` (another leg has reached it); raise if it never is."""
+    deadline = time.monotonic() + EVENT_TIMEOUT_S
+    while not set(events) <= set(_events(record)):
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"still waiting for {sorted(set(events) - set(_events(record)))}")
+        time.sleep(0.005)
+
+
+def _stand_in(record: Path, gates: dict[str, tuple] | None = None, fail: str | None = None,
+              spawn: str | None = None):
+    """A leg runner that logs ``start <leg> <ranks>`` and ``end <leg>`` to ``record`` and commits a done state. A
+    leg named in ``gates`` first waits for the events listed there, so the order the tests assert is forced by
+    events, never by how long a leg sleeps. Leg ``spawn`` first starts a long-lived subprocess (as an mpirun would),
+    writes its pid beside ``record`` and logs ``spawned <leg>``; leg ``fail`` raises after its gate."""
+    gates = gates or {}
+
     def run_leg(leg, leg_dir, np_=1, **_):
-        t0 = time.monotonic()
+        _log(record, f"start {leg.name} {np_}")
         if leg.name == spawn:
             child = subprocess.Popen(["sleep", "120"])
             (record.parent / "grandchild.pid").write_text(str(child.pid))
-        time.sleep(seconds.get(leg.name, 0.3))
+            _log(record, f"spawned {leg.name}")
+        _await(record, gates.get(leg.name, ()))
         if leg.name == fail:
             raise RuntimeError(f"boom in {leg.name}")
         leg_dir.mkdir(parents=True, exist_ok=True)
         (leg_dir / "state.json").write_text(json.dumps({"done": True, "step": leg.total_steps}))
-        with open(record, "a") as fh:
-            fh.write(json.dumps([leg.name, t0, time.monotonic(), np_]) + "\n")
+        _log(record, f"end {leg.name}")
     return run_leg
 
 
+def _order(record: Path) -> list[str]:
+    """``start x`` / ``end x`` events in the order they happened (ranks dropped)."""
+    return [" ".join(e.split()[:2]) for e in _events(record) if e.split()[0] in ("start", "end")]
+
+
 def test_legs_start_when_what_they_read_is_done_and_independent_ones_overlap(tmp_path, monkeypatch):
-    record = tmp_path / "record.jsonl"
-    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"b": 0.6, "c": 0.6}))
+    """b and c each wait for the other's start: they can only finish if the scheduler runs them side by side."""
+    record = tmp_path / "record.txt"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"b": ("start c 1",), "c": ("start b 1",)}))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     legs = [_leg("a", ()), _leg("b", ("a",)), _leg("c", ("a",)), _leg("d")]
     states = runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=False, bar=None,
                                        extra_commands=())
     assert all(states[n]["done"] for n in "abcd")
-    ran = {n: (t0, t1) for n, t0, t1, _ in map(json.loads, record.read_text().splitlines())}
-    assert ran["b"][0] >= ran["a"][1] and ran["c"][0] >= ran["a"][1]       # they read a's restart
-    assert ran["b"][0] < ran["c"][1] and ran["c"][0] < ran["b"][1]         # b and c overlap: two jobs
-    assert ran["d"][0] >= max(ran["b"][1], ran["c"][1])                     # after=None: waits for all
+    at = {e: k for k, e in enumerate(_order(record))}
+    assert at["start b"] > at["end a"] and at["start c"] > at["end a"]       # they read a's restart
+    assert at["start d"] > max(at["end b"], at["end c"])                     # after=None: waits for all
+
+
+def test_a_gate_that_never_opens_fails_the_run_instead_of_hanging_it(tmp_path, monkeypatch):
+    """Negative control of the test above: with one job, b waits for c's start in vain and the run fails."""
+    record = tmp_path / "record.txt"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"b": ("start c 1",)}))
+    monkeypatch.setattr(runner, "POLL_S", 0.05)
+    monkeypatch.setattr(sys.modules[__name__], "EVENT_TIMEOUT_S", 0.5)
+    with pytest.raises(MDRunError, match="still waiting for"):
+        runner._run_legs_parallel(_plan([_leg("a", ()), _leg("b", ("a",)), _leg("c", ("a",))]), tmp_path,
+                                  jobs=1, np_=1, resume=False, bar=None, extra_commands=())
 
 
 @pytest.mark.parametrize("fill, expected", [
@@ -86,15 +135,17 @@ def test_legs_start_when_what_they_read_is_done_and_independent_ones_overlap(tmp
 ])
 def test_fill_cores_gives_a_lone_leg_every_core_and_shared_legs_their_own(tmp_path, monkeypatch, fill, expected):
     """jobs = 2 of np = 3 ranks: a leg that starts with nothing else running or able to start takes 2 x 3 ranks;
-    legs that start side by side keep 3 each, also the one left running alone when its neighbour ends."""
-    record = tmp_path / "record.jsonl"
-    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"e": 0.8, "f": 0.2}))
+    legs that start side by side keep 3 each, also the one left running alone when its neighbour ends (e waits for
+    f's end)."""
+    record = tmp_path / "record.txt"
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"e": ("end f",)}))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     legs = [_leg("a", ()), _leg("b", ("a",)), _leg("c", ("a",)), _leg("d"), _leg("e", ("d",)), _leg("f", ("d",))]
     runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=3, resume=False, bar=None, extra_commands=(),
                               fill=fill)
-    ranks = {n: r for n, _, _, r in map(json.loads, record.read_text().splitlines())}
+    ranks = {e.split()[1]: int(e.split()[2]) for e in _events(record) if e.startswith("start ")}
     assert ranks == expected
+    assert _order(record)[-2:] == ["end f", "end e"]
 
 
 def test_fill_cores_without_jobs_is_refused_in_one_line_naming_both():
@@ -112,26 +163,36 @@ def test_the_leg_with_the_longest_chain_behind_it_starts_first(tmp_path, monkeyp
     waits = leg_dependencies(legs)
     assert runner.critical_paths(legs, waits, {"x": 100, "y": 10, "z": 1000}) == {"x": 100, "y": 1010, "z": 1000}
     assert runner.critical_paths(legs, waits, {"x": 100, "y": 0, "z": 400}) == {"x": 100, "y": 400, "z": 400}
-    record = tmp_path / "record.jsonl"
+    record = tmp_path / "record.txt"
     monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     runner._run_legs_parallel(_plan(legs), tmp_path, jobs=1, np_=1, resume=False, bar=None, extra_commands=())
-    assert [json.loads(l)[0] for l in record.read_text().splitlines()] == ["y", "z", "x"]
+    assert [e for e in _order(record) if e.startswith("start")] == ["start y", "start z", "start x"]
     record.unlink()
     same = [_leg("p", (), 10), _leg("q", (), 10), _leg("r", (), 10)]
     runner._run_legs_parallel(_plan(same), tmp_path / "same", jobs=1, np_=1, resume=False, bar=None,
                               extra_commands=())
-    assert [json.loads(l)[0] for l in record.read_text().splitlines()] == ["p", "q", "r"]
+    assert [e for e in _order(record) if e.startswith("start")] == ["start p", "start q", "start r"]
 
 
 def test_one_job_at_a_time_never_overlaps(tmp_path, monkeypatch):
-    record = tmp_path / "record.jsonl"
+    record = tmp_path / "record.txt"
     monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     legs = [_leg("a", ()), _leg("b", ()), _leg("c", ())]
     runner._run_legs_parallel(_plan(legs), tmp_path, jobs=1, np_=1, resume=False, bar=None, extra_commands=())
-    spans = sorted((t0, t1) for _, t0, t1, _ in map(json.loads, record.read_text().splitlines()))
-    assert all(spans[k + 1][0] >= spans[k][1] for k in range(len(spans) - 1))
+    assert _order(record) == ["start a", "end a", "start b", "end b", "start c", "end c"]
+
+
+def _until(condition, timeout: float = EVENT_TIMEOUT_S) -> bool:
+    """Whether ``condition()`` became true within ``timeout`` seconds (checked every 10 ms): a wait on a state,
+    whose limit is reached only when the state never comes."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True
 
 
 def _gone(pid: int) -> bool:
@@ -146,35 +207,33 @@ def _gone(pid: int) -> bool:
 def test_a_failing_leg_stops_the_others_and_its_error_names_it(tmp_path, monkeypatch):
     """The slow leg's own subprocess (an mpirun, in a real run) is stopped with it: the child leads a process
     group of its own, and the parent stops the group."""
-    record = tmp_path / "record.jsonl"
-    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"slow": 60.0, "bad": 1.0}, fail="bad",
-                                                      spawn="slow"))
+    record = tmp_path / "record.txt"
+    # slow waits for an event that never comes (a leg that would run on); bad fails once slow has its subprocess
+    monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {"slow": ("never",), "bad": ("spawned slow",)},
+                                                      fail="bad", spawn="slow"))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     legs = [_leg("slow", ()), _leg("bad", ()), _leg("later", ("bad",))]
     t0 = time.monotonic()
     with pytest.raises(MDRunError, match=r"leg 'bad' failed: RuntimeError: boom in bad"):
         runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=False, bar=None,
                                   extra_commands=())
-    assert time.monotonic() - t0 < 20.0                     # the 60-s leg was stopped, not waited for
-    assert not record.exists()                              # nothing finished; 'later' never started
+    assert time.monotonic() - t0 < 20.0                     # the leg that would run on was stopped, not waited for
+    assert not any(e.startswith("end") for e in _events(record))   # nothing finished
+    assert "start later 1" not in _events(record) and not (tmp_path / "later").exists()
     assert not (tmp_path / "later").exists()
     pid = int((tmp_path / "grandchild.pid").read_text())
-    for _ in range(50):                                     # SIGTERM is delivered at once; allow it 5 s
-        if _gone(pid):
-            break
-        time.sleep(0.1)
-    assert _gone(pid), "the failed run left its leg's subprocess running"
+    assert _until(lambda: _gone(pid)), "the failed run left its leg's subprocess running"
 
 
 def test_legs_already_done_are_not_run_again(tmp_path, monkeypatch):
-    record = tmp_path / "record.jsonl"
+    record = tmp_path / "record.txt"
     monkeypatch.setattr(runner, "_run_leg", _stand_in(record, {}))
     monkeypatch.setattr(runner, "POLL_S", 0.05)
     (tmp_path / "legs" / "a").mkdir(parents=True)
     (tmp_path / "legs" / "a" / "state.json").write_text(json.dumps({"done": True, "step": 10}))
     legs = [_leg("a", ()), _leg("b", ("a",))]
     runner._run_legs_parallel(_plan(legs), tmp_path, jobs=2, np_=1, resume=True, bar=None, extra_commands=())
-    assert [json.loads(l)[0] for l in record.read_text().splitlines()] == ["b"]
+    assert _order(record) == ["start b", "end b"]
 
 
 def test_stop_after_chunks_needs_one_job():
@@ -252,37 +311,30 @@ runner._run_legs_parallel(Plan(legs=[leg], timestep_fs=1.0, n_atoms=1, seeds={{}
 """
     parent = subprocess.Popen([sys.executable, "-c", code])
     pid_file = tmp_path / "child.pid"
-    for _ in range(300):
-        if pid_file.exists() and pid_file.read_text():
-            break
-        time.sleep(0.1)
+    assert _until(lambda: pid_file.exists() and pid_file.read_text()), "the leg never started"
     child = int(pid_file.read_text())
     parent.kill()
     parent.wait()
-    for _ in range(50):
-        if _gone(child):
-            break
-        time.sleep(0.1)
-    alive = not _gone(child)
+    alive = not _until(lambda: _gone(child))
     if alive:
         os.kill(child, 9)
     assert not alive, "a leg ran on after its parent was killed"
 
 
-def test_a_checkout_run_without_the_installed_package_hashes_like_the_installed_one(monkeypatch):
-    """A source checkout run with PYTHONPATH (no installed metadata) takes the version from the source tree (the
-    attribute pyproject.toml reads), so its run hash is the installed package's and a run started there resumes
-    here; before, such a run hashed with "unknown" and could not be resumed by the installed package."""
+def test_a_checkout_run_without_the_installed_package_records_the_source_trees_version(monkeypatch):
+    """A source checkout run with PYTHONPATH (no installed metadata) records the version from the source tree (the
+    attribute pyproject.toml reads), as the installed package would; the run hash holds no version at all."""
     import importlib.metadata
 
     import nanoimpact
     from md.engine import hashing
+    from nanoimpact.provenance import package_version
 
-    installed = hashing.package_version()
-    key = hashing.run_hash({"name": "r"}, "quick", [])
+    installed = package_version()
+    key = hashing.run_hash({"name": "r"}, "quick", [], 1)
 
     def missing(name):
         raise importlib.metadata.PackageNotFoundError(name)
     monkeypatch.setattr(importlib.metadata, "version", missing)
-    assert hashing.package_version() == nanoimpact.__version__ == installed
-    assert hashing.run_hash({"name": "r"}, "quick", []) == key
+    assert package_version() == nanoimpact.__version__ == installed
+    assert hashing.run_hash({"name": "r"}, "quick", [], 1) == key

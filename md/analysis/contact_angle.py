@@ -354,8 +354,8 @@ def cutoff_crossing_work(site_z_A, c6, z_plane_A, number_density_A3, r_cut_A, ar
         dW = (n / A) sum_j C6_j V(d_j) / r_c^6.
 
     Beside the beyond-cutoff tail it turns the shifted-potential W_SL into the full potential's; for two
-    half-spaces in contact it is half that tail (pi C n^2 / (4 r_c^2) against pi C n^2 / (2 r_c^2)), the term the
-    droplets' correction lacked (md-review-2 F8; the same bookkeeping as the adhesion workflow's force route)."""
+    half-spaces in contact it is half that tail (pi C n^2 / (4 r_c^2) against pi C n^2 / (2 r_c^2)); the same
+    bookkeeping as the adhesion workflow's force route."""
     z = np.asarray(site_z_A, float)
     c = np.broadcast_to(np.asarray(c6, float), z.shape)
     rc = float(r_cut_A)

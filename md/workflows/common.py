@@ -317,12 +317,13 @@ def surface_slab(kind: str, nx: int, ny: int, thickness: float, settings: Settin
 # ================================================================================================ base class
 
 class Workflow:
-    """``version`` counts changes of a workflow's simulation protocol; above 1 it enters the run hash.
+    """``version``, which every workflow declares, counts changes of its simulation protocol and enters the run
+    hash (:func:`md.engine.hashing.run_hash`), so raising it invalidates the workflow's cached and committed runs.
     ``protocol_version(settings)`` is the version a run with those settings follows (``version`` unless a change
     touched only some systems: then the others keep the version of their unchanged plans, and their hashes).
     ``yields``: the quantities every result of the workflow reports (name -> SI units); some report more."""
     name = ""
-    version = 1
+    version: int
     yields: dict[str, str] = {}
 
     @classmethod

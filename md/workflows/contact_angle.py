@@ -55,7 +55,7 @@ class ContactAngleWorkflow(Workflow):
     The water and the substrate's mobile atoms have a thermostat each
     (:func:`md.workflows.common.water_solid_thermostat_lines`: heat crosses a water-solid interface slowly), both
     temperatures sampled and reported. The substrate's FIRE minimisation runs at :data:`FIRE_TIMESTEP_FS` (FIRE's
-    steps at a 2 fs timestep make the unconstrained silanol O-H diverge). ``version`` (4) enters the run hash."""
+    steps at a 2 fs timestep make the unconstrained silanol O-H diverge). ``version`` enters the run hash."""
     name = "contact_angle"
     version = 4
     yields = {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"}

@@ -112,16 +112,17 @@ def run_recipe(recipe: Recipe | str | Path, fidelity: str = "quick", *, out: str
                cache: str | Path | None = None, resume: bool = False, np_: int = 1, progress: bool = True,
                force: bool = False, stop_after_chunks: int | None = None, extra_commands: Sequence[str] = (),
                echo: Callable[[str], None] | None = None, wait: bool = True,
-               wait_timeout: float | None = None, jobs: int = 1, fill: bool = False) -> MDResult:
+               wait_timeout: float | None = None, jobs: int = 1, fill: bool = False,
+               same_versions: bool = False) -> MDResult:
     """Run ``recipe`` (a :class:`~md.recipe.Recipe`, a shipped name or a file) at ``fidelity``, or reuse its
     cached result, and copy the files into ``out``; returns the :class:`MDResult`.
 
     The options are :func:`md.engine.runner.run_job`'s (cache, resume, MPI ranks, legs at once, idle cores to a
-    lone leg, locking)."""
+    lone leg, locking, ``same_versions``: rerun a cached result made under other nanoimpact or LAMMPS versions)."""
     if not isinstance(recipe, Recipe):
         recipe = load_recipe(recipe)
     outcome = run_job(job_for(recipe, fidelity), get_workflow(recipe.workflow), out=out, cache=cache,
                       resume=resume, np_=np_, progress=progress, force=force, stop_after_chunks=stop_after_chunks,
                       extra_commands=extra_commands, echo=echo, wait=wait, wait_timeout=wait_timeout, jobs=jobs,
-                      fill=fill)
+                      fill=fill, same_versions=same_versions)
     return MDResult.from_result(outcome.result, outcome.run_dir, outcome.reused, outcome.out_dir)

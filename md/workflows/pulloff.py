@@ -47,7 +47,7 @@ class PullOff(Workflow):
     residual drag on the asperity is measured from the holder's reaction and reported; ``retract_repeats``
     independent retractions per speed give the pull-off force a spread (from one held contact: "same contact");
     ``tip_positions`` gives each position its own contact; the OTS asperity carries >= 4 chains per nm^2 of
-    projected cap. ``version`` (2) enters the run hash; the options at their neutral values
+    projected cap. ``version`` enters the run hash; the options at their neutral values
     (:data:`md.recipe.NEUTRAL_KEYS`) run the same plan as without them."""
     name = "pulloff"
     version = 2

@@ -26,6 +26,7 @@ from md.workflows.common import (common_define, derived_seed, equilibrate_stage,
 class SurfaceTension(Workflow):
     """SPC/E film: gamma_lv from the pressure tensor, bulk density from the profile."""
     name = "surface_tension"
+    version = 1
     yields = {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"}
 
     def forcefield_files(self, s):

@@ -110,7 +110,7 @@ class WslTI(Workflow):
 
     Each reference node starts from its film node's starting state, water deleted, so the solid's slow
     configuration (silanol orientations, SAM head groups) is the same in both: the solid-solid share of
-    dU/dlambda_q is tens of thousands of kcal/mol and must cancel to the few kcal/mol W_SL needs. ``version`` (3)
+    dU/dlambda_q is tens of thousands of kcal/mol and must cancel to the few kcal/mol W_SL needs. ``version``
     enters the run hash."""
     name = "wsl_ti"
     version = 3
