@@ -44,7 +44,7 @@ stored energy of the branch the summit is on, so work = stored + plastic + booke
 With p_y = inf no summit yields and every function is L's own on beta (bit for bit: tests).
 
 Range: the construction rests on the small-strain relations of L (a << R); `range_radius_ratio` gives a*/R_p at
-the deepest state, which callers compare with `continuum.limiting_pressure.LAW_RANGE_RADIUS_RATIO`.
+the deepest state, which callers compare with `continuum.reference.thornton_ning.LAW_RANGE_RADIUS_RATIO`.
 
 Sources: C. Thornton & Z. Ning, Powder Technol. 99 (1998) 154-162; D. Maugis, J. Colloid Interface Sci. 150
 (1992) 243; K. L. Johnson & J. A. Greenwood, J. Colloid Interface Sci. 192 (1997) 326; L. Kogut & I. Etsion,
