@@ -63,6 +63,8 @@ class GridRun:
     """Wall time of the cycle (s)."""
     unconverged: int = 0
     """States the solver left above its tolerance."""
+    cpu_seconds: float = math.nan
+    """CPU time of the cycle (s): the cost that does not move with the machine's load."""
 
 
 def _order(coarse: float, mid: float, fine: float, ratio: float) -> float:
@@ -81,8 +83,8 @@ def convergence(runs: list[GridRun], zone_length: float, patch_size: float, *, t
     finest (where three were run), the first-order fit loss = L0 + c a by least squares, the successive first-order
     (Richardson) extrapolations 2 L(a) - L(2a), and the pixel at which c a would fall to `tolerance` of the
     converged loss (taken as the smallest positive extrapolation, the finest loss where none is positive: the
-    bound is then optimistic), with the grid and the solve time that pixel needs (time growing as n^q, q measured
-    on the two finest grids)."""
+    bound is then optimistic), with the grid and the solve time that pixel needs (CPU time where the runs give it,
+    growing as n^q, q measured on the two finest grids)."""
     if len(runs) < 2:
         raise InputError("bem_convergence.grids", len(runs), "at least two grids")
     runs = sorted(runs, key=lambda r: -r.pixel)                 # coarse -> fine
@@ -90,7 +92,8 @@ def convergence(runs: list[GridRun], zone_length: float, patch_size: float, *, t
     loss = np.array([r.loss for r in runs])
     pull = np.array([r.pull_off for r in runs])
     rows = [{"grid": r.grid, "pixel_m": r.pixel, "zone_pixels": zone_length / r.pixel, "pull_off_force_N": r.pull_off,
-             "hysteresis_energy_J": r.loss, "seconds": r.seconds, "unconverged_states": r.unconverged} for r in runs]
+             "hysteresis_energy_J": r.loss, "seconds": r.seconds, "cpu_seconds": r.cpu_seconds,
+             "unconverged_states": r.unconverged} for r in runs]
     rel = lambda f, c: abs(f - c) / abs(f) if f else math.inf   # noqa: E731
     loss_change, pull_change = rel(loss[-1], loss[-2]), rel(pull[-1], pull[-2])
     order = _order(*loss[-3:], a[-2] / a[-1]) if len(runs) >= 3 else math.nan
@@ -110,9 +113,9 @@ def convergence(runs: list[GridRun], zone_length: float, patch_size: float, *, t
     target = min(positive) if positive else float(loss[-1])
     need_pixel = tolerance * target / slope if slope > 0 else math.nan
     need_grid = int(math.ceil(patch_size / need_pixel)) if need_pixel > 0 else None
-    q = math.log(runs[-1].seconds / runs[-2].seconds) / math.log(runs[-1].grid / runs[-2].grid) \
-        if runs[-2].seconds > 0 and runs[-1].seconds > 0 else math.nan
-    need_seconds = runs[-1].seconds * (need_grid / runs[-1].grid) ** q if need_grid and np.isfinite(q) else math.nan
+    cost = [r.cpu_seconds if np.isfinite(r.cpu_seconds) else r.seconds for r in runs[-2:]]
+    q = math.log(cost[1] / cost[0]) / math.log(runs[-1].grid / runs[-2].grid) if min(cost) > 0 else math.nan
+    need_seconds = cost[1] * (need_grid / runs[-1].grid) ** q if need_grid and np.isfinite(q) else math.nan
     record.update(required_pixel_m=need_pixel, required_grid=need_grid, solve_time_exponent=q,
                   required_seconds_estimate=need_seconds)
     spread = (max(positive) / min(positive)) if len(positive) >= 2 else math.nan
@@ -125,5 +128,5 @@ def convergence(runs: list[GridRun], zone_length: float, patch_size: float, *, t
         f"{', '.join(f'{r:.3g}' for r in rich)} J (spread {spread:.2g}x), so the finest loss {loss[-1]:.3g} J is an "
         f"upper bound. Bringing the trapping term under {100 * tolerance:.0f} % of {target:.3g} J needs a pixel of "
         f"{need_pixel * 1e9:.3g} nm, a {need_grid}^2 grid on this {patch_size * 1e9:.3g} nm patch, ~{need_seconds:.2g} "
-        f"s per cycle at the measured n^{q:.2f} growth (the finest took {runs[-1].seconds:.3g} s)")
+        f"CPU s per cycle at the measured n^{q:.2f} growth (the finest took {cost[1]:.3g} CPU s)")
     return record

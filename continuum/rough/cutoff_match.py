@@ -130,8 +130,9 @@ def match_cutoff(ladder: list[dict], reference_loss: float, upper_bound: float, 
         "cutoff_at_upper_bound_m)")
     if cutoff is None:
         losses = [r["loss_J"] for r in ladder]
-        reason = (f"no cutoff from {ladder[0]['cutoff_m']:.3g} to {ladder[-1]['cutoff_m']:.3g} m brings the discrete "
-                  f"loss ({min(losses):.3g} to {max(losses):.3g} J) to the reference's {reference_loss:.3g} J ({basis})")
+        reason = (f"no cutoff from {ladder[0]['cutoff_m']:.3g} to {ladder[-1]['cutoff_m']:.3g} m brings the "
+                  f"discrete loss ({min(losses):.3g} to {max(losses):.3g} J) to the reference's "
+                  f"{reference_loss:.3g} J ({basis})")
     else:
         reason = f"matched to {basis}; match error at the nearest rung ({nearest['cutoff_m']:.3g} m)"
     return CutoffMatch(cutoff, float(error), float(reference_loss), bool(converged), _crossing(ladder, upper_bound),
