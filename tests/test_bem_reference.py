@@ -5,6 +5,8 @@ the z0 -> rho mapping, the quasi-static path), not Tamaas itself. Then the pixel
 cutoff matched to the reference's loss, with its cache (cutoff_match)."""
 from __future__ import annotations
 
+import tomllib
+
 import numpy as np
 import pytest
 
@@ -16,6 +18,7 @@ from continuum.rough.bem_reference import BEMContact, bem_cycle, dugdale_range
 from continuum.rough.branch_laws import DUGDALE_FACTOR, make_summit_law
 from continuum.rough.cutoff_match import cache_key, match_cutoff, measured_cutoff
 from continuum.rough.quasistatic import discrete_cycle, separation_path
+from nanoimpact import data
 from nanoimpact.errors import InputError
 
 R, L, E = 1e-6, 1e-6, 1e9          # paraboloid radius, periodic cell, contact modulus (SI)
@@ -232,3 +235,46 @@ def test_measured_cutoff_is_cached_by_map_and_law(tmp_path):
     assert again["origin"] == first["origin"] and first["origin"]["kind"] == "bem"
     assert len(list(tmp_path.iterdir())) == 1
     assert cache_key(h, size, 88.8e9, 0.192, 0.207e-9, {}) != cache_key(h, size, 88.8e9, 0.192, 0.21e-9, {})
+
+
+# --- a scene asking for the measured cutoff (surfaces.roughness.summit_cutoff_from = "bem") ----------------------
+
+_SMALL = {"surfaces.roughness.synthetic.size": 0.25e-6, "surfaces.roughness.synthetic.rms_height": 1.2e-9,
+          "surfaces.roughness.synthetic.short_cutoff": 0.25e-6 / 8,
+          "surfaces.roughness.synthetic.long_cutoff": 0.25e-6 / 2, "surfaces.roughness.synthetic.grid_points": 64}
+
+
+@pytest.mark.parametrize("extra, message", [
+    ({}, "needs the cohesive zone"),                                        # 5 um map: 78 nm pixels, zone 19 nm
+    ({"surfaces.roughness.summit_cutoff": 1e-7}, "measures the cutoff"),    # two sources for one cutoff
+])
+def test_a_scene_asking_for_the_bem_cutoff_is_refused_where_the_reference_cannot_stand(extra, message):
+    from continuum.scene import SceneError, resolve_scene
+    with pytest.raises(SceneError, match=rf"surfaces.roughness.summit_cutoff_from = 'bem': .*{message}"):
+        resolve_scene("rough_synthetic", params="calibrated",
+                      overrides={"surfaces.roughness.summit_cutoff_from": "bem", **extra})
+
+
+def test_the_bem_cutoff_of_a_small_patch_reaches_the_scene(tmp_path, monkeypatch):
+    """The benchmark's patch on its own 64^2 grid: the reference's ladder (16, 32, 64) runs once, the discrete
+    summits' loss meets the extrapolated reference loss inside the ladder's cutoffs (origin kind "bem", the
+    reference's loss not converged), and the scene asking for it reads the cached match, whose cutoff leaves this
+    0.25 um patch fewer summits than statistics need: refused with the key and the count."""
+    from continuum.rough.cutoff_match import scene_cutoff
+    from continuum.rough.topography import Synthesis, synthesise_height_map
+    from continuum.scene import SceneError, resolve_scene
+    monkeypatch.setenv("NANOIMPACT_CACHE", str(tmp_path))
+    hmap = synthesise_height_map(Synthesis(hurst=0.8, rms_height=1.2e-9, short_cutoff=0.25e-6 / 8, size=0.25e-6,
+                                           grid_points=64, long_cutoff=0.25e-6 / 2, seed=1))
+    raw = tomllib.loads(data.find("params", "calibrated").read_text())["surfaces"]
+    e_star = float(hertz.effective_modulus(raw["body"]["youngs_modulus"], raw["body"]["poisson_ratio"],
+                                           raw["substrate"]["youngs_modulus"], raw["substrate"]["poisson_ratio"]))
+    cutoff, origin = scene_cutoff(hmap.heights, hmap.physical_size[0], True, e_star, raw["work_of_adhesion"],
+                                  raw["interaction_range"])
+    pixel = hmap.physical_size[0] / 64
+    assert 4 * pixel < cutoff < 32 * pixel
+    assert origin["kind"] == "bem" and origin["bem_loss_converged"] is False and not origin["cached"]
+    with pytest.raises(SceneError, match=r"holds \d summits at summit_cutoff .*need >= 20"):
+        resolve_scene("rough_synthetic", params="calibrated",
+                      overrides={**_SMALL, "surfaces.roughness.summit_cutoff_from": "bem"})
+    assert len(list((tmp_path / "bem").iterdir())) == 1                     # the scene reused the match

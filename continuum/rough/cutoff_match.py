@@ -42,7 +42,7 @@ from .quasistatic import discrete_cycle, separation_path
 from .topography import identify_summits
 
 __all__ = ["CutoffMatch", "discrete_loss", "match_cutoff", "cache_key", "cache_dir", "measured_cutoff",
-           "CUTOFF_PIXELS", "MATCH_VERSION"]
+           "scene_cutoff", "CUTOFF_PIXELS", "MATCH_VERSION", "MAX_GRID", "MIN_ZONE_PIXELS", "KEY_CUTOFF_FROM"]
 
 log = logging.getLogger(__name__)
 
@@ -50,6 +50,13 @@ log = logging.getLogger(__name__)
 CUTOFF_PIXELS = (4, 6, 8, 12, 16, 24, 32)
 #: Bumped when the match's method changes, so that cached matches of the old method are not reused.
 MATCH_VERSION = 1
+#: The scene key that asks for the measured cutoff.
+KEY_CUTOFF_FROM = "surfaces.roughness.summit_cutoff_from"
+#: Largest map (points per side) a scene may send to the reference: its cycle costs ~n^3.4 CPU (bem_convergence's
+#: measured growth; ~1 CPU min at 128^2 on the benchmark's patch).
+MAX_GRID = 256
+#: Pixels the cohesive zone E* dgamma / sigma0^2 must span on the map's own grid (the reference's finest).
+MIN_ZONE_PIXELS = 4.0
 
 
 @dataclass(frozen=True)
@@ -174,17 +181,19 @@ def _fourier_resample(heights: np.ndarray, n: int) -> np.ndarray:
 
 
 def measured_cutoff(heights, size: float, e_star: float, work_of_adhesion: float, z0: float, *,
-                    grids: tuple[int, ...] = (32, 64, 128), depth_in_summit_std: float = 0.5,
+                    grids: tuple[int, ...] | None = None, depth_in_summit_std: float = 0.5,
                     cutoffs_pixels: tuple[float, ...] = CUTOFF_PIXELS, cache: str | Path | None = None) -> dict:
     """The measured cutoff of a square periodic map (heights m, side `size` m) with its BEM ladder, cached.
 
-    The reference runs on `grids` (Fourier-resampled), along the path from 2 rho above the tallest point down to
+    The reference runs on `grids` (Fourier-resampled; default: the map's own grid, its half and its quarter),
+    along the path from 2 rho above the tallest point down to
     the mean summit height (at the smallest cutoff) + `depth_in_summit_std` summit standard deviations, in steps
     of rho/8. Returns {"match": CutoffMatch.to_json(), "origin": ..., "bem_convergence": ..., "cached": bool}."""
     h = np.asarray(heights, float)
     if h.ndim != 2 or h.shape[0] != h.shape[1]:
         raise InputError("summit_cutoff", f"map of shape {h.shape}", '"bem" needs a square periodic map')
     h = h - h.mean()
+    grids = grids or (h.shape[0] // 4, h.shape[0] // 2, h.shape[0])
     settings = {"grids": list(grids), "depth": depth_in_summit_std, "cutoffs_pixels": list(cutoffs_pixels)}
     key = cache_key(h, size, e_star, work_of_adhesion, z0, settings)
     path_file = cache_dir(cache) / f"cutoff-{key[:24]}.json"
@@ -221,3 +230,29 @@ def reference_estimate(record: dict) -> float:
         return float(finest)
     rich = record["loss_richardson_J"][-1] if record["loss_richardson_J"] else math.nan
     return float(rich) if np.isfinite(rich) and rich > 0 else float(finest)
+
+
+def scene_cutoff(heights, size: float, periodic: bool, e_star: float, work_of_adhesion: float, z0: float, *,
+                 cache: str | Path | None = None) -> tuple[float, dict]:
+    """(cutoff (m), origin) for a scene that asks `summit_cutoff_from = "bem"`: the measured cutoff of its map, run
+    once and cached (`measured_cutoff` on the map's own grid, half and quarter). Refused, naming the key, where the
+    reference cannot stand: a map that is not square, larger than MAX_GRID^2, or whose grid does not resolve the
+    cohesive zone (MIN_ZONE_PIXELS), or a ladder that brackets no cutoff. A measured map is treated as periodic
+    (its wrap-around step is part of the reference); the origin says so."""
+    h = np.asarray(heights, float)
+    if h.ndim != 2 or h.shape[0] != h.shape[1] or h.shape[0] > MAX_GRID:
+        raise InputError(KEY_CUTOFF_FROM, "bem", f"needs a square map of at most {MAX_GRID}^2 points (this one: "
+                                                 f"{h.shape}): the reference's cycle grows as ~n^3.4")
+    zone = cohesive_zone_length(e_star, work_of_adhesion, z0)
+    pixel = size / h.shape[0]
+    if zone < MIN_ZONE_PIXELS * pixel:
+        raise InputError(KEY_CUTOFF_FROM, "bem", f"needs the cohesive zone E* dgamma/sigma0^2 = {zone:.3g} m to span "
+                                                 f">= {MIN_ZONE_PIXELS:g} pixels of the map ({pixel:.3g} m): use a "
+                                                 "smaller patch or a finer map")
+    found = measured_cutoff(h, size, e_star, work_of_adhesion, z0, cache=cache)
+    origin = dict(found["origin"], cached=found["cached"], periodic_map=bool(periodic),
+                  bem_loss_converged=found["bem_convergence"]["converged"],
+                  bem_not_converged=found["bem_convergence"]["not_converged"])
+    if origin["cutoff_m"] is None:
+        raise InputError(KEY_CUTOFF_FROM, "bem", f"found no cutoff: {origin['note']}")
+    return float(origin["cutoff_m"]), origin

@@ -8,6 +8,10 @@ scene file itself or as an override next to a map is an error, since two sources
 reader guessing which one ran. `surfaces.roughness.sigma` holds the summits' height standard deviation (the GW
 sigma), so a map fills it with sigma_s, not with the surface's rms height.
 
+The cutoff is the scene's summit_cutoff (or its tip_radius, or a synthesis' short cutoff), or, with
+`summit_cutoff_from = "bem"`, the one the boundary-element reference measures on the map
+(`continuum.rough.cutoff_match`); `cutoff_from` in the block says which.
+
 The map supplies statistics for the mean-field (Greenwood-Williamson) model only: the roller's footprint may be
 far larger than the map, and nothing here tiles the map under it.
 """
@@ -18,7 +22,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from nanoimpact import data
+from nanoimpact.errors import InputError
 
+from ..reference.hertz import effective_modulus
+from .cutoff_match import KEY_CUTOFF_FROM, scene_cutoff
 from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_FILE, KEY_SIZE, KEY_SYNTH, KEY_TIP, KEY_UNIT, HeightMap,
                          SurfaceStatistics, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map,
                          summit_statistics)
@@ -105,7 +112,9 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
     cutoff, tip = values.get(KEY_CUTOFF), values.get(KEY_TIP)
     if cutoff is not None and tip is not None:
         raise TopographyError(KEY_TIP, tip, "give summit_cutoff or tip_radius, not both")
-    if synthesis is None and cutoff is None and tip is None:
+    if values.get(KEY_CUTOFF_FROM) == "bem" and (cutoff is not None or tip is not None):
+        raise TopographyError(KEY_CUTOFF_FROM, "bem", "measures the cutoff: remove summit_cutoff and tip_radius")
+    if synthesis is None and cutoff is None and tip is None and values.get(KEY_CUTOFF_FROM) != "bem":
         raise TopographyError(KEY_CUTOFF, None, "is required with a measured map (or give tip_radius): summit "
                                                 "radius and density depend on the shortest wavelength kept")
     replaced = {}
@@ -118,10 +127,11 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
             replaced[key] = {"value": values[key], "source": source}
     spec, stamp = _map_spec(file_spec, synthesis, scene_dir)
     size = values.get(KEY_SIZE)
+    cutoff, bem_origin = _cutoff(values, spec, stamp)
     hmap, stats, origin = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
                                       values.get(KEY_UNIT), cutoff, tip, values.get(KEY_ROUTE, "direct"), stamp)
-    block = {**stats.to_json(), "cutoff_from": origin, "source": dict(hmap.source), "replaced": replaced,
-             "fills": {key: attr for key, attr in MAP_KEYS.items()},
+    block = {**stats.to_json(), "cutoff_from": bem_origin or origin, "source": dict(hmap.source),
+             "replaced": replaced, "fills": {key: attr for key, attr in MAP_KEYS.items()},
              "note": "the map supplies summit statistics to the mean-field (GW) law and to discrete draws; the "
                      "members of an ensemble are patches of the map's own summits (result.json -> ensemble.patches)"}
     return MapStatistics(values={key: getattr(stats, attr) for key, attr in MAP_KEYS.items()}, block=block)
@@ -154,6 +164,34 @@ def height_map(values: dict, scene_dir: Path | None) -> tuple[HeightMap, float] 
     spec, stamp = _map_spec(file_spec, synthesis, scene_dir)
     size = values.get(KEY_SIZE)
     hmap, stats, _ = _statistics(spec, values.get(KEY_CHANNEL), None if size is None else tuple(size),
-                                 values.get(KEY_UNIT), values.get(KEY_CUTOFF), values.get(KEY_TIP),
+                                 values.get(KEY_UNIT), _cutoff(values, spec, stamp)[0], values.get(KEY_TIP),
                                  values.get(KEY_ROUTE, "direct"), stamp)
     return hmap, float(stats.cutoff)
+
+
+def _cutoff(values: dict, spec, stamp) -> tuple[float | None, dict | None]:
+    """(cutoff, its origin when the boundary-element reference measured it): the scene's summit_cutoff, or with
+    summit_cutoff_from = "bem" the cutoff `continuum.rough.cutoff_match.scene_cutoff` measures on the map with the
+    scene's dry law (work_of_adhesion, interaction_range, E* of body and substrate)."""
+    if values.get(KEY_CUTOFF_FROM) != "bem":
+        return values.get(KEY_CUTOFF), None
+    size = values.get(KEY_SIZE)
+    if isinstance(spec, Synthesis):
+        hmap = _statistics(spec, None, None, None, None, None, "direct", stamp)[0]
+    else:
+        hmap = load_height_map(spec, channel=values.get(KEY_CHANNEL), size=None if size is None else list(size),
+                               unit=values.get(KEY_UNIT))
+    e_star = float(effective_modulus(values["surfaces.body.youngs_modulus"], values["surfaces.body.poisson_ratio"],
+                                     values["surfaces.substrate.youngs_modulus"],
+                                     values["surfaces.substrate.poisson_ratio"]))
+    return _measured(hmap, e_star, values["surfaces.work_of_adhesion"], values["surfaces.interaction_range"])
+
+
+def _measured(hmap: HeightMap, e_star: float, w: float, z0: float) -> tuple[float, dict]:
+    """The measured cutoff (run once per map and law: the match is cached on disk by the heights' hash)."""
+    try:
+        return scene_cutoff(hmap.heights, hmap.physical_size[0], hmap.periodic, e_star, w, z0)
+    except TopographyError:
+        raise
+    except InputError as exc:
+        raise TopographyError(exc.key, exc.value, exc.allowed) from None
