@@ -51,7 +51,7 @@ sys.path.insert(0, str(ROOT))
 from continuum.reference.hertz import effective_modulus   # noqa: E402
 from continuum.reference.maugis import md_parameter   # noqa: E402
 from continuum.rough.bem_convergence import (GridRun, cohesive_zone_length, convergence,   # noqa: E402
-                                              dugdale_crack_zone)
+                                              dugdale_crack_zone, single_summit_ladder)
 from continuum.rough.bem_impact import STANDARD_G, impact_at_energy, impact_outcome   # noqa: E402
 from continuum.rough.bem_reference import bem_cycle, dugdale_range   # noqa: E402
 from continuum.rough.cutoff_match import CUTOFF_PIXELS, discrete_loss, match_cutoff, reference_estimate   # noqa: E402
@@ -368,6 +368,14 @@ def markdown_bem(result: dict) -> str:
              f"{g['unconverged_states']} |" for g in conv["grids"]]
     verdict = (f"Converged: the two finest grids' losses within {100 * conv['tolerance']:.0f} %."
                if conv["converged"] else f"`not_converged`: {conv['not_converged']}.")
+    one = conv.get("single_summit", {"grids": []})
+    verdict += "" if not one["grids"] else (f"\n\nOne summit of the patch's mean tip radius ({one['radius_m'] * 1e9:.3g} nm, a "
+                f"{one['cell_m'] * 1e9:.3g} nm cell, flat {one['depth_m'] * 1e9:.2g} nm below the apex): the summit "
+                f"law loses {one['summit_law_loss_J']:.3g} J per cycle and pulls off at "
+                f"{one['summit_law_pull_off_N']:.3g} N; the reference, by pixel: " + "; ".join(
+                    f"{g['pixel_m'] * 1e9:.3g} nm: pull-off {g['pull_off_force_N']:.3g} N, loss "
+                    f"{g['hysteresis_energy_J']:.3g} J ({g['loss_over_summit_law']:.0f}x the summit law's)"
+                    for g in one["grids"]) + ".")
     ref_e = body["reference"]["restitution"]
     imp = ["| level | restitution e | first rebound h1/h0 = e² | energy lost 1 − e² | sticks | impact_rel_error | "
            "vs extrapolated reference | seconds (cycle + impact) |", "|---|---|---|---|---|---|---|---|",
@@ -444,6 +452,9 @@ def run(args) -> dict:
             e2 = 1 - est / body["impact_energy_J"]
             row["impact_rel_error_vs_extrapolated"] = _rel(row["impact"]["restitution"] ** 2, e2)
     match = cutoff_match(grids[n_ref], desc, mat, path, ref_record["bem_convergence"])
+    ref_record["bem_convergence"]["single_summit"] = single_summit_ladder(
+        sets["direct"].summit_radius, mat["e_star"], mat["work_of_adhesion"], mat["z0"],
+        grids=(16, 32, 64) if args.quick else (16, 32, 64, 128))
     beta = sets["direct"].summit_radius
     pixel = desc["size_m"] / n_ref
     surface = {k: v for k, v in desc.items()}

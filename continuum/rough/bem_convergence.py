@@ -25,9 +25,12 @@ import numpy as np
 
 from nanoimpact.errors import InputError
 
-from .bem_reference import dugdale_range
+from .bem_reference import bem_cycle, dugdale_range
+from .branch_laws import make_summit_law
+from .quasistatic import discrete_cycle, separation_path
 
-__all__ = ["GridRun", "cohesive_zone_length", "dugdale_crack_zone", "convergence", "TOLERANCE"]
+__all__ = ["GridRun", "cohesive_zone_length", "dugdale_crack_zone", "convergence", "single_summit_ladder",
+           "TOLERANCE"]
 
 #: Convergence criterion on the loss per cycle: the two finest grids within this relative difference.
 TOLERANCE = 0.10
@@ -130,3 +133,30 @@ def convergence(runs: list[GridRun], zone_length: float, patch_size: float, *, t
         f"{need_pixel * 1e9:.3g} nm, a {need_grid}^2 grid on this {patch_size * 1e9:.3g} nm patch, ~{need_seconds:.2g} "
         f"CPU s per cycle at the measured n^{q:.2f} growth (the finest took {cost[1]:.3g} CPU s)")
     return record
+
+
+def single_summit_ladder(radius: float, e_star: float, work_of_adhesion: float, z0: float, grids=(16, 32, 64), *,
+                         depth_in_rho: float = 5.0) -> dict:
+    """The reference on one paraboloid of tip radius `radius` (m) against the same Dugdale law, on a ladder of
+    grids, beside the Maugis-Dugdale summit law's own cycle (the continuum answer for one summit, `branch_laws`):
+    the flat goes from 2 rho above the apex to `depth_in_rho` rho below it and back in steps of rho/16, in a
+    periodic cell four contact radii wide at that depth. Per grid: pixel, pull-off, loss and the loss over the
+    summit law's."""
+    _, rho = dugdale_range(work_of_adhesion, z0)
+    depth = depth_in_rho * rho
+    cell = 4 * math.sqrt(2 * radius * depth)
+    law = make_summit_law("maugis_dugdale", radius, work_of_adhesion, e_star, z0=z0, delta_max=10 * depth)
+    path = separation_path(2 * rho, -depth, rho / 16)
+    exact = discrete_cycle(law, [0.0], path)
+    rows = []
+    for n in grids:
+        x = (np.arange(n) - n // 2) * cell / n
+        xx, yy = np.meshgrid(x, x, indexing="ij")
+        h = -(xx**2 + yy**2) / (2 * radius)
+        cyc, stats = bem_cycle(h, cell, e_star, work_of_adhesion, z0, path + float((h - h.mean()).max()))
+        rows.append({"grid": n, "pixel_m": cell / n, "pull_off_force_N": cyc.pull_off_force,
+                     "hysteresis_energy_J": cyc.hysteresis_energy,
+                     "loss_over_summit_law": cyc.hysteresis_energy / exact.hysteresis_energy,
+                     "seconds": stats.seconds, "cpu_seconds": stats.notes["cpu_seconds"]})
+    return {"radius_m": radius, "cell_m": cell, "depth_m": depth, "summit_law_loss_J": exact.hysteresis_energy,
+            "summit_law_pull_off_N": exact.pull_off_force, "grids": rows}
