@@ -156,7 +156,8 @@ def single_summit_ladder(radius: float, e_star: float, work_of_adhesion: float, 
         cyc, stats = bem_cycle(h, cell, e_star, work_of_adhesion, z0, path + float((h - h.mean()).max()))
         rows.append({"grid": n, "pixel_m": cell / n, "pull_off_force_N": cyc.pull_off_force,
                      "hysteresis_energy_J": cyc.hysteresis_energy,
-                     "loss_over_summit_law": cyc.hysteresis_energy / exact.hysteresis_energy,
+                     "loss_over_summit_law": cyc.hysteresis_energy / law.loop_energy,
                      "seconds": stats.seconds, "cpu_seconds": stats.notes["cpu_seconds"]})
-    return {"radius_m": radius, "cell_m": cell, "depth_m": depth, "summit_law_loss_J": exact.hysteresis_energy,
-            "summit_law_pull_off_N": exact.pull_off_force, "grids": rows}
+    return {"radius_m": radius, "cell_m": cell, "depth_m": depth, "summit_law_loss_J": law.loop_energy,
+            "summit_law_loss_sampled_J": exact.hysteresis_energy, "summit_law_pull_off_N": exact.pull_off_force,
+            "grids": rows}

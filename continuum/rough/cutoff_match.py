@@ -49,7 +49,7 @@ log = logging.getLogger(__name__)
 #: The ladder of cutoffs, in pixels of the map as given (>= 4: `topography.MIN_CUTOFF_PIXELS`).
 CUTOFF_PIXELS = (4, 6, 8, 12, 16, 24, 32)
 #: Bumped when the match's method changes, so that cached matches of the old method are not reused.
-MATCH_VERSION = 1
+MATCH_VERSION = 2
 #: The scene key that asks for the measured cutoff.
 KEY_CUTOFF_FROM = "surfaces.roughness.summit_cutoff_from"
 #: Largest map (points per side) a scene may send to the reference: its cycle costs ~n^3.4 CPU (bem_convergence's
@@ -92,7 +92,12 @@ class CutoffMatch:
 def discrete_loss(heights: np.ndarray, size: float, cutoff: float, e_star: float, work_of_adhesion: float,
                   z0: float, path: np.ndarray) -> dict:
     """Loss per cycle (J) of the map's summits at `cutoff` (m), each at its own height, all of the mean tip radius,
-    Maugis-Dugdale, along `path` (m above the heights' mean plane); with the summit count and mean radius."""
+    Maugis-Dugdale, along `path` (m above the heights' mean plane); with the summit count and mean radius.
+
+    Exact: a summit whose approach reaches its jump-in delta_in is on the retreat branch from there to its jump-out
+    whatever the turn, so it loses the law's loop_energy once per cycle and the level loses (number jumped in) x
+    loop_energy. The trapezoid loop along the sampled path (`loss_sampled_J`) misses or overcounts each summit's
+    sliver of loop (narrower than a step of rho/8 at lambda < 1) and is kept for comparison only."""
     h = np.asarray(heights, float)
     summits = identify_summits(h - h.mean(), size / h.shape[0], cutoff, periodic=True)
     keep = np.isfinite(summits.radius)
@@ -103,7 +108,9 @@ def discrete_loss(heights: np.ndarray, size: float, cutoff: float, e_star: float
     radius = float(np.mean(beta))
     delta_max = 1.5 * float(z.max() - np.min(path)) + 10 * z0
     law = make_summit_law("maugis_dugdale", radius, work_of_adhesion, e_star, z0=z0, delta_max=delta_max)
-    return {**row, "summit_radius_m": radius, "loss_J": discrete_cycle(law, z, path).hysteresis_energy}
+    touched = int(np.sum(z - np.min(path) >= law.delta_in))
+    return {**row, "summit_radius_m": radius, "summits_jumped_in": touched, "loss_J": touched * law.loop_energy,
+            "loss_sampled_J": discrete_cycle(law, z, path).hysteresis_energy}
 
 
 def _crossing(ladder: list[dict], target: float) -> float | None:
