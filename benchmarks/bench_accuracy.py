@@ -31,6 +31,7 @@ the contact modulus of its body and substrate. Writes JSON (the numbers and curv
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
 import json
 import math
 import os
@@ -49,7 +50,11 @@ sys.path.insert(0, str(ROOT))
 
 from continuum.reference.hertz import effective_modulus   # noqa: E402
 from continuum.reference.maugis import md_parameter   # noqa: E402
+from continuum.rough.bem_convergence import (GridRun, cohesive_zone_length, convergence,   # noqa: E402
+                                              dugdale_crack_zone, single_summit_ladder)
+from continuum.rough.bem_impact import STANDARD_G, impact_at_energy, impact_outcome   # noqa: E402
 from continuum.rough.bem_reference import bem_cycle, dugdale_range   # noqa: E402
+from continuum.rough.cutoff_match import CUTOFF_PIXELS, discrete_loss, match_cutoff, reference_estimate   # noqa: E402
 from continuum.rough.branch_laws import make_summit_law   # noqa: E402
 from continuum.rough.gw_branches import GWBranchSurface   # noqa: E402
 from continuum.rough.quasistatic import discrete_cycle, gw_cycle, separation_path   # noqa: E402
@@ -57,6 +62,8 @@ from continuum.rough.summit_stats import direct_summary, spectral_summits   # no
 from continuum.rough.summits import SummitStatistics, expected_max_height   # noqa: E402
 from continuum.rough.topography import Synthesis, identify_summits, load_height_map, synthesise_height_map   # noqa: E402
 from nanoimpact import data   # noqa: E402
+from nanoimpact.errors import InputError   # noqa: E402
+from nanoimpact.provenance import git_commit   # noqa: E402
 from nanoimpact.fileio import atomic_save_figure, atomic_write_json   # noqa: E402
 
 #: The default patch: the shipped map's spectrum shape (Hurst 0.8, long cutoff 4x and summit cutoff 8 pixels of
@@ -96,8 +103,10 @@ def patch(args) -> tuple[dict, dict]:
         base = np.asarray(topo.heights())
     periodic = Topography(base - base.mean(), topo.physical_sizes, periodic=True)
     grids = {}
-    for n in (n_ref // 2, n_ref):
+    for n in (n_ref // 4, n_ref // 2, n_ref):
         if cutoff < 4 * float(topo.physical_sizes[0]) / n:
+            if n == n_ref // 4:
+                continue                                 # the ladder's coarsest rung only where it holds the map
             raise SystemExit(f"--grid {n_ref}: the cutoff {cutoff:.3g} m spans fewer than 4 pixels of the {n}^2 grid")
         if n >= base.shape[0]:
             grids[n] = np.asarray(periodic.interpolate_fourier((n, n)).heights()) if n > base.shape[0] else base
@@ -187,6 +196,58 @@ LEVELS = {
 }
 
 
+#: Density of the dropped body (kg/m^3): silicon (the calibrated set's body is polysilicon, E = 169 GPa), a choice
+#: that sets the impact speed and the drop height, not the restitution.
+BODY_DENSITY = 2330.0
+
+
+def impact_body(size: float, ref) -> dict:
+    """The dropped body: a cube of silicon of the patch's side, its face the patch's flat counter-surface, arriving
+    with the kinetic energy that turns it at the reference cycle's deepest state (`bem_impact.impact_outcome`)."""
+    mass = BODY_DENSITY * size**3
+    k0 = impact_outcome(ref).impact_energy
+    return {"shape": "cube of the patch's side, face = the patch's flat counter-surface", "density_kg_m3": BODY_DENSITY,
+            "mass_kg": mass, "impact_energy_J": k0, "impact_velocity_m_s": math.sqrt(2 * k0 / mass),
+            "drop_height_m": k0 / (mass * STANDARD_G),
+            "gravity_work_ratio": mass * STANDARD_G * float(ref.separation[0] - ref.separation[ref.turn]) / k0,
+            "method": "quasi-static energy balance through each level's tabulated approach and retraction branches "
+                      "(continuum/rough/bem_impact.py): e^2 = 1 - W_loop/K0, stuck when the way out needs more than "
+                      "the body keeps; the summit levels are rerun to their own turn"}
+
+
+def level_impact(cycle_to, body: dict, path: np.ndarray, mat: dict):
+    """A summit level's impact at the body's energy; its turn searched down to 3x the reference's depth below the
+    start. None when even that does not absorb the energy."""
+    start, deepest = float(path[0]), float(path.min())
+    try:
+        outcome, _ = impact_at_energy(cycle_to, body["impact_energy_J"], start, mat["dugdale_range"] / 8,
+                                      start - 3 * (start - deepest))
+    except InputError as exc:
+        return str(exc)
+    return outcome
+
+
+def impact_row(outcome, ref_outcome, body: dict, seconds: float) -> dict:
+    """A level's impact numbers: first-rebound height, stick, restitution, error against the reference."""
+    if isinstance(outcome, str):
+        return {"impact": {"not_run": outcome}, "impact_rel_error": math.nan, "impact_seconds": seconds}
+    h1, h1_ref = outcome.rebound_height(body["drop_height_m"]), ref_outcome.rebound_height(body["drop_height_m"])
+    return {"impact": {**outcome.to_json(), "rebound_height_m": h1}, "impact_seconds": seconds,
+            "stuck": outcome.stuck, "impact_rel_error": _rel(h1, h1_ref) if h1_ref else math.nan,
+            "impact_stick_agrees": outcome.stuck == ref_outcome.stuck}
+
+
+def cutoff_match(h: np.ndarray, desc: dict, mat: dict, path: np.ndarray, conv: dict):
+    """The summit cutoff at which the discrete level (mean radius) loses the reference's loss per cycle, on the
+    reference's patch and path (`continuum.rough.cutoff_match`); cutoffs in pixels of the map as given."""
+    base_pixel = desc["size_m"] / desc["base_grid"][0]
+    pixel = desc["size_m"] / h.shape[0]
+    ladder = [discrete_loss(h, desc["size_m"], c * base_pixel, mat["e_star"], mat["work_of_adhesion"], mat["z0"],
+                            path) for c in CUTOFF_PIXELS if c * base_pixel >= 4 * pixel]
+    upper = conv["grids"][-1]["hysteresis_energy_J"]
+    return match_cutoff(ladder, reference_estimate(conv), upper, conv["converged"])
+
+
 def _rel(value: float, ref: float) -> float:
     return (value - ref) / ref if ref else math.nan
 
@@ -213,12 +274,20 @@ def _row(name: str, description: str, seconds: float, cycle, ref, rich: dict) ->
 
 
 def reference(grids: dict, desc: dict, mat: dict, path: np.ndarray) -> tuple[dict, dict]:
-    """BEM on the reference grid and the half grid; (record, cycles by grid)."""
+    """BEM on the ladder of grids (the reference grid, its half and, where the map allows, its quarter); (record
+    with `bem_convergence`, cycles by grid)."""
     cycles, runs = {}, {}
     for n in sorted(grids):
         cyc, stats = bem_cycle(grids[n], desc["size_m"], mat["e_star"], mat["work_of_adhesion"], mat["z0"], path)
         cycles[n], runs[n] = cyc, stats.to_json()
-    fine, coarse = max(grids), min(grids)
+    fine = max(grids)
+    coarse = sorted(grids)[-2]
+    ladder = [GridRun(n, desc["size_m"] / n, cycles[n].pull_off_force, cycles[n].hysteresis_energy,
+                      runs[n]["seconds"], runs[n]["unconverged"], runs[n]["cpu_seconds"]) for n in sorted(grids)]
+    zone = cohesive_zone_length(mat["e_star"], mat["work_of_adhesion"], mat["z0"])
+    conv = convergence(ladder, zone, desc["size_m"])
+    conv["dugdale_crack_zone_m"] = dugdale_crack_zone(mat["e_star"], mat["work_of_adhesion"], mat["z0"])
+    conv["solvers"] = {str(n): runs[n] for n in sorted(grids)}
     f, c = cycles[fine], cycles[coarse]
     rich = {"pull_off_force_N": 2 * f.pull_off_force - c.pull_off_force,
             "hysteresis_energy_J": 2 * f.hysteresis_energy - c.hysteresis_energy}
@@ -229,6 +298,7 @@ def reference(grids: dict, desc: dict, mat: dict, path: np.ndarray) -> tuple[dic
               "richardson": rich,
               "discretisation_rel": {"pull_off": _rel(rich["pull_off_force_N"], f.pull_off_force),
                                      "hysteresis": _rel(rich["hysteresis_energy_J"], f.hysteresis_energy)},
+              "bem_convergence": conv,
               "note": "errors of the levels are relative to the reference grid's values; discretisation_rel is "
                       "the first-order Richardson estimate's distance from them (the reference's own error)"}
     return record, cycles
@@ -287,8 +357,66 @@ def markdown(result: dict) -> str:
     return "\n".join(rows)
 
 
+def markdown_bem(result: dict) -> str:
+    """The reference's pixel ladder, the impact per level and the summit cutoff it measures (docs/benchmarks.md,
+    between the `bench_accuracy:bem` markers; tests/test_accuracy_docs.py checks the page against the JSON)."""
+    conv, body = result["bem_convergence"], result["impact"]
+    rows = ["| grid | pixel (nm) | cohesive zone (pixels) | pull-off (N) | loss per cycle (J) | seconds (CPU) | "
+            "unconverged states |", "|---|---|---|---|---|---|---|"]
+    rows += [f"| {g['grid']}² | {g['pixel_m'] * 1e9:.3g} | {g['zone_pixels']:.1f} | {g['pull_off_force_N']:.3g} | "
+             f"{g['hysteresis_energy_J']:.3g} | {g['seconds']:.1f} ({g['cpu_seconds']:.1f}) | "
+             f"{g['unconverged_states']} |" for g in conv["grids"]]
+    verdict = (f"Converged: the two finest grids' losses within {100 * conv['tolerance']:.0f} %."
+               if conv["converged"] else f"`not_converged`: {conv['not_converged']}.")
+    one = conv.get("single_summit", {"grids": []})
+    verdict += "" if not one["grids"] else (f"\n\nOne summit of the patch's mean tip radius ({one['radius_m'] * 1e9:.3g} nm, a "
+                f"{one['cell_m'] * 1e9:.3g} nm cell, flat {one['depth_m'] * 1e9:.2g} nm below the apex): the summit "
+                f"law loses {one['summit_law_loss_J']:.3g} J per cycle and pulls off at "
+                f"{one['summit_law_pull_off_N']:.3g} N; the reference, by pixel: " + "; ".join(
+                    f"{g['pixel_m'] * 1e9:.3g} nm: pull-off {g['pull_off_force_N']:.3g} N, loss "
+                    f"{g['hysteresis_energy_J']:.3g} J ({g['loss_over_summit_law']:.0f}x the summit law's)"
+                    for g in one["grids"]) + ".")
+    ref_e = body["reference"]["restitution"]
+    imp = ["| level | restitution e | first rebound h1/h0 = e² | energy lost 1 − e² | sticks | impact_rel_error | "
+           "vs extrapolated reference | seconds (cycle + impact) |", "|---|---|---|---|---|---|---|---|",
+           f"| `bem` {result['reference']['grid']}² (reference) | {ref_e:.4f} | {ref_e ** 2:.4f} | "
+           f"{1 - ref_e ** 2:.2g} | {'yes' if body['reference']['stuck'] else 'no'} | | | "
+           f"{result['reference']['seconds']:.1f} |"]
+    for r in result["levels"]:
+        i = r["impact"]
+        if "restitution" not in i:
+            imp.append(f"| `{r['name']}` | not run: {i['not_run']} | | | | | | |")
+            continue
+        imp.append(f"| `{r['name']}` | {i['restitution']:.4f} | {i['restitution'] ** 2:.4f} | "
+                   f"{1 - i['restitution'] ** 2:.2g} | {'yes' if i['stuck'] else 'no'} | "
+                   f"{100 * r['impact_rel_error']:+.1f} % | "
+                   f"{100 * r.get('impact_rel_error_vs_extrapolated', math.nan):+.1f} % | "
+                   f"{r['seconds'] + r['impact_seconds']:.2f} |")
+    ext = body["reference_at_extrapolated_loss"]
+    cut = result["summit_cutoff"]
+    match = result["cutoff_match"]
+    ladder = ", ".join(f"{r['cutoff_m'] * 1e9:.3g} nm: {r['summits']} summits, {r['loss_J']:.2g} J"
+                       for r in match["ladder"])
+    cut_line = (f"Summit cutoff measured by the reference (`summit_cutoff`, kind `bem`): "
+                + (f"{cut['cutoff_m'] * 1e9:.3g} nm" if cut["cutoff_m"] else "none")
+                + f", match error {100 * cut['match_error']:+.0f} % against {cut['reference_loss_J']:.3g} J ("
+                + ("converged reference" if cut["reference_converged"] else "unconverged reference: extrapolated")
+                + "); at the finest grid's loss, its upper bound: "
+                + (f"{cut['cutoff_at_upper_bound_m'] * 1e9:.3g} nm" if cut["cutoff_at_upper_bound_m"] else "none")
+                + f". Discrete loss per cycle by cutoff: {ladder}.")
+    head = (f"Body: {body['shape']}, {body['mass_kg']:.3g} kg, K0 = {body['impact_energy_J']:.3g} J "
+            f"({body['impact_velocity_m_s']:.3g} m/s; it turns at the reference's deepest state); with the "
+            f"reference's loss extrapolated to zero pixel ({ext['loss_J']:.3g} J) its restitution would be "
+            f"{ext['restitution']:.4f}.")
+    load = result.get("load_average_1min", {})
+    cost = (f"Whole run: {result['wall_s']:.0f} s wall, {result.get('cpu_s', math.nan):.0f} s CPU, 1-minute load "
+            f"average {load.get('start', math.nan):.1f} at the start and {load.get('end', math.nan):.1f} at the end "
+            f"({result['machine']['cores']} cores, shared).")
+    return "\n".join(rows + ["", verdict, "", head, ""] + imp + ["", cut_line, "", cost])
+
+
 def run(args) -> dict:
-    start = time.perf_counter()
+    start, cpu, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
     mat = materials(args.params)
     grids, desc = patch(args)
     n_ref = desc["reference_grid"]
@@ -296,13 +424,37 @@ def run(args) -> dict:
     path = path_for(grids[n_ref], sets, mat, args.quick, args.depth)
     ref_record, bem = reference(grids, desc, mat, path)
     ref = bem[n_ref]
-    cycles, levels = {"bem": ref, f"bem_{min(grids)}": bem[min(grids)]}, []
-    levels.append(_row(f"bem_half_grid_{min(grids)}", "the reference on the half grid (numerical error only)",
-                       ref_record["half_grid"]["solver"]["seconds"], bem[min(grids)], ref, ref_record["richardson"]))
+    half = n_ref // 2
+    cycles, levels = {"bem": ref, f"bem_{half}": bem[half]}, []
+    levels.append(_row(f"bem_half_grid_{half}", "the reference on the half grid (numerical error only)",
+                       ref_record["half_grid"]["solver"]["seconds"], bem[half], ref, ref_record["richardson"]))
+    body = impact_body(desc["size_m"], ref)
+    ref_impact = impact_outcome(ref)
+    levels[0].update(impact_row(impact_outcome(bem[half], body["impact_energy_J"]), ref_impact, body, 0.0))
     for name, (description, build) in LEVELS.items():
         t0 = time.perf_counter()
         cycles[name] = build(sets, mat, path)
         levels.append(_row(name, description, time.perf_counter() - t0, cycles[name], ref, ref_record["richardson"]))
+        t0 = time.perf_counter()
+        outcome = level_impact(lambda p, b=build: b(sets, mat, p), body, path, mat)
+        levels[-1].update(impact_row(outcome, ref_impact, body, time.perf_counter() - t0))
+    body["reference"] = ref_impact.to_json()
+    body["reference"]["rebound_height_m"] = ref_impact.rebound_height(body["drop_height_m"])
+    body["reference_by_grid"] = {str(n): impact_outcome(c, body["impact_energy_J"]).to_json() for n, c in bem.items()}
+    est = reference_estimate(ref_record["bem_convergence"])
+    body["reference_at_extrapolated_loss"] = {
+        "loss_J": est, "restitution": math.sqrt(max(0.0, 1 - est / body["impact_energy_J"])),
+        "note": "e^2 = 1 - L/K0 with the reference's loss per cycle extrapolated to zero pixel (bem_convergence; "
+                "the finest grid's where the extrapolation is not positive): the rebound the reference would give "
+                "without its lattice-trapping term, the forces of its finest grid otherwise"}
+    for row in levels:
+        if "restitution" in row["impact"]:
+            e2 = 1 - est / body["impact_energy_J"]
+            row["impact_rel_error_vs_extrapolated"] = _rel(row["impact"]["restitution"] ** 2, e2)
+    match = cutoff_match(grids[n_ref], desc, mat, path, ref_record["bem_convergence"])
+    ref_record["bem_convergence"]["single_summit"] = single_summit_ladder(
+        sets["direct"].summit_radius, mat["e_star"], mat["work_of_adhesion"], mat["z0"],
+        grids=(16, 32, 64) if args.quick else (16, 32, 64, 128))
     beta = sets["direct"].summit_radius
     pixel = desc["size_m"] / n_ref
     surface = {k: v for k, v in desc.items()}
@@ -313,13 +465,18 @@ def run(args) -> dict:
     result = {"benchmark": "benchmarks/bench_accuracy.py", "mode": "quick" if args.quick else "full",
               "machine": {"cores": os.cpu_count(), "platform": platform.platform(),
                           "python": platform.python_version()},
+              "provenance": {"git_commit": git_commit(), "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                             "tamaas": importlib.metadata.version("tamaas"), "numpy": np.__version__,
+                             "command": "benchmarks/bench_accuracy.py " + " ".join(sys.argv[1:])},
               "materials": mat, "surface": surface,
               "path": {"start_m": float(path[0]), "deepest_m": float(path.min()), "states": int(path.size)},
-              "reference": ref_record, "levels": levels,
+              "reference": ref_record, "bem_convergence": ref_record["bem_convergence"], "impact": body,
+              "summit_cutoff": match.origin(), "cutoff_match": match.to_json(), "levels": levels,
               "curves": {"separation_m": path.tolist(), **{n: {"force_N": c.force.tolist(),
                                                                 "contact_area_m2": c.contact_area.tolist()}
                                                             for n, c in cycles.items()}},
-              "wall_s": time.perf_counter() - start}
+              "wall_s": time.perf_counter() - start, "cpu_s": time.process_time() - cpu,
+              "load_average_1min": {"start": load0, "end": os.getloadavg()[0]}}
     return result
 
 
@@ -343,6 +500,8 @@ def main(argv=None):
         if args.png:
             figure(old, args.png)
         print(markdown(old))
+        if "bem_convergence" in old:
+            print(markdown_bem(old))
         return
     if args.map and not args.cutoff:
         p.error("--map needs --cutoff (the summit cutoff wavelength, m)")
@@ -356,7 +515,23 @@ def main(argv=None):
         print(f"{r['name']:24s} {r['seconds']:8.2f} {r['pull_off_rel_error']:+13.3f} "
               f"{r['hysteresis_rel_error']:+15.3f} {r['area_rel_error']:9.3f} "
               f"{r['pull_off_rel_error_vs_richardson']:+14.3f} {r['hysteresis_rel_error_vs_richardson']:+11.3f}")
-    print(f"total {result['wall_s']:.1f} s")
+    conv = result["bem_convergence"]
+    print("bem_convergence: " + ", ".join(f"{g['grid']}^2 ({g['zone_pixels']:.1f} px/zone): pull-off "
+                                          f"{g['pull_off_force_N']:.4g} N, loss {g['hysteresis_energy_J']:.4g} J"
+                                          for g in conv["grids"]))
+    print("converged" if conv["converged"] else f"not converged: {conv['not_converged']}")
+    body = result["impact"]
+    print(f"impact: K0 {body['impact_energy_J']:.4g} J, v {body['impact_velocity_m_s']:.3g} m/s; reference "
+          f"e = {body['reference']['restitution']:.4f}, stuck {body['reference']['stuck']}")
+    for r in result["levels"]:
+        imp = r["impact"]
+        print(f"  {r['name']:24s} " + (f"e = {imp['restitution']:.4f} stuck {imp['stuck']} rebound error "
+                                       f"{r['impact_rel_error']:+.3f} ({r['impact_seconds']:.2f} s)"
+                                       if "restitution" in imp else imp["not_run"]))
+    cut = result["summit_cutoff"]
+    print(f"summit_cutoff (kind bem): {cut['cutoff_m']} m, match error {cut['match_error']:+.3f}; {cut['note']}")
+    print(f"total {result['wall_s']:.1f} s wall, {result['cpu_s']:.1f} s CPU, load average "
+          f"{result['load_average_1min']['start']:.1f} -> {result['load_average_1min']['end']:.1f}")
     if args.json:
         atomic_write_json(args.json, result)
     if args.png:

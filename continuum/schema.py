@@ -264,6 +264,12 @@ FIELDS: tuple[Field, ...] = (
           "is low-pass filtered there; >= 4 pixels): summit radius and density depend on it. Required with a "
           "measured map unless tip_radius is given; a synthetic map defaults to its short_cutoff.", None,
           low=1e-10, high=1e-3),
+    Field("surfaces.roughness.summit_cutoff_from", str, "", "'bem': the summit cutoff is measured on the map, where "
+          "its discrete summits lose per quasi-static cycle the energy the boundary-element reference loses "
+          "(continuum/rough/cutoff_match.py; a square map of at most 256^2 points whose grid resolves the cohesive "
+          "zone; minutes per map, cached by its hash and the law). Instead of summit_cutoff and tip_radius; "
+          "result.json's surface.cutoff_from records the origin (kind 'bem', the match error, whether the "
+          "reference's loss converged).", None, choices=("bem",)),
     Field("surfaces.roughness.tip_radius", float, "m", "AFM tip radius: the cutoff becomes the shortest wavelength "
           "the tip resolves (SurfaceTopography's scanning_probe_reliability_cutoff; Sanner et al. 2022). Instead "
           "of summit_cutoff.", None, low=1e-10, high=1e-4),

@@ -190,7 +190,7 @@ def bem_cycle(heights, physical_size, e_star: float, work_of_adhesion: float, z0
     """Quasi-static approach-retraction of a periodic height map (m, mean removed here) against an elastic flat
     of contact modulus `e_star` (Pa) with the Dugdale law of `work_of_adhesion` (J/m^2) and range `z0` (m),
     along `path` (rigid separations above the map's mean plane, m; `quasistatic.separation_path`)."""
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     contact = BEMContact(heights, physical_size, e_star, work_of_adhesion, z0, tolerance=tolerance,
                          length_unit=length_unit)
     path = np.asarray(path, float)
@@ -211,6 +211,7 @@ def bem_cycle(heights, physical_size, e_star: float, work_of_adhesion: float, z0
         force[k], area[k] = state["force"], state["area"]
     stats = BEMStats(solves, free, bad, max_err, time.perf_counter() - start, contact.shape,
                      contact.size[0] / contact.shape[0], contact.rho, contact.sigma0,
-                     notes={"cold_restarts": contact.restarts, "continued_solves": contact.continued})
+                     notes={"cold_restarts": contact.restarts, "continued_solves": contact.continued,
+                            "cpu_seconds": time.process_time() - cpu})
     log.info("BEM cycle: %d solves, %d free, %d unconverged, %.1f s", solves, free, bad, stats.seconds)
     return ForceCycle(path, force, area, turn), stats

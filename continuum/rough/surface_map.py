@@ -13,6 +13,10 @@ The map supplies statistics (to the mean-field law and to the draws of an ensemb
 `topography` may list several scans of one surface (`continuum.rough.map_scans`: each takes part at the cutoff where
 it resolves it, and their summits are pooled); the block records each scan, how deep the data reach against the
 impact (`data_depth`), and the range-of-validity checks (`validity`, `warnings`).
+
+The cutoff is the scene's summit_cutoff (or its tip_radius, or a synthesis' short cutoff), or, with
+`summit_cutoff_from = "bem"`, the one the boundary-element reference measures on the map
+(`continuum.rough.cutoff_match`); `cutoff_from` in the block says which.
 """
 from __future__ import annotations
 
@@ -21,7 +25,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from nanoimpact import data
+from nanoimpact.errors import InputError
 
+from ..reference.hertz import effective_modulus
+from .cutoff_match import KEY_CUTOFF_FROM, scene_cutoff
 from .map_scans import PooledScans, data_depth, pooled_statistics, validity
 from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_DETREND, KEY_FILE, KEY_SIZE, KEY_SYNTH, KEY_TIP, KEY_UNIT,
                          HeightMap, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map)
@@ -118,7 +125,9 @@ def map_statistics(values: dict, sources: dict, scene_dir: Path | None) -> MapSt
     cutoff, tip = values.get(KEY_CUTOFF), values.get(KEY_TIP)
     if cutoff is not None and tip is not None:
         raise TopographyError(KEY_TIP, tip, "give summit_cutoff or tip_radius, not both")
-    if synthesis is None and cutoff is None and tip is None:
+    if values.get(KEY_CUTOFF_FROM) == "bem" and (cutoff is not None or tip is not None):
+        raise TopographyError(KEY_CUTOFF_FROM, "bem", "measures the cutoff: remove summit_cutoff and tip_radius")
+    if synthesis is None and cutoff is None and tip is None and values.get(KEY_CUTOFF_FROM) != "bem":
         raise TopographyError(KEY_CUTOFF, None, "is required with a measured map (or give tip_radius): summit "
                                                 "radius and density depend on the shortest wavelength kept")
     replaced = {}
@@ -153,9 +162,42 @@ def _load(values: dict, scene_dir: Path | None) -> tuple[tuple[HeightMap, ...], 
     spec, stamp = _map_spec(values.get(KEY_FILE), _synthesis(values), scene_dir)
     size = values.get(KEY_SIZE)
     channel = values.get(KEY_CHANNEL)
-    return _statistics(spec, channel, None if size is None else tuple(size), values.get(KEY_UNIT),
-                       values.get(KEY_CUTOFF), values.get(KEY_TIP), values.get(KEY_ROUTE, "direct"), stamp,
-                       values.get(KEY_DETREND) or "plane")
+    cutoff, bem_origin = _cutoff(values, spec, stamp)
+    hmaps, pooled, origin = _statistics(spec, channel, None if size is None else tuple(size), values.get(KEY_UNIT),
+                                        cutoff, values.get(KEY_TIP), values.get(KEY_ROUTE, "direct"), stamp,
+                                        values.get(KEY_DETREND) or "plane")
+    return hmaps, pooled, bem_origin or origin
+
+
+def _cutoff(values: dict, spec, stamp) -> tuple[float | None, dict | None]:
+    """(cutoff, its origin when the boundary-element reference measured it): the scene's summit_cutoff, or with
+    summit_cutoff_from = "bem" the cutoff `continuum.rough.cutoff_match.scene_cutoff` measures on the map with the
+    scene's dry law (work_of_adhesion, interaction_range, E* of body and substrate)."""
+    if values.get(KEY_CUTOFF_FROM) != "bem":
+        return values.get(KEY_CUTOFF), None
+    size = values.get(KEY_SIZE)
+    if isinstance(spec, Synthesis):
+        hmap = _statistics(spec, None, None, None, None, None, "direct", stamp)[0][0]
+    elif len(spec) != 1:
+        raise TopographyError(KEY_CUTOFF_FROM, "bem", f"measures the cutoff on one scan: give one {KEY_FILE} "
+                                                      f"(this scene gives {len(spec)})")
+    else:
+        hmap = load_height_map(spec[0], channel=values.get(KEY_CHANNEL), size=None if size is None else list(size),
+                               unit=values.get(KEY_UNIT), detrend=values.get(KEY_DETREND) or "plane")
+    e_star = float(effective_modulus(values["surfaces.body.youngs_modulus"], values["surfaces.body.poisson_ratio"],
+                                     values["surfaces.substrate.youngs_modulus"],
+                                     values["surfaces.substrate.poisson_ratio"]))
+    return _measured(hmap, e_star, values["surfaces.work_of_adhesion"], values["surfaces.interaction_range"])
+
+
+def _measured(hmap: HeightMap, e_star: float, w: float, z0: float) -> tuple[float, dict]:
+    """The measured cutoff (run once per map and law: the match is cached on disk by the heights' hash)."""
+    try:
+        return scene_cutoff(hmap.heights, hmap.physical_size[0], hmap.periodic, e_star, w, z0)
+    except TopographyError:
+        raise
+    except InputError as exc:
+        raise TopographyError(exc.key, exc.value, exc.allowed) from None
 
 
 
