@@ -4,7 +4,7 @@
     python benchmarks/bench_ensemble.py [--params calibrated,paper] [--members 64] [--half-space N] [--escape]
                                         [--json FILE]
 
-Members on a rigid substrate (each contact in the compiled kernel, continuum.contact_kernel): the scene's
+Members on a rigid substrate (each contact in the compiled kernel, continuum.numerics.contact_kernel): the scene's
 physics.half_space = 'auto' leaves it out (the deflection is femtometres). `--half-space N` also times N members
 with physics.half_space = 'on' (the coupled fixed point in Python, ~1 s per impact). The ensemble's
 own wall time is reported (`EnsembleResult.wall_s`: the members, not the scene's resolution or the mean-field run),
@@ -21,8 +21,8 @@ import resource
 import time
 from pathlib import Path
 
-from continuum.compiled_contact import warm_up
-from continuum.ensemble_run import run_ensemble
+from continuum.numerics.compiled_contact import warm_up
+from continuum.dynamics.ensemble_run import run_ensemble
 from continuum.scene import resolve_scene
 
 RIGID = {"physics.half_space": "auto"}

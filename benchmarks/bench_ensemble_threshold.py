@@ -2,10 +2,10 @@
 
 For the paper's roller on rough silica (the `paper` set: JKR summits, rigid substrate, one impact), the release
 height is swept from 100 nm to 100 um so that the expected number of summits in contact at the first impact, N_c
-(the Hertz estimate of `continuum.estimates`, the number `auto` reads), runs from a few to several hundred on the
+(the Hertz estimate of `continuum.model.estimates`, the number `auto` reads), runs from a few to several hundred on the
 same surface. (Raising the summit density barely moves N_c: the datum, the tallest summit, rises with it.) At
 each height the first impact's energy loss fraction L = 1 - h1/h0 of the mean field is compared with its mean
-over an ensemble of discrete realisations (`continuum.ensemble_run`), relative to that mean, with the mean's
+over an ensemble of discrete realisations (`continuum.dynamics.ensemble_run`), relative to that mean, with the mean's
 standard error. Beyond ten contacts the departure falls like A/sqrt(N_c) (the datum, the realisation's tallest
 summit, scatters, and the loss counts summits within a fixed depth of it); A is fitted by weighted least squares
 (weights 1/s.e.^2) and the threshold is where the fit meets the tolerance (continuum.model.decisions.
@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from continuum.ensemble_run import run_ensemble
-from continuum.impact import run_impact
+from continuum.dynamics.ensemble_run import run_ensemble
+from continuum.dynamics.impact import run_impact
 from continuum.model.decisions import ENSEMBLE_BELOW_CONTACTS, ENSEMBLE_TOLERANCE
 from continuum.scene import resolve_scene
 

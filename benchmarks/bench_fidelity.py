@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from continuum.impact import run_impact
+from continuum.dynamics.impact import run_impact
 from continuum.paper.cases import Case, sigma_case
 from continuum.paper.checks import rebounds
 from continuum.paper.run import resolve_case

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from continuum.halfspace import choose_grid, solve_coupled, solve_hard_contact
+from continuum.elastic.halfspace import choose_grid, solve_coupled, solve_hard_contact
 from continuum.reference.hertz import line_peak_pressure
 
 E_STAR, RADIUS, LOAD, X_REF = 100e9, 5e-6, 1.0, 3.3e-3

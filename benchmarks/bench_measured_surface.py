@@ -1,6 +1,6 @@
 """Seconds and memory of the whole measured-surface answer (target: <= 60 s on 2 cores and <= 1 GB): the calibrated
 roller of `rough_topography` on a height map, `members = "auto"`, both tail models and the cutoff band, end to end
-(`continuum.impact.run_impact`: the map's statistics, the mean-field run, the scene's ensemble, the other tail
+(`continuum.dynamics.impact.run_impact`: the map's statistics, the mean-field run, the scene's ensemble, the other tail
 model's and the band's ensembles).
 
     python benchmarks/bench_measured_surface.py PATH [--cutoff M] [--workers 2] [--executor processes]
@@ -22,8 +22,8 @@ import resource
 import time
 import tomllib
 
-from continuum.compiled_contact import warm_up
-from continuum.impact import run_impact
+from continuum.numerics.compiled_contact import warm_up
+from continuum.dynamics.impact import run_impact
 from continuum.scene import resolve_scene
 
 log = logging.getLogger("bench_measured_surface")

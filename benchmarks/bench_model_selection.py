@@ -13,7 +13,7 @@ import argparse
 import time
 from pathlib import Path
 
-from continuum.impact import run_impact
+from continuum.dynamics.impact import run_impact
 from continuum.scene import resolve_scene
 
 ROOT = Path(__file__).resolve().parent.parent

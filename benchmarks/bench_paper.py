@@ -44,7 +44,7 @@ sys.path.insert(0, str(ROOT))
 #: numba's one-time compile of the contact kernel (cached beside the module) is not a run's cost; an exported
 #: baseline tree starts with an empty cache, so every tree is warmed first, untimed.
 # compile (or load) a tree's numba kernels untimed (whole_command skips it for a revision from before the kernels)
-WARM_SNIPPET = "from continuum.compiled_contact import warm_up; warm_up()"
+WARM_SNIPPET = "from continuum.numerics.compiled_contact import warm_up; warm_up()"
 
 PAPER_SNIPPET = """
 import sys
@@ -99,11 +99,11 @@ def whole_command(code_root: Path, sets: list[str], workers: int) -> tuple[float
 
 BREAKDOWN_SNIPPET = """
 import json, os, resource, sys, time
-from continuum.compiled_contact import warm_up
+from continuum.numerics.compiled_contact import warm_up
 warm_up()
 import continuum.paper.run as run
 import continuum.paper.figures as figures
-import continuum.plots as plots
+import continuum.output.plots as plots
 from continuum.laws import rough_rigid
 log = open(sys.argv[4], "a", buffering=1)
 
@@ -182,9 +182,9 @@ def _best(fn, repeat: int) -> float:
 
 def per_impact(repeat: int, resolution: str = "standard") -> dict:
     """Seconds per rough impact: driver + kernel, driver + Python stepper, kernel alone (the floor)."""
-    from continuum.compiled_contact import run_compiled
-    from continuum.driver import DriverSettings, simulate
-    from continuum.impact import first_impact_speed
+    from continuum.numerics.compiled_contact import run_compiled
+    from continuum.dynamics.driver import DriverSettings, simulate
+    from continuum.dynamics.impact import first_impact_speed
     from continuum.model import select_law
     from continuum.scene import resolve_scene
 
@@ -221,7 +221,7 @@ def per_impact(repeat: int, resolution: str = "standard") -> dict:
 def per_bounce(repeat: int) -> list[tuple[int, float, int]]:
     """Wall (s) of the whole rough_silica impact run (select_law, tables, driver; `silicon` set, which rebounds
     100 times) for 1 to 100 bounces."""
-    from continuum.impact import run_impact
+    from continuum.dynamics.impact import run_impact
     from continuum.scene import resolve_scene
 
     rows = []
@@ -265,7 +265,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     sets = args.sets.split(",")
     print(f"load average at start: {load()}  ({os.cpu_count()} CPUs, Python {sys.version.split()[0]})")
-    from continuum.compiled_contact import warm_up
+    from continuum.numerics.compiled_contact import warm_up
     warm_up()                                   # the kernel's load (or first compile) is not an impact's cost
 
     print("\n## Cost of one rough impact (rough_silica, paper set, rigid substrate, 100 nm drop; best of "

@@ -27,8 +27,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from continuum.driver import DriverSettings, simulate  # noqa: E402
-from continuum.ensemble_run import _release, member_law, member_plan, run_member  # noqa: E402
+from continuum.dynamics.driver import DriverSettings, simulate  # noqa: E402
+from continuum.dynamics.ensemble_run import _release, member_law, member_plan, run_member  # noqa: E402
 from continuum.model.regime import first_impact_speed  # noqa: E402
 from continuum.scene import resolve_scene  # noqa: E402
 

@@ -500,8 +500,8 @@ def sample_inputs(calibration: dict, ranges: dict, n: int, seed: int) -> tuple[l
 def uncertainty_sample(task: tuple) -> dict:
     """One sample: the scene with the set and the sampled overrides; rebounds and escape velocity. Picklable."""
     scene, params, overrides, max_bounces = task
-    from continuum.escape import escape_velocity, single_impact
-    from continuum.impact import first_impact_speed, run_impact
+    from continuum.dynamics.escape import escape_velocity, single_impact
+    from continuum.dynamics.impact import first_impact_speed, run_impact
     from continuum.model import select_law
     from continuum.scene import SceneError, resolve_scene
 

@@ -88,8 +88,8 @@ def _failed_row(input_hash: str, reason: str) -> dict:
 def run_point(task: tuple) -> dict:
     """Run one point (module-level: picklable for process pools and Dask) and write its result.json."""
     scene, params, overrides, folder = task
-    from continuum.impact import run_impact
-    from continuum.results import write_result_files
+    from continuum.dynamics.impact import run_impact
+    from continuum.output.results import write_result_files
 
     resolved = resolve_scene(scene, params=params, overrides=overrides, override_label="sweep")
     result, _ = run_impact(resolved)

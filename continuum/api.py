@@ -19,9 +19,9 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .driver import Bounce
-from .impact import run_impact, write_impact
-from .results import TIMESERIES_COLUMNS, load_result
+from .dynamics.driver import Bounce
+from .dynamics.impact import run_impact, write_impact
+from .output.results import TIMESERIES_COLUMNS, load_result
 from .rough.ensemble import EnsembleResult
 from .scene import ResolvedScene, resolve_scene
 

@@ -37,10 +37,10 @@ def bounce_table(bounces: list[dict]) -> str:
 
 def check_params_set(spec: str) -> Path:
     """A parameter set (name or file) that exists, parses, whose every value passes the scene checks and has an
-    origin ([meta.origin], continuum.origins)."""
+    origin ([meta.origin], continuum.model.origins)."""
     from continuum.scene import FIELD_BY_PATH, check_value, find_params, flatten, read_toml
 
-    from continuum.origins import check_origins
+    from continuum.model.origins import check_origins
 
     path = find_params(spec)
     raw = read_toml(path, "params")
@@ -108,7 +108,7 @@ def ensemble_summary(ens: dict, surface: dict | None = None) -> str:
 
 
 def cmd_impact(args) -> int:
-    from continuum.impact import run_impact, write_impact
+    from continuum.dynamics.impact import run_impact, write_impact
     from continuum.scene import SceneError, resolve_scene
 
     check_out_dir(args.out)

@@ -218,7 +218,7 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation; of an ensemble, "
           "the master seed its members' seeds are derived from (numpy SeedSequence).", 0, low=0, high=2**63 - 1),
     NumberOrWord("surfaces.roughness.members", int, "1", "Realisations in an ensemble (mode 'ensemble', or 'auto' "
-                 "where it runs one); 'auto' adds members in batches (continuum.ensemble_run.AUTO_BATCH) until the "
+                 "where it runs one); 'auto' adds members in batches (continuum.dynamics.ensemble_run.AUTO_BATCH) until the "
                  "Wilson 95 % half-width of the stick probabilities (first impact and within the run) is below "
                  "surfaces.roughness.target_half_width, or surfaces.roughness.max_members are run; result.json -> "
                  "ensemble.members_rule records why it stopped.", 64, low=2, high=100000, words=("auto",)),
@@ -232,7 +232,7 @@ FIELDS: tuple[Field, ...] = (
           "threshold, continuum.rough.tail). With a map the ensemble is also run under the other model and both "
           "are reported (result.json -> ensemble.tail_models).", "gaussian", choices=("gaussian", "empirical_gpd")),
     Field("surfaces.roughness.escape_velocities", bool, "", "Of an ensemble, also bisect each member's escape "
-          "velocity (the smallest first-impact speed from which it rebounds, continuum.escape) and report their "
+          "velocity (the smallest first-impact speed from which it rebounds, continuum.dynamics.escape) and report their "
           "percentiles in result.json -> ensemble -> escape_velocity; each member then runs a dozen or more single "
           "impacts besides its drop.", False),
     _OneOrList("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography "
@@ -408,7 +408,7 @@ def json_schema() -> dict:
                                          "Required keys may come from the scene's parameter set, so none is "
                                          "required here; the loader checks the merged scene. See docs/scenes.md.")
     doc["properties"]["meta"] = {"type": "object", "description": "Parameter sets: description, provenance, and "
-                                 "[meta.origin], each value's origin (continuum.origins)."}
+                                 "[meta.origin], each value's origin (continuum.model.origins)."}
     return doc
 
 

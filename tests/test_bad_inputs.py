@@ -401,7 +401,7 @@ def no_work():
         raise AssertionError("work started: validation let a bad input through")
 
     with pytest.MonkeyPatch.context() as mp:
-        for target in ("continuum.impact.run_impact", "continuum.paper.report.make_paper",
+        for target in ("continuum.dynamics.impact.run_impact", "continuum.paper.report.make_paper",
                        "calibration.pipeline.executor", "calibration.pipeline.md_job", "calibration.sweep.executor",
                        "md.workflows.run_recipe", "md.doctor.run_doctor"):
             mp.setattr(target, started)

@@ -11,8 +11,8 @@ import math
 
 import pytest
 
-from continuum import regimes
-from continuum.escape import single_impact
+from continuum.model import regimes
+from continuum.dynamics.escape import single_impact
 from continuum.laws.branch_sphere import BranchSphere
 from continuum.reference import jkr as jkr_ref
 from continuum.reference import thornton_ning as tn
@@ -40,7 +40,7 @@ def test_maugis_dugdale_sphere_loses_one_tabulated_loop():
 
 def test_maugis_dugdale_sphere_bounces_under_gravity():
     """Each impact of a thrown sphere loses one loop: e_k = sqrt(1 - loop / (m v_k^2 / 2))."""
-    from continuum.driver import DriverSettings, simulate
+    from continuum.dynamics.driver import DriverSettings, simulate
     law = BranchSphere("maugis_dugdale", R, W, E_STAR, Z0)
     run = simulate(law, MASS, 9.80665, impact_velocity=5.0, settings=DriverSettings(rtol=1e-10, max_bounces=3,
                                                                                     max_time=10.0))
@@ -94,7 +94,7 @@ def test_auto_keeps_jkr_under_load_control_and_explicit_md_refuses_it():
 
 
 def test_scene_runs_the_maugis_dugdale_sphere():
-    from continuum.impact import run_impact
+    from continuum.dynamics.impact import run_impact
     result, _ = run_impact(_scene(50e-9))
     assert result["models"]["contact_law"]["name"] == "maugis_dugdale_sphere"
     assert result["models"]["adhesion"]["law"] == "maugis_dugdale"

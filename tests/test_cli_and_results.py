@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from calibration.cli import main
-from continuum.results import ResultSchemaError, load_result
+from continuum.output.results import ResultSchemaError, load_result
 
 ROOT = Path(__file__).resolve().parent.parent
 KEYS = {"schema_version", "scene", "models", "bounces", "n_bounces", "stuck", "energy_audit", "provenance", "timing"}

@@ -85,7 +85,7 @@ def test_shipped_calibration_recipes_are_found_by_name(capsys):
 # ----------------------------------------------------------------------------- -v / -q
 def _fake_command(args):
     """Stands in for a command: one record per level, from the CLI's logger and a library logger."""
-    for name in ("calibration.cli", "continuum.impact"):
+    for name in ("calibration.cli", "continuum.dynamics.impact"):
         lg = logging.getLogger(name)
         lg.debug("debug from %s", name)
         lg.info("info from %s", name)
@@ -112,7 +112,7 @@ def test_verbosity_sets_the_logging_levels_and_results_stay_on_stdout(monkeypatc
     captured = capsys.readouterr()
     assert captured.out == "result table\n"
     for level in ("debug", "info", "warning"):
-        for name in ("calibration.cli", "continuum.impact"):
+        for name in ("calibration.cli", "continuum.dynamics.impact"):
             assert (f"{level} from {name}" in captured.err) == (level in levels), (level, name, captured.err)
 
 
@@ -120,7 +120,7 @@ def test_progress_lines_go_to_stderr_through_logging_and_quiet_silences_them(tmp
     """A real (short) impact: per-impact progress on stderr by default, none with -q; the table on stdout."""
     scene = tmp_path / "short.toml"
     scene.write_text((ROOT / "inputs" / "scenes" / "jkr_sphere.toml").read_text() + "\n")
-    monkeypatch.setattr("continuum.impact.write_impact", lambda out, result, trace: None)   # no figures: fast
+    monkeypatch.setattr("continuum.dynamics.impact.write_impact", lambda out, result, trace: None)   # no figures: fast
     for flags, expect_progress in (([], True), (["-q"], False)):
         assert main([*flags, "impact", str(scene), "--fidelity", "fast", "--out", str(tmp_path / "o")]) == 0
         captured = capsys.readouterr()
@@ -340,7 +340,7 @@ def test_an_interrupt_swallowed_by_foreign_code_still_exits_130(capsys):
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # ctypes' "Exception ignored"
 def test_an_interrupt_swallowed_by_foreign_code_writes_no_output_folder(tmp_path):
     """write_run's commit point re-raises an interrupt that arrived while the run was being computed."""
-    from continuum.results import write_run
+    from continuum.output.results import write_run
     from nanoimpact.interrupt import sigint_guard
 
     with pytest.raises(KeyboardInterrupt), sigint_guard():

@@ -1,4 +1,4 @@
-"""The compiled contact integrator (continuum.contact_kernel) against closed forms and the Python stepper.
+"""The compiled contact integrator (continuum.numerics.contact_kernel) against closed forms and the Python stepper.
 
 Tolerances follow the problems, not one CPU's last digits:
 - Hertz sphere (F = 4/3 E* sqrt(R) delta^1.5, no gravity): the integration runs at rtol 1e-10, the
@@ -21,11 +21,11 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline, RectBivariateSpline
 
-from continuum import contact_kernel as ck
-from continuum.compiled_contact import power_law, run_compiled
-from continuum.driver import DriverSettings, simulate
-from continuum.escape import escape_velocity, single_impact
-from continuum.impact import first_impact_speed
+from continuum.numerics import contact_kernel as ck
+from continuum.numerics.compiled_contact import power_law, run_compiled
+from continuum.dynamics.driver import DriverSettings, simulate
+from continuum.dynamics.escape import escape_velocity, single_impact
+from continuum.dynamics.impact import first_impact_speed
 from continuum.model import select_law
 from continuum.reference import hertz as ref
 from continuum.scene import resolve_scene

@@ -1,5 +1,5 @@
 """Bridges on the summits of discrete realisations (continuum.laws.discrete_bridges), the wet work of adhesion from a
-measured W_SL, and the condensation time from nucleation (continuum.menisci, continuum.model.regime)."""
+measured W_SL, and the condensation time from nucleation (continuum.wet.menisci, continuum.model.regime)."""
 from __future__ import annotations
 
 import math
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from continuum import menisci as men
-from continuum.ensemble_run import run_ensemble
-from continuum.impact import run_impact
+from continuum.wet import menisci as men
+from continuum.dynamics.ensemble_run import run_ensemble
+from continuum.dynamics.impact import run_impact
 from continuum.laws.discrete_bridges import DiscreteBridges, wet_discrete
 from continuum.laws.discrete_roller import DiscreteRoughRoller
 from continuum.model.regime import condensation_time, meniscus_parameters
@@ -145,7 +145,7 @@ def test_a_humid_ensemble_carries_menisci_on_its_members():
 
 def test_a_discrete_run_with_bridges_keeps_its_energy_books():
     """A single realisation, bridges on: E_kin + E_pot + stored + booked constant to the driver's tolerance."""
-    from continuum.driver import DriverSettings, simulate
+    from continuum.dynamics.driver import DriverSettings, simulate
 
     scene = resolve_scene("wet_silica", params="calibrated").scene
     stats = SummitStatistics(scene.surfaces.roughness.sigma, scene.surfaces.roughness.summit_density,
@@ -211,7 +211,7 @@ def test_a_summit_inside_its_bridge_lets_go_with_the_wet_loop_and_the_books_clos
 def test_a_humid_member_runs_its_summits_at_the_wet_work_of_adhesion():
     """wet_silica (calibrated: measured W_SL, 'wet' solid adhesion) members: Maugis-Dugdale summits rebuilt at W_wet
     inside bridges, the bridges without the DMT pull (the summit law carries the solids' adhesion)."""
-    from continuum.ensemble_run import member_law, member_plan
+    from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model.regime import first_impact_speed
 
     # elastic summits (plasticity off): the calibrated silicon's hardness makes psi > 0.6, and plastic summits keep
@@ -227,7 +227,7 @@ def test_a_humid_member_runs_its_summits_at_the_wet_work_of_adhesion():
 def test_a_humid_plastic_member_keeps_its_bridges_with_the_dry_loop_and_says_so():
     """Where the summits yield (calibrated silicon, psi > 0.6) a member carries its bridges on plastic summits; the
     solids inside a bridge keep the dry summit law with the mean field's DMT correction, and the record says why."""
-    from continuum.ensemble_run import member_law, member_plan
+    from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model.regime import first_impact_speed
 
     scene = resolve_scene("wet_silica", params="calibrated", overrides={"surfaces.roughness.mode": "ensemble"}).scene
@@ -241,7 +241,7 @@ def test_a_humid_scene_reports_its_sticking_against_t_a():
     """result.json -> menisci_condensation_time: the scene's t_a and the estimate's range at its humidity and
     temperature, the stick probability at each t_a; at the paper's 40 % RH the range (ms) lies beyond every contact
     and no bridge formed, so every point is the scene's run, reused."""
-    from continuum.impact import run_impact
+    from continuum.dynamics.impact import run_impact
 
     over = {"surfaces.roughness.mode": "ensemble", "surfaces.roughness.members": 2, "numerics.max_bounces": 2}
     result, _ = run_impact(resolve_scene("wet_silica", params="paper", overrides=over))
@@ -261,7 +261,8 @@ def test_a_humid_scene_reports_its_sticking_against_t_a():
 def test_the_t_a_sweep_runs_again_exactly_the_points_that_can_differ(monkeypatch):
     """Points at or below the longest contact, or any point once a bridge formed, are run again; the others reuse the
     scene's run (bridges cannot form before t_a: the run is the same step for step)."""
-    from continuum import ensemble_run, wet_sweep
+    from continuum.dynamics import ensemble_run
+    from continuum.dynamics import wet_sweep
 
     resolved = resolve_scene("wet_silica", params="paper")
     asked = []

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from continuum.driver import DriverSettings, simulate
+from continuum.dynamics.driver import DriverSettings, simulate
 from continuum.laws.discrete_roller import DiscreteRoughRoller
 from continuum.model import rough_law
 from continuum.reference import jkr as ref

@@ -1,4 +1,4 @@
-"""Ensembles of discrete summit realisations (continuum.rough.ensemble, continuum.ensemble_run) and the 'auto' rule.
+"""Ensembles of discrete summit realisations (continuum.rough.ensemble, continuum.dynamics.ensemble_run) and the 'auto' rule.
 
 The paper's roller on rough silica (`paper` set, rigid substrate): about 3 summits carry the first impact, each
 loop a sizeable part of the impact energy, so realisations differ by whole loops."""
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from continuum import EnsembleResult, run_scene
-from continuum.ensemble_run import member_law, member_plan, run_ensemble, run_member
+from continuum.dynamics.ensemble_run import member_law, member_plan, run_ensemble, run_member
 from continuum.model.decisions import ENSEMBLE_BELOW_CONTACTS, realisation_decision
 from continuum.model.regime import first_impact_speed, regime_of
 from continuum.rough.ensemble import MemberOutcome, member_seeds
@@ -64,8 +64,8 @@ def test_the_compiled_discrete_contact_is_the_python_stepper(law):
     law with the law's own history rule, summit by summit. Rebound heights agree to the integration's accuracy:
     these runs close their energy books to ~1e-6 (JKR) and ~1e-5 (tabulated branches, whose force has a kink at
     every table node) of the impact energy, and a rebound height is that energy over m g."""
-    import continuum.ensemble_run as er
-    from continuum.driver import DriverSettings
+    import continuum.dynamics.ensemble_run as er
+    from continuum.dynamics.driver import DriverSettings
 
     scene = _scene(**{"numerics.max_bounces": 4, "physics.adhesion_law": law})
     plan = member_plan(scene, first_impact_speed(scene))
@@ -210,7 +210,7 @@ def test_tabulated_first_approach_forces_are_the_summit_sums_at_each_depth():
 def test_samples_inside_steps_do_not_change_a_members_rebounds(law):
     """Members keep no time series (samples_per_step = 0): the samples are read off each step's dense output
     and do not steer the steps, so the rebounds are those of a fully sampled run, to the last bit."""
-    from continuum.driver import DriverSettings, simulate
+    from continuum.dynamics.driver import DriverSettings, simulate
 
     scene = _scene(**{"physics.adhesion_law": law, "numerics.max_bounces": 6})
     runs = []
@@ -246,7 +246,7 @@ def test_escape_velocities_are_asked_for_by_the_scene_and_their_percentiles_brac
     release point (the datum is the tallest summit's top): v_1 = sqrt(2 (U + m g delta_c) / m). Every member
     needs at least that (more summits lose more loops), and a member with a lone tallest summit needs exactly
     that (seed 3 has some)."""
-    from continuum.escape import single_impact
+    from continuum.dynamics.escape import single_impact
     from continuum.reference import jkr
 
     scene = _scene(**{"numerics.max_bounces": 2, "surfaces.roughness.escape_velocities": True})
@@ -283,7 +283,7 @@ def test_without_the_scene_key_the_ensemble_says_no_escape_velocities_were_asked
 
 
 def test_the_ensemble_figure_and_summary_show_the_escape_velocity_spread():
-    from continuum import plots
+    from continuum.output import plots
     from continuum.cli import ensemble_summary
 
     scene = _scene(**{"numerics.max_bounces": 1})

@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from continuum.escape import escape_velocity
+from continuum.dynamics.escape import escape_velocity
 from continuum.laws.jkr import JKRSphere
 
 RADIUS, W, E_STAR = 5e-6, 0.1, 37.6e9

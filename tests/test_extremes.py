@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from continuum import estimates
-from continuum.impact import run_impact
+from continuum.model import estimates
+from continuum.dynamics.impact import run_impact
 from continuum.laws import rough_rigid
 from continuum.reference import jkr
 from continuum.rough.gw import GWJKRSurface

@@ -54,7 +54,7 @@ TOP_BRANCHES = {B.BRANCH_ABOVE_APPROACH, B.BRANCH_BAND_RELEASE, B.BRANCH_BAND_WI
 def built(name):
     """The surface of CASES[name], or the rough_silica scene's own ("scene")."""
     if name == "scene":
-        from continuum.impact import first_impact_speed
+        from continuum.dynamics.impact import first_impact_speed
         from continuum.model import select_law
         from continuum.scene import resolve_scene
 
@@ -210,9 +210,9 @@ def test_nan_in_nan_out_and_derivatives_stay_numpy():
 
 
 def test_warm_up_loads_the_specialisation_the_surfaces_use():
-    """`continuum.compiled_contact.warm_up` compiles (or loads) the kernel with the argument types a surface passes,
+    """`continuum.numerics.compiled_contact.warm_up` compiles (or loads) the kernel with the argument types a surface passes,
     so a forked worker never compiles it again."""
-    from continuum.compiled_contact import warm_up
+    from continuum.numerics.compiled_contact import warm_up
 
     warm_up()
     s = built("paper, untruncated, load, fast")

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from continuum.halfspace import LineHalfSpace, choose_grid, solve_coupled, solve_hard_contact, strip_displacement
+from continuum.elastic.halfspace import LineHalfSpace, choose_grid, solve_coupled, solve_hard_contact, strip_displacement
 from continuum.reference import hertz
 
 E_STAR, RADIUS, LOAD, LENGTH = 100e9, 5e-6, 1.0, 3.3e-3  # Pa, m, N/m, m (x_ref = roller length)

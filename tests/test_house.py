@@ -260,9 +260,9 @@ def test_the_scanners_find_what_they_look_for():
     assert compatibility_reexports(marked, "pkg/m.py") == ["pkg/m.py:1: " + marked.splitlines()[0]]
     clean = "from .costs import LIMIT\n\n\ndef law():\n    return LIMIT\n\n\n__all__ = ['law']\n"
     assert compatibility_reexports(clean, "pkg/law.py") == []
-    doc = ("See `md.engine.hashing.run_hash`, continuum.driver._contact and `calibration.executors`;\n"
+    doc = ("See `md.engine.hashing.run_hash`, continuum.dynamics.driver._contact and `calibration.executors`;\n"
            "the `md.engine.plan.Job` fields (`md.engine.plan.Job.canonical`), docs/md.md and md.md.\n")
-    assert unresolved_names(doc, "page.md") == ["page.md:1: continuum.driver._contact",
+    assert unresolved_names(doc, "page.md") == ["page.md:1: continuum.dynamics.driver._contact",
                                                 "page.md:1: calibration.executors"]
     code = '"""Uses `md.nowhere`."""\nimport md\nx = md.read_text()  # md.gone\n'
     assert unresolved_names(code, "m.py") == ["m.py:1: md.nowhere", "m.py:3: md.gone"]

@@ -4,8 +4,8 @@ from pathlib import Path
 
 import pytest
 
-from continuum.driver import DriverSettings, flight_time_to, simulate
-from continuum.impact import run_impact
+from continuum.dynamics.driver import DriverSettings, flight_time_to, simulate
+from continuum.dynamics.impact import run_impact
 from continuum.laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
 from continuum.reference import hertz as ref
 from continuum.scene import resolve_scene

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from continuum.driver import DriverSettings, simulate
+from continuum.dynamics.driver import DriverSettings, simulate
 from continuum.laws.jkr import JKRSphere
 from continuum.reference import jkr as ref
 

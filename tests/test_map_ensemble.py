@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from scipy import stats as sps
 
-from continuum.ensemble_run import auto_members, member_law, member_plan, run_ensemble
+from continuum.dynamics.ensemble_run import auto_members, member_law, member_plan, run_ensemble
 from continuum.model.regime import first_impact_speed
-from continuum.proportions import wilson_interval
+from continuum.output.proportions import wilson_interval
 from continuum.rough.cutoff_band import band_crosses, band_entry, band_warning, tail_warning
 from continuum.rough.ensemble import MemberOutcome, first_impact_record, within_run_record
 from continuum.rough.tail import fit_empirical_gpd, gpd_pwm
@@ -68,7 +68,7 @@ def test_a_member_draws_the_whole_strip_and_copies_no_summit():
     standard deviations), each at its own position (no two at one x, as tiled copies were), its heights in the tail
     drawn from the fitted GPD and so not the map's own values."""
     resolved = resolve_scene("rough_synthetic", overrides={**SMALL, "surfaces.roughness.tail_model": "empirical_gpd"})
-    from continuum.map_ensembles import map_tail
+    from continuum.dynamics.map_ensembles import map_tail
     model, _ = map_tail(resolved)
     scene = resolved.scene
     plan = member_plan(scene, first_impact_speed(scene), model)
@@ -155,7 +155,7 @@ def test_a_map_run_records_both_tail_models_and_the_cutoff_band_at_the_maps_own_
         assert p["members"] == 6 and p["interval"] == list(wilson_interval(p["count"], 6))
     out = r.write(tmp_path / "run")
     assert (out / "ensemble.png").is_file()
-    from continuum import plots
+    from continuum.output import plots
     from continuum.cli import ensemble_summary
     assert len(plots.ensemble_spread(r.record["ensemble"], band=band).figure.axes) == 2
     assert "cutoff" in ensemble_summary(r.record["ensemble"], r.record["surface"])

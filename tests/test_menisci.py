@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from continuum import menisci as men
-from continuum.impact import run_impact
+from continuum.wet import menisci as men
+from continuum.dynamics.impact import run_impact
 from continuum.laws.wet import MeniscusBridges
 from continuum.rough.gw import SummitStatistics
 from continuum.scene import resolve_scene
@@ -214,7 +214,7 @@ def test_condensation_time_is_computed_once_for_every_record(rh):
     goes as ln(1/RH)); the regime record once guarded RH = 1 to infinity while the menisci did not."""
     from types import SimpleNamespace
 
-    from continuum.impact import regime_numbers
+    from continuum.dynamics.impact import regime_numbers
     from continuum.model.regime import condensation_time
 
     scene = _scene(**{"menisci.condensation_model": "nucleation", "environment.relative_humidity": rh,

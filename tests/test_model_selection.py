@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from continuum import regimes
-from continuum.impact import first_impact_speed, run_impact
+from continuum.model import regimes
+from continuum.dynamics.impact import first_impact_speed, run_impact
 from continuum.model import TABOR_DMT, TABOR_JKR, adhesion_decision, regime_of, select_law
 from continuum.scene import resolve_scene
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from continuum.driver import DriverSettings, simulate
+from continuum.dynamics.driver import DriverSettings, simulate
 from continuum.laws.plastic_rough import PlasticSummitsPunch
 from continuum.rough.branch_laws import make_summit_law
 from continuum.rough.plastic_branches import NODE_RATIO, PlasticBranchSummitLaw
@@ -163,7 +163,7 @@ def test_calibrated_rough_silica_members_run_plastic_maugis_dugdale_summits_and_
     records psi = (E*/H) sqrt(sigma/beta)."""
     from pathlib import Path
 
-    from continuum.ensemble_run import member_law, member_plan
+    from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model import plasticity_decision
     from continuum.model.regime import first_impact_speed, summit_e_star
     from continuum.scene import resolve_scene

@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from continuum.driver import DriverSettings, simulate
-from continuum.escape import escape_velocity, single_impact
+from continuum.dynamics.driver import DriverSettings, simulate
+from continuum.dynamics.escape import escape_velocity, single_impact
 from continuum.laws.jkr import JKRSphere
 from continuum.laws.plastic_sphere import PlasticJKRSphere
 from continuum.reference import jkr as ref
@@ -137,7 +137,7 @@ def _scene(hardness=P_Y, **overrides):
 
 
 def test_scene_runs_the_plastic_law_when_faster_than_the_yield_velocity():
-    from continuum.impact import run_impact
+    from continuum.dynamics.impact import run_impact
     result, _ = run_impact(_scene())
     plastic = result["models"]["plasticity"]
     assert plastic["used"] and plastic["decided_by"] == "yield_velocity"
@@ -149,7 +149,7 @@ def test_scene_runs_the_plastic_law_when_faster_than_the_yield_velocity():
 
 
 def test_scene_without_yield_key_stays_elastic_and_says_why():
-    from continuum.impact import run_impact
+    from continuum.dynamics.impact import run_impact
     result, _ = run_impact(_scene(hardness=None))
     plastic = result["models"]["plasticity"]
     assert not plastic["used"] and plastic["decided_by"] == "yield_strength"

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from continuum.driver import DriverSettings, simulate
+from continuum.dynamics.driver import DriverSettings, simulate
 from continuum.reference import jkr
 from continuum.reference import thornton_ning as tn
 from continuum.rough.branch_laws import make_summit_law
@@ -210,7 +210,7 @@ def test_rough_scene_runs_plastic_summits_where_they_yield(mode, names):
     realisation of discrete summits."""
     from pathlib import Path
 
-    from continuum.impact import run_impact
+    from continuum.dynamics.impact import run_impact
     from continuum.scene import resolve_scene
 
     path = Path(__file__).resolve().parents[1] / "inputs" / "scenes" / "rough_silica.toml"
@@ -326,7 +326,7 @@ def test_ensemble_members_take_the_scenes_summit_plasticity(hardness, name):
     """An ensemble member's realisation runs plastic summits exactly where the mean field does."""
     from pathlib import Path
 
-    from continuum.ensemble_run import member_law, member_plan
+    from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model.regime import first_impact_speed
     from continuum.scene import resolve_scene
 

@@ -1,4 +1,4 @@
-"""result.json text (continuum.results.dumps): the values json.dumps(indent=2) would write, long lists of numbers
+"""result.json text (continuum.output.results.dumps): the values json.dumps(indent=2) would write, long lists of numbers
 on one line. A reader sees the same JSON; only the whitespace differs."""
 import json
 import math
@@ -8,7 +8,7 @@ import numpy as np
 
 import pytest
 
-from continuum.results import (PROFILES_FILE, SCHEMA_VERSION, ResultSchemaError, _clean, _json_default, dumps,
+from continuum.output.results import (PROFILES_FILE, SCHEMA_VERSION, ResultSchemaError, _clean, _json_default, dumps,
                                load_result, write_result_files)
 
 

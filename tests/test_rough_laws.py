@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from continuum.driver import DriverSettings, simulate
-from continuum.impact import run_impact
+from continuum.dynamics.driver import DriverSettings, simulate
+from continuum.dynamics.impact import run_impact
 from continuum.laws.rough_rigid import RigidRoughRoller
 from continuum.laws.rough_roller import RoughRoller
 from continuum.model import rough_law

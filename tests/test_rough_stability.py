@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import continuum.impact as impact
-from continuum.impact import run_impact
+import continuum.dynamics.impact as impact
+from continuum.dynamics.impact import run_impact
 from continuum.scene import SceneError, resolve_scene
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from continuum.impact import run_impact
+from continuum.dynamics.impact import run_impact
 from continuum.scene import resolve_scene
 
 ROOT = Path(__file__).resolve().parent.parent

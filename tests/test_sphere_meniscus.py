@@ -11,7 +11,8 @@ import math
 
 import pytest
 
-from continuum import load_scene, menisci, run_scene
+from continuum import load_scene, run_scene
+from continuum.wet import menisci
 from continuum.laws.hertz import HertzSphere
 from continuum.laws.sphere_meniscus import SphereBridge, pull_off
 from continuum.model.regime import first_impact_speed

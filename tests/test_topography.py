@@ -295,7 +295,7 @@ def test_bad_maps_are_one_line_naming_the_key_and_nothing_is_written(tmp_path, c
     def started(*a, **k):
         raise AssertionError("work started: a bad map got through")
 
-    monkeypatch.setattr("continuum.impact.run_impact", started)
+    monkeypatch.setattr("continuum.dynamics.impact.run_impact", started)
     for k, (rough, key, expect) in enumerate(_bad_cases(tmp_path)):
         scene = tmp_path / f"scene{k}.toml"
         body = "\n".join(f"{a} = {b!r}" for a, b in SCENE["body"].items())
@@ -509,7 +509,7 @@ def test_an_energy_audit_above_the_scene_s_tolerance_warns_with_its_numbers():
     from dataclasses import replace
 
     from continuum import run_scene
-    from continuum.warnings import audit_warnings
+    from continuum.output.notices import audit_warnings
 
     r = run_scene("rough_afm_scan", overrides={"numerics.max_bounces": 1, "numerics.fidelity": "fast",
                                                "numerics.audit_tolerance": 1e-15})

@@ -1,7 +1,7 @@
 """Results warn when the elastic model's assumptions fail: yield onset, too few summits."""
 from pathlib import Path
 
-from continuum.impact import run_impact
+from continuum.dynamics.impact import run_impact
 from continuum.scene import resolve_scene
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -245,7 +245,7 @@ def restitution_case(name, ds, simulate):
 # ------------------------------------------------------------------------------------------------
 def capillary_case(name, ds):
     """Upper limit of capillary adhesion between flat surfaces, gamma_lv (cos th1 + cos th2)."""
-    from continuum import menisci
+    from continuum.wet import menisci
     gamma = ds["liquid"]["surface_tension"]
     th_lo, th_hi = ds["bands"]["contact_angle"]
     band = sorted(gamma * menisci.wetting_sum(np.radians(t), np.radians(t)) for t in (th_lo, th_hi))

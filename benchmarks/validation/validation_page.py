@@ -143,7 +143,7 @@ def _largest_losses(res):
 def _capillary(res, ds):
     return [f"## Capillary adhesion of rough MEMS surfaces: {ds['title']}", "",
             f"Source: {ds['citation']}. DOI: {ds['doi']}.", f"Where: {ds['where']}.", "", ds["note"], "",
-            f"Predicted upper limit: gamma_lv (cos th1 + cos th2) (the project's `continuum.menisci` wetting sum), "
+            f"Predicted upper limit: gamma_lv (cos th1 + cos th2) (the project's `continuum.wet.menisci` wetting sum), "
             f"gamma_lv = {res['surface_tension']:g} N/m ({ds['liquid']['source']}), contact angle "
             f"{_band(res['contact_angle_band'])} deg ({ds['bands']['contact_angle_reason']}).", "",
             "| quantity | measured (J/m^2) | how | predicted (J/m^2) | vs predicted |", "|---|---|---|---|---|",

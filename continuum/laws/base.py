@@ -107,7 +107,7 @@ class ContactLaw(ABC):
 
     def compiled(self, t0: float):
         """The law's compiled form for the contact that starts at `t0` (s), a
-        `continuum.compiled_contact.CompiledLaw`, or None (the driver's Python stepper integrates it).
+        `continuum.numerics.compiled_contact.CompiledLaw`, or None (the driver's Python stepper integrates it).
         Called after `prepare` and `reset`."""
         return None
 

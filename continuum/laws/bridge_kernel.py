@@ -66,7 +66,7 @@ def bridge_integral(kind, gap, s_lo, s_hi, formed, g_hi, g_lo, z_top, radius, le
                     comp, stretch, gl_x, gl_w):
     """Sum over bridged summits with s_lo <= u <= s_hi of F (KIND_FORCE, N), U (KIND_ENERGY, J) or their number
     (KIND_COUNT); with `formed`, U at the formation gaps, linear in u from g_hi (u = s_hi) to g_lo (u = s_lo).
-    `comp`, `stretch`: the bridge law's coefficients on g <= 0 and 0 < g < D_K (`continuum.menisci`)."""
+    `comp`, `stretch`: the bridge law's coefficients on g <= 0 and 0 < g < D_K (`continuum.wet.menisci`)."""
     q_top = min(-s_lo, d_k - gap)
     if not q_top > 0.0 or s_hi <= s_lo:
         return 0.0

@@ -1,6 +1,6 @@
 """What the rough rollers' tables and grids cost, and the bounds that refuse a scene before it runs.
 
-Pure numbers and functions, no law: the estimates (`continuum.estimates`) check a scene's tables against
+Pure numbers and functions, no law: the estimates (`continuum.model.estimates`) check a scene's tables against
 these bounds before anything is built, and the laws (`rough_roller`, `rough_rigid`) check them again at run
 time. The costs per surface state are used for the footprint tables' build (`RigidRoughRoller`) and the
 grid law's run budget (`RoughRoller`) alike.

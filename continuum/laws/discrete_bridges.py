@@ -1,6 +1,6 @@
 """Capillary bridges on the individual summits of a discrete realisation: the mean field's bridges, summit by summit.
 
-The mean-field wet law (`continuum.laws.wet`) sums the bridge law of `continuum.menisci` over the Gaussian density
+The mean-field wet law (`continuum.laws.wet`) sums the bridge law of `continuum.wet.menisci` over the Gaussian density
 of summits under the roller. A discrete realisation (`continuum.laws.discrete_roller`, one ensemble member, or a map
 patch) has its own summits: each grows its own bridge, on the same clock and by the same law:
 
@@ -10,9 +10,9 @@ patch) has its own summits: each grows its own bridge, on the same clock and by 
   g_i <= h_mw(t) carries a bridge until g_i > D_K. Lower summits bridge last and break first, so the bridged summits
   are those with u_i >= s, one offset for the realisation, updated exactly as the mean field's
   (`MeniscusBridges.offset`, `accept`): a prefix of the summits sorted by effective height;
-- each bridge pulls F(g_i) and stores U(g_i) (`continuum.menisci.bridge_force`, `bridge_energy`: constant Kelvin
+- each bridge pulls F(g_i) and stores U(g_i) (`continuum.wet.menisci.bridge_force`, `bridge_energy`: constant Kelvin
   radius, rupture at D_K, U(D_K) = 0) with the wet solid-solid pull taken from compressed bridged summits (the
-  `solid_pull` of `continuum.menisci.solid_pull_inside_bridge`, the same DMT correction as the mean field);
+  `solid_pull` of `continuum.wet.menisci.solid_pull_inside_bridge`, the same DMT correction as the mean field);
 - the formation work is booked as in the mean field: at t_a -sum U(g_i) over the summits bridged where they stand,
   after it -U at each summit's formation gap, interpolated linearly in u between the last accepted boundary and the
   trial one (`MeniscusBridges.pending_formation`, which this class inherits: only the sum changes).
@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from .. import menisci as men
+from ..wet import menisci as men
 from .wet import MeniscusBridges
 
 
@@ -81,7 +81,7 @@ class DiscreteBridges(MeniscusBridges):
                 x = (g_hi + k * (u - s_hi)) / d_k
                 total += a0 + x * (a1 + x * a2)
             return scale * total
-        for u in us:                                   # the law of `continuum.menisci` on its two pieces
+        for u in us:                                   # the law of `continuum.wet.menisci` on its two pieces
             x = (gap - u) / d_k
             a0, a1, a2 = comp if x <= 0.0 else stretch
             total += a0 + x * (a1 + x * a2)

@@ -24,7 +24,7 @@ the load-controlled stretch 3^(-2/3) delta_c). Trial states apply the rule witho
 (exactly as the averaged law's effective threshold), `accept` commits it. Attached summits push
 with P_JKR(delta_i) on the stable branch. With the half-space on, summit forces are binned into
 the cells of a uniform grid (nearest cell), p_j = F_j/(dx l), delta_e = D p
-(`continuum.halfspace.LineHalfSpace`, x_ref = l) and each summit sees its cell's delta_e: the
+(`continuum.elastic.halfspace.LineHalfSpace`, x_ref = l) and each summit sees its cell's delta_e: the
 binning and the sampling are transposes of each other, so force = -d(stored)/d(gap) holds exactly
 at equilibrium. The coupled state is a fixed point on the summit forces, warm-started from the last
 accepted state (the deflection is femtometres under the paper's roller: 3-4 iterations); it raises
@@ -39,7 +39,7 @@ at delta = -Delta there): `on_release` books the loops of those still attached.
 Compiled form (rigid substrate only): on a rigid substrate the history rule leaves attached exactly a prefix of
 the summits sorted by effective height (those reached, e_i - z_top >= h_min, that have not let go, e_i - z_top
 >= gap - Delta), so the deepest accepted gap h_min is the whole history and a contact runs in the compiled
-kernel (`continuum.contact_kernel.LAW_DISCRETE`, the same per-summit closed forms), ~100x faster than the
+kernel (`continuum.numerics.contact_kernel.LAW_DISCRETE`, the same per-summit closed forms), ~100x faster than the
 Python stepper; a state below the kept summits hands the contact back to the Python stepper, which keeps more.
 
 Cost: each force evaluation touches only the prefix of the summits sorted by effective height
@@ -517,10 +517,10 @@ class DiscreteRoughRoller(RoughRollerBase):
             self.max_pressure = max(self.max_pressure, float(np.max(p)))
 
     def compiled(self, t0: float):
-        """The kept summits as the compiled kernel reads them (`continuum.contact_kernel.LAW_DISCRETE`); None with
+        """The kept summits as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_DISCRETE`); None with
         the half-space on (its coupled fixed point runs in Python)."""
-        from .. import contact_kernel as ck
-        from ..compiled_contact import EMPTY_TABLES, CompiledLaw
+        from ..numerics import contact_kernel as ck
+        from ..numerics.compiled_contact import EMPTY_TABLES, CompiledLaw
 
         if self.use_half_space:
             return None
@@ -540,9 +540,9 @@ class DiscreteRoughRoller(RoughRollerBase):
         return CompiledLaw(ck.LAW_DISCRETE, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def _compiled_branches(self):
-        """`continuum.contact_kernel.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two branches."""
-        from .. import contact_kernel as ck
-        from ..compiled_contact import EMPTY_TABLES, CompiledLaw
+        """`continuum.numerics.contact_kernel.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two branches."""
+        from ..numerics import contact_kernel as ck
+        from ..numerics.compiled_contact import EMPTY_TABLES, CompiledLaw
 
         if self._compiled_for is not self.eff:
             P = np.zeros(ck.BRANCH_PARAMS)

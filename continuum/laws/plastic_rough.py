@@ -244,8 +244,8 @@ class PlasticSummitsPunch(ContactLaw):
         `PlasticBranchSummitLaw`; None for the closed-form JKR law (the Python stepper runs it)."""
         if not self.law.compiled_form:
             return None
-        from .. import contact_kernel as ck
-        from ..compiled_contact import CompiledLaw
+        from ..numerics import contact_kernel as ck
+        from ..numerics.compiled_contact import CompiledLaw
         from ..rough.plastic_kernel import compiled_tables
         P, T = compiled_tables(self.law, self.heights - self.z_top, self.delta_max, self.release_gap(),
                                self.law.max_stretch, self._lowest)

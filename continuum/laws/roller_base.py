@@ -34,7 +34,7 @@ from abc import abstractmethod
 
 import numpy as np
 
-from ..halfspace import LineHalfSpace
+from ..elastic.halfspace import LineHalfSpace
 from .base import ContactLaw
 from .costs import beyond_range
 from .depth import DEPTH_LIMIT_SIGMAS, absorbing_depth

@@ -315,9 +315,9 @@ class RigidRoughRoller(RoughRollerBase):
 
     # ------------------------------------------------------------------ compiled form
     def compiled(self, t0: float):
-        """The tables as the compiled kernel reads them (`continuum.contact_kernel.LAW_RIGID_TABLE`)."""
-        from ..compiled_contact import CompiledLaw
-        from .. import contact_kernel as ck
+        """The tables as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_RIGID_TABLE`)."""
+        from ..numerics.compiled_contact import CompiledLaw
+        from ..numerics import contact_kernel as ck
 
         # the splines these arrays came from are kept with them (an identity test on live objects)
         if self._compiled_for != (self._force, self._energy, self._count):

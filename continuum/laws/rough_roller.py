@@ -9,7 +9,7 @@ roller surface (eq 16)
 where `gap` is the driver's coordinate (height of the roller's lowest point above the datum, the
 tallest summit expected in the footprint, z_max above the mean plane) and delta_e = D * p is the
 elastic displacement of the half-space under the summit pressure p (eq 17; FFT influence
-coefficients referenced at x_ref = l, so that a smooth roller recovers eq 1; `continuum.halfspace`).
+coefficients referenced at x_ref = l, so that a smooth roller recovers eq 1; `continuum.elastic.halfspace`).
 Each cell keeps one history threshold zeta*_i (summits taller than it are attached; notes on
 eq 11), updated on every accepted integration step and at every extremum of the motion. The
 force on the roller is W = l * sum_i p_i dx (eq 14 without menisci).
@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from ..halfspace import solve_coupled
+from ..elastic.halfspace import solve_coupled
 from ..rough.surface import SummitSurface
 from .costs import MAX_RUN_SECONDS, SECONDS_PER_STATE
 from .roller_base import RoughRollerBase

@@ -4,7 +4,7 @@ What it is
 ----------
 The sphere's own law (Hertz, JKR, DMT, Maugis-Dugdale or Thornton-Ning, chosen by the Tabor parameter as
 without humidity) carries the solids' contact; one bridge at the contact adds the capillary attraction of
-`continuum.menisci`, the same constant-Kelvin-radius law the rough summits use with beta = the sphere's
+`continuum.wet.menisci`, the same constant-Kelvin-radius law the rough summits use with beta = the sphere's
 radius R (Butt & Kappl, Adv. Colloid Interface Sci. 146 (2009) 48, sphere-plane at constant r_K;
 Israelachvili, Intermolecular and Surface Forces, 3rd ed. (2011) ch. 17):
 
@@ -13,7 +13,7 @@ Israelachvili, Intermolecular and Surface Forces, 3rd ed. (2011) ch. 17):
 
 valid for r_K << R; the bridge ruptures at D_K, where its force and energy are zero. Inside the bridge the
 solids touch under the liquid: with ``menisci.solid_adhesion = 'wet'`` a compressed contact loses the solid
-pull 2 pi R (dgamma - max(W_wet, 0)) (`continuum.menisci.solid_pull_inside_bridge`, DMT's force, the rough
+pull 2 pi R (dgamma - max(W_wet, 0)) (`continuum.wet.menisci.solid_pull_inside_bridge`, DMT's force, the rough
 summits' construction), so a DMT sphere's wet pull-off is 2 pi R dgamma when W_wet >= 0 (Israelachvili eq
 17.25) and F0 when the liquid wets between the solids; 'additive' keeps the dry adhesion beside the bridge.
 
@@ -21,7 +21,7 @@ When the bridge is there
 ------------------------
 A meniscus narrower than a molecule is not a liquid: no bridge where r_K is below the scene's cutoff
 (``menisci.min_kelvin_radius``, one water molecule by default; the decision is `continuum.model.decisions`).
-A bridge condenses only after the solids touch, on the rough model's clock (`continuum.menisci.bridgeable_gap`:
+A bridge condenses only after the solids touch, on the rough model's clock (`continuum.wet.menisci.bridgeable_gap`:
 nothing before the condensation time t_a, then every gap up to h_mw(t) = min(h1 ln(t/t_a), D_K)); it is
 not there on the approach. Formation books -U(g_f) (work the condensing liquid does, the rough law's
 `formation`), rupture at D_K books nothing, so E_kin + E_pot + stored + booked stays constant.
@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .. import menisci as men
+from ..wet import menisci as men
 from .base import ContactLaw
 
 

@@ -2,7 +2,7 @@
 
 The dry law (GW summits, rigid substrate or elastic half-space) is unchanged; bridges add an
 attraction that depends on the contact time t (from first touch of this impact) and on the gap.
-Bridge physics: ``continuum.menisci`` (force F(g), energy U(g), Kelvin gap D_K, h_mw(t)).
+Bridge physics: ``continuum.wet.menisci`` (force F(g), energy U(g), Kelvin gap D_K, h_mw(t)).
 
 Geometry and history (rigid geometry for the bridges)
 -----------------------------------------------------
@@ -35,7 +35,7 @@ import math
 import numpy as np
 from scipy import special
 
-from .. import menisci as men
+from ..wet import menisci as men
 from . import bridge_kernel as bk
 from .base import ContactLaw
 
@@ -68,7 +68,7 @@ class MeniscusBridges:
     stats: SummitStatistics (sigma m, density 1/m^2, radius m); z_top: tallest summit (m above the
     summit mean plane); radius R and length l of the roller (m); f0 (N) and d_k (m) per bridge; t_a (s)
     and growth length h1 (m) of h_mw(t); solid_pull (N): the solid-solid pull a bridge takes from each
-    compressed summit it wets (``continuum.menisci.solid_pull_inside_bridge``; 0 = the paper's additive eq 14).
+    compressed summit it wets (``continuum.wet.menisci.solid_pull_inside_bridge``; 0 = the paper's additive eq 14).
     """
 
     def __init__(self, stats, z_top: float, radius: float, length: float, f0: float, d_k: float,

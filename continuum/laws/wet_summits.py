@@ -1,7 +1,7 @@
 """Discrete summits that adhere with the wet work of adhesion inside their bridges: force and hysteresis loop.
 
 Inside a capillary bridge the two solids touch under liquid, so a bridged summit's solid-solid law is the dry one
-with W_wet = gamma_1L + gamma_2L - gamma_12 in place of dgamma (Dupre in the liquid, `continuum.menisci.
+with W_wet = gamma_1L + gamma_2L - gamma_12 in place of dgamma (Dupre in the liquid, `continuum.wet.menisci.
 wet_work_of_adhesion`; Israelachvili 2011 §17.7, Butt & Kappl 2009): its force, its jump-in and release points,
 and the loop it dissipates when it lets go (a JKR loop scales as W^(5/3): at W_wet / dgamma = 0.15 it is 0.04 of
 the dry one). The mean field corrects only the force (a DMT pull taken from compressed bridged summits,

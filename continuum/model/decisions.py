@@ -12,11 +12,11 @@ Tabor's nominally flat criterion) yet loses 28 % per impact, because only ~3 sum
 each loop is a sizeable part of a 6e-16 J impact.
 
 Half-space. Left out when the estimated deflection span across the footprint is below 1e-3 sigma
-(`continuum.estimates`): the summits' gaps then move by less than a thousandth of their spread.
+(`continuum.model.estimates`): the summits' gaps then move by less than a thousandth of their spread.
 
 Menisci. Left out when the air is dry (RH = 0), when the faces are hydrophobic (cos t1 + cos t2
 <= 0: no bridge pulls), for smooth contact and discrete summits (not modelled), and otherwise
-decided after a dry run (`dry_run_verdict`; `continuum.impact.run_impact` runs the two): bridges cannot
+decided after a dry run (`dry_run_verdict`; `continuum.dynamics.impact.run_impact` runs the two): bridges cannot
 form before t_a, so if no contact of the dry run lasts t_a, the wet run is identical and the dry one is kept.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .. import menisci as men
+from ..wet import menisci as men
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
 from .regime import Regime, kelvin_radius_cutoff, meniscus_parameters, summit_e_star
@@ -307,7 +307,7 @@ def dry_run_verdict(scene: Scene, durations, status: str) -> DryRunVerdict:
 
 # ----------------------------------------------------------------------------- realisation (few summits)
 #: 'auto' runs an ensemble of discrete realisations below this many expected summits in contact at the first
-#: impact (the Hertz estimate's count, continuum.estimates): above it the mean field's first-impact energy loss lies
+#: impact (the Hertz estimate's count, continuum.model.estimates): above it the mean field's first-impact energy loss lies
 #: within ENSEMBLE_TOLERANCE of the ensemble mean. Measured by benchmarks/bench_ensemble_threshold.py (the
 #: departure falls like A / sqrt(N_c), A = 0.45 +- 0.12; N* = (A / tolerance)^2 = 80 (47-125 within A's standard
 #: error); docs/figures/ensemble_threshold.json, docs/model.md "Few summits: ensembles").
@@ -364,7 +364,7 @@ def realisation_decision(scene: Scene, regime: Regime) -> RealisationDecision:
 class PlasticityDecision:
     """Whether a smooth sphere (or the summits of rough contact, `summit_plasticity`) runs the Thornton-Ning adhesive
     elastic-plastic law, and the numbers that decided it: the softer partner's limiting contact pressure (Pa,
-    `continuum.limiting_pressure`) and the yield velocity (m/s, `continuum.reference.thornton_ning.yield_velocity`)
+    `continuum.model.limiting_pressure`) and the yield velocity (m/s, `continuum.reference.thornton_ning.yield_velocity`)
     against the first impact's speed (m/s), or the summits' plasticity index."""
 
     used: bool
@@ -375,7 +375,7 @@ class PlasticityDecision:
     yield_velocity: float | None = None
     impact_speed: float | None = None
     partners: tuple = ()
-    """Each partner with a yield key: `continuum.limiting_pressure.PartnerLimit`."""
+    """Each partner with a yield key: `continuum.model.limiting_pressure.PartnerLimit`."""
     plasticity_index: float | None = None
     """Rough contact: the summits' Greenwood-Williamson psi = (E*/p_y) sqrt(sigma/beta) (`summit_plasticity`)."""
     summits_yield: bool | None = None
@@ -433,7 +433,7 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
     (the summits' E*, `summit_e_star`; the softer partner's limiting pressure p_y, H or 2.8 Y) decides for the
     surface under any practical load; the first impact's estimated depth below the tallest summit (`depth`, m,
-    `continuum.estimates`) beyond a summit's yield approach delta_y decides for an impact hard enough to yield
+    `continuum.model.estimates`) beyond a summit's yield approach delta_y decides for an impact hard enough to yield
     the tallest summits of an otherwise elastic surface.
 
     Where they yield, adhesive elastic-plastic summits under a rigid roller run (`continuum.laws.plastic_rough`):
@@ -447,7 +447,7 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     ('on' and 'auto' decide alike for rough contact; 'off' is handled by `plasticity_decision`).
     A p_y below the summits' adhesive stress scale (they would yield on snap-in, outside Thornton-Ning) is refused
     naming its key."""
-    from ..limiting_pressure import partner_limits, softer_partner
+    from .limiting_pressure import partner_limits, softer_partner
 
     limits = tuple(partner_limits(_yield_values(scene)))
     soft = softer_partner(list(limits))
@@ -509,7 +509,7 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
     `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key. Rough
     contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
     `depth`, m)."""
-    from ..limiting_pressure import partner_limits, softer_partner
+    from .limiting_pressure import partner_limits, softer_partner
     from ..reference import thornton_ning as tn
 
     choice = scene.physics.plasticity

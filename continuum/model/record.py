@@ -12,7 +12,7 @@ from .regime import Regime, coated_summits
 
 #: The estimate's record says what it is.
 ESTIMATE_WHAT = ("quasi-static first approach of Hertz summits on a rigid substrate absorbing the first impact's "
-                 "energy (continuum.estimates)")
+                 "energy (continuum.model.estimates)")
 FREE_FLIGHT = {"used": True, "why": "closed form under gravity (no time steps spent in flight)"}
 
 

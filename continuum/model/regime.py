@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .. import menisci as men
-from .. import regimes
-from ..estimates import RoughImpactEstimate, rough_impact_estimate
+from ..wet import menisci as men
+from . import regimes
+from .estimates import RoughImpactEstimate, rough_impact_estimate
 from ..scene import Scene
 
 
@@ -66,7 +66,7 @@ def first_impact_speed(scene: Scene) -> float:
 
 def impact_estimate(scene: Scene, speed: float) -> RoughImpactEstimate:
     """Quasi-static first approach of Hertz summits on a rigid substrate absorbing an impact at `speed` (m/s)
-    (`continuum.estimates`): depth, contacts, peak force and the half-space's deflection span."""
+    (`continuum.model.estimates`): depth, contacts, peak force and the half-space's deflection span."""
     from ..rough.datum import tallest_summit
     from ..rough.summits import SummitStatistics
 
@@ -141,7 +141,7 @@ def condensation_time(scene: Scene) -> tuple[float, str]:
 
 def condensation_time_range(scene: Scene) -> dict:
     """The scene's t_a (s, `condensation_time`) and the range the nucleation estimate allows at the scene's humidity
-    and temperature (`continuum.menisci.nucleation_time_range`: the attempt frequency anywhere in Szoszkiewicz &
+    and temperature (`continuum.wet.menisci.nucleation_time_range`: the attempt frequency anywhere in Szoszkiewicz &
     Riedo's 4-250 GHz), with the inputs it rests on; SI. A 'fixed' t_a is a declared choice: the range is reported
     beside it, so a reader sees where the declared value sits."""
     env = scene.environment
@@ -165,7 +165,7 @@ def kelvin_radius_cutoff(scene: Scene) -> tuple[float, float, str]:
 
 def solid_liquid_works(scene: Scene) -> tuple[float | None, float | None]:
     """Measured solid-water works of adhesion W_SL (J/m^2) of the two contacting faces (the SAM's on both when
-    covered), None where not given (then `continuum.menisci.solid_liquid_work` takes gamma_lv (1 + cos theta))."""
+    covered), None where not given (then `continuum.wet.menisci.solid_liquid_work` takes gamma_lv (1 + cos theta))."""
     surf = scene.surfaces
     if surf.sam is not None:
         return surf.sam.work_of_adhesion_sl, surf.sam.work_of_adhesion_sl

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import functools
 
-from ..estimates import check_table_cost
+from .estimates import check_table_cost
 from ..laws.base import ContactLaw
 from ..laws.discrete_bridges import wet_discrete
 from ..reference import jkr as jkr_ref
@@ -45,7 +45,7 @@ def _mean_field_cost(scene: Scene, adhesion: str, half_space: bool, w: float, e_
                      table: str, est, speed: float):
     """The mean-field rough law's table resolution, its summit law (branch summits), the impact estimate and the
     tables' cost, checked before any table is built: a scene beyond the bounds is refused with a SceneError
-    (`continuum.estimates.check_table_cost`). Returns (table, summit law or None, estimate, cost)."""
+    (`continuum.model.estimates.check_table_cost`). Returns (table, summit law or None, estimate, cost)."""
     rough, phys = scene.surfaces.roughness, scene.physics
     generic = branch_summits(adhesion)
     slaw = None
@@ -88,7 +88,7 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     `adhesion` (a law name) and `half_space` default to the scene's choices; where the scene says
     'auto' they are decided as `select_law` does (with the estimate at `speed`, m/s, if given, else
     at the scene's first impact). Before any table is built the tables' size is estimated and a
-    scene beyond the bounds is refused with a `SceneError` (`continuum.estimates.check_table_cost`).
+    scene beyond the bounds is refused with a `SceneError` (`continuum.model.estimates.check_table_cost`).
     """
     from ..rough.datum import tallest_summit
     from ..rough.summits import SummitStatistics
@@ -145,9 +145,9 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
 
 def _wet_solids_record(scene: Scene, plastic: bool) -> dict:
     """How a smooth sphere's solids adhere inside its bridge (menisci.solid_adhesion): 'wet', at the work of
-    adhesion under the liquid max(W_wet, 0) (continuum.menisci.wet_work_of_adhesion), their law rebuilt at it;
+    adhesion under the liquid max(W_wet, 0) (continuum.wet.menisci.wet_work_of_adhesion), their law rebuilt at it;
     'additive', the dry law unchanged. The summits' DMT solid pull is not used: the sphere's own law carries it."""
-    from .. import menisci as men
+    from ..wet import menisci as men
     surf, m = scene.surfaces, scene.menisci
     t1, t2 = surf.contact_angles
     w = surf.interface_work_of_adhesion

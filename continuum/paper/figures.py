@@ -14,8 +14,8 @@ from matplotlib.transforms import blended_transform_factory
 
 from nanoimpact.fileio import atomic_save_figure
 
-from ..plots import PNG_FAST
-from ..results import load_result
+from ..output.plots import PNG_FAST
+from ..output.results import load_result
 
 
 def _subplots(*args, figsize, **kw):

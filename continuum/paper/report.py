@@ -7,8 +7,8 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ..provenance import provenance
-from ..results import dumps
+from ..output.provenance import provenance
+from ..output.results import dumps
 from . import checks, figures
 from .run import fig4_curves, run_paper
 from .checks import NOMINAL_ONLY

@@ -23,11 +23,11 @@ import numpy as np
 
 from nanoimpact.executors import executor as make_executor
 
-from .. import menisci as men
-from ..compiled_contact import warm_up
-from ..escape import single_impact
-from ..impact import first_impact_speed, run_impact, write_impact
-from ..results import write_run
+from ..wet import menisci as men
+from ..numerics.compiled_contact import warm_up
+from ..dynamics.escape import single_impact
+from ..dynamics.impact import first_impact_speed, run_impact, write_impact
+from ..output.results import write_run
 from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases

@@ -21,8 +21,8 @@ import csv
 import math
 from pathlib import Path
 
-from ..escape import escape_velocity, single_impact
-from ..impact import first_impact_speed, run_impact
+from ..dynamics.escape import escape_velocity, single_impact
+from ..dynamics.impact import first_impact_speed, run_impact
 from ..model import select_law
 from ..scene import SceneError, resolve_scene
 from .cases import FIG8_SIGMAS_NM, RIGID, Case, sigma_case

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 
-from ..proportions import wilson_interval
+from ..output.proportions import wilson_interval
 
 PASS, FAIL, NOT_EVALUABLE = "pass", "fail", "not_evaluable"
 VERIFICATION, REPRODUCTION = "verification", "reproduction"

@@ -7,7 +7,7 @@ cutoff it used (BAND_FACTORS) and reports the band (result.json -> surface.cutof
 sigma_s, stick probability at the first impact (Wilson 95 %) and first-rebound median. Likewise the ensemble is
 run under both tail models of `continuum.rough.tail` (result.json -> ensemble.tail_models). Where the band, or the
 tail models, put the first impact on both sides of sticking, a warning names the scene: the outcome then rests on
-an input the data cannot fix. Pure functions of the records; the runs are `continuum.map_ensembles`'.
+an input the data cannot fix. Pure functions of the records; the runs are `continuum.dynamics.map_ensembles`'.
 """
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ distribution over realisations of the same summit statistics (docs/model.md, "Fe
 member is one seeded realisation (`continuum.laws.discrete_roller`, surfaces.roughness.mode = 'discrete'); this
 module holds what is pure about an ensemble: how member seeds follow from one master seed, what a member's
 run reduces to (`MemberOutcome`), and the statistics reported in result.json -> ensemble (`EnsembleResult`):
-stick probabilities as counts of members with their Wilson 95 % interval (`continuum.proportions`), with the
+stick probabilities as counts of members with their Wilson 95 % interval (`continuum.output.proportions`), with the
 members whose run a numerical cap ended (`censored`) apart from those stuck or at rest.
 
 Seeds: numpy's `SeedSequence(master).generate_state(members, uint64)`, each word's top bit cleared (the scene's
@@ -23,7 +23,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..proportions import wilson_interval
+from ..output.proportions import wilson_interval
 
 #: Percentiles reported for the rebound count, the first rebound height and the escape velocity.
 PERCENTILES = (5, 25, 50, 75, 95)
@@ -45,7 +45,7 @@ class MemberOutcome:
 
     seed: int
     status: str
-    """How the run ended: stuck, rest, max_bounces, max_time (`continuum.driver.ImpactRun.status`)."""
+    """How the run ended: stuck, rest, max_bounces, max_time (`continuum.dynamics.driver.ImpactRun.status`)."""
     rebound_heights: tuple[float, ...]
     """Height (m, above the realisation's datum) of each rebound, in order; a contact that never let go adds none."""
     release_height: float | None
@@ -59,7 +59,7 @@ class MemberOutcome:
     """The member's capillary bridges where its summits carry them (`continuum.laws.wet.WetRoughRoller.diagnostics`:
     longest contact, t_a, contacts with bridges, most summits bridged at once); None: a dry member."""
     escape: Mapping[str, Any] | None = None
-    """The member's escape velocity where the ensemble was asked for it (`continuum.escape.escape_velocity`:
+    """The member's escape velocity where the ensemble was asked for it (`continuum.dynamics.escape.escape_velocity`:
     escape_velocity, lower, upper (m/s), runs), or {"escape_velocity": None, "reason": ...}; None: not asked."""
 
     @property
@@ -107,7 +107,7 @@ CENSORING_STATUSES = ("max_bounces", "max_time")
 
 
 def _proportion(count: int, members: int) -> dict:
-    """count of members, the fraction and its Wilson 95 % interval (`continuum.proportions`)."""
+    """count of members, the fraction and its Wilson 95 % interval (`continuum.output.proportions`)."""
     lo, hi = wilson_interval(count, members)
     return {"count": int(count), "members": int(members), "value": count / members, "interval": [lo, hi],
             "interval_rule": "Wilson score 95 % (Wilson 1927)"}
@@ -177,7 +177,7 @@ class EnsembleResult:
     `continuum.rough.tail`); never copies of a map."""
     members_rule: Mapping[str, Any] = field(default_factory=lambda: {"rule": "fixed"})
     """How the member count was set: {"rule": "fixed"} (surfaces.roughness.members), or the 'auto' rule's target,
-    cap, batch and why it stopped (`continuum.ensemble_run`)."""
+    cap, batch and why it stopped (`continuum.dynamics.ensemble_run`)."""
     escape_rel_tol: float | None = None
     """Relative bracket width of each member's escape velocity; None where the scene did not ask for them."""
 
@@ -250,7 +250,7 @@ class EnsembleResult:
         found = v[np.isfinite(v)]
         rec: dict = {"requested": True, "rel_tol": self.escape_rel_tol, "members_with_value": int(found.size),
                      "rule": "each member's smallest first-impact speed from which it rebounds: bracketed by "
-                             "halving/doubling the first-impact speed, bisected (continuum.escape.escape_velocity)",
+                             "halving/doubling the first-impact speed, bisected (continuum.dynamics.escape.escape_velocity)",
                      "without_value": {str(o.seed): (o.escape or {}).get("reason", "not run")
                                        for o, x in zip(self.outcomes, v) if not math.isfinite(x)}}
         if found.size:

@@ -26,7 +26,7 @@ by branch. NaN separations, and NaN thresholds of adhesive surfaces, give NaN (t
 Divisions follow NumPy's error model (inf or NaN, no exception).
 
 The surface's scalars travel in one float vector (`P_*` indices, built by `GWJKRSurface._kernel_tables`), so one
-compiled specialisation serves every surface; `continuum.compiled_contact.warm_up` loads it.
+compiled specialisation serves every surface; `continuum.numerics.compiled_contact.warm_up` loads it.
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ What it is
 ----------
 A summit is a sphere of tip radius beta with the summits' contact modulus E* and the pair's work of adhesion w,
 pressed by its approach delta against a flat (displacement control, as under a roller or a punch). Above its
-limiting contact pressure p_y (`continuum.limiting_pressure`) it follows the Thornton-Ning adhesive
+limiting contact pressure p_y (`continuum.model.limiting_pressure`) it follows the Thornton-Ning adhesive
 elastic-plastic law of `continuum.reference.thornton_ning` (the same law as the smooth sphere's
 `continuum.laws.plastic_sphere`):
 
@@ -45,7 +45,7 @@ surfaces are evaluated state by state (a few hundred nodes), with no tables; the
 `continuum.laws.plastic_rough` (flat punch, rigid roller, discrete summits).
 
 Plasticity index (Greenwood & Williamson 1966): psi = (E*/H) sqrt(sigma_s/beta); psi < 0.6 the summits stay
-elastic under any practical load, psi > 1 most touching summits yield (`continuum.regimes.plasticity_index`).
+elastic under any practical load, psi > 1 most touching summits yield (`continuum.model.regimes.plasticity_index`).
 
 Sources: C. Thornton & Z. Ning, Powder Technol. 99 (1998) 154-162; J. A. Greenwood & J. B. P. Williamson,
 Proc. R. Soc. Lond. A 295 (1966) 300; K. L. Johnson, K. Kendall & A. D. Roberts, Proc. R. Soc. Lond. A 324

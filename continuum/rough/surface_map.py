@@ -9,7 +9,7 @@ reader guessing which one ran. `surfaces.roughness.sigma` holds the summits' hei
 sigma), so a map fills it with sigma_s, not with the surface's rms height.
 
 The map supplies statistics (to the mean-field law and to the draws of an ensemble's members,
-`continuum.ensemble_run`): the roller's footprint may be far larger than the map, and nothing tiles the map under it.
+`continuum.dynamics.ensemble_run`): the roller's footprint may be far larger than the map, and nothing tiles the map under it.
 `topography` may list several scans of one surface (`continuum.rough.map_scans`: each takes part at the cutoff where
 it resolves it, and their summits are pooled); the block records each scan, how deep the data reach against the
 impact (`data_depth`), and the range-of-validity checks (`validity`, `warnings`).

@@ -6,14 +6,14 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from . import plots
+from ..output import plots
 from .driver import Bounce, DriverSettings, simulate
-from .model import dry_run_verdict, select_law
-from .model.decisions import menisci_decision
-from .provenance import provenance
-from .results import SCHEMA_VERSION, write_run
-from .scene import ResolvedScene, SceneError
-from .warnings import audit_warnings, model_warnings, result_warnings
+from ..model import dry_run_verdict, select_law
+from ..model.decisions import menisci_decision
+from ..output.provenance import provenance
+from ..output.results import SCHEMA_VERSION, write_run
+from ..scene import ResolvedScene, SceneError
+from ..output.notices import audit_warnings, model_warnings, result_warnings
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:
@@ -33,7 +33,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     executor; None: in this process) and adds result.json -> ensemble; the trajectory (bounces, time series) is
     then the mean-field law's, with the members' summit law, for comparison. A humid scene (menisci not 'off')
     adds result.json -> menisci_condensation_time, its sticking against t_a over the range the estimate allows
-    (`continuum.wet_sweep`; `condensation_sweep` False leaves it out)."""
+    (`continuum.dynamics.wet_sweep`; `condensation_sweep` False leaves it out)."""
     start = time.perf_counter()
     resolved, realisation = _settle_realisation(resolved)
     scene = resolved.scene
@@ -71,7 +71,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     }
     if realisation is not None and realisation.mode == "ensemble":
         result["ensemble"], extra = _ensemble_record(resolved, run, executor, workers)
-        if extra is not None:           # a height map: its cutoff band and the tail models (continuum.map_ensembles)
+        if extra is not None:           # a height map: its cutoff band and the tail models (continuum.dynamics.map_ensembles)
             result["surface"] = {**result["surface"], "cutoff_band": extra["cutoff_band"]}
             result["warnings"] += extra["warnings"]
         result["timing"]["wall_s"] = time.perf_counter() - start
@@ -92,8 +92,8 @@ def _settle_realisation(resolved: ResolvedScene):
     from dataclasses import replace
 
     from .ensemble_run import with_realisation
-    from .model.decisions import realisation_decision
-    from .model.regime import regime_of
+    from ..model.decisions import realisation_decision
+    from ..model.regime import regime_of
 
     scene = resolved.scene
     if scene.contact != "rough":
@@ -106,7 +106,7 @@ def _settle_realisation(resolved: ResolvedScene):
 
 def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> tuple[dict, dict | None]:
     """(result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them; for a
-    scene with a height map, what `continuum.map_ensembles` adds: the tail models, the cutoff band, warnings)."""
+    scene with a height map, what `continuum.dynamics.map_ensembles` adds: the tail models, the cutoff band, warnings)."""
     from .ensemble_run import open_executor, run_ensemble
     from .map_ensembles import map_ensembles
 
@@ -128,7 +128,7 @@ def regime_numbers(scene, models: dict, run) -> dict:
     (`continuum.model.regime`): Tabor parameter of the summits (or sphere), Fuller-Tabor theta, half-space
     deflection span / sigma, expected contacts, and the longest contact of the run against the condensation
     time t_a (SI)."""
-    from .model.regime import condensation_time, regime_of
+    from ..model.regime import condensation_time, regime_of
 
     regime = regime_of(scene)
     rough = regime.rough

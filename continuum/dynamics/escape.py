@@ -9,7 +9,7 @@ import math
 from typing import Callable
 
 from .driver import DriverSettings, ImpactRun, simulate
-from .laws.base import ContactLaw
+from ..laws.base import ContactLaw
 
 
 def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rtol: float = 1e-9) -> ImpactRun:

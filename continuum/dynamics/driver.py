@@ -13,7 +13,7 @@ accepted step, with events located on the dense output by Brent's method:
   attached (`bound_is_final`), the body can never leave: it is stuck (or at rest, for Hertz).
 
 Laws with a compiled form (`ContactLaw.compiled`: the rigid rough roller's tables, and the wet law up
-to t_a) run the same loop compiled (`continuum.contact_kernel`, ~1 ms a contact instead of ~0.1 s);
+to t_a) run the same loop compiled (`continuum.numerics.contact_kernel`, ~1 ms a contact instead of ~0.1 s);
 `DriverSettings(compiled=False)` keeps every contact on the Python stepper below.
 
 Energy audit: E(t) = kinetic + gravitational + stored (law) + dissipated (law's own loss terms,
@@ -33,7 +33,7 @@ from scipy.optimize import brentq
 
 from nanoimpact.interrupt import raise_if_interrupted
 
-from .laws.base import ContactLaw
+from ..laws.base import ContactLaw
 
 
 @dataclass
@@ -114,7 +114,7 @@ class DriverSettings:
     samples_per_flight: int = 64
     samples_per_step: int = 3
     #: integrate contacts of laws with a compiled form (`ContactLaw.compiled`) with the compiled kernel
-    #: (`continuum.contact_kernel`, the same DOP853 algorithm); False: always the Python stepper
+    #: (`continuum.numerics.contact_kernel`, the same DOP853 algorithm); False: always the Python stepper
     compiled: bool = True
 
 
@@ -334,7 +334,7 @@ class _ContactRun:
         compiled = law.compiled(self.t0) if settings.compiled else None
         kernel = None
         if compiled is not None:
-            from .compiled_contact import run_compiled
+            from ..numerics.compiled_contact import run_compiled
             kernel = run_compiled(compiled, self.mass, self.gravity, self.t0, self.gap0, self.v0, rtol=settings.rtol,
                                   atol=self.atol, first_step=1e-3 * self.length / self.speed,
                                   max_step=law.max_step(self.speed), t_bound=settings.max_time,

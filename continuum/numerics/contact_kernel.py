@@ -1,6 +1,6 @@
 """Compiled contact phase: DOP853 with dense output and event location, for laws with a compiled form.
 
-One contact of the event-driven driver (`continuum.driver._ContactRun`) is a 1-D ODE, h' = v,
+One contact of the event-driven driver (`continuum.dynamics.driver._ContactRun`) is a 1-D ODE, h' = v,
 v' = F(h)/M - g, integrated until the body leaves (release), turns back while attached (stuck or
 at rest), reaches a time the law asks to stop at (capillary bridges condense at t_a), or the run's
 time limit. Stepped in Python through `scipy.integrate.DOP853`, a rough impact costs ~0.05-0.2 s,
@@ -12,7 +12,7 @@ tolerance; `tests/test_contact_kernel.py` checks both):
 * Runge-Kutta: Dormand & Prince's explicit 8th-order method with its 5th- and 3rd-order error
   estimators and 7th-order dense output (E. Hairer, S. P. Norsett, G. Wanner, *Solving Ordinary
   Differential Equations I*, 2nd ed., Springer 1993, section II.10 and the code dop853.f; coefficients
-  in `continuum.dop853_tableau`). Step-size control, error norm and factor limits (safety 0.9,
+  in `continuum.numerics.dop853_tableau`). Step-size control, error norm and factor limits (safety 0.9,
   0.2-10) are those of SciPy's `DOP853`, which follows Hairer's code.
 * Events (maximum approach, turning back, release, a stop time) are sign changes of the dense
   output between the ends of an accepted step, located by Brent's method (R. P. Brent, *Algorithms
@@ -25,11 +25,12 @@ Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid rough roller's footprint
 `LAW_DISCRETE`: a realisation of closed-form JKR or Hertz summits on a rigid base (`continuum.laws.discrete_roller`)
 or, `LAW_DISCRETE_BRANCH`, of tabulated branches of any summit law; `LAW_PLASTIC`: elastic-plastic summits,
 `continuum.rough.plastic_kernel`; `LAW_POWER`: F = k (-h)^n, Hertz, to validate the integrator against closed forms)
-give parameters `P`, tables `T` (a tuple of arrays) and a history `S` that the kernel updates in place.
+give parameters `P`, tables `T` (a tuple of arrays) and a history `S` that the kernel updates in place; their
+compiled force and energies live in `continuum.numerics.kernel_laws` (re-exported here).
 
 Where the compiled law cannot evaluate a state (deeper than its tables, where the Python law
 evaluates its integral directly) or a buffer is full, the kernel returns a status saying so, and
-the caller (`continuum.compiled_contact`) integrates that contact with the Python stepper, the
+the caller (`continuum.numerics.compiled_contact`) integrates that contact with the Python stepper, the
 same algorithm: an explicit, recorded path, never a different model.
 """
 from __future__ import annotations
@@ -39,375 +40,39 @@ import math
 import numpy as np
 from numba import njit
 
-from .dop853_tableau import A, B, C, D, E3, E5
-from .rough import plastic_kernel as pk
+from .dop853_tableau import A, B, D, E3, E5
+from .kernel_laws import (BRANCH_PARAMS, DISCRETE_PARAMS, LAW_DISCRETE, LAW_DISCRETE_BRANCH, LAW_PLASTIC, LAW_POWER,
+                          LAW_RIGID_TABLE, P_ATTACH, P_B_END_GAP, P_B_IN, P_B_LOOP, P_B_LOWEST, P_B_OUT, P_B_REACH,
+                          P_D_ADHESIVE, P_D_END_GAP, P_D_ESCALE, P_D_HERTZ_K, P_D_INV_DELTA0, P_D_LOOP, P_D_LOWEST,
+                          P_D_PSCALE, P_D_RELEASE, P_END_GAP, P_H_LO, P_K, P_LOOP, P_N, P_REACH, P_RELEASE, P_R_IN,
+                          S_BEYOND_ACCEPTED, S_BEYOND_FLAG, S_COUNT_MIN, S_H_MIN, S_MAX_CONTACTS, bicubic,
+                          law_accept, law_dissipated, law_force, law_stored, ppoly3)
 
-#: Law kinds.
-LAW_RIGID_TABLE = 0
-LAW_POWER = 1
-LAW_DISCRETE = 2
-LAW_DISCRETE_BRANCH = 3
-LAW_PLASTIC = 4
+__all__ = ["ABORT_BEYOND_TABLES", "ABORT_BUFFER", "ABORT_STEP", "BRANCH_PARAMS", "DISCRETE_PARAMS", "END_MAX_TIME",
+           "END_RELEASE", "END_REST", "END_STOP_TIME", "END_STUCK", "INFO_SIZE", "I_BOOKED", "I_END", "I_EVALS",
+           "I_GAP", "I_HAS_MAX", "I_HAS_PULL", "I_LAST_ACCEPT_T", "I_MAXPEN", "I_MAX_GAP", "I_MAX_T", "I_NSAMPLES",
+           "I_PEAK", "I_PULL_F", "I_PULL_GAP", "I_PULL_T", "I_STEPS", "I_T", "I_V", "LAW_DISCRETE",
+           "LAW_DISCRETE_BRANCH", "LAW_PLASTIC", "LAW_POWER", "LAW_RIGID_TABLE", "P_ATTACH", "P_B_END_GAP", "P_B_IN",
+           "P_B_LOOP", "P_B_LOWEST", "P_B_OUT", "P_B_REACH", "P_D_ADHESIVE", "P_D_END_GAP", "P_D_ESCALE",
+           "P_D_HERTZ_K", "P_D_INV_DELTA0", "P_D_LOOP", "P_D_LOWEST", "P_D_PSCALE", "P_D_RELEASE", "P_END_GAP",
+           "P_H_LO", "P_K", "P_LOOP", "P_N", "P_REACH", "P_RELEASE", "P_R_IN", "SAMPLE_COLUMNS", "S_BEYOND_ACCEPTED",
+           "S_BEYOND_FLAG", "S_COUNT_MIN", "S_H_MIN", "S_MAX_CONTACTS", "bicubic", "integrate_contact", "law_accept",
+           "law_dissipated", "law_force", "law_stored", "ppoly3"]
 
 #: Ends of a kernel call (info[END]).
 END_RELEASE, END_STUCK, END_REST, END_MAX_TIME, END_STOP_TIME = 0, 1, 2, 3, 4
 #: The compiled law met a state it cannot evaluate; the buffer filled up; the step size underflowed.
 ABORT_BEYOND_TABLES, ABORT_BUFFER, ABORT_STEP = 10, 11, 12
-
 #: info[] slots.
 (I_END, I_T, I_GAP, I_V, I_PEAK, I_MAXPEN, I_BOOKED, I_NSAMPLES, I_MAX_T, I_MAX_GAP, I_HAS_MAX,
  I_PULL_T, I_PULL_GAP, I_PULL_F, I_HAS_PULL, I_LAST_ACCEPT_T, I_STEPS, I_EVALS) = range(18)
 INFO_SIZE = 18
-
 #: Sample columns: t, gap, v, force, stored, dissipated (booked this contact), kind (0 sample, 1 the
 #: instant after release: nothing stored, the loss booked).
 SAMPLE_COLUMNS = 7
-
-#: Rigid-table law: P slots and S slots.
-(P_END_GAP, P_REACH, P_ATTACH, P_RELEASE, P_R_IN, P_H_LO, P_LOOP) = range(7)
-(S_H_MIN, S_COUNT_MIN, S_MAX_CONTACTS, S_BEYOND_ACCEPTED, S_BEYOND_FLAG) = range(5)
-#: Power law: P = (k, n).
-P_K, P_N = 0, 1
-#: Discrete law: P slots (its S slots are the rigid-table law's); T[0] holds the kept summits' effective heights
-#: below the datum, e_i - z_top (m, descending, T[0][0] = 0).
-(P_D_END_GAP, P_D_RELEASE, P_D_LOOP, P_D_INV_DELTA0, P_D_PSCALE, P_D_ESCALE, P_D_HERTZ_K, P_D_ADHESIVE,
- P_D_LOWEST) = range(9)
-DISCRETE_PARAMS = 9
-#: Discrete summits with tabulated branches (`continuum.rough.branch_laws.SummitLaw`: Maugis-Dugdale, DMT): P slots;
-#: T = (e_i - z_top, approach delta, force, energy, retreat delta, force, energy, unused 2-D).
-(P_B_END_GAP, P_B_IN, P_B_OUT, P_B_REACH, P_B_LOOP, P_B_LOWEST) = range(6)
-BRANCH_PARAMS = 6
-#: JKR constants of `continuum.physics.jkr_kernel`: the fold d = -D_C and the Horner coefficients of h(s).
-_D_C = 0.75 * 4.0 ** (-1.0 / 3.0)
-_H_COEF = np.array((16.0 / 15.0, 16.0 / 15.0, 16.0 / 15.0, -1.6, -1.6, -1.6, -0.6, -0.6, -0.6, -0.6))
-
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 _ERROR_EXPONENT = -1.0 / 8.0          # -1/(error estimator order + 1), order 7 (Hairer's dop853.f)
 _EPS = np.finfo(float).eps
-
-
-# ----------------------------------------------------------------------------- splines
-@njit(cache=True)
-def _span(t, k, x):
-    """Knot interval l (0-based) with t[l] <= x < t[l+1], k <= l <= len(t) - k - 2 (x clamped, FITPACK fpbisp)."""
-    n = t.size
-    lo, hi = k, n - k - 2
-    if x >= t[hi]:
-        return hi
-    if x <= t[lo]:
-        return lo
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if t[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    return lo
-
-
-@njit(cache=True)
-def _basis3(t, l, x, h):
-    """The 4 non-zero cubic B-splines at x in knot interval l (de Boor-Cox recursion, FITPACK fpbspl)."""
-    hh = np.empty(3)
-    h[0] = 1.0
-    for j in range(1, 4):
-        for i in range(j):
-            hh[i] = h[i]
-        h[0] = 0.0
-        for i in range(1, j + 1):
-            li = l + i
-            lj = li - j
-            if t[li] == t[lj]:
-                h[i] = 0.0
-                continue
-            f = hh[i - 1] / (t[li] - t[lj])
-            h[i - 1] += f * (t[li] - x)
-            h[i] = f * (x - t[lj])
-
-
-@njit(cache=True)
-def bicubic(tx, ty, c, x, y):
-    """Tensor-product cubic B-spline (FITPACK's tck as in scipy's RectBivariateSpline) at (x, y), clamped to its box."""
-    x = min(max(x, tx[3]), tx[tx.size - 4])
-    y = min(max(y, ty[3]), ty[ty.size - 4])
-    lx, ly = _span(tx, 3, x), _span(ty, 3, y)
-    hx, hy = np.empty(4), np.empty(4)
-    _basis3(tx, lx, x, hx)
-    _basis3(ty, ly, y, hy)
-    ny = ty.size - 4
-    total = 0.0
-    for i in range(4):
-        row = (lx - 3 + i) * ny + ly - 3
-        acc = 0.0
-        for j in range(4):
-            acc += c[row + j] * hy[j]
-        total += acc * hx[i]
-    return total
-
-
-@njit(cache=True)
-def ppoly3(x, c, a):
-    """Piecewise cubic (scipy PPoly coefficients c[4, n-1], breakpoints x) at a, end pieces extrapolated."""
-    n = x.size
-    if a < x[1]:
-        i = 0
-    elif a >= x[n - 2]:
-        i = n - 2
-    else:
-        lo, hi = 1, n - 2
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            if x[mid] <= a:
-                lo = mid
-            else:
-                hi = mid
-        i = lo
-    d = a - x[i]
-    return ((c[0, i] * d + c[1, i]) * d + c[2, i]) * d + c[3, i]
-
-
-# ----------------------------------------------------------------------------- discrete summits
-@njit(cache=True)
-def _jkr_root(d):
-    """(d clamped to the fold, stable root s of s^4 - s = d): `continuum.physics.jkr_kernel.stable_root_scalar`,
-    the same closed form (Ferrari's resolvent by Cardano, one Newton polish) with np.cbrt for math.cbrt."""
-    d = max(d, -_D_C)
-    cc = np.cbrt(1.0 / 16.0 + math.sqrt(max(1.0 / 256.0 + d * d * d / 27.0, 0.0)))
-    dd = -d / (3.0 * cc)
-    w = math.sqrt(0.25 / (cc * cc + d / 3.0 + dd * dd))
-    s = 0.5 * (w + math.sqrt(max(2.0 / w - w * w, 0.0)))
-    s3 = s * s * s
-    fp = 4.0 * s3 - 1.0
-    if fp > 1e-3:
-        s -= (s3 * s - s - d) / fp
-    return d, s
-
-
-_count_at_least = pk.count_at_least     # entries of a descending array >= a level (binary search)
-
-
-@njit(cache=True)
-def _discrete_attached(gap, S, P, T):
-    """Summits attached at `gap`: a prefix of T[0]. On a rigid substrate the history rule (attach at delta >= 0,
-    let go below -Delta) leaves attached exactly the summits with e_i >= gap on a new deepest approach, else those
-    reached (e_i >= h_min) that have not let go (e_i >= gap - Delta). Flags a level below the kept summits."""
-    level = gap if gap <= S[S_H_MIN] else max(S[S_H_MIN], gap - P[P_D_RELEASE])
-    if level < P[P_D_LOWEST]:
-        S[S_BEYOND_FLAG] = 1.0
-    return _count_at_least(T[0], level)
-
-
-@njit(cache=True)
-def _discrete_sum(gap, S, P, T, energy):
-    """Sum over the attached summits of the force (N) or, `energy` True, the stored energy (J) of each: JKR on its
-    stable branch in s = sqrt(a/a0) (`continuum.physics.jkr_kernel`), or Hertz without adhesion."""
-    e = T[0]
-    k = _discrete_attached(gap, S, P, T)
-    total = 0.0
-    for i in range(k):
-        dl = e[i] - gap
-        if P[P_D_ADHESIVE] != 0.0:
-            d, s = _jkr_root(dl * P[P_D_INV_DELTA0])
-            s3 = s * s * s
-            if energy:
-                h = _H_COEF[0]
-                for c in range(1, _H_COEF.size):
-                    h = h * s + _H_COEF[c]
-                total += P[P_D_ESCALE] * d / (s * (s * s + s + 1.0)) * h
-            else:
-                total += P[P_D_PSCALE] * s3 * (8.0 / 3.0 * s3 - 4.0)
-        elif dl > 0.0:
-            total += P[P_D_HERTZ_K] * dl * math.sqrt(dl) * (0.4 * dl if energy else 1.0)
-    return total
-
-
-@njit(cache=True)
-def _lin(x, xs, ys):
-    """Linear interpolation of the table (xs increasing, ys) at x, clamped to its ends (numpy.interp)."""
-    n = xs.size
-    if x <= xs[0]:
-        return ys[0]
-    if x >= xs[n - 1]:
-        return ys[n - 1]
-    lo, hi = 0, n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if xs[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    w = (x - xs[lo]) / (xs[hi] - xs[lo])
-    return ys[lo] + w * (ys[hi] - ys[lo])
-
-
-@njit(cache=True)
-def _branch_counts(gap, S, P, T):
-    """(summits on the retreat branch, summits within reach, summits jumped in) at `gap`: prefixes of T[0]. On a
-    rigid substrate a summit has jumped in iff its deepest approach e_i - h_min reached delta_in, and it follows
-    its retreat branch R until delta = e_i - gap falls below delta_out; every other summit within reach
-    (delta >= -reach) is on its approach branch A (A = R above delta_in)."""
-    e = T[0]
-    h = min(gap, S[S_H_MIN])
-    jumped = _count_at_least(e, h + P[P_B_IN])
-    on_r = _count_at_least(e, max(h + P[P_B_IN], gap + P[P_B_OUT]))
-    level = gap - P[P_B_REACH]
-    if min(level, gap + P[P_B_OUT]) < P[P_B_LOWEST]:
-        S[S_BEYOND_FLAG] = 1.0
-    return on_r, _count_at_least(e, level), jumped
-
-
-@njit(cache=True)
-def _branch_sum(gap, S, P, T, energy):
-    """Force (N) or, `energy` True, stored energy (J) of the summits in reach, each on its branch."""
-    e = T[0]
-    on_r, reach, _ = _branch_counts(gap, S, P, T)
-    total = 0.0
-    for i in range(max(on_r, reach)):
-        dl = e[i] - gap
-        if i < on_r:
-            total += _lin(dl, T[4], T[6]) if energy else _lin(dl, T[4], T[5])
-        else:
-            total += _lin(dl, T[1], T[3]) if energy else _lin(dl, T[1], T[2])
-    return total
-
-
-@njit(cache=True)
-def _branch_dissipated(gap, S, P, T):
-    """One loop per summit that jumped in and then out; at the release gap every summit has let go."""
-    if S[S_H_MIN] == math.inf:
-        return 0.0
-    on_r, _, jumped = _branch_counts(gap, S, P, T)
-    if gap >= P[P_B_END_GAP]:
-        on_r = 0
-    return P[P_B_LOOP] * max(jumped - on_r, 0)
-
-
-@njit(cache=True)
-def _discrete_dissipated(gap, S, P, T):
-    """One loop per summit reached and let go; at the release gap every summit has let go."""
-    if S[S_H_MIN] == math.inf:
-        return 0.0
-    if gap >= P[P_D_END_GAP]:
-        return P[P_D_LOOP] * S[S_COUNT_MIN]
-    return P[P_D_LOOP] * max(S[S_COUNT_MIN] - _discrete_attached(gap, S, P, T), 0.0)
-
-
-@njit(cache=True)
-def _discrete_accept(gap, S, P, T):
-    if gap < S[S_H_MIN]:
-        S[S_H_MIN] = gap
-        S[S_COUNT_MIN] = _count_at_least(T[0], gap)
-    S[S_MAX_CONTACTS] = max(S[S_MAX_CONTACTS], float(_discrete_attached(gap, S, P, T)))
-
-
-# ----------------------------------------------------------------------------- laws
-@njit(cache=True)
-def _rigid_window(gap, S, P):
-    if gap <= S[S_H_MIN]:
-        return min(P[P_ATTACH], P[P_RELEASE])
-    return min(gap - S[S_H_MIN] + P[P_ATTACH], P[P_RELEASE])
-
-
-@njit(cache=True)
-def _rigid_w(r, P):
-    span = P[P_RELEASE] - P[P_R_IN]
-    if span > 0.0:
-        return math.sqrt(min(max((P[P_RELEASE] - r) / span, 0.0), 1.0))
-    return 0.0
-
-
-@njit(cache=True)
-def _rigid_count(a, S, P, T):
-    if a < P[P_H_LO]:
-        S[S_BEYOND_FLAG] = 1.0
-        return 0.0
-    return ppoly3(T[6], T[7], a)
-
-
-@njit(cache=True)
-def _rigid_attached(gap, S, P, T):
-    a = gap - _rigid_window(gap, S, P) + P[P_ATTACH]
-    if a < P[P_ATTACH]:
-        return _rigid_count(a, S, P, T)
-    return 0.0
-
-
-@njit(cache=True)
-def law_force(kind, gap, S, P, T):
-    """Upward contact force (N) at `gap` (m) on the current branch (S: the law's history)."""
-    if kind == LAW_POWER:
-        return P[P_K] * (-gap) ** P[P_N] if gap < 0.0 else 0.0
-    if kind == LAW_DISCRETE:
-        return _discrete_sum(gap, S, P, T, False)
-    if kind == LAW_DISCRETE_BRANCH:
-        return _branch_sum(gap, S, P, T, False) if gap < P[P_B_END_GAP] else 0.0
-    if kind == LAW_PLASTIC:
-        return pk.plastic_value(gap, S, P, T, 0)
-    if gap >= P[P_END_GAP]:
-        return 0.0
-    if gap < P[P_H_LO]:
-        S[S_BEYOND_FLAG] = 1.0
-        return 0.0
-    return bicubic(T[0], T[1], T[2], gap, _rigid_w(_rigid_window(gap, S, P), P))
-
-
-@njit(cache=True)
-def law_stored(kind, gap, S, P, T):
-    """Energy (J) stored in the contact relative to touch."""
-    if kind == LAW_POWER:
-        return P[P_K] * (-gap) ** (P[P_N] + 1.0) / (P[P_N] + 1.0) if gap < 0.0 else 0.0
-    if kind == LAW_DISCRETE:
-        return _discrete_sum(gap, S, P, T, True) if gap < P[P_D_END_GAP] else 0.0
-    if kind == LAW_DISCRETE_BRANCH:
-        return _branch_sum(gap, S, P, T, True) if gap < P[P_B_END_GAP] else 0.0
-    if kind == LAW_PLASTIC:
-        return pk.plastic_value(gap, S, P, T, 1)
-    if gap >= P[P_END_GAP] or (S[S_H_MIN] == math.inf and gap >= P[P_REACH]):
-        return 0.0
-    if gap < P[P_H_LO]:
-        S[S_BEYOND_FLAG] = 1.0
-        return 0.0
-    return bicubic(T[3], T[4], T[5], gap, _rigid_w(_rigid_window(gap, S, P), P))
-
-
-@njit(cache=True)
-def law_dissipated(kind, gap, S, P, T):
-    """Energy (J) this contact would have booked as lost at `gap`."""
-    if kind == LAW_DISCRETE:
-        return _discrete_dissipated(gap, S, P, T)
-    if kind == LAW_DISCRETE_BRANCH:
-        return _branch_dissipated(gap, S, P, T)
-    if kind == LAW_PLASTIC:
-        return pk.plastic_value(gap, S, P, T, 2)
-    if kind == LAW_POWER or S[S_H_MIN] == math.inf:
-        return 0.0
-    return P[P_LOOP] * max(S[S_COUNT_MIN] - _rigid_attached(gap, S, P, T), 0.0)
-
-
-@njit(cache=True)
-def law_accept(kind, gap, S, P, T):
-    """History update after an accepted state (`RigidRoughRoller.accept`)."""
-    if kind == LAW_POWER:
-        return
-    if kind == LAW_DISCRETE:
-        _discrete_accept(gap, S, P, T)
-        return
-    if kind == LAW_PLASTIC:
-        pk.plastic_accept(gap, S, P, T)
-        return
-    if kind == LAW_DISCRETE_BRANCH:
-        if gap < S[S_H_MIN]:
-            S[S_H_MIN] = gap
-        on_r, reach, jumped = _branch_counts(gap, S, P, T)
-        S[S_COUNT_MIN] = jumped
-        S[S_MAX_CONTACTS] = max(S[S_MAX_CONTACTS], float(on_r))
-        return
-    if gap < P[P_H_LO]:
-        S[S_BEYOND_ACCEPTED] += 1.0
-    if gap < S[S_H_MIN]:
-        S[S_H_MIN] = gap
-        S[S_COUNT_MIN] = _rigid_count(gap, S, P, T) if gap < P[P_ATTACH] else 0.0
-    S[S_MAX_CONTACTS] = max(S[S_MAX_CONTACTS], _rigid_attached(gap, S, P, T))
 
 
 # ----------------------------------------------------------------------------- DOP853

@@ -22,8 +22,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .model.regime import condensation_time_range
-from .scene import ResolvedScene
+from ..model.regime import condensation_time_range
+from ..scene import ResolvedScene
 
 log = logging.getLogger(__name__)
 
@@ -73,7 +73,7 @@ def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, wor
                        rerun: Callable[..., tuple[dict, Any]]) -> dict:
     """result.json -> menisci_condensation_time for the humid scene `resolved` whose run gave `result`: the scene's
     t_a, the range the estimate allows, and the stick probability at each t_a of the grid (`t_a_grid`). `rerun`
-    runs a single (non-ensemble) scene again (`continuum.impact.run_impact`, passed in by its caller)."""
+    runs a single (non-ensemble) scene again (`continuum.dynamics.impact.run_impact`, passed in by its caller)."""
     from .ensemble_run import run_ensemble
     run_impact = rerun
 

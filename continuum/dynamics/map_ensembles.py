@@ -21,11 +21,11 @@ from pathlib import Path
 from typing import Any
 
 from .ensemble_run import open_executor, run_ensemble
-from .rough.cutoff_band import BAND_FACTORS, band_entry, band_warning, tail_warning
-from .rough.ensemble import EnsembleResult, first_impact_summary
+from ..rough.cutoff_band import BAND_FACTORS, band_entry, band_warning, tail_warning
+from ..rough.ensemble import EnsembleResult, first_impact_summary
 from .map_tail import _map, _pooled, _summits, map_tail
-from .rough.tail import TAIL_MODELS, TailFitError, fit_empirical_gpd
-from .scene import ResolvedScene, Scene
+from ..rough.tail import TAIL_MODELS, TailFitError, fit_empirical_gpd
+from ..scene import ResolvedScene, Scene
 
 log = logging.getLogger(__name__)
 
@@ -76,7 +76,7 @@ def _stats_of(scene: Scene) -> dict:
 
 def _band_point(sc: Scene, hmap, cutoff: float, factor: float, route: str, tail_model: str, ex) -> dict:
     """One cutoff of the band: the map's statistics there and an ensemble of them, or why it was not evaluated."""
-    from .rough.topography import TopographyError
+    from ..rough.topography import TopographyError
 
     try:
         stats = _pooled(hmap, cutoff, route).statistics
@@ -105,8 +105,8 @@ def _mean_field_first_impact(scene: Scene) -> dict:
     """The mean-field law's first impact of `scene` (to its first rebound): a summary shaped as an ensemble's of
     one deterministic member (no interval: nothing random is sampled), with the law that ran."""
     from .driver import DriverSettings, simulate
-    from .model import dry_run_verdict, select_law
-    from .model.regime import first_impact_speed
+    from ..model import dry_run_verdict, select_law
+    from ..model.regime import first_impact_speed
 
     speed = first_impact_speed(scene)
     law, models = select_law(scene, speed)
@@ -139,7 +139,7 @@ def _mean_field_first_impact(scene: Scene) -> dict:
 def mean_field_band(resolved: ResolvedScene) -> dict | None:
     """{'cutoff_band': [...], 'warnings': [...]} of a mean-field run on a height map: the mean-field law's first
     impact at each cutoff of BAND_FACTORS with the map's statistics there; None for a scene without a map."""
-    from .rough.topography import TopographyError
+    from ..rough.topography import TopographyError
 
     found = _map(resolved)
     if found is None:

@@ -16,7 +16,7 @@ def package_version() -> str:
     try:
         return importlib.metadata.version("nanoimpact")
     except importlib.metadata.PackageNotFoundError:
-        from . import __version__
+        from .. import __version__
         return __version__
 
 

@@ -3,7 +3,7 @@
 From E. Hairer, S. P. Norsett and G. Wanner, *Solving Ordinary Differential Equations I*, 2nd ed.,
 Springer (1993), section II.10, and Hairer's Fortran code dop853.f (the same values SciPy's
 `scipy.integrate.DOP853` uses, copied here so that the compiled contact integrator,
-`continuum.contact_kernel`, and the Python one step identically). Stages 0-11 make the step, stage 12
+`continuum.numerics.contact_kernel`, and the Python one step identically). Stages 0-11 make the step, stage 12
 is the first stage of the next step (FSAL), stages 13-15 are the extra stages of the dense output.
 """
 import numpy as np

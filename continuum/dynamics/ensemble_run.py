@@ -1,7 +1,7 @@
 """Run an ensemble of discrete summit realisations of one rough scene on an executor.
 
     >>> from continuum import load_scene
-    >>> from continuum.ensemble_run import run_ensemble
+    >>> from continuum.dynamics.ensemble_run import run_ensemble
     >>> ens = run_ensemble(load_scene("rough_silica", params="calibrated"), members=64, seed=1, executor="processes")
     >>> ens.stick_probability, ens.stick_probability_first_impact, ens.rebound_counts()
 
@@ -9,7 +9,7 @@ The decisions that do not depend on the realisation (adhesion law, half-space, t
 adhesion, the footprint strip) are made once, from the scene's regime, exactly as a single discrete run makes
 them (`continuum.model.select`); each member then only draws its summits (`continuum.laws.discrete_roller`, a few
 ms) and runs the event-driven driver (on a rigid substrate each contact runs in the compiled kernel,
-`continuum.contact_kernel.LAW_DISCRETE`). A run ends where the driver ends it: a member held by adhesion stops
+`continuum.numerics.contact_kernel.LAW_DISCRETE`). A run ends where the driver ends it: a member held by adhesion stops
 at 'stuck'. Members go to `nanoimpact.executors` (local, processes, dask): jobs are module-level and picklable.
 
 Every member is an independent realisation of the whole strip under the roller: a Poisson number of summits at
@@ -19,7 +19,7 @@ summit heights with a fitted extreme-value tail, `continuum.rough.tail`), never 
 repeated along a 3.3 mm roller would put thousands of copies of each summit at one x, all touching at once.
 `members = "auto"` grows the ensemble in batches until the Wilson interval of its stick probabilities is narrow
 enough (`auto_members`). The runs a measured map adds (the other tail model, the cutoff band) are
-`continuum.map_ensembles`'.
+`continuum.dynamics.map_ensembles`'.
 """
 from __future__ import annotations
 
@@ -30,9 +30,9 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from .driver import DriverSettings, simulate
-from .proportions import wilson_half_width
-from .rough.ensemble import EnsembleResult, MemberOutcome, member_seeds
-from .scene import ResolvedScene, Scene, SceneError
+from ..output.proportions import wilson_half_width
+from ..rough.ensemble import EnsembleResult, MemberOutcome, member_seeds
+from ..scene import ResolvedScene, Scene, SceneError
 
 log = logging.getLogger(__name__)
 
@@ -79,10 +79,10 @@ class MemberPlan:
 def member_plan(scene: Scene, speed: float, heights=None) -> MemberPlan:
     """The realisation-independent decisions of a discrete run of `scene` at first-impact `speed` (m/s), its
     members drawing summit heights from `heights` (None: Gaussian)."""
-    from .model import decisions
-    from .model.regime import regime_of
-    from .model.select import branch_summits
-    from .rough.tail import strip_half_width
+    from ..model import decisions
+    from ..model.regime import regime_of
+    from ..model.select import branch_summits
+    from ..rough.tail import strip_half_width
 
     regime = regime_of(scene, speed)
     law = decisions.adhesion_decision(scene, regime).law
@@ -94,7 +94,7 @@ def member_plan(scene: Scene, speed: float, heights=None) -> MemberPlan:
 
 
 def _release(scene: Scene, z_top: float) -> float | None:
-    """Release height above the realisation's tallest summit (m), as `continuum.impact` measures it."""
+    """Release height above the realisation's tallest summit (m), as `continuum.dynamics.impact` measures it."""
     if scene.release_height is None:
         return None
     if scene.surfaces.roughness.datum == "mean_plane":
@@ -105,9 +105,9 @@ def _release(scene: Scene, z_top: float) -> float | None:
 def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any]:
     """(the member's scene, its discrete law) for realisation `seed`: the strip's summits drawn from the plan's
     height distribution."""
-    from .model import factory
-    from .model.select import member_summit_law  # plastic summits where they yield, bridges where humid
-    from .rough.gw import SummitStatistics
+    from ..model import factory
+    from ..model.select import member_summit_law  # plastic summits where they yield, bridges where humid
+    from ..rough.gw import SummitStatistics
 
     member = with_realisation(scene, "discrete", seed)
     rough = member.surfaces.roughness
@@ -120,7 +120,7 @@ def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any]:
 def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:
     """The realisation's escape velocity (m/s): the first-impact speed `speed` halved until the body sticks or
     doubled until it rebounds (at most MAX_ESCAPE_BRACKET_STEPS times), then bisected to `rel_tol`
-    (`continuum.escape.escape_velocity`, single impacts on virgin summits); {'escape_velocity': None, 'reason'}
+    (`continuum.dynamics.escape.escape_velocity`, single impacts on virgin summits); {'escape_velocity': None, 'reason'}
     where no bracket is found (summits without adhesion never hold the body)."""
     from .escape import escape_velocity, single_impact
 
@@ -176,7 +176,7 @@ def open_executor(executor: Any = None, workers: int | None = None):
         yield executor
         return
     if (executor or "local") != "local":
-        from .compiled_contact import warm_up
+        from ..numerics.compiled_contact import warm_up
         warm_up()                       # forked workers inherit the loaded kernel
     ex = make_executor(executor or "local", workers)
     try:
@@ -246,12 +246,12 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | str | None = None,
     """Run `members` discrete realisations (an int, or 'auto'; default surfaces.roughness.members) of the rough
     `scene` with seeds derived from `seed` (default surfaces.roughness.seed), their summit heights drawn from
     `heights` (None: Gaussian of surfaces.roughness.sigma; a ResolvedScene with a map and tail_model
-    'empirical_gpd': the map's fitted model, `continuum.map_ensembles.map_tail`). `executor`: None or a name
+    'empirical_gpd': the map's fitted model, `continuum.dynamics.map_ensembles.map_tail`). `executor`: None or a name
     ('local', 'processes', 'dask'; None is 'local') opened and closed here with `workers`, or an open
     `nanoimpact.executors` executor. `escape` (default surfaces.roughness.escape_velocities): also bisect each
     member's escape velocity to `escape_rel_tol` (`member_escape`). `first_impact`: run each member to its first
     rebound only."""
-    from .model.regime import first_impact_speed
+    from ..model.regime import first_impact_speed
 
     sc = scene.scene if isinstance(scene, ResolvedScene) else scene
     if sc.contact != "rough":

@@ -6,7 +6,7 @@ The estimate is the quasi-static first approach of the roller onto non-adhesive 
 on a rigid substrate, pressed until it has absorbed the impact's kinetic energy against its
 weight (the same estimate that sizes the tables and grids, `continuum.laws.depth`). From the
 pressure profile at that depth, the plane-strain half-space (FFT influence coefficients,
-`continuum.halfspace.LineHalfSpace`, referenced at x_ref = l) gives the deflection across the
+`continuum.elastic.halfspace.LineHalfSpace`, referenced at x_ref = l) gives the deflection across the
 footprint; its span (largest minus smallest over the loaded cells) is what changes the summits'
 gaps relative to the rigid geometry. Cost: ~10-50 ms.
 
@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .halfspace import LineHalfSpace
+from ..elastic.halfspace import LineHalfSpace
 
 #: Most memory (bytes) the averaged rough model's tables may take while they are built.
 MEMORY_BOUND_BYTES = 2 * 2**30
@@ -68,7 +68,7 @@ def rough_impact_estimate(stats, summit_e_star: float, e_star: float, radius: fl
     the summits' and the bodies' contact moduli; radius, length (m) of the roller; z_max_sigma: the
     truncation (tallest summit, units of sigma); mass (kg), speed (m/s) at touch, gravity (m/s^2).
     """
-    from .model.factory import averaged_surface, rigid_roller
+    from .factory import averaged_surface, rigid_roller
 
     start = time.perf_counter()
     surface = averaged_surface(stats, work_of_adhesion=0.0, summit_e_star=summit_e_star, z_max=z_max_sigma,
@@ -103,9 +103,9 @@ def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_
     which coarsens those tables' spacing). Returns the estimates (recorded in the result).
     Raises `continuum.scene.SceneError` (key surfaces.roughness.sigma) with a one-line reason.
     """
-    from .laws.costs import MAX_BUILD_SECONDS, SECONDS_PER_STATE, table_cost_refusal, table_shape
-    from .rough.gw_layout import table_size
-    from .scene import SceneError
+    from ..laws.costs import MAX_BUILD_SECONDS, SECONDS_PER_STATE, table_cost_refusal, table_shape
+    from ..rough.gw_layout import table_size
+    from ..scene import SceneError
 
     sigma = stats.sigma
     rec: dict = {"memory_bound_bytes": MEMORY_BOUND_BYTES}

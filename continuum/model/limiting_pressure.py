@@ -19,7 +19,7 @@ from typing import Mapping
 
 from nanoimpact.errors import InputError
 
-from .reference import thornton_ning as tn
+from ..reference import thornton_ning as tn
 
 #: The two partners whose material tables may carry a yield key.
 PARTNERS = ("surfaces.body", "surfaces.substrate")

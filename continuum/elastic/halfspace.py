@@ -91,7 +91,7 @@ from scipy import fft as sfft
 from scipy.linalg import toeplitz
 from scipy.sparse.linalg import LinearOperator, gmres
 
-from .reference.hertz import line_half_width
+from ..reference.hertz import line_half_width
 
 PressureLaw = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray]"]
 

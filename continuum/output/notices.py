@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import math
 
-from . import regimes
-from .reference import hertz as href
+from ..model import regimes
+from ..reference import hertz as href
 
 #: Below this many summits attached at maximum approach, the GW average is not to be trusted.
 MIN_CONTACTS = 10.0

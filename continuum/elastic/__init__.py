@@ -1,0 +1,1 @@
+"""The elastic half-space under the roller (FFT influence, limiting-pressure checks)."""

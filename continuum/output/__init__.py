@@ -1,0 +1,1 @@
+"""What a run gives back: the typed result, its provenance, notices (warnings) and figures."""

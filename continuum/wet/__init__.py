@@ -1,0 +1,1 @@
+"""Capillary physics: Kelvin radius, meniscus bridges and their condensation clock."""
