@@ -32,7 +32,7 @@ from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, low_speed_runs, seed_overrides
-from .wet_flips import BAND_EDGE, FAILS, HOLDS, NO_SUBJECT, REFUSED, at_condensation_time, t_a_flips
+from .wet_flips import BAND_EDGE, BEYOND_SCAN, FAILS, HOLDS, NO_SUBJECT, REFUSED, at_condensation_time, t_a_flips
 
 #: Fig 8a velocity sweep: impact speeds as multiples of the 100 nm drop speed.
 FIG8_SPEED_FACTORS = tuple(np.geomspace(0.05, 20.0, 10))
@@ -47,6 +47,8 @@ WET_EPS = tuple(np.geomspace(WET_DRY_REL_TOL, 2.0, 10))
 #: Largest v / v_esc - 1 the t_a band's scan is extended to when every scanned impact outlasts t_a (for a set
 #: whose escape velocity is tens of um/s, impacts at several times it still last longer than t_a = 25 us).
 MAX_BAND_EPS = 1e3
+#: The t_a study scans bands up to this many times the declared t_a's band (`_t_a_study`).
+STUDY_BAND_FACTOR = 4.0
 #: Speeds sampled inside the band where dry impacts outlast t_a.
 BAND_POINTS = 6
 
@@ -194,13 +196,20 @@ def _t_a_study(scene, v0, fidelity, case, params, dry, wet, mass, g, rtol, esc_d
         r = resolve_scene(case.path, params=params, overrides=o, override_label=f"paper t_a study {case.name}")
         return select_law(r.scene, v0, menisci=True)[0]
 
+    # the study's band scans stop at a few times the declared band (at least v = 3 v_esc): wider bands push the dry
+    # law to impacts whose footprint tables cost seconds each; a t_a whose band reaches past that is not judged
+    declared = _t_a_band(dry, mass, g, rtol, up, t_a, dry_runs)[1] if t_a and longest and longest >= t_a else None
+    max_eps = max(WET_EPS[-1], STUDY_BAND_FACTOR * ((declared or {}).get("eps") or 0.0))
+
     def state_at(t):
         if longest is None or longest < t:
             return NO_SUBJECT, {}
         try:
-            _, e = _t_a_band(dry, mass, g, rtol, up, t, dry_runs)
-            if e is None or e.get("speed") is None:
+            _, e = _t_a_band(dry, mass, g, rtol, up, t, dry_runs, max_eps)
+            if e is None:
                 return NO_SUBJECT, {}
+            if e.get("speed") is None:
+                return (BEYOND_SCAN if "fastest speed" in e.get("reason", "") else NO_SUBJECT), {}
             v_star = v_dry + (1.0 - BAND_EDGE) * (e["speed"] - v_dry)
             stuck = _outcome(at_condensation_time(wet, t, rebuild), mass, g, v_star, rtol)["stuck"]
         except SceneError as exc:       # a speed the law refuses (its tables would cost too much): said, not run
@@ -217,7 +226,8 @@ def _nucleation_time(scene) -> float | None:
         else None
 
 
-def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -> tuple[list[float], dict | None]:
+def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict,
+              max_eps: float = MAX_BAND_EPS) -> tuple[list[float], dict | None]:
     """Speeds inside the band above the escape velocity where dry impacts rebound after more than t_a: the band's
     upper end (dry duration = t_a) found by `t_a_band_edge` on the dry law's impact time, then BAND_POINTS speeds
     spread geometrically in it. Returns (speeds, edge); edge is `t_a_band_edge`'s dict, with 'speed' added when
@@ -231,7 +241,7 @@ def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -
             runs[v] = _outcome(dry, mass, g, v, rtol)
         return math.inf if runs[v]["stuck"] else runs[v]["duration"]
 
-    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL)
+    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL, max_eps=max_eps)
     if edge.get("eps") is None:
         return [], edge
     edge["speed"] = upper * (1.0 + edge["eps"])
@@ -239,20 +249,20 @@ def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -
 
 
 def t_a_band_edge(duration: Callable[[float], float], t_a: float, scan: tuple, eps_floor: float,
-                  ln_width: float = 2e-8) -> dict:
+                  ln_width: float = 2e-8, max_eps: float = MAX_BAND_EPS) -> dict:
     """Where the dry impact time falls through t_a above the escape velocity: eps of v = v_esc (1 + eps).
 
     `duration(eps)` is the dry impact time (inf where it sticks), known to be >= t_a at eps = 0. The scan speeds
-    (eps values `scan`, extended by factors of 4 up to MAX_BAND_EPS while every impact outlasts t_a) bracket the
+    (eps values `scan`, extended by factors of 4 up to `max_eps` while every impact outlasts t_a) bracket the
     crossing first; only a scan whose impacts outlast t_a up to one point and no further (one crossing, from long
     to short) is bisected, in ln eps, to `ln_width` (below the scan's first point the bracket's lower end is
     `eps_floor`, the escape velocity's own relative bracket). A scan that crosses t_a more than once (the impact
     time is not monotone in the speed there), that starts short and turns long, or that outlasts t_a up to
-    MAX_BAND_EPS gives no edge: {'eps': None, 'reason': ...}. Returns {'eps', 'rel_tol' (the bracket's width in
+    `max_eps` gives no edge: {'eps': None, 'reason': ...}. Returns {'eps', 'rel_tol' (the bracket's width in
     eps plus eps_floor), 'scan': [[eps, outlasts], ...]}."""
     grid = sorted(scan)
     long = [duration(e) >= t_a for e in grid]
-    while all(long) and grid[-1] < MAX_BAND_EPS:          # the band reaches past the scan: extend it upwards
+    while all(long) and grid[-1] < max_eps:               # the band reaches past the scan: extend it upwards
         grid.append(4.0 * grid[-1])
         long.append(duration(grid[-1]) >= t_a)
     record = [[e, bool(x)] for e, x in zip(grid, long)]

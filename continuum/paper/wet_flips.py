@@ -7,8 +7,9 @@ when the wet impact at that speed, v*, sticks: one wet run per t_a instead of a 
 found on the dry law's impact time (compiled runs, cached across t_a).
 
 States per t_a: ``holds``, ``fails``, ``no_subject`` (no dry impact that rebounds lasts t_a: above the
-longest dry rebound menisci change nothing; or no band edge) or ``refused`` (the band reaches speeds whose
-impacts the law refuses to tabulate at its cost bound: not judged there). A geometric grid
+longest dry rebound menisci change nothing; or no band edge), ``refused`` (the band reaches speeds whose
+impacts the law refuses to tabulate at its cost bound) or ``band_beyond_scan`` (the band reaches past the
+study's scan, a few times the declared t_a's band): not judged there. A geometric grid
 of t_a around the declared value is evaluated and every change of state between neighbours is bisected in
 ln t_a to T_A_REL_TOL, a reporting resolution far coarser than the runs' accuracy (1e-6 relative in an impact's
 duration, ``sampled_claims.RUN_RTOL``).
@@ -29,13 +30,14 @@ from ..laws.wet import WetRoughRoller
 BAND_EDGE = 0.01
 #: Relative resolution of a flip in t_a (the bisection stops when the bracket's ratio is below 1 + this).
 T_A_REL_TOL = 1e-2
-#: The t_a grid: the reference (declared t_a, or the longest dry rebound when that is lower) times
+#: The t_a grid (down to a quarter of the reference): the reference (declared t_a, or the longest dry rebound when
+#: that is lower) times
 #: T_A_DOWN_FACTORS, T_A_UP_POINTS points between it and the longest dry rebound, and that rebound times
 #: T_A_NEAR_LONGEST (the claim can fail just below it, where bridges form an instant before the impacts end).
-T_A_DOWN_FACTORS = tuple(2.0 ** (-k / 2) for k in range(0, 9))
+T_A_DOWN_FACTORS = tuple(2.0 ** (-k / 2) for k in range(0, 5))
 T_A_UP_POINTS = 3
 T_A_NEAR_LONGEST = (0.7, 0.8, 0.9, 0.97, 1.0 - T_A_REL_TOL, 1.0, 1.0 + T_A_REL_TOL)
-HOLDS, FAILS, NO_SUBJECT, REFUSED = "holds", "fails", "no_subject", "refused"
+HOLDS, FAILS, NO_SUBJECT, REFUSED, BEYOND_SCAN = "holds", "fails", "no_subject", "refused", "band_beyond_scan"
 
 
 def at_condensation_time(wet, t_a: float, rebuild: Callable[[float], object]):
