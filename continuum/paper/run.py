@@ -47,8 +47,10 @@ WET_EPS = tuple(np.geomspace(WET_DRY_REL_TOL, 2.0, 10))
 #: Largest v / v_esc - 1 the t_a band's scan is extended to when every scanned impact outlasts t_a (for a set
 #: whose escape velocity is tens of um/s, impacts at several times it still last longer than t_a = 25 us).
 MAX_BAND_EPS = 1e3
-#: The t_a study scans bands up to this many times the declared t_a's band (`_t_a_study`).
+#: The t_a study scans bands up to this many times the declared t_a's band (`_t_a_study`), and bisects each band
+#: edge to this width in ln eps: v_ta to ~1e-4 of the band, against the claim's 1 % band edge.
 STUDY_BAND_FACTOR = 4.0
+STUDY_LN_WIDTH = 1e-4
 #: Speeds sampled inside the band where dry impacts outlast t_a.
 BAND_POINTS = 6
 
@@ -205,7 +207,7 @@ def _t_a_study(scene, v0, fidelity, case, params, dry, wet, mass, g, rtol, esc_d
         if longest is None or longest < t:
             return NO_SUBJECT, {}
         try:
-            _, e = _t_a_band(dry, mass, g, rtol, up, t, dry_runs, max_eps)
+            _, e = _t_a_band(dry, mass, g, rtol, up, t, dry_runs, max_eps, STUDY_LN_WIDTH)
             if e is None:
                 return NO_SUBJECT, {}
             if e.get("speed") is None:
@@ -227,7 +229,7 @@ def _nucleation_time(scene) -> float | None:
 
 
 def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict,
-              max_eps: float = MAX_BAND_EPS) -> tuple[list[float], dict | None]:
+              max_eps: float = MAX_BAND_EPS, ln_width: float = 2e-8) -> tuple[list[float], dict | None]:
     """Speeds inside the band above the escape velocity where dry impacts rebound after more than t_a: the band's
     upper end (dry duration = t_a) found by `t_a_band_edge` on the dry law's impact time, then BAND_POINTS speeds
     spread geometrically in it. Returns (speeds, edge); edge is `t_a_band_edge`'s dict, with 'speed' added when
@@ -241,7 +243,7 @@ def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict,
             runs[v] = _outcome(dry, mass, g, v, rtol)
         return math.inf if runs[v]["stuck"] else runs[v]["duration"]
 
-    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL, max_eps=max_eps)
+    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL, ln_width=ln_width, max_eps=max_eps)
     if edge.get("eps") is None:
         return [], edge
     edge["speed"] = upper * (1.0 + edge["eps"])

@@ -35,8 +35,8 @@ T_A_REL_TOL = 1e-2
 #: T_A_DOWN_FACTORS, T_A_UP_POINTS points between it and the longest dry rebound, and that rebound times
 #: T_A_NEAR_LONGEST (the claim can fail just below it, where bridges form an instant before the impacts end).
 T_A_DOWN_FACTORS = tuple(2.0 ** (-k / 2) for k in range(0, 5))
-T_A_UP_POINTS = 3
-T_A_NEAR_LONGEST = (0.7, 0.8, 0.9, 0.97, 1.0 - T_A_REL_TOL, 1.0, 1.0 + T_A_REL_TOL)
+T_A_UP_POINTS = 2
+T_A_NEAR_LONGEST = (0.9, 1.0 - T_A_REL_TOL, 1.0, 1.0 + T_A_REL_TOL)
 HOLDS, FAILS, NO_SUBJECT, REFUSED, BEYOND_SCAN = "holds", "fails", "no_subject", "refused", "band_beyond_scan"
 
 
