@@ -265,8 +265,8 @@ def report_markdown(rec: CalibrationReport) -> str:
         single = c.get("single_surfaces") or {}
         beside = (f"; single surfaces {single['holds']} of {single['decided']} ({single['wilson95'][0]:.2f}-"
                   f"{single['wilson95'][1]:.2f})" if single.get("decided") else "")
-        by.setdefault(c["name"], {})[c["set"]] = ("pass" if c["pass"] else "**fail**" if c["state"] == "fail"
-                                                  else c["state"]) + beside
+        by.setdefault(c["name"], {})[c["set"]] = ("pass" if c["pass"] else "**fail**"
+                                                  if c.get("state", "fail") == "fail" else c["state"]) + beside
     for name, res in by.items():
         lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
     name = Path(rec.set_path).stem
