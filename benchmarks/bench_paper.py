@@ -1,9 +1,18 @@
-"""What `nanoimpact paper` costs, per set and per impact, against a floor; how the cost grows.
+"""What `nanoimpact paper` costs against the previous cycle's code, per set and per impact, against a floor.
 
+    python benchmarks/bench_paper.py --side-by-side 5 [--baseline REV]      # the budget check (docs/benchmarks.md)
     python benchmarks/bench_paper.py [--sets paper,silicon,calibrated] [--workers 2]
                                      [--baseline REV] [--skip-paper] [--whole] [--breakdown] [--repeat 5]
 
-Prints, from one run of this script (so the ratios are comparable on a shared machine):
+With `--side-by-side N` it prints only the budget check: the whole command as a user runs it
+(`nanoimpact paper` with its defaults: every set, the default discrete-summit seeds and the sampled claims, 2
+workers), for this tree and for git revision `--baseline` (default PREVIOUS_CYCLE, checked out into a temporary
+git worktree that is removed afterwards), run alternately N times each (baseline, this tree, baseline, ...), each
+tree's numba kernels loaded or compiled first, untimed. Each pair's ratio (baseline / this tree, wall and CPU of
+the command and its pool) and their range are printed: on a shared machine the load moves both runs of a pair
+alike, so the pair ratios scatter far less than the times.
+
+Otherwise it prints, from one run of this script (so the ratios are comparable on a shared machine):
 
 1. the paper's wall and CPU time per parameter set (`continuum.paper.run.run_paper`, one set at a time,
    each in a fresh interpreter with a process pool of `--workers`), and with `--baseline REV` the same
@@ -40,6 +49,11 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+
+#: The previous cycle's code: the last commit before the merge of the cycle that added the discrete-summit seeds
+#: and the sampled claims to `nanoimpact paper` (`git log`: 4b7d0e0, 2026-11-26 16:13, then ten hours without a
+#: commit until that cycle's merge began).
+PREVIOUS_CYCLE = "4b7d0e0"
 
 #: numba's one-time compile of the contact kernel (cached beside the module) is not a run's cost; an exported
 #: baseline tree starts with an empty cache, so every tree is warmed first, untimed.
@@ -80,18 +94,21 @@ sys.exit(main(["paper", "--out", sys.argv[1], "--params", sys.argv[2], "--worker
 """
 
 
-def whole_command(code_root: Path, sets: list[str], workers: int) -> tuple[float, float]:
-    """(wall s, CPU s) of `nanoimpact paper` for all `sets` in one process, run from `code_root`."""
+def whole_command(code_root: Path, sets: list[str], workers: int, warm: bool = True) -> tuple[float, float]:
+    """(wall s, CPU s) of `nanoimpact paper` for all `sets` in one process, run from `code_root` (its numba
+    kernels loaded or compiled first, untimed, unless `warm` is False)."""
     import resource
 
     env = {**os.environ, "PYTHONPATH": str(code_root)}
-    if (code_root / "continuum" / "compiled_contact.py").exists():
+    if warm and (code_root / "continuum" / "compiled_contact.py").exists():
         subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=code_root, env=env, check=True, capture_output=True)
     with tempfile.TemporaryDirectory() as folder:
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
-        subprocess.run([sys.executable, "-c", WHOLE_SNIPPET, folder, ",".join(sets), str(workers)], cwd=code_root,
-                       env=env, check=True, capture_output=True)
+        proc = subprocess.run([sys.executable, "-c", WHOLE_SNIPPET, folder, ",".join(sets), str(workers)],
+                              cwd=code_root, env=env, capture_output=True, text=True)
+        if proc.returncode not in (0, 4):
+            raise RuntimeError(f"nanoimpact paper in {code_root} failed: {proc.stderr[-2000:]}")
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -162,6 +179,60 @@ def breakdown(sets: list[str], workers: int) -> dict:
         out[r["what"]] = (here + r["cpu"] * (r["pid"] == main_pid), pool + r["cpu"] * (r["pid"] != main_pid), calls + 1)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return {"wall": wall, "cpu": cpu, "parts": out}
+
+
+def worktree(rev: str, dest: Path) -> Path:
+    """A temporary git worktree of revision `rev` at `dest` (detached; `drop_worktree` removes it). Its shipped data
+    is linked where an installed package keeps it (`nanoimpact/inputs`): the virtual environment's editable install
+    would otherwise resolve `nanoimpact.inputs` to this tree's inputs/, whose parameter sets the older code may
+    refuse."""
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(dest), rev], check=True,
+                   capture_output=True)
+    link = dest / "nanoimpact" / "inputs"
+    if not link.exists():
+        link.symlink_to(Path("..") / "inputs")
+    return dest
+
+
+def drop_worktree(dest: Path) -> None:
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(dest)], check=False,
+                   capture_output=True)
+
+
+def machine() -> str:
+    """The CPU model, its count and the Python version: the machine a timing belongs to."""
+    model = "unknown CPU"
+    try:
+        model = next(ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    return f"{model}, {os.cpu_count()} CPUs, Python {sys.version.split()[0]}"
+
+
+def side_by_side(rev: str, repeat: int, workers: int, sets: list[str]) -> list[dict]:
+    """`nanoimpact paper --params SETS` of revision `rev` and of this tree, alternately `repeat` times each (module
+    docstring); [{'baseline': (wall, CPU), 'this tree': (wall, CPU), 'load': ...}, ...] per pair."""
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        base = worktree(rev, Path(tmp) / "baseline")
+        try:
+            for root in (base, ROOT):                # compile or load each tree's kernels once, untimed
+                subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=root,
+                               env={**os.environ, "PYTHONPATH": str(root)}, check=True, capture_output=True)
+            for i in range(repeat):
+                pair = {"load": load()}
+                order = ((("baseline", base), ("this tree", ROOT)) if i % 2 == 0 else
+                         (("this tree", ROOT), ("baseline", base)))
+                for name, root in order:
+                    pair[name] = whole_command(root, sets, workers, warm=False)
+                rows.append(pair)
+                b, n = pair["baseline"], pair["this tree"]
+                print(f"pair {i + 1} (load {pair['load']}): baseline {b[0]:6.1f} s wall {b[1]:6.1f} s CPU; "
+                      f"this tree {n[0]:6.1f} s wall {n[1]:6.1f} s CPU; ratio baseline/this wall {b[0] / n[0]:.2f} "
+                      f"CPU {b[1] / n[1]:.2f}", flush=True)
+        finally:
+            drop_worktree(base)
+    return rows
 
 
 def export_revision(rev: str, dest: Path) -> Path:
@@ -249,6 +320,11 @@ def print_breakdown(sets: list[str], workers: int) -> None:
             print(f"{what:28s} {here:14.1f} {pool:11.1f} {calls:6d}")
 
 
+def _dirty() -> bool:
+    return bool(subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip())
+
+
 def load() -> str:
     return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
@@ -262,9 +338,27 @@ def main(argv=None):
     parser.add_argument("--whole", action="store_true", help="also time the whole `nanoimpact paper` command")
     parser.add_argument("--breakdown", action="store_true", help="where the whole command's CPU goes (this tree)")
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--side-by-side", type=int, default=0, metavar="N",
+                        help="only the budget check: this tree and --baseline (default PREVIOUS_CYCLE) alternately, "
+                        "N times each")
     args = parser.parse_args(argv)
     sets = args.sets.split(",")
-    print(f"load average at start: {load()}  ({os.cpu_count()} CPUs, Python {sys.version.split()[0]})")
+    print(f"load average at start: {load()}  ({machine()})")
+    if args.side_by_side:
+        rev = args.baseline or PREVIOUS_CYCLE
+        head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True).stdout.strip() + (" + uncommitted changes" if _dirty() else "")
+        print(f"\n## nanoimpact paper --params {args.sets} --workers {args.workers}: {rev} against this tree "
+              f"({head}), alternately")
+        rows = side_by_side(rev, args.side_by_side, args.workers, sets)
+        for what, k in (("wall", 0), ("CPU", 1)):
+            r = sorted(p["baseline"][k] / p["this tree"][k] for p in rows)
+            t = sorted(p["this tree"][k] for p in rows)
+            b = sorted(p["baseline"][k] for p in rows)
+            print(f"{what}: ratio baseline / this tree {r[0]:.2f}-{r[-1]:.2f} (median {r[len(r) // 2]:.2f}); "
+                  f"this tree {t[0]:.1f}-{t[-1]:.1f} s, baseline {b[0]:.1f}-{b[-1]:.1f} s")
+        print(f"\nload average at end: {load()}")
+        return
     from continuum.numerics.compiled_contact import warm_up
     warm_up()                                   # the kernel's load (or first compile) is not an impact's cost
 

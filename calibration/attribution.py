@@ -47,7 +47,6 @@ PHYSICAL_DIRECTION = {
     "fig8b_ots_impact_shorter_at_the_same_low_velocity": _SILICA_OVER_OTS,
     "fig5a_silica_impacts_weaken_until_it_sticks": {_W_SI: +1, _Z_SI: -1},
     "fig7_sigma3_sticks_at_first_impact": {_W_SI: +1, _Z_SI: -1},
-    "fig8a_menisci_raise_the_escape_velocity": _BRIDGES,
     "fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a": _BRIDGES,
 }
 

@@ -12,9 +12,9 @@ Steps (each timed in the report):
 3. The paper's dry, wet and SAM cases for the base set, the recipe's `compare_sets` (default: the literature
    `silicon` set) and the new set
    (continuum.paper.report.make_paper, on the same executor as the MD jobs), into OUT/paper. The sampled
-   claims are judged on the paper command's discrete-summit seeds and, for the new set, on the Latin-hypercube
-   rows of step 4 (the same draws), so a calibrated claim's holds_fraction covers the calibration's own
-   uncertainty.
+   claims are judged on the paper's averaged model: for the new set over the Latin-hypercube rows of step 4 (the
+   same draws), so a calibrated claim's holds_fraction covers the calibration's own uncertainty; the paper
+   command's discrete-summit seeds are reported beside each claim (single_surfaces) and decide nothing.
    3b. Claim attribution (calibration.attribution): when a claim holds with the base set and fails with the new
    one, each group of MD values is put back to the base values alone and the paper's cases run again (no
    figures), into OUT/attribution; the claims that hold again name the value that broke them.
@@ -593,7 +593,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         sets = [cal.base, *[s for s in paper_sets if s != cal.base], str(set_path)]
         keys, samples = sample_inputs(table["meta"].get("calibration", {}), cal.uncertainty.ranges,
                                       cal.uncertainty.samples, cal.uncertainty.seed)
-        # the new set's claims judged over the calibration's own Latin-hypercube rows and the discrete seeds
+        # the new set's claims judged over the calibration's own Latin-hypercube rows; the seeds reported beside them
         rows_paper = paper_uncertainty(cal.uncertainty, samples, set_path)
         paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None,   # the user's executor
                            seeds=DEFAULT_SEEDS, uncertainty=rows_paper)

@@ -256,10 +256,17 @@ def report_markdown(rec: CalibrationReport) -> str:
               "A rejected or missing value keeps the base set's value (with the base set's [meta.origin] entry).",
               _work_sentence(rec.rows),
               "", "## The paper's claims per set", "",
+              "Each cell: the verdict on the paper's model (the averaged GW surface), then, for a reproduction claim "
+              "judged on single discrete-summit surfaces, on how many of them it holds (Wilson 95 %): the project's "
+              "finding beyond the paper, which decides nothing.", "",
               "| claim | " + " | ".join(sets) + " |", "|---|" + "---|" * len(sets)]
     by: dict[str, dict] = {}
     for c in rec.paper_checks:
-        by.setdefault(c["name"], {})[c["set"]] = "pass" if c["pass"] else "**fail**"
+        single = c.get("single_surfaces") or {}
+        beside = (f"; single surfaces {single['holds']} of {single['decided']} ({single['wilson95'][0]:.2f}-"
+                  f"{single['wilson95'][1]:.2f})" if single.get("decided") else "")
+        by.setdefault(c["name"], {})[c["set"]] = ("pass" if c["pass"] else "**fail**"
+                                                  if c.get("state", "fail") == "fail" else c["state"]) + beside
     for name, res in by.items():
         lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
     name = Path(rec.set_path).stem

@@ -17,12 +17,29 @@ EXIT_BUSY = 75           # EX_TEMPFAIL: another process holds the run directory;
 EXIT_INTERRUPTED = 130   # Ctrl-C (128 + SIGINT)
 
 
+def _rebuild(cls: type, args: tuple, state: dict) -> BaseException:
+    """An exception of class `cls` with `args` and attributes `state`, made without calling its `__init__`
+    (`NanoimpactError.__reduce__`)."""
+    exc = cls.__new__(cls, *args)
+    exc.args = args
+    exc.__dict__.update(state)
+    return exc
+
+
 class NanoimpactError(Exception):
-    """Base class of the errors the command line turns into one line and an exit code."""
+    """Base class of the errors the command line turns into one line and an exit code.
+
+    Every subclass survives pickling whatever its `__init__` takes (a worker process or a Dask worker sends the
+    error back pickled): the default reduction calls `cls(*args)` with the formatted message alone, which an
+    `__init__` asking for (key, value, allowed) refuses on the way back, breaking the pool. This one restores the
+    message and the attributes without calling `__init__`."""
 
     exit_code = EXIT_FAILED
     #: the command that raised it (`nanoimpact impact`), named at the start of the line; None: the program's name
     prog: str | None = None
+
+    def __reduce__(self):
+        return _rebuild, (type(self), self.args, dict(self.__dict__))
 
 
 class InputError(NanoimpactError, ValueError):

@@ -36,6 +36,7 @@ import importlib.util
 import logging
 import multiprocessing
 import os
+import pickle
 import signal
 import sys
 import threading
@@ -44,7 +45,8 @@ from concurrent.futures import CancelledError, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator
 
-from .errors import BackendUnavailable, InputError
+from . import data
+from .errors import BackendUnavailable, InputError, RunFailed
 
 log = logging.getLogger(__name__)
 
@@ -78,6 +80,39 @@ class Failure:
 
     def __str__(self) -> str:
         return self.reason
+
+
+class _Carried:
+    """`fn` for a worker process or a Dask worker, whose error must come back pickled: an exception that does not
+    survive pickling (a foreign class whose `__init__` the default reduction cannot call again) would break the
+    pool (`BrokenProcessPool`) or lose the message; it is sent back as `RunFailed` with its one line instead. The
+    project's own errors survive as they are (`nanoimpact.errors.NanoimpactError.__reduce__`).
+
+    The caller's user data folder (`--data`, `nanoimpact.data.set_user_root`) travels with it: a spawned process or
+    a Dask worker does not inherit it, and would look a user's parameter set up in the shipped data alone."""
+
+    def __init__(self, fn: Callable):
+        self.fn = fn
+        self.data_root = data.user_root()
+        self.__name__ = getattr(fn, "__name__", type(fn).__name__)     # Dask names its tasks after it
+
+    def __call__(self, item):
+        if self.data_root is not None and data.user_root() != self.data_root:
+            data.set_user_root(self.data_root)
+        try:
+            return self.fn(item)
+        except Exception as exc:                # noqa: BLE001 -- re-raised as it is, or as its one line
+            if _survives_pickling(exc):
+                raise
+            raise RunFailed(one_line(exc)) from None
+
+
+def _survives_pickling(exc: BaseException) -> bool:
+    try:
+        back = pickle.loads(pickle.dumps(exc))
+    except Exception:                           # noqa: BLE001 -- any failure of the round trip
+        return False
+    return type(back) is type(exc) and str(back) == str(exc)
 
 
 def _check_on_error(on_error: str) -> None:
@@ -260,7 +295,7 @@ class Processes(_Base):
 
     def map(self, fn: Callable, items: Iterable, on_error: str = "raise") -> Iterator[tuple[int, Any]]:
         _check_on_error(on_error)
-        futures = {self.pool.submit(fn, item): i for i, item in enumerate(items)}
+        futures = {self.pool.submit(_Carried(fn), item): i for i, item in enumerate(items)}
         self._procs.update(self.pool._processes or {})          # noqa: SLF001 -- no public accessor
         self._manager = self.pool._executor_manager_thread or self._manager   # noqa: SLF001
 
@@ -277,7 +312,8 @@ class Processes(_Base):
                     else:
                         self._aborted = True
                         n = self._drop_queued(futures)
-                        log.warning("job %d failed (%s); %d queued job(s) cancelled", i, one_line(exc), n)
+                        # info: the error itself reaches the caller, which reports it in one line
+                        log.info("job %d failed (%s); %d queued job(s) cancelled", i, one_line(exc), n)
                         raise exc
             finally:                            # left before the end: the queued jobs never start
                 if not all(f.done() for f in futures):
@@ -348,7 +384,7 @@ class Dask(_Base):
             # the preload makes every worker end with this process (guard_parent)
             try:
                 self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                            dashboard_address=":0", silence_logs=logging.ERROR,
+                                            dashboard_address=":0", silence_logs=logging.CRITICAL,
                                             preload=["nanoimpact.executors"])
                 self.client = Client(self.cluster)
             except BaseException:
@@ -370,7 +406,7 @@ class Dask(_Base):
         from dask.distributed import as_completed as dask_completed
 
         _check_on_error(on_error)
-        futures = [self.client.submit(fn, item, pure=False) for item in items]
+        futures = [self.client.submit(_Carried(fn), item, pure=False) for item in items]
         self._futures = [f for f in self._futures if not f.done()] + futures
         index = {f.key: i for i, f in enumerate(futures)}
 
@@ -393,7 +429,7 @@ class Dask(_Base):
                     else:
                         self._aborted = True
                         n = self._cancel(futures)
-                        log.warning("job %d failed (%s); %d other job(s) cancelled", i, one_line(exc), n)
+                        log.info("job %d failed (%s); %d other job(s) cancelled", i, one_line(exc), n)
                         raise exc
             finally:                            # the consumer stopped early: drop what is left
                 self._cancel(futures)
@@ -419,7 +455,16 @@ class Dask(_Base):
             self.client.close()
         finally:
             if self.cluster is not None:
-                self.cluster.close()
+                # after a failure the nannies kill the workers still running a job and warn about each (the
+                # failure itself reaches the caller, which reports it in one line)
+                nanny = logging.getLogger("distributed.nanny")
+                level = nanny.level
+                if cancel:
+                    nanny.setLevel(logging.ERROR)
+                try:
+                    self.cluster.close()
+                finally:
+                    nanny.setLevel(level)
             self._restore_logging()
 
     def _restore_logging(self) -> None:

@@ -2,6 +2,7 @@
 with their parent however it dies (SIGKILL included)."""
 from __future__ import annotations
 
+import functools
 import json
 import os
 import select
@@ -193,3 +194,103 @@ def test_the_paper_runner_runs_on_the_executor_it_is_given_and_leaves_it_open(tm
     assert (tmp_path / "paper" / "cases" / "hertz" / "paper" / "result.json").is_file()
     assert set(got["curves"]) == {"paper"}                           # Fig 4's curves: a pool task per set
     assert lines[0].startswith("paper: 3 runs for set(s) paper on " + ex.describe())   # impact, sweep, curves
+
+
+# ------------------------------------------------------------------------------ errors that come back from workers
+PACKAGES = ("nanoimpact", "continuum", "md", "calibration")
+
+
+@functools.lru_cache(maxsize=None)
+def project_exception_classes() -> tuple[str, ...]:
+    """'module:Class' of every exception class the project defines, found in the source (a class whose base is a
+    built-in exception or another such class), so a new one without a case below fails the test."""
+    import builtins
+    import re
+
+    known = {n for n in dir(builtins) if isinstance(getattr(builtins, n), type)
+             and issubclass(getattr(builtins, n), BaseException)}
+    defs = []
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            module = ".".join(path.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")
+            for name, bases in re.findall(r"^class (\w+)\(([^)]*)\):", path.read_text(), re.M):
+                defs.append((module, name, {b.strip().split(".")[-1] for b in bases.split(",")}))
+    found: set[str] = set()
+    while True:
+        more = {f"{m}:{c}" for m, c, bases in defs if bases & known} - found
+        if not more:
+            return tuple(sorted(found))
+        found |= more
+        known |= {x.split(":")[1] for x in more}
+
+
+def make_error(name: str) -> BaseException:
+    """An instance of the project exception class `name` ('module:Class'), built as the code raises it."""
+    import importlib
+
+    module, attr = name.split(":")
+    c = getattr(importlib.import_module(module), attr)
+    if issubclass(c, InputError):
+        return c("surfaces.sigma", -1.0, "a length > 0 (m)", "user/params/mine.toml")
+    if name.endswith(":MDRunError"):
+        return c("LAMMPS stopped", "ERROR: lost atoms", Path("/tmp/leg/log.lammps"))
+    return c(f"{c.__name__}: what went wrong")
+
+
+def project_errors() -> dict[str, BaseException]:
+    return {name: make_error(name) for name in project_exception_classes()}
+
+
+def raise_project_error(name):
+    raise make_error(name)
+
+
+def _same(a: BaseException, b: BaseException) -> bool:
+    return type(a) is type(b) and str(a) == str(b) and a.__dict__ == b.__dict__
+
+
+def test_every_project_error_survives_pickling_with_its_message_and_fields():
+    import pickle
+
+    errors = project_errors()
+    assert {"nanoimpact.errors:InputError", "continuum.scene:SceneError", "md.engine.lammps:MDRunError",
+            "calibration.pipeline:CalibrationError"} <= set(errors)
+    for name, exc in errors.items():
+        back = pickle.loads(pickle.dumps(exc))
+        assert _same(back, exc), name
+    e = pickle.loads(pickle.dumps(errors["continuum.scene:SceneError"]))
+    assert (e.key, e.value, e.allowed, e.origin, e.exit_code) == ("surfaces.sigma", -1.0, "a length > 0 (m)",
+                                                                  "user/params/mine.toml", 2)
+
+
+@pytest.mark.parametrize("name", ["processes", "dask"])
+def test_every_project_error_comes_back_from_a_worker_as_it_was_raised(name):
+    """Raised inside a pool process or a Dask worker, each error reaches the caller with its class, message and
+    fields (an InputError whose __init__ needs key, value and allowed once broke the pool on the way back)."""
+    if name == "dask":
+        require_backend("dask.distributed", "dask.distributed")
+    errors = project_errors()
+    names = sorted(errors)
+    with executor(name, workers=2) as ex:
+        got = dict(ex.map(raise_project_error, names, on_error="collect"))
+        for i, n in enumerate(names):
+            assert isinstance(got[i], Failure) and _same(got[i].exception, errors[n]), n
+        with pytest.raises(InputError, match=r"mine.toml: surfaces.sigma = -1.0: a length > 0 \(m\)"):
+            dict(ex.map(raise_project_error, ["continuum.scene:SceneError"]))
+
+
+class Unpicklable(Exception):
+    def __init__(self, a, b):
+        super().__init__(f"needs {a} and {b}")
+
+
+def raise_unpicklable(_):
+    raise Unpicklable(1, 2)
+
+
+def test_a_foreign_error_that_cannot_be_pickled_comes_back_as_its_one_line_not_a_broken_pool():
+    from nanoimpact.errors import RunFailed
+
+    with executor("processes", workers=1) as ex:
+        with pytest.raises(RunFailed, match="Unpicklable: needs 1 and 2"):
+            dict(ex.map(raise_unpicklable, [0]))

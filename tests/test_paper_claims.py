@@ -86,22 +86,68 @@ def test_silica_that_never_sticks_or_sticks_at_once_fails_the_decay_claim():
     assert _states(_bundle(silica=_seq([])))[sc.NAMES[2]] == FAIL
 
 
-def test_a_claim_that_holds_nominally_but_not_on_its_seeds_names_them_and_reports_its_stick_probability():
-    """The sigma = 3 nm claim: the averaged law sticks, 2 of 4 seeds rebound. The claim fails over the samples,
-    names the two seeds with their margins, and reports the stick probability 3 of 5 with its Wilson interval
-    (closed form: p = 0.6, n = 5 -> 0.231-0.882)."""
+def test_seeds_decide_nothing_and_are_reported_beside_the_claim_with_their_interval_and_mechanism():
+    """The sigma = 3 nm claim: the averaged law sticks, 2 of 4 single surfaces rebound. The verdict is the paper's
+    model's (pass); single_surfaces holds 2 of 4 with the closed-form Wilson interval (p = 0.5, n = 4:
+    0.150-0.850) and the summit ladder: a loop of 0.0886 of the drop per summit needs >= 12 summits to stick."""
     nominal = _bundle()
-    seeds = [dict(_bundle(sigma3=_seq([0.2 * i], stuck=False) if i else _seq([])), label=f"seed {k}", seed=True)
+    seeds = [dict(_bundle(sigma3=dict(_seq([0.2 * i], stuck=False) if i else _seq([]), max_contacts=5 + i,
+                                      loop_per_summit_over_drop=0.0886)), label=f"seed {k}", seed=True)
              for k, i in ((1, 1), (2, 0), (3, 2), (4, 0))]
     claims = {c["name"]: c for c in sc.judged_over_samples("t", nominal, seeds)}
     c = claims["fig7_sigma3_sticks_at_first_impact"]
-    assert c["state"] == FAIL and c["holds_fraction"] == pytest.approx(0.6)
-    assert [f["label"] for f in c["failing_samples"]] == ["seed 1", "seed 3"]
-    assert c["failing_samples"][1]["margin"] == pytest.approx(1e-3 - 0.4)
-    assert "fails on seed 1 (margin -0.199), seed 3 (margin -0.399)" in c["reason"]
-    p = c["bands"]["stuck_at_first_impact"]
-    assert (p["k"], p["n"]) == (3, 5) and p["wilson95"] == pytest.approx([0.2307, 0.8824], abs=1e-4)
-    assert "failing_samples" not in claims["fig4_ots_loop_smaller_than_silica"]
+    assert c["state"] == PASS and c["samples"] == 1 and c["sampled"]["uncertainty"] == 0
+    ss = c["single_surfaces"]
+    assert (ss["holds"], ss["decided"], ss["n"]) == (2, 4, 4) and ss["failing"] == ["seed 1", "seed 3"]
+    assert ss["wilson95"] == pytest.approx([0.1500, 0.8500], abs=1e-4)
+    assert "0.0886 of the drop energy" in ss["mechanism"] and ">= 12 of them" in ss["mechanism"]
+    assert "5-7 summits" in ss["mechanism"]
+    assert "mechanism" not in claims["fig5a_ots_outbounces_silica"]["single_surfaces"]     # holds on every seed
+    assert claims["fig4_ots_loop_smaller_than_silica"]["single_surfaces"]["n"] == 0        # needs the averaged law
+
+
+def test_a_claim_is_judged_over_its_uncertainty_rows_on_the_averaged_law_and_names_the_failing_rows():
+    nominal = _bundle()
+    rows = [dict(_bundle(**(BROKEN["fig5a_ots_outbounces_silica"] if i in (2, 5) else {})), label=f"uncertainty {i}")
+            for i in range(1, 11)]
+    c = {c["name"]: c for c in sc.judged_over_samples("t", nominal, rows)}["fig5a_ots_outbounces_silica"]
+    assert c["state"] == FAIL and c["holds_fraction"] == pytest.approx(9 / 11) and c["sampled"]["uncertainty"] == 10
+    assert [f["label"] for f in c["failing_samples"]] == ["uncertainty 2", "uncertainty 5"]
+    assert "fails on uncertainty 2" in c["reason"]
+
+
+def test_the_sigma3_margin_is_the_drops_distance_below_escape_in_energy():
+    """On the averaged law the margin is 1 - (v0 / v_esc)^2: 0.43 for 1.40 against 1.856 mm/s (the paper set)."""
+    seq = dict(_seq([]), v_impact=1.40e-3)
+    b = _bundle(sigma3=seq, escape_sigma={3e-9: {"escape_velocity": 1.856e-3, "rel_tol": 1e-3}})
+    c = {c["name"]: c for c in sc.bundle_claims("t", b)}["fig7_sigma3_sticks_at_first_impact"]
+    assert c["state"] == PASS and c["margin"] == pytest.approx(1 - (1.40 / 1.856) ** 2)
+    assert c["tolerance"] == pytest.approx(2e-3 + sc.RUN_RTOL)
+    fast = _bundle(sigma3=dict(_seq([0.2], stuck=False), v_impact=2.0e-3),
+                   escape_sigma={3e-9: {"escape_velocity": 1.856e-3, "rel_tol": 1e-3}})
+    assert _states(fast)["fig7_sigma3_sticks_at_first_impact"] == FAIL
+
+
+def test_a_lower_first_rebound_of_ots_fails_the_outbounce_claim_even_when_both_still_rebound():
+    """silicon's case: OTS 0.918 against silica 1.000 at the first impact, both still rebounding after 20: a failed
+    conjunct is a fail, not 'not evaluable'."""
+    b = _bundle(silica=_seq([0.9999] * 20, stuck=False), ots=_seq([0.918] + [0.91] * 19, stuck=False))
+    c = {c["name"]: c for c in sc.bundle_claims("t", b)}["fig5a_ots_outbounces_silica"]
+    assert c["state"] == FAIL and "first rebound is lower" in c["reason"]
+    same = _bundle(silica=_seq([0.9] * 20, stuck=False), ots=_seq([0.95] * 20, stuck=False))
+    assert _states(same)["fig5a_ots_outbounces_silica"] == NOT_EVALUABLE
+
+
+def test_every_reproduction_claim_says_whose_threshold_it_applies():
+    from continuum.paper.sources import THRESHOLD_SOURCES
+
+    names = set(sc.NAMES) | {"fig7_rebounds_rise_with_sigma", "fig8a_rough_impact_time_rises_as_velocity_falls",
+                             "fig8a_escape_velocity_falls_as_sigma_rises", wet_checks.T_A_CLAIM}
+    assert names == set(THRESHOLD_SOURCES)
+    for name, src in THRESHOLD_SOURCES.items():
+        assert src["source"] in ("paper", "project") and (src.get("quote") or src.get("reason")), name
+    for c in sc.bundle_claims("t", _bundle()):
+        assert c["threshold_source"] == THRESHOLD_SOURCES[c["name"]]
 
 
 # ------------------------------------------------------------------------------ sweep claims (nominal runs)
@@ -153,10 +199,12 @@ def test_the_escape_velocitys_fall_with_sigma_is_judged_on_every_sample_that_sea
 
 
 def _wet(v_dry, v_wet, v_ta, t_a=25e-6):
+    """A wet_silica sweep record: escape velocities, the band edge (bracket 1e-9) and one impact outlasting t_a."""
     pts = [{"v_impact": v_dry * 1.001, "dry": {"stuck": False, "duration": 30e-6, "restitution": 0.1},
             "wet": {"stuck": True, "duration": None, "restitution": 0.0}}]
     return {"wet_silica": {"menisci_possible": True, "condensation_time": t_a, "points": pts,
-                           "escape_dry": {"escape_velocity": v_dry}, "escape_wet": {"escape_velocity": v_wet},
+                           "escape_dry": {"escape_velocity": v_dry, "rel_tol": 1e-6},
+                           "escape_wet": {"escape_velocity": v_wet, "rel_tol": 1e-6},
                            "t_a_band_edge": {"speed": v_ta, "rel_tol": 1e-9}, "longest_dry_rebound_s": 31e-6,
                            "condensation_time_nucleation": 4e-3}}
 
@@ -165,26 +213,48 @@ def _wet_states(w):
     return {c["name"]: c["state"] for c in wet_checks.evaluate_wet("t", w, {})}
 
 
-def test_wet_claims_hold_and_each_can_fail():
-    good = _wet_states(_wet(1e-3, 1.0105e-3, 1.01e-3))
-    assert good["fig8a_menisci_raise_the_escape_velocity"] == PASS
-    assert good["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"] == PASS
+def test_the_t_a_claim_holds_and_can_fail_and_its_margin_is_the_captured_fraction():
+    T = wet_checks.T_A_CLAIM
+    good = {c["name"]: c for c in wet_checks.evaluate_wet("t", _wet(1e-3, 1.0105e-3, 1.01e-3), {})}
+    assert good[T]["state"] == PASS and "fig8a_menisci_raise_the_escape_velocity" not in good     # one claim
+    assert good[T]["margin"] == pytest.approx(1.05 - 0.99)       # captured fraction 0.0105 / 0.01 of the band
+    assert good[T]["values"]["wet_over_dry_escape_velocity"] == pytest.approx(1.0105)
+    # the tolerance is the three speeds' brackets and the runs' accuracy over the band's width (1e-2)
+    assert good[T]["tolerance"] == pytest.approx((1e-6 + 1e-6 + 1e-9 + 3e-6) / 1e-2, rel=1e-6)
     # menisci capture only half of the band of impacts that outlast t_a
-    half = _wet_states(_wet(1e-3, 1.005e-3, 1.01e-3))
-    assert half["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"] == FAIL
-    # menisci lower the escape velocity
-    assert _wet_states(_wet(1e-3, 0.99e-3, 1.01e-3))["fig8a_menisci_raise_the_escape_velocity"] == FAIL
-    # a rise inside the bisection brackets is not evaluable (the audit's 1.000087 ratio at a 1e-3 bracket)
-    tiny = _wet(1e-3, 1e-3 * (1 + 5e-8), 1.01e-3)
-    assert _wet_states(tiny)["fig8a_menisci_raise_the_escape_velocity"] == NOT_EVALUABLE
+    half = {c["name"]: c for c in wet_checks.evaluate_wet("t", _wet(1e-3, 1.005e-3, 1.01e-3), {})}[T]
+    assert half["state"] == FAIL and half["margin"] == pytest.approx(0.5 - 0.99)
 
 
-def test_wet_claim_without_an_impact_outlasting_t_a_is_not_evaluable_and_says_where_it_flips():
+def test_wet_claim_without_an_impact_outlasting_t_a_is_not_evaluable_and_says_why():
     w = _wet(1e-3, 1e-3, 1.01e-3)
     w["wet_silica"]["t_a_band_edge"] = None
-    c = {c["name"]: c for c in wet_checks.evaluate_wet("t", w, {})}["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]
+    c = {c["name"]: c for c in wet_checks.evaluate_wet("t", w, {})}[wet_checks.T_A_CLAIM]
     assert c["state"] == NOT_EVALUABLE and "no dry impact that rebounds lasts t_a" in c["reason"]
-    assert c["values"]["t_a_flip_s"] == 31e-6
+    assert c["values"]["longest_dry_rebound_s"] == 31e-6
+    w = _wet(1e-3, None, 1.01e-3)
+    w["wet_silica"]["escape_wet"] = {"escape_velocity": None, "reason": "no bracket"}
+    c = {c["name"]: c for c in wet_checks.evaluate_wet("t", w, {})}[wet_checks.T_A_CLAIM]
+    assert c["state"] == NOT_EVALUABLE and "wet: no bracket" in c["reason"]
+
+
+def test_the_t_a_study_bisects_both_flips_of_a_claim_that_holds_in_a_window():
+    """A claim that holds for 24 <= t_a < 30.7 us, fails below and between 30.7 us and the longest rebound 31 us,
+    and has no subject above it: both flips within the study's resolution, the window around the declared 25 us,
+    and the same window found from a declared t_a above the longest rebound (the nucleation estimate's case)."""
+    from continuum.paper.wet_flips import FAILS, HOLDS, NO_SUBJECT, T_A_REL_TOL, t_a_flips
+
+    def state(t):
+        return (NO_SUBJECT if t > 31e-6 else HOLDS if 24e-6 <= t < 30.7e-6 else FAILS), {}
+
+    study = t_a_flips(state, 25e-6, 31e-6)
+    assert study["lower_flip_s"] == pytest.approx(24e-6, rel=T_A_REL_TOL)
+    assert study["upper_flip_s"] == pytest.approx(30.7e-6, rel=T_A_REL_TOL)
+    assert study["holds_in_s"] == [study["lower_flip_s"], study["upper_flip_s"]]
+    assert [f["to"] for f in study["flips"]] == [HOLDS, FAILS, NO_SUBJECT]
+    above = t_a_flips(state, 4.4e-3, 31e-6)
+    assert above["state_at_t_a"] == NO_SUBJECT and above["holds_in_s"] is None
+    assert above["holds_anywhere_s"][0] == pytest.approx([24e-6, 30.7e-6], rel=T_A_REL_TOL)
 
 
 # ------------------------------------------------------------------------------ the t_a band's edge
@@ -196,9 +266,9 @@ def test_the_t_a_band_edge_is_bisected_to_the_closed_form_crossing_of_a_monotone
     edge = t_a_band_edge(lambda e: t_a * (eps_c / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)
     assert edge["eps"] == pytest.approx(eps_c, rel=1e-6) and edge["eps"] <= eps_c
     assert 0 < edge["rel_tol"] < 1e-6 * eps_c + 2 * WET_DRY_REL_TOL
-    # a crossing below the scan's first point is bracketed by the escape velocity's own bracket
-    low = t_a_band_edge(lambda e: t_a * (3e-9 / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)
-    assert low["eps"] == pytest.approx(3e-9, rel=1e-6)
+    # a crossing inside the escape velocity's own bracket (below the scan's first point) is reported at the bracket
+    low = t_a_band_edge(lambda e: t_a * (3e-7 / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)
+    assert low["eps"] == pytest.approx(WET_DRY_REL_TOL, rel=1e-9) and min(WET_EPS) == pytest.approx(WET_DRY_REL_TOL)
 
 
 def test_an_impact_time_that_crosses_t_a_twice_gives_no_band_edge_and_the_wet_claim_says_why():

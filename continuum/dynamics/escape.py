@@ -22,11 +22,13 @@ def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rt
 
 def escape_velocity(law: ContactLaw, mass: float, gravity: float, v_low: float, v_high: float, *,
                     rel_tol: float = 1e-3, rtol: float = 1e-9,
-                    on_run: Callable[[float, ImpactRun], None] | None = None) -> dict:
+                    on_run: Callable[[float, ImpactRun], None] | None = None, ends_known: bool = False) -> dict:
     """Bisect [v_low, v_high] (m/s) for the escape velocity to `rel_tol`.
 
     Returns dict(escape_velocity, lower, upper, runs) where `lower` sticks and `upper` rebounds;
-    raises ValueError if the bracket does not straddle the transition.
+    raises ValueError if the bracket does not straddle the transition. With `ends_known` the caller has run both
+    ends already (they stick and rebound): they are not run again, so a bracket found on runs made in another
+    order (a law whose tables were sized by deeper impacts in between) is not contradicted by its own rerun.
     """
     def escapes(v):
         run = single_impact(law, mass, gravity, v, rtol)
@@ -35,12 +37,13 @@ def escape_velocity(law: ContactLaw, mass: float, gravity: float, v_low: float, 
         return not run.stuck
 
     runs = 0
-    if escapes(v_low):
-        raise ValueError(f"escape velocity below the bracket: the body already rebounds at {v_low:.3e} m/s")
-    if not escapes(v_high):
-        raise ValueError(f"escape velocity above the bracket: the body still sticks at {v_high:.3e} m/s")
+    if not ends_known:
+        if escapes(v_low):
+            raise ValueError(f"escape velocity below the bracket: the body already rebounds at {v_low:.3e} m/s")
+        if not escapes(v_high):
+            raise ValueError(f"escape velocity above the bracket: the body still sticks at {v_high:.3e} m/s")
+        runs = 2
     lo, hi = v_low, v_high
-    runs = 2
     while hi / lo - 1.0 > rel_tol:
         mid = math.sqrt(lo * hi)
         runs += 1

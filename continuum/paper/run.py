@@ -31,21 +31,26 @@ from ..output.results import write_run
 from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
-from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, seed_overrides
+from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, low_speed_runs, seed_overrides
+from .wet_flips import BAND_EDGE, BEYOND_SCAN, FAILS, HOLDS, NO_SUBJECT, REFUSED, at_condensation_time, t_a_flips
 
 #: Fig 8a velocity sweep: impact speeds as multiples of the 100 nm drop speed.
 FIG8_SPEED_FACTORS = tuple(np.geomspace(0.05, 20.0, 10))
-#: Wet sweeps: impact speeds just above the dry escape velocity, v = v_esc (1 + eps), where the
-#: impact time grows and may outlast t_a.
-WET_EPS = tuple(np.geomspace(1e-8, 2.0, 12))
-#: Relative bracket of the dry escape velocity in the wet sweep: far below the band of speeds where dry
-#: impacts outlast t_a (~3e-4 wide for the MD-calibrated silica, continuum audit), so the band is resolved.
-WET_DRY_REL_TOL = 1e-9
-#: Relative bracket of the wet escape velocity (the menisci raise it by ~1e-4 to ~1e-2).
-WET_REL_TOL = 1e-7
+#: Relative bracket of the dry and the wet escape velocity in the wet sweep: the runs' own accuracy (an impact's
+#: duration and rebound to ~1e-6 relative, `sampled_claims.RUN_RTOL`), never finer; far below the band of speeds
+#: where dry impacts outlast t_a (0.02 to 11 of v_esc wide in the shipped sets), so the band is resolved.
+WET_DRY_REL_TOL = 1e-6
+WET_REL_TOL = 1e-6
+#: Wet sweeps: impact speeds just above the dry escape velocity, v = v_esc (1 + eps), where the impact time grows
+#: and may outlast t_a; from the escape bracket's own width up (closer speeds cannot be told from it).
+WET_EPS = tuple(np.geomspace(WET_DRY_REL_TOL, 2.0, 10))
 #: Largest v / v_esc - 1 the t_a band's scan is extended to when every scanned impact outlasts t_a (for a set
 #: whose escape velocity is tens of um/s, impacts at several times it still last longer than t_a = 25 us).
 MAX_BAND_EPS = 1e3
+#: The t_a study scans bands up to this many times the declared t_a's band (`_t_a_study`), and bisects each band
+#: edge to this width in ln eps: v_ta to ~1e-4 of the band, against the claim's 1 % band edge.
+STUDY_BAND_FACTOR = 4.0
+STUDY_LN_WIDTH = 1e-4
 #: Speeds sampled inside the band where dry impacts outlast t_a.
 BAND_POINTS = 6
 
@@ -99,8 +104,11 @@ def _sweep_task(case: Case, params: str, fidelity: str | None) -> dict:
     # the grid's outcomes bracket the escape velocity where they can; below the grid the bracket is extended
     escape = escape_search(law, mass, g, v0, rtol, ESCAPE_REL_TOL, {p["v_impact"]: p["stuck"] for p in points})
     sigma = scene.surfaces.roughness.sigma if scene.surfaces.roughness is not None else None
-    return {"kind": "sweep", "case": case.name, "set": Path(params).stem, "points": points, "escape": escape,
-            "skipped": skipped, "v_drop": v0, "sigma": sigma if scene.contact == "rough" else None}
+    out = {"kind": "sweep", "case": case.name, "set": Path(params).stem, "points": points, "escape": escape,
+           "skipped": skipped, "v_drop": v0, "sigma": sigma if scene.contact == "rough" else None}
+    if case.name == "rough_silica":     # Fig 8b's low-speed pair at 1.2 v_esc, on the escape velocity found here
+        out["low_speed"] = low_speed_runs(params, fidelity, law, mass, g, rtol, escape.get("escape_velocity"))
+    return out
 
 
 def _outcome(law, mass, g, v, rtol) -> dict:
@@ -114,8 +122,11 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
 
     The dry escape velocity is bracketed (adaptively, from the drop speed) and bisected to WET_DRY_REL_TOL;
     speeds just above it (WET_EPS) and inside the band where dry impacts outlast t_a (`_t_a_band`) run dry
-    and wet; the wet escape velocity is bisected with the wet law to WET_REL_TOL. The longest dry impact that
-    still rebounds (at the dry bracket's upper end) is the t_a above which menisci change nothing.
+    and wet; the wet escape velocity is bracketed from the wet runs' own outcomes and bisected with the wet law to
+    WET_REL_TOL. The longest dry impact that still rebounds (at the dry bracket's upper end) is the t_a above which
+    menisci change nothing. A search that finds no bracket, or whose bracket the law contradicts, gives no escape
+    velocity and its reason (the claims built on it are then not evaluable), never an error. With menisci, the
+    t_a study (`wet_flips.t_a_flips`) finds where Fig 8a's t_a claim flips, below and above the declared t_a.
     """
     resolved = resolve_case(case, params, fidelity)
     scene = resolved.scene
@@ -139,9 +150,13 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     longest = edge = None
     if esc_dry.get("escape_velocity"):
         up = esc_dry["upper"]
-        dry_runs.setdefault(up, _outcome(dry, mass, g, up, rtol))
-        longest = dry_runs[up]["duration"]
-        band, edge = _t_a_band(dry, mass, g, rtol, up, t_a, dry_runs)
+        if up not in dry_runs:
+            dry_runs[up] = _outcome(dry, mass, g, up, rtol)
+        longest = None if dry_runs[up]["stuck"] else dry_runs[up]["duration"]
+        try:
+            band, edge = _t_a_band(dry, mass, g, rtol, up, t_a, dry_runs)
+        except SceneError as exc:       # the band reaches speeds the law refuses: no edge, and why
+            band, edge = [], {"eps": None, "reason": f"a speed in the band's scan is refused: {exc}"}
         speeds |= {up * (1.0 + e) for e in WET_EPS} | set(band)
     speeds = sorted(speeds)
     for v in fastest_first(speeds):
@@ -155,20 +170,55 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
             skipped.append({"v_impact": v, "reason": f"with menisci: {exc}"})
     speeds = [v for v in speeds if wet is None or v in wet_runs]
     points = [{"v_impact": v, "dry": dry_runs[v], **({"wet": wet_runs[v]} if wet is not None else {})} for v in speeds]
-    esc_wet = None
+    esc_wet = flips = None
     if wet is not None and esc_dry.get("escape_velocity"):
-        free_wet = [p["v_impact"] for p in points if not p["wet"]["stuck"]]
-        esc_wet = (escape_search(wet, mass, g, esc_dry["upper"], rtol, WET_REL_TOL,
-                                 {esc_dry["lower"]: True, min(free_wet): False}) if free_wet else
-                   {"escape_velocity": None, "reason": "no wet impact rebounds in the sweep"})
+        start = min((v for v, r in wet_runs.items() if not r["stuck"]), default=esc_dry["upper"])
+        esc_wet = escape_search(wet, mass, g, start, rtol, WET_REL_TOL, {v: r["stuck"] for v, r in wet_runs.items()})
+        flips = _t_a_study(scene, v0, fidelity, case, params, dry, wet, mass, g, rtol, esc_dry, t_a, longest,
+                           dry_runs)
     return {"kind": "wet", "case": case.name, "set": Path(params).stem, "points": points, "escape_dry": esc_dry,
             "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": t_a,
             "condensation_time_nucleation": _nucleation_time(scene), "longest_dry_rebound_s": longest,
-            "t_a_band_edge": edge, "skipped": skipped,
+            "t_a_band_edge": edge, "t_a_study": flips, "skipped": skipped,
             "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length", "solid_adhesion",
                                           "solid_pull")} if m else None,
             "why_no_menisci": None if wet_possible else menisci.why,
             "gravity": g, "v_drop": v0, "sigma": scene.surfaces.roughness.sigma}
+
+
+def _t_a_study(scene, v0, fidelity, case, params, dry, wet, mass, g, rtol, esc_dry, t_a, longest, dry_runs) -> dict:
+    """Fig 8a's t_a claim at other condensation times (`wet_flips`): at each t_a the band edge on the dry law's
+    impact time, then one wet run at v* = v_esc,dry + (1 - BAND_EDGE) (v_ta - v_esc,dry)."""
+    v_dry, up = esc_dry["escape_velocity"], esc_dry["upper"]
+
+    def rebuild(t):
+        o = {**case.overrides, "menisci.condensation_time": t}
+        if fidelity is not None:
+            o["numerics.fidelity"] = fidelity
+        r = resolve_scene(case.path, params=params, overrides=o, override_label=f"paper t_a study {case.name}")
+        return select_law(r.scene, v0, menisci=True)[0]
+
+    # the study's band scans stop at a few times the declared band (at least v = 3 v_esc): wider bands push the dry
+    # law to impacts whose footprint tables cost seconds each; a t_a whose band reaches past that is not judged
+    declared = _t_a_band(dry, mass, g, rtol, up, t_a, dry_runs)[1] if t_a and longest and longest >= t_a else None
+    max_eps = max(WET_EPS[-1], STUDY_BAND_FACTOR * ((declared or {}).get("eps") or 0.0))
+
+    def state_at(t):
+        if longest is None or longest < t:
+            return NO_SUBJECT, {}
+        try:
+            _, e = _t_a_band(dry, mass, g, rtol, up, t, dry_runs, max_eps, STUDY_LN_WIDTH)
+            if e is None:
+                return NO_SUBJECT, {}
+            if e.get("speed") is None:
+                return (BEYOND_SCAN if "fastest speed" in e.get("reason", "") else NO_SUBJECT), {}
+            v_star = v_dry + (1.0 - BAND_EDGE) * (e["speed"] - v_dry)
+            stuck = _outcome(at_condensation_time(wet, t, rebuild), mass, g, v_star, rtol)["stuck"]
+        except SceneError as exc:       # a speed the law refuses (its tables would cost too much): said, not run
+            return REFUSED, {"reason": str(exc)}
+        return (HOLDS if stuck else FAILS), {}
+
+    return t_a_flips(state_at, t_a, longest)
 
 
 def _nucleation_time(scene) -> float | None:
@@ -178,7 +228,8 @@ def _nucleation_time(scene) -> float | None:
         else None
 
 
-def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -> tuple[list[float], dict | None]:
+def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict,
+              max_eps: float = MAX_BAND_EPS, ln_width: float = 2e-8) -> tuple[list[float], dict | None]:
     """Speeds inside the band above the escape velocity where dry impacts rebound after more than t_a: the band's
     upper end (dry duration = t_a) found by `t_a_band_edge` on the dry law's impact time, then BAND_POINTS speeds
     spread geometrically in it. Returns (speeds, edge); edge is `t_a_band_edge`'s dict, with 'speed' added when
@@ -188,10 +239,11 @@ def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -
 
     def duration(eps: float) -> float:
         v = upper * (1.0 + eps)
-        runs.setdefault(v, _outcome(dry, mass, g, v, rtol))
+        if v not in runs:
+            runs[v] = _outcome(dry, mass, g, v, rtol)
         return math.inf if runs[v]["stuck"] else runs[v]["duration"]
 
-    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL)
+    edge = t_a_band_edge(duration, t_a, WET_EPS, WET_DRY_REL_TOL, ln_width=ln_width, max_eps=max_eps)
     if edge.get("eps") is None:
         return [], edge
     edge["speed"] = upper * (1.0 + edge["eps"])
@@ -199,20 +251,20 @@ def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict) -
 
 
 def t_a_band_edge(duration: Callable[[float], float], t_a: float, scan: tuple, eps_floor: float,
-                  ln_width: float = 2e-8) -> dict:
+                  ln_width: float = 2e-8, max_eps: float = MAX_BAND_EPS) -> dict:
     """Where the dry impact time falls through t_a above the escape velocity: eps of v = v_esc (1 + eps).
 
     `duration(eps)` is the dry impact time (inf where it sticks), known to be >= t_a at eps = 0. The scan speeds
-    (eps values `scan`, extended by factors of 4 up to MAX_BAND_EPS while every impact outlasts t_a) bracket the
+    (eps values `scan`, extended by factors of 4 up to `max_eps` while every impact outlasts t_a) bracket the
     crossing first; only a scan whose impacts outlast t_a up to one point and no further (one crossing, from long
     to short) is bisected, in ln eps, to `ln_width` (below the scan's first point the bracket's lower end is
     `eps_floor`, the escape velocity's own relative bracket). A scan that crosses t_a more than once (the impact
     time is not monotone in the speed there), that starts short and turns long, or that outlasts t_a up to
-    MAX_BAND_EPS gives no edge: {'eps': None, 'reason': ...}. Returns {'eps', 'rel_tol' (the bracket's width in
+    `max_eps` gives no edge: {'eps': None, 'reason': ...}. Returns {'eps', 'rel_tol' (the bracket's width in
     eps plus eps_floor), 'scan': [[eps, outlasts], ...]}."""
     grid = sorted(scan)
     long = [duration(e) >= t_a for e in grid]
-    while all(long) and grid[-1] < MAX_BAND_EPS:          # the band reaches past the scan: extend it upwards
+    while all(long) and grid[-1] < max_eps:               # the band reaches past the scan: extend it upwards
         grid.append(4.0 * grid[-1])
         long.append(duration(grid[-1]) >= t_a)
     record = [[e, bool(x)] for e, x in zip(grid, long)]
@@ -277,13 +329,13 @@ def _bundle_task(params: str, label: str, overrides: dict, fidelity: str | None,
 
 
 def sample_tasks(s: str, fidelity: str | None, seeds: int, uncertainty: list[dict]) -> list[tuple[str, tuple]]:
-    """The sampled claims' bundles of set `s`: the nominal one, `seeds` discrete seeds, the `uncertainty` rows
-    (scene overrides). None when the run leaves out rough silica or OTS (their claims have no nominal case)."""
+    """The sampled claims' bundles of set `s`: `seeds` discrete seeds and the `uncertainty` rows (scene overrides);
+    the nominal bundle is made of the set's own runs (`samples.nominal_bundle`). None when the run leaves out rough
+    silica or OTS (their claims have no nominal case)."""
     cases = bundle_cases(dry_cases())
     if cases is None:
         return []
-    tasks = [("bundle", (s, "nominal", {}, fidelity, cases, True))]
-    tasks += [("bundle", (s, label, o, fidelity, cases, False)) for label, o in seed_overrides(seeds)]
+    tasks = [("bundle", (s, label, o, fidelity, cases, False)) for label, o in seed_overrides(seeds)]
     tasks += [("bundle", (s, f"uncertainty {i + 1}", o, fidelity, cases, True)) for i, o in enumerate(uncertainty)]
     return tasks
 
@@ -320,8 +372,8 @@ def run_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None, 
               uncertainty: dict[str, list[dict]] | None = None, case_figures: bool = False) -> dict:
     """Run every dry case and sweep for every parameter set; returns the collected outputs.
 
-    With the sampled claims' bundles (`sample_tasks`): the nominal one always, `seeds` discrete-summit seeds and
-    the `uncertainty` rows ({set name: [scene overrides, ...]}) per set; collected["bundles"][(label, set)].
+    With the sampled claims' bundles (`sample_tasks`): `seeds` discrete-summit seeds and the `uncertainty` rows
+    ({set name: [scene overrides, ...]}) per set; collected["bundles"][(label, set)].
     `case_figures`: each impact run also draws its own height.png and impacts.png (`_impact_task`).
 
     Runs go to `executor` (an object from nanoimpact.executors, left open: its owner closes it) or, without one,

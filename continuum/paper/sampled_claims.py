@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from .samples import ESCAPE_REL_TOL, SAMPLE_MAX_BOUNCES
-from .verdict import FAIL, NOT_EVALUABLE, REPRODUCTION, band, entry, not_evaluable, over_samples, proportion
+from .verdict import FAIL, NOT_EVALUABLE, PASS, REPRODUCTION, band, entry, not_evaluable, over_samples, proportion
 
 #: "Sticks" means no rebound above this fraction of the release height h0 (the paper notes).
 STICK_FRACTION = 1e-3
@@ -49,6 +49,9 @@ def loop_claim(s: str, b: dict) -> dict:
 
 
 def _outbounce(s, b):
+    """OTS's first rebound higher than silica's and at least as many rebounds. A conjunct that fails decides a fail;
+    the claim is not evaluable only when the first rebounds hold and both drops still rebound at the end of the
+    run with as many rebounds (the count undecided)."""
     name, units = NAMES[1], "h0 (first rebound of OTS - of silica)"
     thr = ("OTS-covered silica rebounds higher at the first impact than bare silica and bounces at least as often "
            "before sticking")
@@ -58,11 +61,13 @@ def _outbounce(s, b):
               "first_rebound_ots_over_h0": r_ots[0] if r_ots else 0.0,
               "first_rebound_silica_over_h0": r_si[0] if r_si else 0.0}
     e = entry(name, s, REPRODUCTION, values, thr, first, RUN_RTOL, units)
-    if len(r_ots) < len(r_si):
-        e.update(state="fail", reason="OTS sticks after fewer rebounds than silica")
-    elif len(r_ots) == len(r_si) and b["ots"]["status"] == "max_bounces":
+    if e["state"] == FAIL:
+        e["reason"] = "OTS's first rebound is lower than silica's"
+    elif len(r_ots) < len(r_si):
+        e.update(state=FAIL, reason="OTS sticks after fewer rebounds than silica")
+    elif e["state"] == PASS and len(r_ots) == len(r_si) and b["ots"]["status"] == "max_bounces":
         e.update(state=NOT_EVALUABLE, reason=f"both still rebound after {b['ots']['impacts']} impacts")
-    e["pass"] = e["state"] == "pass"
+    e["pass"] = e["state"] == PASS
     return e
 
 
@@ -90,10 +95,27 @@ def _weaken(s, b):
 
 
 def _sigma3(s, b):
-    name, units = NAMES[3], "h0 (1e-3 - first rebound)"
-    first = b["sigma3"]["rebound_over_h0"][0]
-    return entry(name, s, REPRODUCTION, {"first_rebound_over_h0": first},
-                 "sigma = 3 nm: no rebound above 1e-3 h0 at the first impact", STICK_FRACTION - first, RUN_RTOL, units)
+    """sigma = 3 nm sticks at the first impact. On the averaged law (a bundle that searched the escape velocity at
+    3 nm) the margin is the drop's distance below escape in energy, 1 - (v0 / v_esc)^2, with the escape bracket's
+    and the runs' accuracy as tolerance; a discrete surface (no escape search) is judged on its first rebound."""
+    name = NAMES[3]
+    thr = "sigma = 3 nm: no rebound above 1e-3 h0 at the first impact"
+    if "sigma3" not in b:
+        return not_evaluable(name, s, REPRODUCTION, thr, "1", "the sigma = 3 nm drop was not run")
+    seq = b["sigma3"]
+    first = seq["rebound_over_h0"][0]
+    esc = next((e for x, e in (b.get("escape_sigma") or {}).items() if abs(x / 3e-9 - 1.0) < 1e-6), None) or {}
+    v0, v_esc = seq.get("v_impact"), esc.get("escape_velocity")
+    values = {"first_rebound_over_h0": first}
+    if v0 and v_esc:
+        values.update(v_impact_m_per_s=v0, escape_velocity_m_per_s=v_esc)
+        e = entry(name, s, REPRODUCTION, values, thr, 1.0 - (v0 / v_esc) ** 2,
+                  2.0 * esc.get("rel_tol", ESCAPE_REL_TOL) + RUN_RTOL, "1 (1 - (v0 / v_esc,3nm)^2)")
+        if (first <= STICK_FRACTION) != (e["state"] == PASS) and e["state"] != NOT_EVALUABLE:
+            e.update(state=NOT_EVALUABLE, reason=f"the drop's first rebound ({first:.3g} h0) disagrees with its "
+                     f"speed against the escape velocity ({v0:.4g} against {v_esc:.4g} m/s)", **{"pass": False})
+        return e
+    return entry(name, s, REPRODUCTION, values, thr, STICK_FRACTION - first, RUN_RTOL, "h0 (1e-3 - first rebound)")
 
 
 def _escape(s, b):
@@ -104,11 +126,12 @@ def _escape(s, b):
         return not_evaluable(name, s, REPRODUCTION, thr, units, "no averaged law in this sample (discrete seed)")
     e_si, e_ots = b["escape"]["silica"], b["escape"]["ots"]
     values = {"silica_m_per_s": e_si.get("escape_velocity"), "ots_m_per_s": e_ots.get("escape_velocity")}
+    tol = e_si.get("rel_tol", ESCAPE_REL_TOL) + e_ots.get("rel_tol", ESCAPE_REL_TOL) + 2 * RUN_RTOL
     if not (values["silica_m_per_s"] and values["ots_m_per_s"]):
         why = "; ".join(f"{k}: {e['reason']}" for k, e in (("silica", e_si), ("OTS", e_ots)) if e.get("reason"))
-        return not_evaluable(name, s, REPRODUCTION, thr, units, why, values, 2 * ESCAPE_REL_TOL)
-    return entry(name, s, REPRODUCTION, values, thr, 1.0 - values["ots_m_per_s"] / values["silica_m_per_s"],
-                 2 * ESCAPE_REL_TOL, units)
+        return not_evaluable(name, s, REPRODUCTION, thr, units, why, values, tol)
+    return entry(name, s, REPRODUCTION, values, thr, 1.0 - values["ots_m_per_s"] / values["silica_m_per_s"], tol,
+                 units)
 
 
 def _low_speed(s, b):
@@ -136,25 +159,25 @@ def bundle_claims(set_name: str, b: dict) -> list[dict]:
 
 
 def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> list[dict]:
-    """The nominal bundle's claims, each with its holds_fraction over `samples` (bundles: seeds and uncertainty
-    rows) and the bands of its threshold shapes."""
+    """The nominal bundle's claims judged on the paper's model (the averaged GW surface): the nominal set and its
+    uncertainty rows (`samples` without 'seed', each its own averaged-law bundle), holds_fraction over them
+    (`verdict.over_samples`), with the bands of their threshold shapes. The discrete-summit seeds (`samples` with
+    'seed') judge nothing: each claim carries them as its `single_surfaces` block, the project's finding beyond
+    the paper."""
     nom = {c["name"]: c for c in bundle_claims(set_name, nominal)}
-    per = [{c["name"]: c for c in bundle_claims(set_name, b)} for b in samples]
+    rows = [b for b in samples if not b.get("seed")]
     seeds = [b for b in samples if b.get("seed")]
+    per = [{c["name"]: c for c in bundle_claims(set_name, b)} for b in rows]
+    per_seed = [{c["name"]: c for c in bundle_claims(set_name, b)} for b in seeds]
     out = []
     for name in NAMES:
-        used = [p[name]["state"] for p, b in zip(per, samples) if not (name in FULL_ONLY and b.get("seed"))]
-        sources = {"nominal": 1, "uncertainty": len([b for b in samples if not b.get("seed")]),
-                   "seeds": 0 if name in FULL_ONLY else len(seeds)}
-        if name in FULL_ONLY and seeds:
-            sources["seeds_note"] = "not judged on discrete seeds (needs the averaged law's escape search or loop)"
-        e = over_samples(nom[name], used, sources, _bands(name, [nominal] + samples))
+        e = over_samples(nom[name], [p[name]["state"] for p in per], {"nominal": 1, "uncertainty": len(rows)},
+                         _bands(name, [nominal] + rows))
         failing = [{"label": b["label"], "margin": p[name]["margin"], **({"reason": p[name]["reason"]}
                                                                           if p[name].get("reason") else {})}
-                   for p, b in zip(per, samples) if p[name]["state"] == FAIL
-                   and not (name in FULL_ONLY and b.get("seed"))]
+                   for p, b in zip(per, rows) if p[name]["state"] == FAIL]
         e["sample_margins"] = [{"label": b["label"], "margin": p[name]["margin"], "state": p[name]["state"]}
-                               for p, b in zip(per, samples) if not (name in FULL_ONLY and b.get("seed"))]
+                               for p, b in zip(per, rows)]
         if failing:
             e["failing_samples"] = failing
             if e["state"] == FAIL and nom[name]["state"] != FAIL:
@@ -162,8 +185,51 @@ def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> li
                     f["label"] + (f" (margin {f['margin']:.3g})" if f["margin"] is not None else "")
                     for f in failing[:NAMED_FAILURES]) + (f" and {len(failing) - NAMED_FAILURES} more (failing_samples)"
                                                           if len(failing) > NAMED_FAILURES else "")
+        e["single_surfaces"] = single_surfaces(name, e["state"], [p[name] for p in per_seed], seeds, nominal)
         out.append(e)
     return out
+
+
+def single_surfaces(name: str, state: str, claims: list[dict], seeds: list[dict], nominal: dict) -> dict:
+    """How the claim fares on single discrete-summit realisations (`seeds`: their bundles, `claims`: the claim on
+    each): the fraction of the decided ones on which it holds, their count, the Wilson 95 % interval, and where
+    that departs from the paper's model's verdict `state`, the mechanism with its numbers (`_mechanism`)."""
+    if name in FULL_ONLY:
+        return {"n": 0, "note": "not evaluated on single surfaces: it needs the averaged law's escape search or "
+                "adhesive loop (a discrete escape search is ~15 discrete impacts per surface)"}
+    if not seeds:
+        return {"n": 0, "note": "no discrete-summit seeds were run (--seeds 0)"}
+    decided = [c for c in claims if c["state"] in (PASS, FAIL)]
+    p = proportion(c["state"] == PASS for c in decided)
+    out = {"n": len(claims), "decided": len(decided), "holds": p["k"] if p else 0,
+           "holds_fraction": p["fraction"] if p else None, "wilson95": p["wilson95"] if p else None,
+           "failing": [b["label"] for c, b in zip(claims, seeds) if c["state"] == FAIL]}
+    departs = p is not None and ((state == PASS and p["fraction"] < 1.0) or (state == FAIL and p["fraction"] > 0.0))
+    if departs:
+        out["mechanism"] = _mechanism(name, seeds, nominal)
+    return out
+
+
+def _mechanism(name: str, seeds: list[dict], nominal: dict) -> str:
+    """Why single surfaces depart from the averaged one, in a sentence with its numbers: a JKR impact loses a fixed
+    loop per summit it reaches, so what a drop keeps is set by how many summits one realisation puts in reach,
+    where the averaged law spreads a fractional number of them."""
+    key = "sigma3" if name == NAMES[3] else "silica"
+    q = [b[key].get("loop_per_summit_over_drop") for b in seeds if b[key].get("loop_per_summit_over_drop")]
+    n = [b[key].get("max_contacts") for b in seeds if b[key].get("max_contacts") is not None]
+    if not q or not n:
+        return ("single realisations carry few summits, so the number one realisation puts in reach, not the "
+                "averaged law's fractional count, sets each rebound")
+    share = sorted(q)[len(q) // 2]
+    where = "at sigma = 3 nm" if key == "sigma3" else "at sigma = 6 nm (bare silica)"
+    text = (f"every summit a JKR impact reaches takes {share:.3g} of the drop energy {where} (the loop of one summit "
+            f"over m g h0), and single realisations put {min(n):g}-{max(n):g} summits in contact at once")
+    if name == NAMES[3]:
+        text += f", so sticking at the first impact needs >= {math.ceil(1.0 / share):d} of them"
+    nom = nominal.get(key, {}).get("max_contacts")
+    if nom is not None:
+        text += f"; the averaged law spreads {nom:.3g}"
+    return text
 
 
 def _bands(name: str, bundles: list[dict]) -> dict | None:
@@ -175,6 +241,7 @@ def _bands(name: str, bundles: list[dict]) -> dict | None:
     if name == NAMES[2]:
         return {"rebounds_silica": band(len(rebounds(b["silica"])) for b in ok)}
     if name == NAMES[3]:
+        ok = [b for b in ok if "sigma3" in b]
         return {"first_rebound_over_h0": band(b["sigma3"]["rebound_over_h0"][0] for b in ok),
                 "stuck_at_first_impact": proportion(b["sigma3"]["rebound_over_h0"][0] <= STICK_FRACTION
                                                     for b in ok)}

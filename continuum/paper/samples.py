@@ -61,10 +61,17 @@ def read_uncertainty_csv(path: str | Path) -> list[dict]:
 def escape_search(law, mass: float, gravity: float, v_start: float, rtol: float,
                   rel_tol: float = ESCAPE_REL_TOL, known: dict | None = None) -> dict:
     """Escape velocity by an adaptive bracket from `v_start` (halve until it sticks, double until it rebounds),
-    then bisection to `rel_tol`. `known` = {speed: stuck} already run. Returns the bisection's dict, or
-    {'escape_velocity': None, 'reason': ...} when no bracket is found within MAX_BRACKET_STEPS."""
-    known = dict(known or {})
+    then bisection to `rel_tol`. `known` = {speed: stuck} already run with this law. Returns the bisection's dict,
+    or {'escape_velocity': None, 'reason': ...} when no bracket is found within MAX_BRACKET_STEPS, the known
+    outcomes contradict each other (a speed that sticks above one that rebounds: no single escape velocity), or
+    the law refuses a speed the search needs."""
+    try:
+        return _escape_search(law, mass, gravity, v_start, rtol, rel_tol, dict(known or {}))
+    except SceneError as exc:           # a bracket speed the law refuses (its tables would cost too much)
+        return {"escape_velocity": None, "reason": f"refused: {exc}"}
 
+
+def _escape_search(law, mass, gravity, v_start, rtol, rel_tol, known) -> dict:
     def stuck(v):
         if v not in known:
             known[v] = single_impact(law, mass, gravity, v, rtol).stuck
@@ -72,6 +79,9 @@ def escape_search(law, mass: float, gravity: float, v_start: float, rtol: float,
 
     lo = max((v for v, s in known.items() if s), default=None)
     hi = min((v for v, s in known.items() if not s), default=None)
+    if lo is not None and hi is not None and lo > hi:
+        return {"escape_velocity": None, "reason": f"the outcomes are not monotone in the speed: it sticks at "
+                f"{lo:.6g} m/s and rebounds at {hi:.6g} m/s below it"}
     v = v_start
     for _ in range(MAX_BRACKET_STEPS):
         if lo is not None and hi is not None and lo < hi:
@@ -85,18 +95,27 @@ def escape_search(law, mass: float, gravity: float, v_start: float, rtol: float,
     if lo is None or hi is None or not lo < hi:
         return {"escape_velocity": None, "reason": f"no bracket within {v_start * 2.0 ** -MAX_BRACKET_STEPS:.3g}-"
                 f"{v_start * 2.0 ** MAX_BRACKET_STEPS:.3g} m/s ({MAX_BRACKET_STEPS} halvings and doublings)"}
-    out = escape_velocity(law, mass, gravity, lo, hi, rel_tol=rel_tol, rtol=rtol)
+    # both ends were run here (stuck at lo, rebound at hi): not run again, so a law whose outcome at a speed depends
+    # on the impacts run before it (tables sized by the deepest) cannot contradict its bracket
+    out = escape_velocity(law, mass, gravity, lo, hi, rel_tol=rel_tol, rtol=rtol, ends_known=True)
     out["rel_tol"] = rel_tol
     return out
 
 
 def _sequence(result: dict) -> dict:
-    """The drop's impacts in order: rebound heights / h0 (0 when it stuck), durations (inf when stuck), peaks."""
+    """The drop's impacts in order: rebound heights / h0 (0 when it stuck), durations (inf when stuck), peaks; the
+    first impact's speed; the most summits attached at once and one summit's JKR loop over the drop energy
+    m g h0 (where the law records them: the mechanism of `sampled_claims.single_surfaces`)."""
     h0 = result["scene"]["si"]["release_height"]
     b = result["bounces"]
+    law = result["models"].get("contact_law", {})
+    loop, ref = law.get("loop_energy_per_summit"), result.get("energy_audit", {}).get("reference_energy")
     return {"rebound_over_h0": [(x["rebound_height"] or 0.0) / h0 for x in b],
             "duration_s": [x["duration"] if x["duration"] is not None else math.inf for x in b],
-            "peak_force_N": [x["peak_force"] for x in b], "status": result["status"], "impacts": len(b)}
+            "peak_force_N": [x["peak_force"] for x in b], "status": result["status"], "impacts": len(b),
+            "v_impact": b[0]["v_impact"] if b else None,
+            "max_contacts": result["models"].get("diagnostics", {}).get("max_contacts"),
+            "loop_per_summit_over_drop": loop / ref if loop and ref else None}
 
 
 #: Scene keys a case states its claim at, kept against a sample's row: Fig 7's sigma = 3 nm claim is made at
@@ -209,6 +228,53 @@ def _escape_over_sigma(params, overrides, fidelity, at_6nm: dict) -> dict[float,
                                           sc.numerics.rtol)
         except SceneError as exc:       # a speed the law refuses (its tables would cost too much): that sigma alone
             out[s * 1e-9] = {"escape_velocity": None, "reason": f"refused: {exc}"}
+    return out
+
+
+def truncated(seq: dict, n: int) -> dict:
+    """A drop's `_sequence` cut to its first `n` impacts, as a run with numerics.max_bounces = n gives it (the
+    impacts before are the same: each starts from the state the one before left)."""
+    if seq["impacts"] <= n:
+        return seq
+    return dict(seq, rebound_over_h0=seq["rebound_over_h0"][:n], duration_s=seq["duration_s"][:n],
+                peak_force_N=seq["peak_force_N"][:n], status="max_bounces", impacts=n)
+
+
+def low_speed_runs(params: str, fidelity: str | None, silica_law, mass: float, g: float, rtol: float,
+                   v_esc: float | None) -> dict | None:
+    """Fig 8b's low-speed impacts: bare silica (`silica_law`) and OTS at 1.2 times silica's escape velocity (None
+    without one)."""
+    if not v_esc:
+        return None
+    ots = _resolved(Case("rough_ots", "rough_ots.toml"), params, {}, fidelity, 1).scene
+    v = 1.2 * v_esc
+    runs = {"silica": single_impact(silica_law, mass, g, v, rtol),
+            "ots": single_impact(select_law(ots, v)[0], ots.body.mass, ots.environment.gravity, v, ots.numerics.rtol)}
+    return {"v_impact": v, **{k: {"stuck": r.stuck, "duration": r.bounces[0].duration} for k, r in runs.items()}}
+
+
+def nominal_bundle(impacts: dict, sweeps: dict, wet: dict, curves: dict | None) -> dict | None:
+    """The nominal set's bundle from the runs the paper makes anyway (instead of running them again): the drops of
+    rough silica, OTS and sigma = 3 nm (`impacts`: case -> result, cut as `_bundle` runs them), each Fig 8a
+    sigma's escape velocity and the low-speed impacts (`sweeps`), OTS's dry escape velocity (the wet_ots sweep's
+    dry law is rough_ots's: the same scene at 40 % RH, menisci off) and Fig 4's loops (`curves`). None when the
+    run leaves out rough silica or OTS."""
+    if not {"rough_silica", "rough_ots"} <= set(impacts):
+        return None
+    silica = truncated(_sequence(impacts["rough_silica"]), SAMPLE_MAX_BOUNCES)
+    out = {"label": "nominal", "overrides": {}, "seed": False, "silica": silica,
+           "ots": truncated(_sequence(impacts["rough_ots"]), min(SAMPLE_MAX_BOUNCES, silica["impacts"] + 2))}
+    if "sigma_3nm" in impacts:
+        out["sigma3"] = truncated(_sequence(impacts["sigma_3nm"]), 1)
+    rough = {k: sw for k, sw in sweeps.items() if sw.get("sigma")}
+    if "rough_silica" in rough:
+        missing = {"escape_velocity": None, "reason": "the wet_ots sweep was not run"}
+        out["escape"] = {"silica": rough["rough_silica"]["escape"],
+                         "ots": (wet.get("wet_ots") or {}).get("escape_dry") or missing}
+        out["escape_sigma"] = {sw["sigma"]: sw["escape"] for sw in rough.values()}
+        out["low_speed"] = rough["rough_silica"].get("low_speed")
+    if curves:
+        out["loop"] = {k: v["loop_area"] for k, v in curves.items()}
     return out
 
 

@@ -12,16 +12,24 @@ Margin. A signed number in the claim's own units (or relative, as the entry says
 the claim holds. Tolerance: the numerical uncertainty of that margin (bisection bracket, integrator
 and table tolerances), never a physical threshold.
 
-Samples. A reproduction claim is also judged on each uncertainty sample of the parameter set and
-each discrete-summit seed; ``holds_fraction`` is the fraction of the decided samples (the nominal
-run included) on which it holds, and the claim passes when that fraction is at least
-``HOLDS_FRACTION`` (the continuum audit's proposed criterion).
+One rule, decided before any result: every reproduction claim is judged on the model the paper
+defines, the averaged (Greenwood-Williamson mean-field) surface of its eqs 10-11. A set without
+uncertainty rows (`paper`, `silicon`) is judged on its nominal runs; a set with them (a calibrated
+set's Latin hypercube) on the nominal run and each row, each an averaged-law sample:
+``holds_fraction`` is the fraction of the decided ones on which it holds, and the claim passes when
+the nominal run holds and that fraction is at least ``HOLDS_FRACTION``. Single discrete-summit
+realisations are the project's extension beyond the paper: each claim reports them beside its
+verdict (``single_surfaces``: the fraction that holds, its Wilson interval, the mechanism where it
+departs), never as a reason it passes or fails.
+
+Each reproduction entry records whose threshold it applies (``threshold_source``, ``sources``).
 """
 from __future__ import annotations
 
 import math
 
 from ..output.proportions import wilson_interval
+from .sources import threshold_source
 
 PASS, FAIL, NOT_EVALUABLE = "pass", "fail", "not_evaluable"
 VERIFICATION, REPRODUCTION = "verification", "reproduction"
@@ -54,6 +62,8 @@ def entry(name: str, set_name: str, kind: str, values: dict, threshold: str, mar
     out = {"name": name, "set": set_name, "kind": kind, "state": state, "pass": state == PASS,
            "margin": _finite_or_none(margin), "tolerance": tolerance, "units": units, "threshold": threshold,
            "values": values}
+    if kind == REPRODUCTION:
+        out["threshold_source"] = threshold_source(name)
     if reason is not None:
         out["reason"] = reason
     return out
@@ -72,8 +82,9 @@ def _finite_or_none(x):
 
 
 def over_samples(nominal: dict, sample_states: list[str], sources: dict, bands: dict | None = None) -> dict:
-    """A reproduction entry judged over its samples: the nominal run plus `sample_states` (one state per
-    seed or uncertainty sample). `sources` says what was sampled ({'seeds': n, 'uncertainty': n, ...})."""
+    """A reproduction entry judged over its samples on the paper's model: the nominal run plus `sample_states` (one
+    state per uncertainty row, each on the averaged law). `sources` says what was sampled ({'uncertainty': n, ...});
+    without rows the verdict is the nominal run's."""
     states = [nominal["state"]] + list(sample_states)
     held = states.count(PASS)
     decided = held + states.count(FAIL)
