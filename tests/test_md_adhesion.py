@@ -470,7 +470,8 @@ def test_protocol_options_at_their_neutral_values_leave_the_run_hash_alone(name)
         base = r.canonical_sha256(fid)
         assert _recipe(name, fid, registry_sampling="rank1", pmf_return=False).canonical_sha256(fid) == base
         for key, value in (("registry_sampling", "primitive"), ("registry_contact_steps", 1000),
-                           ("sam_anneal_steps", 1000), ("pmf_return", True), ("pmf_extra_windows_A", [2.3])):
+                           ("sam_anneal_steps", 1000), ("pmf_return", True), ("pmf_extra_windows_A", [2.3]),
+                           ("sam_stress", True)):
             assert _recipe(name, fid, **{key: value}).canonical_sha256(fid) != base, (key, fid)
 
 
@@ -520,6 +521,21 @@ def test_sam_anneal_leg_runs_the_separated_pair_before_the_contact(tmp_path):
     (tmp_path / "n").mkdir()
     _, plan0 = _plan("adhesion_ots", "quick", tmp_path / "n")
     assert plan0.legs[0].name == "contact" and "read_data" in " ".join(plan0.legs[0].fresh(tmp_path / "n"))
+
+
+def test_sam_stress_samples_the_sam_atoms_summed_stress_in_every_leg(tmp_path):
+    """sam_stress: the group of both SAMs' atoms, a stress/atom compute summed over it, and its xx, yy, zz columns
+    in every leg (the compression windows' C13/C33); off (the default): none of it."""
+    from md.workflows.adhesion_legs import SAM_STRESS_COLUMNS, SAM_STRESS_LINES
+    s, plan = _plan("adhesion_ots", "quick", tmp_path, sam_stress=True)
+    for leg in plan.legs:
+        define = leg.define(0)
+        assert all(line in define for line in SAM_STRESS_LINES), leg.name
+        assert all(leg.columns[c].startswith("c_sam_stress[") for c in SAM_STRESS_COLUMNS)
+    assert any(c.startswith("group sam_layers id") for c in plan.legs[0].fresh(tmp_path / "x"))
+    (tmp_path / "n").mkdir()
+    _, plan0 = _plan("adhesion_ots", "quick", tmp_path / "n")
+    assert not any("sam_stress" in c for c in plan0.legs[0].define(0)) and "sam_szz" not in plan0.legs[0].columns
 
 
 @pytest.mark.parametrize("name", ["adhesion_silica", "adhesion_ots"])

@@ -89,11 +89,12 @@ def test_sam_thickness_counts_every_sam_between_the_slabs():
 
 # ------------------------------------------------------------- the adhesion workflow's conclude on synthetic windows
 
-def _adhesion_ctx(recipe: str, curve, registry_scale=(1.0, 1.0), noise=0.3, drift=0.0, seed=0):
+def _adhesion_ctx(recipe: str, curve, registry_scale=(1.0, 1.0), noise=0.3, drift=0.0, seed=0, stress=None):
     """A stand-in for the engine's context of an adhesion run at quick fidelity: the committed result's system
     record (its slabs, area, SAM thicknesses) without the dispersion tail, registry r's windows sampled from
     registry_scale[r] x curve(d) with white noise (and a linear drift over each window), contact and separated
-    energies 10 kcal/mol apart."""
+    energies 10 kcal/mol apart. ``stress`` (d -> (sxx, syy, szz), atm A^3): the SAM atoms' summed stress columns
+    (with white noise of 1 % of the largest)."""
     import json
     import types
     from md.recipe import load_recipe
@@ -116,7 +117,12 @@ def _adhesion_ctx(recipe: str, curve, registry_scale=(1.0, 1.0), noise=0.3, drif
         _, reg, suf = leg.split("_")
         d = nominal[suf]
         fz = registry_scale[int(reg[1:])] * curve(d) + rng.normal(0, noise, n) + drift * np.linspace(-1, 1, n)
-        return {**flat, "fz": fz, "z_back": np.full(n, zc + d), "pe": np.zeros(n)}
+        out = {**flat, "fz": fz, "z_back": np.full(n, zc + d), "pe": np.zeros(n)}
+        if stress is not None:
+            sig = stress(d)
+            scale = 0.01 * max(abs(x) for x in stress(-4.0))
+            out.update({k: v + rng.normal(0, scale, n) for k, v in zip(("sam_sxx", "sam_syy", "sam_szz"), sig)})
+        return out
 
     ctx = types.SimpleNamespace(settings=settings, samples=samples, run_dir=None,
                                 plan=types.SimpleNamespace(system_info=info, timestep_fs=1.0, legs=[]),
@@ -238,3 +244,23 @@ def test_plane_strain_modulus_at_fixed_confined_modulus_and_the_nu_spread():
     ep = lambda nu: (1 - 2 * nu) / (1 - nu) ** 2
     assert s["ratio_min"] == pytest.approx(ep(0.45) / ep(0.3)) and s["ratio_max"] == pytest.approx(ep(0.25) / ep(0.3))
     assert s["nu_stderr"] == pytest.approx(0.2 / math.sqrt(12)) and 0.1 < s["relative_stderr"] < 0.6
+
+
+def test_adhesion_conclude_measures_the_layers_poisson_ratio_from_its_own_stress_and_the_tangent_modulus():
+    """OTS/OTS windows of a linear branch whose SAM stress is that of an isotropic layer with nu = 0.38 under
+    uniaxial strain (lateral = nu/(1 - nu) x normal, compression below d = 0): the workflow reports nu within its
+    stderr and C13/C33 = nu/(1 - nu); for a linear branch the small-strain tangent equals the chord (no anneal in
+    this context: the builder's thickness). Without the stress columns: no Poisson ratio (negative control)."""
+    nu = 0.38
+    stress = lambda d: (nu / (1 - nu) * 2e6 * min(d, 0.0), nu / (1 - nu) * 2e6 * min(d, 0.0), 2e6 * min(d, 0.0))
+    wf, ctx = _adhesion_ctx("adhesion_ots", _spring_and_well(40.0), registry_scale=(1.0, 1.0), stress=stress)
+    an = wf.analyse(ctx)
+    pr = an.quantities["sam_poisson_ratio"]
+    assert abs(pr["value"] - nu) <= 3 * pr["stderr"] and pr["stderr"] < 0.02
+    assert pr["c13_over_c33"] == pytest.approx(nu / (1 - nu), abs=3 * pr["c13_over_c33_stderr"])
+    tg, chord = an.quantities["sam_layer_tangent_modulus"], an.quantities["sam_layer_modulus"]
+    assert abs(tg["value"] - chord["value"]) <= 3 * tg["stderr"]
+    info = ctx.plan.system_info
+    assert tg["thickness_m"] == pytest.approx((info["lower"]["thickness_A"] + info["upper"]["thickness_A"]) * 1e-10)
+    wf2, ctx2 = _adhesion_ctx("adhesion_ots", _spring_and_well(40.0), registry_scale=(1.0, 1.0))
+    assert "sam_poisson_ratio" not in wf2.analyse(ctx2).quantities

@@ -33,7 +33,8 @@ from md.analysis.adhesion import (force_integration_work, registry_average, regi
                                   hysteresis)
 from md.analysis.layer_modulus import (confined_layer_modulus, sam_layer_thickness_A, young_from_confined,
                                       tangent_confined_modulus, thickness_at_tilt_A, stress_ratio_poisson,
-                                      plane_strain_from_confined, poisson_spread)
+                                      plane_strain_from_confined, poisson_spread, tilt_of_anneal,
+                                      small_strain_layer_record)
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
                                        work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
@@ -54,7 +55,8 @@ __all__ = [
     "timeseries_stats", "student_t_factor",
     "chain_correlation", "window_length_check", "entropic_term", "grid_interval_bounds", "hysteresis",
     "confined_layer_modulus", "sam_layer_thickness_A", "young_from_confined", "tangent_confined_modulus",
-    "thickness_at_tilt_A", "stress_ratio_poisson", "plane_strain_from_confined", "poisson_spread",
+    "thickness_at_tilt_A", "stress_ratio_poisson", "plane_strain_from_confined", "poisson_spread", "tilt_of_anneal",
+    "small_strain_layer_record",
     "force_integration_work", "registry_average", "registry_consistency", "traction_peak", "flat_slab_range",
     "lj_tail_between",
     "MAUGIS_LJ93",

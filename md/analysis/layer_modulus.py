@@ -43,7 +43,8 @@ import numpy as np
 from md import units as _units
 
 __all__ = ["confined_layer_modulus", "sam_layer_thickness_A", "young_from_confined", "tangent_confined_modulus",
-           "thickness_at_tilt_A", "stress_ratio_poisson", "plane_strain_from_confined", "poisson_spread"]
+           "thickness_at_tilt_A", "stress_ratio_poisson", "plane_strain_from_confined", "poisson_spread",
+           "tilt_of_anneal", "small_strain_layer_record"]
 
 #: fewest repulsive windows for a line with a degree of freedom to spare (two fix it exactly)
 MIN_WINDOWS_CHECKED = 3
@@ -214,7 +215,7 @@ def thickness_at_tilt_A(height_of_tilt, tilt_deg: float, tilt_spread_deg: float,
     h = 0.25
     slope = (height_of_tilt(min(th + h, 89.9)) - height_of_tilt(max(th - h, 0.0))) / (min(th + h, 89.9)
                                                                                    - max(th - h, 0.0))
-    return layers * float(height_of_tilt(th)), layers * abs(slope) * sp
+    return layers * float(height_of_tilt(th)), float(layers * abs(slope) * sp)
 
 
 def stress_ratio_poisson(separation_A, sigma_lateral_Pa, sigma_normal_Pa, sigma_lateral_stderr_Pa,
@@ -284,3 +285,39 @@ def poisson_spread(nu_low: float, nu_high: float, nu_used: float, n: int = 2001)
     ratio = (1.0 - 2.0 * nus) / (1.0 - nus) ** 2 / ((1.0 - 2.0 * nu0) / (1.0 - nu0) ** 2)
     return {"relative_stderr": float(np.sqrt(np.mean((ratio - 1.0) ** 2))), "ratio_min": float(ratio.min()),
             "ratio_max": float(ratio.max()), "nu_mean": 0.5 * (lo + hi), "nu_stderr": (hi - lo) / math.sqrt(12.0)}
+
+
+def tilt_of_anneal(mean_tilt_deg) -> tuple[float, float] | None:
+    """(mean, standard deviation) in deg of a SAM anneal's mean-tilt series over its second half (the first half is
+    the relaxation, md.workflows.adhesion_protocol.anneal_record); None for fewer than four frames. The standard
+    deviation, not the stderr of the mean, is the spread: the tilt the compression windows start from is one draw
+    of it."""
+    t = np.asarray(mean_tilt_deg, float).ravel()
+    t = t[np.isfinite(t)]
+    if t.size < 4:
+        return None
+    half = t[t.size // 2:]
+    return float(np.mean(half)), float(np.std(half, ddof=1))
+
+
+def small_strain_layer_record(separation_A, force_kcal_per_molA, stderr_kcal_per_molA, area_A2: float,
+                              system_info: dict, tilt_deg: tuple[float, float] | None, height_of_tilt) -> dict:
+    """The SAM stack's small-strain confined modulus as a contact model needs it: the tangent at the zero-force
+    point (:func:`tangent_confined_modulus`) normalised by the annealed thickness (:func:`thickness_at_tilt_A` at
+    the anneal's mean tilt, ``tilt_deg`` = (mean, spread) or None for the builder's thickness), with the thickness
+    spread carried into the stderr. ``height_of_tilt`` is the builder's CH3 height at a tilt (one SAM). Returns
+    ``modulus_Pa``, ``stderr_Pa`` (fit and thickness in quadrature), ``thickness_A`` (all layers) and its stderr,
+    ``thickness_per_layer_m``, ``layers``, ``thickness_source``, and the tangent record under ``tangent``.
+    ValueError where :func:`sam_layer_thickness_A` or the tangent fails."""
+    t_built, layers = sam_layer_thickness_A(system_info)
+    if tilt_deg is not None:
+        t, t_err = thickness_at_tilt_A(height_of_tilt, tilt_deg[0], tilt_deg[1], layers)
+        source = (f"annealed: {layers} x the builder's all-trans CH3 height at the anneal's mean tilt "
+                  f"{tilt_deg[0]:.1f} +- {tilt_deg[1]:.1f} deg (second half)")
+    else:
+        t, t_err, source = t_built, 0.0, "the builder's (as-built tilt; no anneal)"
+    tg = tangent_confined_modulus(separation_A, force_kcal_per_molA, stderr_kcal_per_molA, area_A2, t)
+    m = tg["modulus_Pa"]
+    return {"modulus_Pa": m, "stderr_Pa": math.hypot(tg["stderr_Pa"], m * t_err / t), "stderr_fit_Pa": tg["stderr_Pa"],
+            "thickness_A": t, "thickness_stderr_A": t_err, "thickness_per_layer_m": t / layers * 1e-10,
+            "builder_thickness_A": t_built, "layers": layers, "thickness_source": source, "tangent": tg}

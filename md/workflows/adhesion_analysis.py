@@ -14,7 +14,8 @@ from md import analysis as A
 from md import units as U
 from md.engine.plan import Analysis
 from md.workflows import adhesion_protocol as P
-from md.workflows.adhesion_legs import MIN_WINDOW_NEFF, TAIL_R_MAX_A
+from md.build.sam import chain_geometry
+from md.workflows.adhesion_legs import MIN_WINDOW_NEFF, SAM_STRESS_COLUMNS, TAIL_R_MAX_A
 from md.workflows.common import ENERGY_NOT_FREE_ENERGY, figure_writer, quantity_record
 
 if TYPE_CHECKING:                      # the workflow class imports this module
@@ -45,6 +46,8 @@ class _AdhesionAnalysis:
         # mean force of the first and the second half of each window's equilibrated samples (those after the
         # detected start t0, as the mean itself)
         self.halves = np.full((2,) + shape, np.nan)
+        # with sam_stress: the SAM atoms' summed xx, yy, zz stress per window (mean and stderr)
+        self.sam_sig, self.sam_sig_e = np.full((3,) + shape, np.nan), np.full((3,) + shape, np.nan)
         for r in range(self.n_reg):
             for k, suf in enumerate(self.suffixes):
                 self._single_window(r, k, suf)
@@ -147,6 +150,10 @@ class _AdhesionAnalysis:
         st = A.timeseries_stats(win["fz"])
         self.d_A[r, k] = float(np.mean(win["z_back"])) - self.zc
         self.f_m[r, k], self.f_e[r, k], self.g_w[r, k], self.neff_w[r, k] = st["mean"], st["stderr"], st["g"], st["n_eff"]
+        if SAM_STRESS_COLUMNS[0] in win:
+            for c, col in enumerate(SAM_STRESS_COLUMNS):
+                ss = A.timeseries_stats(win[col])
+                self.sam_sig[c, r, k], self.sam_sig_e[c, r, k] = ss["mean"], ss["stderr"]
         fz = np.asarray(win["fz"], float)[int(st["t0"]):]     # the samples the mean uses (after t0)
         if fz.size >= 2:
             self.halves[0, r, k], self.halves[1, r, k] = np.mean(fz[:fz.size // 2]), np.mean(fz[fz.size // 2:])
@@ -157,6 +164,7 @@ class _AdhesionAnalysis:
         self.d_A, self.f_m, self.f_e, self.g_w, self.neff_w = (a[:, order] for a in (self.d_A, self.f_m, self.f_e,
                                                                                      self.g_w, self.neff_w))
         self.halves = self.halves[:, :, order]
+        self.sam_sig, self.sam_sig_e = self.sam_sig[:, :, order], self.sam_sig_e[:, :, order]
         self.suffixes = [self.suffixes[i] for i in order]
         self.dsep = self.d_A.mean(axis=0)
         avg = A.registry_average(self.f_m, self.f_e)
@@ -164,11 +172,11 @@ class _AdhesionAnalysis:
         self.estat = np.asarray(avg["stderr_statistical"])
         self._tail_forces()
         self._free_energy()
-        self._flat_slab_law()
         self._layer_modulus()
         self._window_checks()
         if self.s.pmf_return:
             P.return_path(self, self.wf.return_chain(self.s))
+        self._flat_slab_law()
         self.tail_det.update(tail_energy_last_window_kcal=self.u_tail_last)
         self.details["dispersion_tail"] = self.tail_det
         pmf = self.ti["pmf_J_per_m2"]
@@ -246,14 +254,19 @@ class _AdhesionAnalysis:
                                                 "the last window")
 
     def _flat_slab_law(self) -> None:
-        """z0 and sigma0 from the flat-slab curve (peak traction, Maugis range) and an LJ 9-3 fit beside them."""
+        """z0 and sigma0 from the flat-slab curve (peak traction, Maugis range) and an LJ 9-3 fit beside them. z0 =
+        1.026 W_F / sigma0 takes the W_F the result reports (with a return chain: the out/back mean, its error with
+        half the hysteresis), the same W the continuum's dgamma is, so that its Maugis-Dugdale stress 1.03 dgamma /
+        z0 is the measured sigma0 (sigma0 itself from the outward curve)."""
         dsep, f_tot, ebar, area, conv, q = self.dsep, self.f_tot, self.ebar, self.area, self.conv, self.q
         zsig: dict[str, Any] = {}
+        rec = q["work_of_adhesion_free_energy"]
+        w_used = float(rec["value"])
+        w_err = math.hypot(float(rec["stderr"]), self.wf_disc, float(rec.get("systematic_hysteresis") or 0.0))
         try:
             pk = A.traction_peak(dsep, f_tot, ebar, area)
             pk_disc = pk["discretisation_error"] if np.isfinite(pk["discretisation_error"]) else 0.0
-            rng = A.flat_slab_range(self.wf_val, math.hypot(self.wf_err, self.wf_disc), pk["sigma0"],
-                                    math.hypot(pk["stderr"], pk_disc))
+            rng = A.flat_slab_range(w_used, w_err, pk["sigma0"], math.hypot(pk["stderr"], pk_disc))
             q["peak_traction_sigma0"] = quantity_record(pk["sigma0"], pk["stderr"], "Pa",
                                            kind=f"maximum tensile traction of the flat-slab mean-force curve "
                                                 f"({pk['method']}: the vertex of the quadratic through the three "
@@ -262,7 +275,8 @@ class _AdhesionAnalysis:
                                            separation_m=U.angstrom_to_m(pk["separation_A"]))
             q["interaction_range_z0"] = quantity_record(rng["z0"], rng["stderr"], "m",
                                            kind="z0 = 1.026 W_F / sigma0 (Maugis 1992, LJ 9-3 law), from the "
-                                                "flat-slab mean-force curve", dugdale_range_h0_m=rng["h0"])
+                                                "flat-slab mean-force curve, W_F the value this result reports",
+                                           dugdale_range_h0_m=rng["h0"], work_of_adhesion_used=w_used)
             zsig.update(peak=pk, z0=rng)
         except ValueError as exc:
             zsig["error"] = str(exc)
@@ -302,6 +316,59 @@ class _AdhesionAnalysis:
         self.details["sam_layer_modulus"] = lm
         if lm["note"]:
             self.notes.append(f"SAM layer modulus: {lm['note']}.")
+        self._small_strain_modulus()
+        self._layer_poisson(lm["separation_A"])
+
+    def _small_strain_modulus(self) -> None:
+        """The tangent confined modulus at the zero-force point, normalised by the annealed thickness (the anneal's
+        mean tilt, the builder's chain at that tilt): what a contact at small load sees (md.analysis.
+        small_strain_layer_record). Fewer than four repulsive windows: a note, nothing else."""
+        tilt = A.tilt_of_anneal((self.details.get("anneal") or {}).get("mean_tilt_deg") or [])
+        n = int(self.s.chain_length)
+        try:
+            rec = A.small_strain_layer_record(self.dsep, self.f_tot, self.ebar, self.area, self.info, tilt,
+                                              lambda th: float(chain_geometry(n, th)[0][-1][2]))
+        except ValueError as exc:
+            self.notes.append(f"SAM small-strain modulus not measured: {exc}")
+            return
+        tg = rec["tangent"]
+        self.q["sam_layer_tangent_modulus"] = quantity_record(
+            rec["modulus_Pa"], rec["stderr_Pa"], "Pa",
+            kind=f"confined modulus of the SAM stack at small strain: the tangent at the zero-force point of a "
+                 f"weighted quadratic through the {tg['windows']} repulsive windows, t = {rec['thickness_A']:.1f} A "
+                 f"({rec['thickness_source']}); stderr: fit and thickness", thickness_m=rec["thickness_A"] * 1e-10,
+            thickness_stderr_m=rec["thickness_stderr_A"] * 1e-10, thickness_per_layer_m=rec["thickness_per_layer_m"],
+            layers=rec["layers"], chord_modulus_Pa=tg["chord_modulus_Pa"], curvature_delta_chi2=tg["curvature_delta_chi2"],
+            windows=tg["windows"], strain_max=tg["strain_max"])
+        self.details["sam_layer_tangent_modulus"] = {k: v for k, v in rec.items() if k != "tangent"} | {"tangent": tg}
+
+    def _layer_poisson(self, branch_A) -> None:
+        """With ``sam_stress``: the SAM stack's C13/C33 and Poisson ratio from its own stress in the compression
+        windows (the same repulsive windows as the modulus; registry-averaged lateral (xx + yy)/2 and normal zz
+        stress, md.analysis.stress_ratio_poisson). Without the columns: nothing."""
+        if not np.isfinite(self.sam_sig).any():
+            return
+        sel = np.isin(self.dsep, np.asarray(branch_A, float))
+        if sel.sum() < 3:
+            self.notes.append(f"SAM Poisson ratio not measured: {int(sel.sum())} compression windows (needs three)")
+            return
+        vol = self.area * A.sam_layer_thickness_A(self.info)[0]          # A^3: stress x volume -> stress
+        to_pa = lambda a: U.atm_to_Pa(np.asarray(a, float)) / vol
+        avg = [A.registry_average(self.sam_sig[c][:, sel], self.sam_sig_e[c][:, sel]) for c in range(3)]
+        lat = 0.5 * (np.asarray(avg[0]["mean"]) + np.asarray(avg[1]["mean"]))
+        lat_e = 0.5 * np.hypot(avg[0]["stderr"], avg[1]["stderr"])
+        try:
+            pr = A.stress_ratio_poisson(self.dsep[sel], to_pa(lat), to_pa(avg[2]["mean"]), to_pa(lat_e),
+                                        to_pa(avg[2]["stderr"]))
+        except ValueError as exc:
+            self.notes.append(f"SAM Poisson ratio not measured: {exc}")
+            return
+        self.q["sam_poisson_ratio"] = quantity_record(
+            pr["poisson_ratio"], pr["poisson_ratio_stderr"], "",
+            kind="Poisson ratio of the isotropic layer with the SAM stack's measured C13/C33 = nu / (1 - nu), from "
+                 "the SAM atoms' own stress tensor in the compression windows (uniaxial strain)",
+            c13_over_c33=pr["c13_over_c33"], c13_over_c33_stderr=pr["c13_over_c33_stderr"], windows=pr["windows"])
+        self.details["sam_poisson_ratio"] = pr
 
     def _window_checks(self) -> None:
         """Windows with few independent samples, registries that disagree beyond their stderrs, the window-length

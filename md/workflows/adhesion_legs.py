@@ -39,6 +39,12 @@ TAIL_FRAMES_CONTACT = 5
 TAIL_FRAMES_WINDOW = 2
 #: a window with fewer effectively independent force samples than this is flagged
 MIN_WINDOW_NEFF = 10
+#: with ``sam_stress``: the SAM atoms' per-atom stress (LAMMPS compute stress/atom: minus the per-atom pressure
+#: tensor times volume, atm A^3 in real units; pair virials split half and half between the two atoms, kspace and
+#: bonded terms included), summed over the group ``sam_layers`` (both SAMs), and the sampled columns
+SAM_STRESS_LINES = ["compute sam_sa sam_layers stress/atom NULL",
+                    "compute sam_stress sam_layers reduce sum c_sam_sa[1] c_sam_sa[2] c_sam_sa[3]"]
+SAM_STRESS_COLUMNS = ("sam_sxx", "sam_syy", "sam_szz")
 
 
 class _AdhesionLegs:
@@ -72,8 +78,12 @@ class _AdhesionLegs:
         if len(self.axes):
             self.groups["chain_axes"] = np.unique(self.axes)
         si = s.sample_interval
-        self.base = dict(define=None, restart_head=restart_header_lines(s),
-                         columns={"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_back": "v_zback"},
+        columns = {"pe": "v_pe", "temp": "v_temp", "fz": "c_gg[3]", "z_back": "v_zback"}
+        self.sam_stress = bool(s.sam_stress) and "sam" in system.groups and len(system.group("sam")) > 0
+        if self.sam_stress:       # the SAM atoms' summed per-atom stress (pressure x volume): the layer's C13/C33
+            self.groups["sam_layers"] = system.group("sam")
+            columns.update({k: f"c_sam_stress[{i}]" for i, k in enumerate(SAM_STRESS_COLUMNS, start=1)})
+        self.base = dict(define=None, restart_head=restart_header_lines(s), columns=columns,
                          sample_interval=si, chunk_steps=s.chunk_steps, n_atoms=system.n_atoms)
         self.sample = Stage("sample", steps_of(s.sample_steps, si))
 
@@ -90,7 +100,7 @@ class _AdhesionLegs:
                 "neigh_modify exclude group upper_back upper_back",
                 "fix hold_lower lower_fixed setforce 0.0 0.0 0.0",
                 "compute gg upper group/group lower kspace yes",
-                "variable zback equal xcm(upper_back,z)"]
+                "variable zback equal xcm(upper_back,z)"] + (SAM_STRESS_LINES if self.sam_stress else [])
             if upper_free:      # one rigid body moving along z only, zero load: the contact finds its gap
                 cmds += [_BACK_RIGID]
             else:
