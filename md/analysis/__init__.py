@@ -44,7 +44,7 @@ from md.analysis.drift import block_drift
 from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
                                      angle_from_work_of_adhesion_sl, tether_correction,
                                      film_lower_dividing_plane)
-from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
+from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation, paired_speed_extrapolation
 from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
                                detect_equilibration, timeseries_stats, student_t_factor)
 from md.analysis.surface_tension import surface_tension, lj_tail_correction, density_profile, slab_density
@@ -66,4 +66,5 @@ __all__ = [
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
     "gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
     "tether_correction", "film_lower_dividing_plane", "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
+    "paired_speed_extrapolation",
 ]
