@@ -93,13 +93,15 @@ _PULLOFF_Z0 = ("fallback: the adhesion result has no flat-slab z0; this z0 is a 
                "overestimate)")
 
 _DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this is the droplet's angle, and the quick "
-            "silica droplet keeps the angle it is started at (pinned contact line: 18 deg from a 20 deg start, 39 deg "
-            "from 40 deg), so it measures the start, not the surface")
+            "silica droplet keeps the angle it is started at (a pinned contact line: the committed contact_angle_silica "
+            "and contact_angle_silica_flatstart results end near their different starting angles), so it measures "
+            "the start, not the surface")
 
 _DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the quick R0 = 2 nm droplet's "
-                "angle after 60 ps (116.8 deg); sampled 150 ps, R0 = 2 nm reads 118.2 +- 0.8 and R0 = 3 nm "
-                "111.4 +- 3.1 deg, 2.1 sigma apart, so take +-4 deg for the droplet size (contact-angle version 4: "
-                "docs/md.md)")
+                "angle, which is not size-converged (the committed contact_angle_ots_long and "
+                "contact_angle_ots_large results, R0 = 2 and 3 nm, differ by about 2 sigma, so take +-4 deg for the "
+                "droplet size; docs/md.md, contact-angle "
+                "version 4)")
 
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica_registries",
