@@ -505,7 +505,35 @@ def _calibration_entry(src: Source, res: dict, qname: str, value: float, stderr,
             entry["energy_estimate"] = {"value": de["value"], "stderr": de.get("stderr"),
                                         "note": "dE/A, potential-energy difference (includes T dS/A); "
                                                 "recorded, not used"}
+            spread = _registry_energy_check(res)
+            if spread is not None:
+                entry["energy_estimate"].update(spread)
     return entry
+
+
+def _registry_energy_check(res: dict) -> dict | None:
+    """Whether the registries' own dE/A (each zero-load contact: registry 0 the contact leg, the others
+    details.registry_contacts) agree within their stderrs (md.analysis.registry_consistency: p < 0.01 = disagree).
+    Where they disagree, dE/A and T dS = dE - dF are not converged (the per-registry values in ``per_registry``).
+    None with fewer than two registries."""
+    from md.analysis import registry_consistency
+
+    q, contacts = res.get("quantities") or {}, (res.get("details") or {}).get("registry_contacts") or {}
+    de = q.get("work_of_adhesion") or {}
+    vals = [(de.get("value"), de.get("stderr"))] + [(c.get("energy_work_J_m2"), c.get("stderr_J_m2"))
+                                                    for c in contacts.values()]
+    vals = [(float(v), float(e)) for v, e in vals if v is not None and e]
+    if len(vals) < 2:
+        return None
+    v, e = np.array(vals).T
+    cons = registry_consistency(v[:, None], e[:, None])
+    bad = bool(np.asarray(cons["inconsistent"])[0])
+    out = {"per_registry": v.tolist(), "per_registry_stderr": e.tolist(),
+           "registry_chi2_per_dof": float(np.asarray(cons["chi2_per_dof"])[0]), "registries_agree": not bad}
+    if bad:
+        out["note_registries"] = ("NOT CONVERGED: the registries' dE/A disagree beyond their stderrs (chi^2 p < 0.01), "
+                                  "so dE/A and T dS = dE - dF are not converged numbers")
+    return out
 
 
 def _angle_flags(entry: dict, src: Source, res: dict, qname: str) -> None:

@@ -147,3 +147,19 @@ def test_the_sam_thickness_is_the_annealed_one_and_a_measured_nu_replaces_the_ch
     rel_nu = abs(-2 / 0.2 + 2 / 0.6) * 0.02
     rel_m = cal2["confined_modulus"]["stderr"] / cal2["confined_modulus"]["value"]
     assert cal2["stderr"] == pytest.approx(sam2["layer_modulus"] * math.hypot(rel_m, rel_nu), rel=1e-9)
+
+
+def test_de_and_tds_are_marked_unconverged_where_the_registries_energies_disagree():
+    """Registry 0's dE/A 0.081 +- 0.017 and registries 1, 2 at 0.139 +- 0.004 and 0.111 +- 0.004 (the committed
+    OTS pattern): chi^2 p < 0.01, the entry says NOT CONVERGED; three registries within their errors: agree."""
+    res = _ots(work_of_adhesion={"value": 0.081, "stderr": 0.017, "units": "J/m^2"})
+    res["details"] = {"registry_contacts": {"1": {"energy_work_J_m2": 0.139, "stderr_J_m2": 0.0043},
+                                            "2": {"energy_work_J_m2": 0.111, "stderr_J_m2": 0.0044}}}
+    cal = build_parameter_set({OTS: res}, "paper", "cal")[0]["meta"]["calibration"]["surfaces.sam.work_of_adhesion"]
+    ee = cal["energy_estimate"]
+    assert ee["registries_agree"] is False and "NOT CONVERGED" in ee["note_registries"]
+    assert ee["per_registry"] == [0.081, 0.139, 0.111]
+    res["details"]["registry_contacts"] = {"1": {"energy_work_J_m2": 0.085, "stderr_J_m2": 0.005},
+                                           "2": {"energy_work_J_m2": 0.079, "stderr_J_m2": 0.005}}
+    cal = build_parameter_set({OTS: res}, "paper", "cal")[0]["meta"]["calibration"]["surfaces.sam.work_of_adhesion"]
+    assert cal["energy_estimate"]["registries_agree"] is True and "note_registries" not in cal["energy_estimate"]

@@ -238,12 +238,19 @@ class _AdhesionAnalysis:
             discretisation_error=self.wf_disc, value_pchip=self.wf_pchip, repulsive_end=self.repulsive,
             registry_spread=float(np.std(self.w_reg, ddof=1)) if n_reg >= 2 else 0.0, registries=n_reg)
         regs = self.tds_rec["registries"]
+        e_check = A.registry_consistency(np.array([[v[0]] for v in e_reg.values()]),
+                                         np.array([[v[1]] for v in e_reg.values()])) if len(e_reg) >= 2 else None
+        self.energy_registries_agree = e_check is None or not bool(np.asarray(e_check["inconsistent"])[0])
+        if not self.energy_registries_agree:
+            self.notes.append("dE/A and T dS NOT CONVERGED: the registries' own dE/A (each zero-load contact) disagree "
+                              "beyond their stderrs (chi^2 p < 0.01); their mean is no converged number")
         q["entropic_term_TdS"] = quantity_record(
             self.tds, self.tds_err, "J/m^2", discretisation_error=self.wf_disc,
             kind="T dS / A = (dE - dF) / A of registry 0: dE/A from the zero-load contact leg (registry 0) and W_F of "
                  "registry 0's own chain" if regs == [0] else
                  f"T dS / A = (dE - dF) / A averaged over registries {regs}, each from its own zero-load contact leg "
                  "and its own chain's W_F",
+            converged=self.energy_registries_agree,
             **({"registry": 0} if regs == [0] else {"registries": regs,
                                                    "per_registry": {str(r): v for r, v in
                                                                     self.tds_rec["per_registry"].items()}}))
