@@ -24,7 +24,7 @@ from md.analysis import poisson_spread, small_strain_layer_record, tilt_of_annea
 from md.build.sam import chain_geometry
 
 #: where an unmeasured layer Poisson ratio may lie (a declared choice, docs/md.md "SAM layer modulus"): glassy
-#: polymers 0.3-0.4 and chain-molecule solids up to ~0.45 (md-review-3 F2f, from memory); 0.25 below them
+#: polymers 0.3-0.4 and chain-molecule solids up to ~0.45 (a reviewer's estimate, unchecked); 0.25 below them
 NU_UNMEASURED = (0.25, 0.45)
 
 LAYER_QUANTITIES = ("sam_layer_tangent_modulus",)

@@ -12,7 +12,7 @@ Rate. Each pull-off ran at two retraction speeds at every tip position (paired: 
 held contact). The force at the slowest speed is rate-inflated; the entry gives the force extrapolated position by
 position (md.analysis.paired_speed_extrapolation) with its Student-t stderr over the positions: linear in v to v ->
 0 (a viscous excess force; the quasi-static limit the DMT comparison needs), and beside it linear in ln v
-(Bell-Evans) at 10 m/s, the slowest speed issue 44 asks for, which is not run (its recipes are staged:
+(Bell-Evans) at 10 m/s, the slowest staged speed, which is not run (its recipes are staged:
 docs/md.md, "Pull-off rate"). With two speeds neither model is tested by the data.
 
 DMT. F = 2 pi R W is the small-Tabor-parameter limit (Derjaguin, Muller & Toporov 1975); Tabor's mu
@@ -35,7 +35,7 @@ from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
 VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"),
               ("pulloff_ots_positions", "adhesion_ots_equilibrated"))
 
-#: the slowest speed issue 44 asks the pull-offs to reach (m/s), where the Bell-Evans line is evaluated
+#: the slowest staged pull-off speed (m/s; pulloff_*_slow), where the Bell-Evans line is evaluated
 SLOWEST_ASKED_M_S = 10.0
 
 
@@ -93,7 +93,7 @@ def rate_extrapolation(pull: dict) -> dict:
     out["note"] = ("per tip position a line through its forces at the speeds, evaluated at the target; mean over "
                    "positions, stderr = spread / sqrt(n) x Student t. linear_v0: F linear in v, v -> 0 (viscous "
                    "excess force, the quasi-static estimate used for the ratio); log_at_10: F linear in ln v "
-                   "(Bell-Evans) at 10 m/s. The 20 and 10 m/s pulls issue 44 asks for are NOT run (recipes staged, "
+                   "(Bell-Evans) at 10 m/s. The staged 20 and 10 m/s pulls are NOT run (recipes staged, "
                    "docs/md.md): with two speeds the models are not tested")
     return out
 
