@@ -70,7 +70,7 @@ from nanoimpact.fileio import atomic_write_text
 
 from calibration.sam_layer import (LAYER_QUANTITIES, THICKNESS_QUANTITIES, thickness_record, with_layer_quantities,
                                    young_with_nu)
-from calibration.validation import VALIDATION, pulloff_validation  # noqa: F401 (re-exported)
+from calibration.validation import VALIDATION, pulloff_validation
 
 #: Committed MD results shipped with the package (inputs/md/results, installed as package data).
 RESULTS_DIR = data.shipped_root() / "md" / "results"

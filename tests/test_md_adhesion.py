@@ -60,7 +60,8 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
     """The generated commands: window 0 of every registry starts from the contact leg's last restart, moved
     laterally to the registry's offset; each further window reads its neighbour's last restart and moves the upper
     slab by the difference of the nominal separations -- inwards (compression) and outwards."""
-    from md.workflows.adhesion import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, Adhesion, _registry_offsets
+    from md.workflows.adhesion import Adhesion
+    from md.workflows.adhesion_legs import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, _registry_offsets
     s = _settings("adhesion_silica", "quick")
     wf = Adhesion()
     plan = wf.plan(s, tmp_path)
@@ -115,7 +116,8 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
 def test_dispersion_tail_applies_to_trappe_pairs_only():
     """'trappe': every pair with a CH2/CH3 united atom (OTS-OTS, silica-OTS, water-OTS), never an IFF-IFF pair;
     the OTS head Si (IFF LJ) pairs with silica keep the cutoff."""
-    from md.workflows.adhesion import TRAPPE_UA, _tail_pair_table
+    from md.workflows.adhesion_legs import _tail_pair_table
+    from md.workflows.common import TRAPPE_UA
     from md.workflows.common import forcefield_of
     ff = forcefield_of(["silica_interface", "ots_trappe_ua", "water_spce"])
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")
@@ -260,7 +262,7 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     from md.lammps_loader import new_lammps
     from md.engine.plan import id_ranges
     from md.system.lammps_data import read_atoms
-    from md.workflows.adhesion import _tail_pair_table
+    from md.workflows.adhesion_legs import _tail_pair_table
     from md.workflows.common import forcefield_of, surface_slab
     s = load_recipe("adhesion_ots").typed_settings("smoke")
     ff = forcefield_of(["silica_interface", "ots_trappe_ua"])
@@ -386,7 +388,8 @@ def test_rank1_second_offset_is_a_lattice_translation_and_primitive_offsets_neve
     lattice, whose cell is half the rectangular one (the centring vector found from the slabs)."""
     from md.workflows.adhesion_registries import (MIN_REGISTRY_SPACING_A, degenerate_registries, lattice_distance,
                                                   maps_onto_itself, primitive_offsets)
-    from md.workflows.adhesion import _AdhesionLegs, Adhesion
+    from md.workflows.adhesion import Adhesion
+    from md.workflows.adhesion_legs import _AdhesionLegs
     s = _settings("adhesion_ots", "quick")
     legs = _AdhesionLegs(Adhesion(), Adhesion.typed(s), tmp_path)
     plan = Adhesion().plan(s, tmp_path)
@@ -477,7 +480,8 @@ def test_protocol_options_at_their_neutral_values_leave_the_run_hash_alone(name)
 
 def test_extra_windows_enter_the_outward_grid_and_are_checked():
     from md.recipe import RecipeError
-    from md.workflows.adhesion import Adhesion, outward_grid
+    from md.workflows.adhesion import Adhesion
+    from md.workflows.adhesion_legs import outward_grid
     s = _settings("adhesion_ots", "quick")
     base = outward_grid(Adhesion.typed(s))
     extra = [3.6, 4.9]
@@ -543,7 +547,7 @@ def test_every_registry_gets_its_own_zero_load_contact(tmp_path, name):
     """registry_contact_steps: registry r >= 1 has a leg contact_rN from the contact leg's last state moved to its
     offset (bare silica: lifted, then lowered in minimisation steps), with the upper back one rigid body free
     along z; its chain starts from that leg's last state, not moved."""
-    from md.workflows.adhesion import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, _BACK_RIGID
+    from md.workflows.adhesion_legs import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, _BACK_RIGID
     s, plan = _plan(name, "quick", tmp_path, registry_contact_steps=20000, registry_sampling="primitive",
                     lateral_registries=3)
     legs = {l.name: l for l in plan.legs}

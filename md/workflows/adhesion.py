@@ -19,12 +19,8 @@ from md import analysis as A
 from md.engine.plan import Plan
 from md.system.lammps_data import read_atoms
 from md.workflows.adhesion_analysis import _AdhesionAnalysis
-from md.workflows.adhesion_legs import (_AdhesionLegs, _BACK_RIGID, _chain_axes, _lifts_registries,  # noqa: F401
-                                        _registry_offsets, _tail_applies, _tail_pair_table, ANNEAL_FRAMES,
-                                        MIN_WINDOW_NEFF, outward_grid, REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS,
-                                        registry_approach_lines, TAIL_FRAMES_CONTACT, TAIL_FRAMES_WINDOW,
-                                        TAIL_R_MAX_A)
-from md.workflows.common import derived_seed, forcefield_of, TRAPPE_UA, Workflow  # noqa: F401 (TRAPPE_UA re-exported)
+from md.workflows.adhesion_legs import _AdhesionLegs, _lifts_registries, _tail_pair_table, outward_grid, TAIL_R_MAX_A
+from md.workflows.common import derived_seed, forcefield_of, Workflow
 
 # ================================================================================================ adhesion
 
