@@ -613,6 +613,8 @@ def _toml_value(v) -> str:
         return repr(v)
     if v is None:
         return '""'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     return json.dumps(str(v))
 
 
