@@ -83,7 +83,7 @@ class CalibrationReport:
     claim_attribution: Mapping[str, Any] = field(default_factory=dict)
     """Why each claim that fails with the calibrated set fails (`calibration.attribution.attribute_claims`)."""
     validation: Mapping[str, Any] = field(default_factory=dict)
-    """Pull-off F / (2 pi R) against the flat-slab W_F per pull-off run (`calibration.mdset.pulloff_validation`)."""
+    """Pull-off F / (2 pi R) against the flat-slab W_F per pull-off run (`calibration.validation.pulloff_validation`)."""
     versions: Mapping[str, str] = field(default_factory=versions)
 
     @property

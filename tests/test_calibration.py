@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from nanoimpact.executors import executor
-from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_needed, write_parameter_set
+from calibration.mdset import MAPPING, build_parameter_set, recipes_needed, write_parameter_set
+from calibration.validation import VALIDATION
 from calibration.pipeline import latin_hypercube, load_calibration, CalibrationError
 from calibration.sweep import parse_vary, run_sweep
 from continuum.scene import SceneError, resolve_scene
@@ -19,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: the bare-silica adhesion recipe the calibration reads (the mapping's choice, so these tests follow it)
 SILICA = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")
-#: the pull-off the silica validation reads (calibration.mdset.VALIDATION)
+#: the pull-off the silica validation reads (calibration.validation.VALIDATION)
 PULL_SI = next(pull for pull, adh in VALIDATION if adh == SILICA)
 #: the OTS-OTS adhesion recipe the calibration reads (W, z0 and the layer modulus), and its validation pull-off
 OTS = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")
@@ -111,7 +112,7 @@ def test_an_out_and_back_work_of_adhesion_carries_half_its_hysteresis_as_a_syste
     assert w["systematic_hysteresis"] == 0.006
     assert w["out_and_back"] == {"value_out": 0.052, "stderr_out": 0.0025, "value_back": 0.040, "stderr_back": 0.003}
     # the pull-off validation weighs the difference with the same W_F error the set carries
-    from calibration.mdset import pulloff_validation
+    from calibration.validation import pulloff_validation
     res[PULL_OTS]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.060, "stderr": 0.024, "units": "J/m^2"}
     v = pulloff_validation(res)[PULL_OTS]
     assert v["W_F_stderr"] == pytest.approx(0.007, rel=1e-12)
@@ -512,7 +513,7 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
     """F / (2 pi R) of each pull-off beside W_F of the same pair (DMT at MD scale): ratio, combined stderrs, and a
     sentence when the two differ by more than 2 of them. 0.09 +- 0.004 against 0.18 +- 0.03: ratio 0.50,
     -0.09 / hypot(0.004, 0.03) = -3.0 sigma; OTS 0.05 +- 0.01 against 0.04 (no stderr): +1.0 sigma."""
-    from calibration.mdset import pulloff_validation
+    from calibration.validation import pulloff_validation
     from calibration.report import _validation_lines
 
     res = _results()
@@ -580,7 +581,7 @@ def test_the_sam_layer_modulus_is_derived_from_committed_windows_and_converted_t
 def test_pulloff_validation_carries_tabor_mu_of_the_current_results():
     """mu = (R W^2 / (E*^2 z0^3))^(1/3) from the pull-off's radius and the flat slab's W_F and z0, with E* of silica
     on silica: R = 1.5 nm, W = 0.196 J/m^2, z0 = 0.2075 nm give mu = 0.167 at E* = 37.0 GPa."""
-    from calibration.mdset import pulloff_validation
+    from calibration.validation import pulloff_validation
     from md.analysis.pulloff import SILICA_E_STAR_PA
 
     res = _results()

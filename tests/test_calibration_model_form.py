@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from calibration.mdset import MAPPING, VALIDATION, build_parameter_set
-from calibration.validation import like_for_like_work, pulloff_validation, rate_extrapolation
+from calibration.mdset import MAPPING, build_parameter_set
+from calibration.validation import VALIDATION, like_for_like_work, pulloff_validation, rate_extrapolation
 from md.analysis import MAUGIS_LJ93
 
 OTS = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")

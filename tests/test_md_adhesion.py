@@ -210,7 +210,8 @@ def test_production_ots_asperity_reaches_sam_density_with_leaning_chains():
 
 
 def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
-    from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_first, recipes_needed
+    from calibration.mdset import MAPPING, build_parameter_set, recipes_first, recipes_needed
+    from calibration.validation import VALIDATION
     silica = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")   # the mapping's choice
     pull_si = next(p for p, a in VALIDATION if a == silica)
     ots = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")
