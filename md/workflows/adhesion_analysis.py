@@ -307,6 +307,8 @@ class _AdhesionAnalysis:
             t, n_layers = A.sam_layer_thickness_A(self.info)
         except ValueError:
             return
+        self._small_strain_modulus()
+        self._layer_poisson()
         try:
             lm = A.confined_layer_modulus(self.dsep, self.f_tot, self.ebar, self.area, t)
         except ValueError as exc:
@@ -323,8 +325,6 @@ class _AdhesionAnalysis:
         self.details["sam_layer_modulus"] = lm
         if lm["note"]:
             self.notes.append(f"SAM layer modulus: {lm['note']}.")
-        self._small_strain_modulus()
-        self._layer_poisson(lm["separation_A"])
 
     def _small_strain_modulus(self) -> None:
         """The tangent confined modulus at the zero-force point, normalised by the annealed thickness (the anneal's
@@ -349,13 +349,15 @@ class _AdhesionAnalysis:
             windows=tg["windows"], strain_max=tg["strain_max"])
         self.details["sam_layer_tangent_modulus"] = {k: v for k, v in rec.items() if k != "tangent"} | {"tangent": tg}
 
-    def _layer_poisson(self, branch_A) -> None:
+    def _layer_poisson(self) -> None:
         """With ``sam_stress``: the SAM stack's C13/C33 and Poisson ratio from its own stress in the compression
-        windows (the same repulsive windows as the modulus; registry-averaged lateral (xx + yy)/2 and normal zz
-        stress, md.analysis.stress_ratio_poisson). Without the columns: nothing."""
+        windows (the repulsive windows below the first zero crossing of the mean force with its tail, as the
+        modulus; registry-averaged lateral (xx + yy)/2 and normal zz stress, md.analysis.stress_ratio_poisson).
+        Without the columns: nothing."""
         if not np.isfinite(self.sam_sig).any():
             return
-        sel = np.isin(self.dsep, np.asarray(branch_A, float))
+        attractive = np.flatnonzero(self.f_tot <= 0.0)
+        sel = np.arange(self.dsep.size) < (attractive[0] if attractive.size else self.dsep.size)
         if sel.sum() < 3:
             self.notes.append(f"SAM Poisson ratio not measured: {int(sel.sum())} compression windows (needs three)")
             return
