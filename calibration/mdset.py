@@ -17,33 +17,34 @@ the result has it, with stderr = hypot(statistical, discretisation, systematic),
 out-and-back hysteresis where the run pulled its windows back (the mean of the two directions is the estimate,
 md.analysis.hysteresis: the true reversible work lies between them); dE/A is recorded beside it
 ([meta.calibration] -> `energy_estimate`), and a result without the free energy falls back to dE/A, which
-the set's origin and the report then name as "not a free energy". (The adhesion workflow before version
-2 started its windows outside the adhesive well and gave W_F 20x too small; those runs no longer match
-the run hash and are not read.)
+the set's origin and the report then name as "not a free energy". Runs of an older adhesion protocol (whose
+windows started outside the adhesive well) do not match the run hash and are not read.
 
 Which adhesion runs: bare silica from `adhesion_silica_registries` (six quasi-random lateral registries over the
 primitive cell, each with its own zero-load contact, windows denser over the force peak), not the three-registry
-`adhesion_silica`, whose z0 error was too wide to use (md-review-2). The spread over registries is part of W_F's
+`adhesion_silica`, whose z0 error is too wide to use. The spread over registries is part of W_F's
 stderr (md.analysis). OTS from `adhesion_ots_equilibrated` (both SAMs annealed before contact, three quasi-random
 registries over the primitive cell, each with its own zero-load contact, the windows pulled out and back), not
-`adhesion_ots`, whose two registries were one and whose one-way windows went straight from the builder (md-review-2).
+`adhesion_ots`, whose two registries are one and whose one-way windows go straight from the builder.
 
-Interaction range z0: from the flat-slab mean-force curve of the adhesion workflow (version 3):
+Interaction range z0: from the flat-slab mean-force curve of the adhesion workflow:
 z0 = 1.026 W_F / sigma0 (Maugis 1992, the LJ 9-3 law), with sigma0 the curve's peak tensile traction, so that
 the continuum's Maugis-Dugdale stress 1.03 dgamma / z0 reproduces the measured sigma0 with the W_F used for
 dgamma; its stderr (from the peak fit's covariance and W_F's error) goes into the uncertainty bands like every
-other. An adhesion result without a flat-slab z0 (before version 3) falls back to the pull-off z0 (a 9-3 fit
+other. An adhesion result without a flat-slab z0 falls back to the pull-off z0 (a 9-3 fit
 against the rigid holder's travel: it absorbs the asperity's compliance and overstates z0), and the origin's
 note says so. The pull-off results are otherwise a validation: F / (2 pi R) (DMT, the limit an MD-scale asperity is
-in) is compared with W_F in [meta.validation].
+in) is compared with W_F in [meta.validation] (calibration.validation: like for like, rate-extrapolated).
 
-SAM layer modulus: the confined (uniaxial-strain) modulus M of the SAMs between the adhesion_ots slabs, from the
-compression branch of the same flat-slab curve (md.analysis.confined_layer_modulus: the repulsive windows pressed
-into the contact, t = both SAMs' builder thickness). A result that predates the quantity has it derived here from
-its committed windows (details.pmf_windows, system) with the same function, and the origin says so. The scene key is
-Young's modulus of an isotropic layer, so E = M (1 + nu)(1 - 2 nu) / (1 - nu) with the set's layer Poisson ratio
-(surfaces.sam.layer_poisson_ratio, itself a declared choice); a modulus from fewer than three repulsive windows
-(a line without a check of its linearity) is not used.
+SAM layer: the small-strain tangent confined modulus of the SAM stack between the OTS slabs at the annealed thickness,
+the per-SAM thickness it used (surfaces.sam.thickness: the continuum's layer then has the measured stiffness per
+area), and the Poisson ratio that converts it -- measured where the run sampled the SAM's stress, else the set's
+declared value with its spread in E's stderr (calibration.sam_layer); a tangent from fewer than four repulsive
+windows is not used.
+
+W_F with the static TraPPE tail (OTS): the set's value keeps the tail (TAIL_CHOICE) and its stderr holds half the
+tail as a model-form systematic; [meta.calibration] gives the value with and without it. z0 is formed with the W_F
+the set uses (a committed result whose z0 used the outward W gets it recomputed from its own sigma0).
 
 A value outside the scene schema's range, or not finite, or a contact angle the analysis could not
 measure (0 deg: a film, 180 deg: no contact yet -- what smoke runs give) is not used: the base set's
@@ -66,6 +67,10 @@ from continuum.schema import FIELD_BY_PATH
 from nanoimpact import data
 from nanoimpact.fileio import atomic_write_text
 
+from calibration.sam_layer import (LAYER_QUANTITIES, THICKNESS_QUANTITIES, thickness_record, with_layer_quantities,
+                                   young_with_nu)
+from calibration.validation import VALIDATION, pulloff_validation
+
 #: Committed MD results shipped with the package (inputs/md/results, installed as package data).
 RESULTS_DIR = data.shipped_root() / "md" / "results"
 
@@ -87,13 +92,14 @@ _PULLOFF_Z0 = ("fallback: the adhesion result has no flat-slab z0; this z0 is a 
                "overestimate)")
 
 _DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this is the droplet's angle, and the quick "
-            "silica droplet keeps the angle it is started at (pinned contact line: 18 deg from a 20 deg start, 39 deg "
-            "from 40 deg), so it measures the start, not the surface")
+            "silica droplet keeps the angle it is started at (a pinned contact line: the committed contact_angle_silica "
+            "and contact_angle_silica_flatstart results end near their different starting angles), so it measures "
+            "the start, not the surface")
 
 _DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the quick R0 = 2 nm droplet's "
-                "angle after 60 ps (116.8 deg); sampled 150 ps, R0 = 2 nm reads 118.2 +- 0.8 and R0 = 3 nm "
-                "111.4 +- 3.1 deg, 2.1 sigma apart, so take +-4 deg for the droplet size (contact-angle version 4: "
-                "docs/md.md)")
+                "angle, which is not size-converged (the committed contact_angle_ots_long and "
+                "contact_angle_ots_large results, R0 = 2 and 3 nm, differ by about 2 sigma, so take +-4 deg for the "
+                "droplet size; docs/md.md, contact angles)")
 
 MAPPING: tuple[Source, ...] = (
     Source("surfaces.work_of_adhesion", "adhesion_silica_registries",
@@ -114,15 +120,12 @@ MAPPING: tuple[Source, ...] = (
     Source("surfaces.sam.interaction_range", "adhesion_ots_equilibrated", ("interaction_range_z0",),
            fallback=Source("surfaces.sam.interaction_range", "pulloff_ots", ("interaction_range_z0",),
                            note=_PULLOFF_Z0)),
-    Source("surfaces.sam.layer_modulus", "adhesion_ots_equilibrated", ("sam_layer_modulus",)),
+    Source("surfaces.body.work_of_adhesion_sl", "wsl_silica", ("work_of_adhesion_sl",)),
+    Source("surfaces.substrate.work_of_adhesion_sl", "wsl_silica", ("work_of_adhesion_sl",)),
+    Source("surfaces.sam.work_of_adhesion_sl", "wsl_ots", ("work_of_adhesion_sl",)),
+    Source("surfaces.sam.thickness", "adhesion_ots_equilibrated", THICKNESS_QUANTITIES),
+    Source("surfaces.sam.layer_modulus", "adhesion_ots_equilibrated", LAYER_QUANTITIES),
 )
-
-#: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
-#: (both pull-offs over four tip positions, each its own contact, so their stderr holds the geometric spread, with a
-#: thermostat on the flat's silica only, so nothing the tip drags feels a lab-frame friction)
-VALIDATION = (("pulloff_silica_positions", "adhesion_silica_registries"),
-              ("pulloff_ots_positions", "adhesion_ots_equilibrated"))
-
 
 def recipes_needed(mapping=MAPPING) -> list[str]:
     """MD recipes a calibration may need, in mapping order, each once (fallback recipes -- the pull-offs, also the
@@ -193,12 +196,13 @@ def _pick(result: dict, source: Source):
 
 def _combined_stderr(rec: dict) -> float | None:
     """The error a quantity enters the set with: its statistical stderr, in quadrature with a quadrature's grid
-    error (``discretisation_error``) and, for an out-and-back W_F, half the hysteresis (``systematic_hysteresis``:
-    the reversible work lies between the two directions); None without a finite statistical stderr."""
+    error (``discretisation_error``), for an out-and-back W_F half the hysteresis (``systematic_hysteresis``: the
+    reversible work lies between the two directions) and, for a W_F with the static TraPPE tail, half the tail
+    (``systematic_tail``, :func:`_with_model_form`); None without a finite statistical stderr."""
     e = rec.get("stderr")
     if e is None or not math.isfinite(e):
         return None
-    extra = [float(rec[k]) for k in ("discretisation_error", "systematic_hysteresis")
+    extra = [float(rec[k]) for k in ("discretisation_error", "systematic_hysteresis", "systematic_tail")
              if rec.get(k) is not None and math.isfinite(rec[k])]
     return math.hypot(float(e), *extra)
 
@@ -252,6 +256,15 @@ REPLACED_CHOICES = {
 }
 
 
+#: Values the calibrated set takes by the project's decision (docs/model.md), neither the base set's nor MD's.
+PROJECT_CHOICES = {
+    "menisci.condensation_model": (
+        "nucleation", "t_a from the thermally activated nucleation of a water bridge at the scene's humidity and "
+                      "temperature (Szoszkiewicz & Riedo, PRL 95 (2005) 135502: 0.7-4.2 ms at 40 % RH, 332-299 K) "
+                      "instead of the paper's fixed 25 us; the paper set keeps 25 us"),
+}
+
+
 def _base_table(base: str) -> tuple[dict, dict]:
     """(the base set's table without [meta], its [meta.origin])."""
     table = tomllib.loads(Path(find_params(base)).read_text())
@@ -294,50 +307,82 @@ def _effective_source(src: Source, results: dict) -> Source:
 
 
 def _with_derived(res: dict | None, source: Source) -> dict | None:
-    """The result with ``sam_layer_modulus`` derived from its committed windows where the source asks for it and
-    the run predates the quantity (md.analysis.confined_layer_modulus on details.pmf_windows: the mean force with
-    its dispersion tail, the registry-averaged stderrs, both SAMs' builder thickness); the record says
-    ``derived_from_windows``. A result without windows, or whose compression branch gives no modulus, is returned
-    as it is (the key then has none of its quantities)."""
-    if res is None or "sam_layer_modulus" not in source.quantities or \
-            "sam_layer_modulus" in (res.get("quantities") or {}):
+    """The result with what the set reads from it and a committed result may predate: the SAM layer's small-strain
+    modulus and thickness (calibration.sam_layer.with_layer_quantities), W_F's model-form part
+    (:func:`_with_model_form`) and z0 from the W_F the result reports (:func:`_z0_from_reported_work`)."""
+    if res is None:
+        return None
+    if set(source.quantities) & set(LAYER_QUANTITIES + THICKNESS_QUANTITIES):
+        return with_layer_quantities(res)
+    if "work_of_adhesion_free_energy" in source.quantities:
+        return _with_model_form(res)
+    if "interaction_range_z0" in source.quantities:
+        return _z0_from_reported_work(res)
+    return res
+
+
+#: why a W_F with the static TraPPE tail is the set's value (docs/md.md, "W_OTS with and without the tail")
+TAIL_CHOICE = ("with the tail: TraPPE-UA's CH2/CH3 parameters were fitted to saturated-liquid densities and critical "
+               "temperatures in simulations that added the analytic dispersion tail beyond the cutoff (Martin & "
+               "Siepmann, J. Phys. Chem. B 102 (1998) 2569), so the force field's dispersion is the full 1/r^6 sum; "
+               "the tail is a static, rigid-configuration estimate across a gap, so half of it is a model-form "
+               "systematic")
+
+
+def _with_model_form(res: dict) -> dict:
+    """A W_F that includes the static TraPPE tail (``dispersion_tail_work``) gets half the tail as a model-form
+    systematic (``systematic_tail``) and its cutoff-only value beside it (``value_cutoff_only``)."""
+    q = res.get("quantities") or {}
+    w, tail = q.get("work_of_adhesion_free_energy"), (q.get("dispersion_tail_work") or {}).get("value")
+    if not w or tail is None or not math.isfinite(tail) or tail == 0.0 or "systematic_tail" in w:
         return res
-    from md.analysis import confined_layer_modulus, sam_layer_thickness_A
+    w = {**w, "systematic_tail": 0.5 * abs(float(tail)), "value_cutoff_only": float(w["value"]) - float(tail),
+         "tail": float(tail)}
+    return {**res, "quantities": {**q, "work_of_adhesion_free_energy": w}}
 
-    win, system = (res.get("details") or {}).get("pmf_windows"), res.get("system") or {}
-    try:
-        t, layers = sam_layer_thickness_A(system)
-        force = np.add(win["mean_force_kcal_mol_A"], win.get("tail_force_kcal_mol_A") or 0.0)
-        lm = confined_layer_modulus(win["separation_A"], force, win["stderr_kcal_mol_A"], system["area_A2"], t)
-    except (KeyError, TypeError, ValueError):
+
+def _z0_from_reported_work(res: dict) -> dict:
+    """z0 = 1.026 W_F / sigma0 with the W_F the result reports (the out/back mean), where the committed z0 was formed
+    with the outward W (an adhesion result before the analysis used the reported W: its z0 record has no
+    ``work_of_adhesion_used``): recomputed from the result's own sigma0 and W_F with md.analysis.flat_slab_range,
+    the record says ``recomputed_from_result``. Otherwise the result as it is."""
+    q = res.get("quantities") or {}
+    z, w, sg = q.get("interaction_range_z0"), q.get("work_of_adhesion_free_energy") or {}, q.get("peak_traction_sigma0")
+    if not z or not sg or "work_of_adhesion_used" in z or w.get("value_out") is None:
         return res
-    q = {"value": lm["modulus_Pa"], "stderr": lm["stderr_Pa"], "units": "Pa", "windows": lm["windows"],
-         "layers": layers, "thickness_m": t * 1e-10, "strain_max": lm["strain_max"], "derived_from_windows": True}
-    return {**res, "quantities": {**res["quantities"], "sam_layer_modulus": q}}
+    from md.analysis import flat_slab_range
+
+    w_err = math.hypot(*[float(w[k]) for k in ("stderr", "discretisation_error", "systematic_hysteresis")
+                         if w.get(k) is not None])
+    s_err = math.hypot(float(sg.get("stderr") or 0.0), float(sg.get("discretisation_error") or 0.0))
+    rng = flat_slab_range(float(w["value"]), w_err, float(sg["value"]), s_err)
+    z = {**z, "value": rng["z0"], "stderr": rng["stderr"], "dugdale_range_h0_m": rng["h0"],
+         "work_of_adhesion_used": float(w["value"]), "value_committed": z["value"], "recomputed_from_result": True}
+    return {**res, "quantities": {**q, "interaction_range_z0": z}}
 
 
-def _to_scene_units(key: str, value: float, stderr, table: dict):
-    """(value, stderr, note) in the scene key's meaning: the SAMs' confined modulus M becomes the layer's Young's
-    modulus E = M (1 + nu)(1 - 2 nu) / (1 - nu) with the set's layer Poisson ratio; other keys as they are."""
+def _to_scene_units(key: str, value: float, stderr, table: dict, res: dict):
+    """(value, stderr, note) in the scene key's meaning: the SAM stack's confined modulus M becomes the layer's
+    Young's modulus E = M (1 + nu)(1 - 2 nu) / (1 - nu) (calibration.sam_layer.young_with_nu: the measured nu, else
+    the set's with its spread in the stderr); other keys as they are."""
     if key != "surfaces.sam.layer_modulus":
         return value, stderr, ""
-    from md.analysis import young_from_confined
-
     nu = _get_nested(table, "surfaces.sam.layer_poisson_ratio")
     nu = FIELD_BY_PATH["surfaces.sam.layer_poisson_ratio"].default if nu is None else float(nu)
-    factor = young_from_confined(1.0, nu)
-    return value * factor, None if stderr is None else stderr * factor, (
-        f"confined modulus M = {value / 1e9:.3g} GPa converted to Young's modulus with the set's layer Poisson "
-        f"ratio nu = {nu:g} (E = M (1 + nu)(1 - 2 nu) / (1 - nu) = {factor:.3f} M)")
+    e, e_err, rec = young_with_nu(value, stderr, nu, res)
+    note = (f"confined modulus M = {value / 1e9:.3g} GPa (tangent at the zero-force point) converted to Young's "
+            f"modulus with nu = {rec['value']:g} ({'measured' if rec['measured'] else 'the set' + chr(39) + 's, not measured'}"
+            f"; E = M (1 + nu)(1 - 2 nu) / (1 - nu) = {e / value:.3f} M)")
+    return e, e_err, (note, rec)
 
 
 def _implausible(key: str, qname: str, result: dict) -> str | None:
-    """Why an MD value that is within the schema's range is still not used: a layer modulus from fewer than three
-    repulsive windows rests on a line whose linearity nothing checks."""
-    if qname == "sam_layer_modulus":
+    """Why an MD value that is within the schema's range is still not used: a layer modulus from fewer than four
+    repulsive windows (a quadratic's tangent with no degree of freedom to check it)."""
+    if qname == "sam_layer_tangent_modulus":
         n = (result.get("quantities", {}).get(qname) or {}).get("windows")
-        if n is not None and n < 3:
-            return f"only {n} repulsive windows: the compression branch's linearity is unchecked"
+        if n is not None and n < 4:
+            return f"only {n} repulsive windows: the compression branch's tangent is unchecked"
     return None
 
 
@@ -352,6 +397,9 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
     """
     table, origin = _base_table(base)
     replaced = replace_choices(table, origin)
+    for key, (value, reason) in PROJECT_CHOICES.items():
+        _set_nested(table, key, value)
+        origin[key] = {"kind": "chosen", "reason": reason}
     rows, calib, rejected = [], {}, {}
     water_mismatch = water_model_mismatch(results)
     for src in mapping:
@@ -365,10 +413,14 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
         picked = _pick(res, src)
         if picked[0] is None:
             row.update(status="rejected", why=picked[1], run_hash=res.get("run_hash"))
-            rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "why": picked[1]}
+            rejected[src.key] = {"recipe": src.recipe, "run_hash": res.get("run_hash"), "why": picked[1],
+                                 "kept": "base set value"}
             continue
         qname, value, stderr, units = picked
-        value, stderr, converted = _to_scene_units(src.key, value, stderr, table)
+        value, stderr, converted = _to_scene_units(src.key, value, stderr, table, res)
+        poisson = None
+        if isinstance(converted, tuple):
+            converted, poisson = converted
         row.update(quantity=qname, value=value, stderr=stderr, units=units, run_hash=res.get("run_hash"),
                    fidelity=res.get("fidelity"))
         why = (water_mismatch if water_mismatch and src.recipe in WATER_RECIPES
@@ -383,12 +435,22 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
         calib[src.key] = _calibration_entry(src, res, qname, value, stderr, units)
         if converted:
             calib[src.key]["conversion"] = converted
+        if poisson is not None:
+            calib[src.key]["poisson_ratio"] = poisson
+            calib[src.key]["thickness_used"] = thickness_record(res["quantities"][qname],
+                                                                _get_nested(table, "surfaces.sam.thickness"))
+            if poisson["measured"]:
+                _set_nested(table, "surfaces.sam.layer_poisson_ratio", poisson["value"])
+                origin["surfaces.sam.layer_poisson_ratio"] = {
+                    "kind": "md", "run_hash": str(res.get("run_hash")), "recipe": src.recipe,
+                    "note": f"MD {src.recipe}: nu of the isotropic layer with the SAM stack's measured C13/C33, "
+                            f"{poisson['value']:.3g} +- {poisson['stderr']:.2g}"}
         origin[src.key] = _md_origin(src, res, calib[src.key])
     out_meta = {"description": description or f"MD-calibrated set '{name}' on base '{Path(base).stem}'",
                 "base": Path(base).stem, "origin": origin, "calibration": calib}
     if replaced:
         out_meta["replaced"] = replaced
-    validation = pulloff_validation(results)
+    validation = pulloff_validation(results, table)
     if validation:
         out_meta["validation"] = validation
     if rejected:
@@ -423,17 +485,30 @@ def _calibration_entry(src: Source, res: dict, qname: str, value: float, stderr,
         _angle_flags(entry, src, res, qname)
     if qname == "interaction_range_z0":
         _z0_details(entry, src, qs)
-    if qname == "sam_layer_modulus":
+    if qname == "sam_layer_tangent_modulus":
         lm = qs[qname]
         entry["confined_modulus"] = {"value": lm.get("value"), "stderr": lm.get("stderr"), "units": "Pa",
+                                     "what": "tangent at the zero-force point", "chord_Pa": lm.get("chord_modulus_Pa"),
+                                     "curvature_delta_chi2": lm.get("curvature_delta_chi2"),
                                      "windows": lm.get("windows"), "layers": lm.get("layers"),
                                      "strain_max": lm.get("strain_max")}
+        entry["rate"] = ("not in the stderr: compression windows at ~7 m/s (strain rate ~1e9 /s), an unrelaxed "
+                         "modulus; the slow-loading pass is staged, not run (docs/md.md)")
         if lm.get("derived_from_windows"):
-            entry["note"] = ("derived from the run's committed windows (details.pmf_windows; the result predates the "
-                             "quantity) with md.analysis.confined_layer_modulus")
+            entry["note"] = ("derived from the run's committed windows (details.pmf_windows, anneal tilt; the result "
+                             "predates the quantity) with md.analysis.small_strain_layer_record")
+    if qname == "sam_layer_thickness_per_layer":
+        entry["note"] = ("the per-SAM thickness the layer modulus is normalised by (" + str(qs[qname].get("source"))
+                         + "): the continuum's layer has the stiffness per area the MD measured")
     if qname == "work_of_adhesion_free_energy":
         entry["stderr_statistical"] = qs[qname].get("stderr")
         entry["discretisation_error"] = qs[qname].get("discretisation_error")
+        if qs[qname].get("systematic_tail") is not None:
+            w = qs[qname]
+            entry["systematic_tail"] = w["systematic_tail"]
+            entry["model_form"] = {"with_tail": w["value"], "without_tail": w["value_cutoff_only"],
+                                   "tail": w["tail"], "used": "with_tail", "systematic": w["systematic_tail"],
+                                   "why": TAIL_CHOICE}
         if qs[qname].get("systematic_hysteresis") is not None:
             entry["systematic_hysteresis"] = qs[qname]["systematic_hysteresis"]
             entry["out_and_back"] = {k: qs[qname].get(k) for k in ("value_out", "stderr_out", "value_back",
@@ -443,7 +518,35 @@ def _calibration_entry(src: Source, res: dict, qname: str, value: float, stderr,
             entry["energy_estimate"] = {"value": de["value"], "stderr": de.get("stderr"),
                                         "note": "dE/A, potential-energy difference (includes T dS/A); "
                                                 "recorded, not used"}
+            spread = _registry_energy_check(res)
+            if spread is not None:
+                entry["energy_estimate"].update(spread)
     return entry
+
+
+def _registry_energy_check(res: dict) -> dict | None:
+    """Whether the registries' own dE/A (each zero-load contact: registry 0 the contact leg, the others
+    details.registry_contacts) agree within their stderrs (md.analysis.registry_consistency: p < 0.01 = disagree).
+    Where they disagree, dE/A and T dS = dE - dF are not converged (the per-registry values in ``per_registry``).
+    None with fewer than two registries."""
+    from md.analysis import registry_consistency
+
+    q, contacts = res.get("quantities") or {}, (res.get("details") or {}).get("registry_contacts") or {}
+    de = q.get("work_of_adhesion") or {}
+    vals = [(de.get("value"), de.get("stderr"))] + [(c.get("energy_work_J_m2"), c.get("stderr_J_m2"))
+                                                    for c in contacts.values()]
+    vals = [(float(v), float(e)) for v, e in vals if v is not None and e]
+    if len(vals) < 2:
+        return None
+    v, e = np.array(vals).T
+    cons = registry_consistency(v[:, None], e[:, None])
+    bad = bool(np.asarray(cons["inconsistent"])[0])
+    out = {"per_registry": v.tolist(), "per_registry_stderr": e.tolist(),
+           "registry_chi2_per_dof": float(np.asarray(cons["chi2_per_dof"])[0]), "registries_agree": not bad}
+    if bad:
+        out["note_registries"] = ("NOT CONVERGED: the registries' dE/A disagree beyond their stderrs (chi^2 p < 0.01), "
+                                  "so dE/A and T dS = dE - dF are not converged numbers")
+    return out
 
 
 def _angle_flags(entry: dict, src: Source, res: dict, qname: str) -> None:
@@ -476,6 +579,11 @@ def _z0_details(entry: dict, src: Source, qs: dict) -> None:
                                    "Maugis-Dugdale stress is 1.03 dgamma / z0"}
     if q.get("dugdale_range_h0_m") is not None:
         entry["dugdale_range_h0"] = q["dugdale_range_h0_m"]
+    if q.get("recomputed_from_result"):
+        entry["work_of_adhesion_used"] = q["work_of_adhesion_used"]
+        entry["value_committed"] = q["value_committed"]
+        entry["note"] = ("z0 = 1.026 W_F / sigma0 recomputed from the result's sigma0 with the W_F the set uses (the "
+                         "out/back mean; md.analysis.flat_slab_range): the committed z0 used the outward W_F")
 
 
 def _md_origin(src: Source, res: dict, entry: dict) -> dict:
@@ -485,12 +593,17 @@ def _md_origin(src: Source, res: dict, entry: dict) -> dict:
             "work_of_adhesion_free_energy": "free energy of separation by force integration, stderr "
                                             "incl. the window grid's discretisation error",
             "contact_angle_upper_bound": "the water wets: uniform on [0, the run's upper bound]",
-            "sam_layer_modulus": "Young's modulus of the SAM layer from the confined modulus of the compression "
-                                 "branch of the flat-slab force curve, converted with the set's layer Poisson "
-                                 "ratio" + ("; derived from the run's committed windows"
-                                           if (res.get("quantities", {}).get("sam_layer_modulus") or {}).get(
-                                               "derived_from_windows") else ""),
-            "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve"
+            "sam_layer_tangent_modulus": "Young's modulus of the SAM layer from the small-strain tangent of the "
+                                         "compression branch of the flat-slab force curve at the annealed thickness, "
+                                         "converted with the layer Poisson ratio" + (
+                                             "; derived from the run's committed windows"
+                                             if (res.get("quantities", {}).get("sam_layer_tangent_modulus") or {}).get(
+                                                 "derived_from_windows") else ""),
+            "sam_layer_thickness_per_layer": "per-SAM thickness at the anneal's mean tilt, the one the layer "
+                                             "modulus is normalised by",
+            "interaction_range_z0": ("z0 = 1.026 W_F / sigma0 from the flat-slab force curve, W_F the set's" + (
+                                         " (recomputed from the result's sigma0)" if (res.get("quantities", {}).get(
+                                             "interaction_range_z0") or {}).get("recomputed_from_result") else "")
                                      if src.recipe.startswith("adhesion") else
                                      "z0 of a 9-3 fit to the pull-off curve: " + src.note)}.get(qname, qname)
     if res.get("workflow") == "wsl_ti" and "work_of_adhesion_sl" in entry:
@@ -503,49 +616,6 @@ def _md_origin(src: Source, res: dict, entry: dict) -> dict:
             "note": f"MD {src.recipe} at {res.get('fidelity')} ({kind}): {value:.6g} {err} {units}"}
 
 
-def pulloff_validation(results: dict[str, dict]) -> dict:
-    """F / (2 pi R) of each pull-off (DMT) against the flat-slab W_F of the same surfaces: the ratio and the
-    difference in units of the combined stderr, and Tabor's parameter of the pair from the current results
-    (:func:`_tabor`), which says how far DMT is the right limit. Validation only: nothing here enters the set."""
-    out = {}
-    for pull, adh in VALIDATION:
-        rp, ra = results.get(pull), results.get(adh)
-        if not rp or not ra:
-            continue
-        qp, qa = rp.get("quantities", {}), ra.get("quantities", {})
-        dmt = qp.get("work_of_adhesion_eff_dmt", {})
-        wf = qa.get("work_of_adhesion_free_energy") or qa.get("work_of_adhesion") or {}
-        v1, v2 = dmt.get("value"), wf.get("value")
-        if v1 is None or v2 is None or not (math.isfinite(v1) and math.isfinite(v2)) or v2 == 0:
-            continue
-        e1, e2 = dmt.get("stderr") or 0.0, _combined_stderr(wf) or 0.0      # W_F's error as the set carries it
-        err = math.hypot(e1, e2)
-        drag = qp.get("residual_drag_force", {})
-        out[pull] = {"F_over_2piR": v1, "F_over_2piR_stderr": e1 or None, "W_F": v2, "W_F_stderr": e2 or None,
-                     "ratio": v1 / v2, "difference_in_stderr": (v1 - v2) / err if err > 0 else None,
-                     "adhesion_recipe": adh, "residual_drag_N": drag.get("value"),
-                     "note": "pull-off F / (2 pi R) (DMT) against the flat-slab work of adhesion; validation only",
-                     **_tabor(rp, qa, v2)}
-    return out
-
-
-def _tabor(pull: dict, adhesion_q: dict, work: float) -> dict:
-    """Tabor's mu and Maugis' lambda of a pull-off (md.analysis.pulloff.tabor_parameter) from the current results:
-    R the pull-off's asperity radius, W the flat-slab W_F, z0 the flat-slab range, E* of silica on silica
-    (md.analysis.pulloff.SILICA_E_STAR_PA, a declared choice: the MD asperity's moduli are not measured). For an
-    OTS pair the layers are far more compliant than silica, so its mu is larger than this. Empty when a number
-    is missing."""
-    from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
-
-    radius_A = (pull.get("settings") or {}).get("asperity_radius_A")
-    z0 = (adhesion_q.get("interaction_range_z0") or {}).get("value")
-    if not radius_A or not z0 or not work > 0:
-        return {}
-    t = tabor_parameter(radius_A * 1e-10, work, SILICA_E_STAR_PA, z0)
-    return {"tabor_mu": t["mu"], "maugis_lambda": t["lambda"], "tabor_e_star_Pa": SILICA_E_STAR_PA,
-            "tabor_note": "R of the pull-off, W_F and z0 of the flat slabs, E* of silica on silica"}
-
-
 # ----------------------------------------------------------------------------- TOML writing
 def _toml_value(v) -> str:
     if isinstance(v, bool):
@@ -556,6 +626,8 @@ def _toml_value(v) -> str:
         return repr(v)
     if v is None:
         return '""'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     return json.dumps(str(v))
 
 

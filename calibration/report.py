@@ -83,7 +83,7 @@ class CalibrationReport:
     claim_attribution: Mapping[str, Any] = field(default_factory=dict)
     """Why each claim that fails with the calibrated set fails (`calibration.attribution.attribute_claims`)."""
     validation: Mapping[str, Any] = field(default_factory=dict)
-    """Pull-off F / (2 pi R) against the flat-slab W_F per pull-off run (`calibration.mdset.pulloff_validation`)."""
+    """Pull-off F / (2 pi R) against the flat-slab W_F per pull-off run (`calibration.validation.pulloff_validation`)."""
     versions: Mapping[str, str] = field(default_factory=versions)
 
     @property
@@ -162,6 +162,24 @@ def _validation_lines(validation: Mapping[str, Any]) -> list[str]:
                      f"{_fmt(v.get('F_over_2piR_stderr'), '.2g')} | {_fmt(v['W_F'])} +- {_fmt(v.get('W_F_stderr'), '.2g')} "
                      f"| {v['ratio']:.2f} | {'-' if diff is None else f'{diff:+.1f} sigma'} | "
                      f"{'-' if drag is None else f'{drag * 1e9:+.3f}'} |")
+    lines += ["", "Each W is the flat-slab W of the interaction the pull-off runs (like for like): "
+              + "; ".join(f"{run}: {v['compared_with']}" + (f" (with the static tail it is {_fmt(v['W_F_with_tail'])})"
+                                                             if v.get("W_F_with_tail") is not None else "")
+                          for run, v in validation.items() if v.get("compared_with")) + "."]
+    rate = {run: v["rate_extrapolated"] for run, v in validation.items() if v.get("rate_extrapolated")}
+    if rate:
+        lines += ["", "Rate: the pull-off at the run's slowest speed is rate-inflated; per tip position, extrapolated "
+                      "linearly in v to v -> 0 (quasi-static) and, beside it, linearly in ln v to 10 m/s (Bell-Evans); "
+                      "Student-t stderr over the positions. The 20 and 10 m/s pulls that would test these models are "
+                      "not run.", "",
+                  "| pull-off run | speeds (m/s) | F/(2 pi R), v -> 0 (linear in v) | ratio to W | difference | "
+                  "F/(2 pi R) at 10 m/s (linear in ln v) |", "|---|---|---|---|---|---|"]
+        for run, r in rate.items():
+            lin, lg = r["linear_v0"], r["log_at_10"]
+            lines.append(f"| {run} | {', '.join(f'{x:g}' for x in r['speeds_m_s'])} | {_fmt(lin['F_over_2piR'])} +- "
+                         f"{_fmt(lin['F_over_2piR_stderr'], '.2g')} | {r['ratio']:.2f} | "
+                         f"{r['difference_in_stderr']:+.1f} sigma | {_fmt(lg['F_over_2piR'])} +- "
+                         f"{_fmt(lg['F_over_2piR_stderr'], '.2g')} |")
     off = [run for run, v in validation.items()
            if v.get("difference_in_stderr") is not None and abs(v["difference_in_stderr"]) > 2.0]
     if off:

@@ -62,7 +62,8 @@ BUILDER_LATTICE_A = 7.16
 NEUTRAL_KEYS: dict[str, dict[str, Any]] = {
     "pulloff": {"flat_thermostat": "mobile", "tip_positions": 1, "silica_lattice_A": BUILDER_LATTICE_A},
     "adhesion": {"registry_sampling": "rank1", "registry_contact_steps": 0, "sam_anneal_steps": 0,
-                 "pmf_return": False, "pmf_extra_windows_A": (), "silica_lattice_A": BUILDER_LATTICE_A},
+                 "pmf_return": False, "pmf_extra_windows_A": (), "silica_lattice_A": BUILDER_LATTICE_A,
+                 "sam_stress": False},
     "contact_angle": {"silica_lattice_A": BUILDER_LATTICE_A},
     "wsl_ti": {"silica_lattice_A": BUILDER_LATTICE_A}}
 
@@ -216,6 +217,10 @@ FIELDS: tuple[Field, ...] = (
     Field("pmf_extra_windows_A", "fidelity", list, "A", "Adhesion PMF: separations from contact inserted into the "
           "outward grid (e.g. over the force peak); each strictly between 0 and separation_A and apart from the "
           "grid's own windows.", (), low=0.0, high=60.0, workflows=_ADH, item=float),
+    Field("sam_stress", "fidelity", bool, "", "Adhesion: sample the SAM atoms' summed per-atom stress tensor (compute "
+          "stress/atom) in every leg, so the compression windows give the layer's C13/C33 and Poisson ratio "
+          "(md.analysis.stress_ratio_poisson). false = not sampled (the protocol of every committed run).", False,
+          workflows=_ADH),
     Field("pmf_equilibrate_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window discarded.", 1000,
           low=0, high=100_000_000, workflows=_ADH),
     Field("pmf_sample_steps", "fidelity", int, "steps", "Adhesion PMF: steps per window sampled.", 5000, low=1,

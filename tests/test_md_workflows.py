@@ -24,7 +24,8 @@ from md.recipe import RECIPE_DIR, RecipeError, load_recipe, parse_recipe
 RECIPES = ("adhesion_silica", "adhesion_ots", "adhesion_silica_ots", "pulloff_silica", "pulloff_ots",
            "contact_angle_silica", "contact_angle_ots", "surface_tension_spce", "wsl_silica", "wsl_ots",
            "adhesion_ots_equilibrated", "adhesion_silica_ots_equilibrated", "adhesion_silica_registries",
-           "pulloff_silica_positions", "pulloff_ots_positions")
+           "pulloff_silica_positions", "pulloff_ots_positions", "pulloff_ots_slow", "pulloff_silica_slow",
+           "adhesion_silica_ots_anneal500", "adhesion_ots_long_windows", "sam_layer_ots")
 
 FIGURES = {"adhesion": "energy_timeseries.png", "pulloff": "pulloff_curve.png", "contact_angle": "density_map.png",
            "surface_tension": "density_profile.png", "wsl_ti": "dudl.png"}

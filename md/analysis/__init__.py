@@ -31,7 +31,10 @@ from md.analysis.adhesion import (force_integration_work, registry_average, regi
                                   flat_slab_range, lj_tail_between, MAUGIS_LJ93, energy_separation_work, work_from_energy_curve,
                                   chain_correlation, window_length_check, entropic_term, grid_interval_bounds,
                                   hysteresis)
-from md.analysis.layer_modulus import confined_layer_modulus, sam_layer_thickness_A, young_from_confined
+from md.analysis.layer_modulus import (confined_layer_modulus, sam_layer_thickness_A, young_from_confined,
+                                      tangent_confined_modulus, thickness_at_tilt_A, stress_ratio_poisson,
+                                      plane_strain_from_confined, poisson_spread, tilt_of_anneal,
+                                      small_strain_layer_record)
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M
 from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
                                        work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
@@ -41,7 +44,7 @@ from md.analysis.drift import block_drift
 from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
                                      angle_from_work_of_adhesion_sl, tether_correction,
                                      film_lower_dividing_plane)
-from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation
+from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation, paired_speed_extrapolation
 from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
                                detect_equilibration, timeseries_stats, student_t_factor)
 from md.analysis.surface_tension import surface_tension, lj_tail_correction, density_profile, slab_density
@@ -51,7 +54,9 @@ __all__ = [
     "block_average", "block_analysis", "blocking_stderr", "statistical_inefficiency", "detect_equilibration",
     "timeseries_stats", "student_t_factor",
     "chain_correlation", "window_length_check", "entropic_term", "grid_interval_bounds", "hysteresis",
-    "confined_layer_modulus", "sam_layer_thickness_A", "young_from_confined",
+    "confined_layer_modulus", "sam_layer_thickness_A", "young_from_confined", "tangent_confined_modulus",
+    "thickness_at_tilt_A", "stress_ratio_poisson", "plane_strain_from_confined", "poisson_spread", "tilt_of_anneal",
+    "small_strain_layer_record",
     "force_integration_work", "registry_average", "registry_consistency", "traction_peak", "flat_slab_range",
     "lj_tail_between",
     "MAUGIS_LJ93",
@@ -61,4 +66,5 @@ __all__ = [
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
     "gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
     "tether_correction", "film_lower_dividing_plane", "pull_off_analysis", "fit_traction_law", "rate_extrapolation",
+    "paired_speed_extrapolation",
 ]

@@ -247,6 +247,41 @@ def rate_extrapolation(rates, forces, target_rate: float = 1.0, forces_stderr=No
     return out
 
 
+def paired_speed_extrapolation(speeds_m_s, forces_by_speed, model: str = "linear", target_m_s: float = 0.0) -> dict:
+    """The pull-off force extrapolated in pulling speed, position by position: each tip position's forces at the
+    speeds (``forces_by_speed``: one row per speed, one column per position, the same positions at every speed, each
+    position's pulls from its own held contact) are fitted by a line and evaluated at ``target_m_s``; the mean over
+    positions, its stderr = spread / sqrt(n) x Student t (n - 1 dof; md.analysis.stats.student_t_factor), so the
+    pairing cancels the positions' geometric spread from the slope.
+
+    ``model`` = 'linear': F = F0 + c v, a viscous (drag-like) excess force, whose v -> 0 limit (target 0) is the
+    quasi-static pull-off; 'log': F = a + b ln v, the Bell-Evans thermally activated regime (Bell, Science 200
+    (1978) 618; Evans & Ritchie, Biophys. J. 72 (1997) 1541), which has no v -> 0 limit (target must be > 0) and
+    saturates near equilibrium (Friddle, Noy & De Yoreo, PNAS 109 (2012) 13573). With two speeds neither model is
+    tested: the two bracket what the data allow. Returns ``value``, ``stderr``, ``per_position``, ``slope`` (mean
+    dF/dv or dF/d ln v), ``positions``, ``t_factor``, ``model`` and ``target_m_s``."""
+    from md.analysis.stats import student_t_factor
+
+    v = np.asarray(speeds_m_s, float).ravel()
+    f = np.asarray(forces_by_speed, float)
+    if f.ndim != 2 or f.shape[0] != v.size or v.size < 2 or f.shape[1] < 2:
+        raise ValueError("need >= 2 speeds and >= 2 positions: forces_by_speed has one row per speed")
+    if model not in ("linear", "log"):
+        raise ValueError(f"model = {model!r}: 'linear' or 'log'")
+    if np.any(v <= 0) or (model == "log" and not target_m_s > 0) or target_m_s < 0:
+        raise ValueError(f"speeds must be > 0 and the target >= 0 ('log': > 0); got target {target_m_s}")
+    x = v if model == "linear" else np.log(v)
+    xt = float(target_m_s) if model == "linear" else math.log(float(target_m_s))
+    a = np.column_stack([np.ones_like(x), x])
+    coef, *_ = np.linalg.lstsq(a, f, rcond=None)               # one line per position (columns)
+    per = coef[0] + coef[1] * xt
+    n = per.size
+    t = student_t_factor(n)
+    return {"value": float(per.mean()), "stderr": float(per.std(ddof=1) / math.sqrt(n) * t),
+            "per_position": per.tolist(), "slope": float(coef[1].mean()), "positions": int(n), "t_factor": t,
+            "model": model, "target_m_s": float(target_m_s)}
+
+
 # ------------------------------------------------------------------ surface-element integration (SEI)
 
 def tip_height_map(xy, z, box_xy, bin_A: float, reach_A: float = 0.0) -> dict:

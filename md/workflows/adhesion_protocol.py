@@ -174,4 +174,5 @@ def return_path(an, chain_rows) -> None:
         f"out and back: W_F(out) = {an.wf_val:.4f} +/- {an.wf_err:.4f}, W_F(back) = {w_back:.4f} +/- {err_back:.4f} "
         f"J/m^2 over the same windows; hysteresis {h['hysteresis']:+.4f} +/- {h['hysteresis_stderr']:.4f} J/m^2. "
         f"W_F = their mean {h['value']:.4f} +/- {h['stderr']:.4f} (stat.) +/- {h['systematic']:.4f} (half the "
-        f"hysteresis, systematic) J/m^2; sigma0, z0 and T dS come from the outward curve.")
+        f"hysteresis, systematic) J/m^2; sigma0 and T dS come from the outward curve, z0 = 1.026 W_F / sigma0 "
+        f"from this mean W_F.")
