@@ -10,8 +10,8 @@ energy (the loop's area). Levels:
 
 * `bem` (the reference): Tamaas boundary elements on the whole map, Dugdale law with sigma0 = 1.03 dgamma/z0 and
   range rho = z0/1.03, so the project's Maugis-Dugdale summit law and the reference share the cohesive law
-  (continuum/rough/bem_reference.py); repeated on the half grid for its discretisation error, and the
-  first-order Richardson value 2 F(n) - F(n/2) (the order measured on a sphere in tests/test_bem_reference.py);
+  (continuum/rough/bem_reference.py); repeated on the half grid for its discretisation error, and the first-order
+  Richardson value 2 F(n) - F(n/2) (the order measured on a sphere in tests/continuum/test_bem_reference.py);
 * `gw_direct_md`: the GW mean field with the summits' statistics counted on the map (direct route), all
   summits of the mean tip radius, Maugis-Dugdale summits, truncated at the tallest expected of N;
 * `gw_spectral_md`: the same with Nayak's spectral-moment statistics (continuum/rough/summit_stats.py);
@@ -48,27 +48,32 @@ from SurfaceTopography import Topography
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from continuum.reference.hertz import effective_modulus   # noqa: E402
-from continuum.reference.maugis import md_parameter   # noqa: E402
-from continuum.rough.bem_convergence import (GridRun, cohesive_zone_length, convergence,   # noqa: E402
-                                              dugdale_crack_zone, single_summit_ladder)
-from continuum.rough.bem_impact import STANDARD_G, impact_at_energy, impact_outcome   # noqa: E402
-from continuum.rough.bem_reference import bem_cycle, dugdale_range   # noqa: E402
-from continuum.rough.cutoff_match import CUTOFF_PIXELS, discrete_loss, match_cutoff, reference_estimate   # noqa: E402
-from continuum.rough.branch_laws import make_summit_law   # noqa: E402
-from continuum.rough.gw_branches import GWBranchSurface   # noqa: E402
-from continuum.rough.quasistatic import discrete_cycle, gw_cycle, separation_path   # noqa: E402
-from continuum.rough.summit_stats import direct_summary, spectral_summits   # noqa: E402
-from continuum.rough.summits import SummitStatistics, expected_max_height   # noqa: E402
-from continuum.rough.topography import Synthesis, identify_summits, load_height_map, synthesise_height_map   # noqa: E402
-from nanoimpact import data   # noqa: E402
-from nanoimpact.errors import InputError   # noqa: E402
-from nanoimpact.provenance import git_commit   # noqa: E402
-from nanoimpact.fileio import atomic_save_figure, atomic_write_json   # noqa: E402
+from continuum.reference.hertz import effective_modulus  # noqa: E402
+from continuum.reference.maugis import md_parameter  # noqa: E402
+from continuum.rough.bem_convergence import (  # noqa: E402
+    GridRun,
+    cohesive_zone_length,
+    convergence,
+    dugdale_crack_zone,
+    single_summit_ladder,
+)
+from continuum.rough.bem_impact import STANDARD_G, impact_at_energy, impact_outcome  # noqa: E402
+from continuum.rough.bem_reference import bem_cycle, dugdale_range  # noqa: E402
+from continuum.rough.branch_laws import make_summit_law  # noqa: E402
+from continuum.rough.cutoff_match import CUTOFF_PIXELS, discrete_loss, match_cutoff, reference_estimate  # noqa: E402
+from continuum.rough.gw_branches import GWBranchSurface  # noqa: E402
+from continuum.rough.quasistatic import discrete_cycle, gw_cycle, separation_path  # noqa: E402
+from continuum.rough.summit_stats import direct_summary, spectral_summits  # noqa: E402
+from continuum.rough.summits import SummitStatistics, expected_max_height  # noqa: E402
+from continuum.rough.topography import Synthesis, identify_summits, load_height_map, synthesise_height_map  # noqa: E402
+from nanoimpact import data  # noqa: E402
+from nanoimpact.errors import InputError  # noqa: E402
+from nanoimpact.fileio import atomic_save_figure, atomic_write_json  # noqa: E402
+from nanoimpact.provenance import git_commit  # noqa: E402
 
 #: The default patch: the shipped map's spectrum shape (Hurst 0.8, long cutoff 4x and summit cutoff 8 pixels of
-#: the 64^2 base grid), 0.25 um wide and 1.2 nm rms: the Dugdale zone of a summit at touch, sqrt(2 beta rho),
-#: spans ~3.5 pixels of the 128^2 grid and ~7 of 256^2 (the reference needs several: tests/test_bem_reference.py)
+#: the 64^2 base grid), 0.25 um wide and 1.2 nm rms: the Dugdale zone of a summit at touch, sqrt(2 beta rho), spans
+#: ~3.5 pixels of the 128^2 grid and ~7 of 256^2 (the reference needs several: tests/continuum/test_bem_reference.py)
 #: while the patch holds ~20 summits. The shipped 5 um map (rms 6 nm, summit radii ~2 um) would need ~1000^2.
 PATCH = Synthesis(hurst=0.8, rms_height=1.2e-9, short_cutoff=0.25e-6 / 8, size=0.25e-6, grid_points=64,
                   long_cutoff=0.25e-6 / 2, seed=1)
@@ -349,7 +354,8 @@ def markdown(result: dict) -> str:
     rows = ["| level | seconds | pull-off error | hysteresis error | contact-area error (approach) | "
             "pull-off error vs Richardson |", "|---|---|---|---|---|---|",
             f"| `bem` {ref['grid']}^2 (reference) | {ref['seconds']:.1f} | {ref['pull_off_force_N']:.3g} N | "
-            f"{ref['hysteresis_energy_J']:.3g} J | | Richardson shift {100 * ref['discretisation_rel']['pull_off']:+.1f} % |"]
+            f"{ref['hysteresis_energy_J']:.3g} J | | "
+            f"Richardson shift {100 * ref['discretisation_rel']['pull_off']:+.1f} % |"]
     for r in result["levels"]:
         rows.append(f"| `{r['name']}` | {r['seconds']:.2f} | {100 * r['pull_off_rel_error']:+.0f} % | "
                     f"{100 * r['hysteresis_rel_error']:+.0f} % | {100 * r['area_rel_error']:.0f} % | "
@@ -369,7 +375,8 @@ def markdown_bem(result: dict) -> str:
     verdict = (f"Converged: the two finest grids' losses within {100 * conv['tolerance']:.0f} %."
                if conv["converged"] else f"`not_converged`: {conv['not_converged']}.")
     one = conv.get("single_summit", {"grids": []})
-    verdict += "" if not one["grids"] else (f"\n\nOne summit of the patch's mean tip radius ({one['radius_m'] * 1e9:.3g} nm, a "
+    verdict += "" if not one["grids"] else ("\n\nOne summit of the patch's mean tip radius "
+                f"({one['radius_m'] * 1e9:.3g} nm, a "
                 f"{one['cell_m'] * 1e9:.3g} nm cell, flat {one['depth_m'] * 1e9:.2g} nm below the apex): the summit "
                 f"law loses {one['summit_law_loss_J']:.3g} J per cycle and pulls off at "
                 f"{one['summit_law_pull_off_N']:.3g} N; the reference, by pixel: " + "; ".join(
@@ -397,7 +404,7 @@ def markdown_bem(result: dict) -> str:
     match = result["cutoff_match"]
     ladder = ", ".join(f"{r['cutoff_m'] * 1e9:.3g} nm: {r['summits']} summits, {r['loss_J']:.2g} J"
                        for r in match["ladder"])
-    cut_line = (f"Summit cutoff measured by the reference (`summit_cutoff`, kind `bem`): "
+    cut_line = ("Summit cutoff measured by the reference (`summit_cutoff`, kind `bem`): "
                 + (f"{cut['cutoff_m'] * 1e9:.3g} nm" if cut["cutoff_m"] else "none")
                 + f", match error {100 * cut['match_error']:+.0f} % against {cut['reference_loss_J']:.3g} J ("
                 + ("converged reference" if cut["reference_converged"] else "unconverged reference: extrapolated")

@@ -21,8 +21,8 @@ import resource
 import time
 from pathlib import Path
 
-from continuum.numerics.compiled_contact import warm_up
 from continuum.dynamics.ensemble_run import run_ensemble
+from continuum.numerics.compiled_contact import warm_up
 from continuum.scene import resolve_scene
 
 RIGID = {"physics.half_space": "auto"}
@@ -72,7 +72,8 @@ def main() -> None:
         row = one(params, overrides, members, executor, workers)
         out["cases"].setdefault(f"{params} {name}", []).append(row)
         print(f"{params:11s} {name:14s} {executor:9s} {members} members: {row['seconds']:6.2f} s wall, "
-              f"{row['cpu_seconds']:6.2f} s CPU (members' own wall {row['member_seconds_sum']:.2f} s; stick p {row['stick_probability']:.3f}, first impact "
+              f"{row['cpu_seconds']:6.2f} s CPU (members' own wall {row['member_seconds_sum']:.2f} s; "
+              f"stick p {row['stick_probability']:.3f}, first impact "
               f"{row['stick_probability_first_impact']:.3f}; load {row['load_average_before']:.2f} -> "
               f"{row['load_average_after']:.2f})", flush=True)
     if args.json:

@@ -119,8 +119,11 @@ def main() -> None:
     n_star = threshold(points)
     a, a_se = fit_amplitude(points)
     out = {"fit": {"form": "relative departure = A / sqrt(N_c), N_c >= 10, weights 1/s.e.^2", "A": a,
-                   "A_standard_error": a_se, "threshold_at_1_percent": threshold(points, 0.01)},"what": __doc__.splitlines()[0], "scene": "rough_silica", "params": "paper", "overrides": BASE,
-           "tolerance_over_h0": ENSEMBLE_TOLERANCE, "criterion": "fit A / sqrt(N*) = tolerance; a point 'fails' where |L_mf / <L>_ens - 1| > tolerance + 2 s.e., L = 1 - h1/h0",
+                   "A_standard_error": a_se, "threshold_at_1_percent": threshold(points, 0.01)},
+           "what": __doc__.splitlines()[0], "scene": "rough_silica", "params": "paper", "overrides": BASE,
+           "tolerance_over_h0": ENSEMBLE_TOLERANCE,
+           "criterion": "fit A / sqrt(N*) = tolerance; a point 'fails' where |L_mf / <L>_ens - 1| > tolerance "
+                        "+ 2 s.e., L = 1 - h1/h0",
            "threshold_expected_contacts": n_star, "constant_in_code": ENSEMBLE_BELOW_CONTACTS, "points": points}
     Path(args.json).parent.mkdir(parents=True, exist_ok=True)
     Path(args.json).write_text(json.dumps(out, indent=2) + "\n")

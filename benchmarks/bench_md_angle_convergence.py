@@ -23,7 +23,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from md.analysis import angle_from_work_of_adhesion_sl   # noqa: E402
+from md.analysis import angle_from_work_of_adhesion_sl  # noqa: E402
 
 RESULTS = ROOT / "inputs" / "md" / "results"
 DROPLETS = ("contact_angle_ots-quick", "contact_angle_ots_long-quick", "contact_angle_ots_large-quick")
@@ -72,7 +72,7 @@ def ti_summary(folder: Path) -> dict:
 
 
 def draw(rows: list[dict], ti: dict, path: Path) -> None:
-    from matplotlib.figure import Figure   # noqa: PLC0415
+    from matplotlib.figure import Figure  # noqa: PLC0415
     fig = Figure(figsize=(6.4, 4.0))
     ax = fig.add_subplot()
     lo, hi = ti["theta_deg"] - ti["stderr_deg"], ti["theta_deg"] + ti["stderr_deg"]

@@ -27,7 +27,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from md.analysis import block_analysis, block_average   # noqa: E402
+from md.analysis import block_analysis, block_average  # noqa: E402
 
 
 def load(folder: Path):

@@ -34,10 +34,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from md import workflows as W                   # noqa: E402
-from md.engine.lammps import InProcess          # noqa: E402
-from md.lammps_loader import lmp_binary, mpi_env   # noqa: E402
-from md.recipe import RECIPE_DIR, parse_recipe   # noqa: E402
+from md import workflows as W  # noqa: E402
+from md.engine.lammps import InProcess  # noqa: E402
+from md.lammps_loader import lmp_binary, mpi_env  # noqa: E402
+from md.recipe import RECIPE_DIR, parse_recipe  # noqa: E402
 
 LOOP = re.compile(r"^Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 
@@ -137,7 +137,8 @@ def main(argv=None):
             if k == 0:
                 shutil.copy(pl["script"], tmp / "bench.in")
             row = {"repeat": k, "atoms": ip["loop"][2], "steps_in_logs": ip["loop"][1],
-                   "inprocess_lammps_wall_s": ip["lammps_wall_s"], "inprocess_run_recipe_wall_s": ip["run_recipe_wall_s"],
+                   "inprocess_lammps_wall_s": ip["lammps_wall_s"],
+                   "inprocess_run_recipe_wall_s": ip["run_recipe_wall_s"],
                    "inprocess_loop_s": ip["loop"][0], "plain_wall_s": pl["wall_s"], "plain_loop_s": pl["loop"][0],
                    "plain_steps_in_logs": pl["loop"][1]}
             if row["steps_in_logs"] != row["plain_steps_in_logs"]:
@@ -157,9 +158,11 @@ def main(argv=None):
         "ratio_loop_per_repeat": [r["plain_loop_s"] / r["inprocess_loop_s"] for r in rows],
     }
     per = sorted(summary["ratio_loop_per_repeat"])
-    summary["ratio_loop_median"] = per[len(per) // 2] if len(per) % 2 else 0.5 * (per[len(per) // 2 - 1] + per[len(per) // 2])
+    summary["ratio_loop_median"] = (per[len(per) // 2] if len(per) % 2
+                                    else 0.5 * (per[len(per) // 2 - 1] + per[len(per) // 2]))
     print(f"throughput in-process / plain lmp -in: dynamics (Loop time) {summary['ratio_loop']:.3f}, "
-          f"all LAMMPS work {summary['ratio_lammps_wall']:.3f}, whole run_recipe call {summary['ratio_whole_run']:.3f}; "
+          f"all LAMMPS work {summary['ratio_lammps_wall']:.3f}, "
+          f"whole run_recipe call {summary['ratio_whole_run']:.3f}; "
           f"per repeat (dynamics) {', '.join(f'{x:.3f}' for x in summary['ratio_loop_per_repeat'])}, "
           f"median {summary['ratio_loop_median']:.3f}")
     if args.json:

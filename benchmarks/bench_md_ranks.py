@@ -23,10 +23,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from bench_md_engine import LOOP, bench_recipe     # noqa: E402  (same folder)
-import md.engine.lammps as E                       # noqa: E402
-from md import workflows as W                      # noqa: E402
-from md.engine.runner import Interrupted           # noqa: E402
+from bench_md_engine import LOOP, bench_recipe  # noqa: E402  (same folder)
+
+import md.engine.lammps as E  # noqa: E402
+from md import workflows as W  # noqa: E402
+from md.engine.runner import Interrupted  # noqa: E402
 
 GRID = re.compile(r"^\s*(\d+) by (\d+) by (\d+) MPI processor grid")
 SECTION = re.compile(r"^(Pair|Kspace|Neigh|Comm|Modify)\s*\|\s*([0-9.eE+-]+)\s*\|\s*([0-9.eE+-]+)\s*\|\s*([0-9.eE+-]+)")
@@ -86,7 +87,8 @@ def main(argv=None):
               f"speed-up {r['speedup_vs_one_rank']:.2f}  pair min/max {pair.get('min_s', float('nan')):.2f}/"
               f"{pair.get('max_s', float('nan')):.2f} s")
     if args.json:
-        Path(args.json).write_text(json.dumps({"recipe": args.recipe, "fidelity": args.fidelity, "rows": rows}, indent=1))
+        Path(args.json).write_text(json.dumps({"recipe": args.recipe, "fidelity": args.fidelity, "rows": rows},
+                                              indent=1))
 
 
 if __name__ == "__main__":

@@ -22,8 +22,8 @@ import resource
 import time
 import tomllib
 
-from continuum.numerics.compiled_contact import warm_up
 from continuum.dynamics.impact import run_impact
+from continuum.numerics.compiled_contact import warm_up
 from continuum.scene import resolve_scene
 
 log = logging.getLogger("bench_measured_surface")

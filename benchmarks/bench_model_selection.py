@@ -4,7 +4,7 @@
 
 For each pair the scene runs once with the model `auto` leaves out and once with it forced back on;
 the table gives best-of-N wall times, their ratio, and the largest rebound difference in units of
-the release height (the omission is "safe" below 5e-3; tests/test_model_selection.py enforces it).
+the release height (the omission is "safe" below 5e-3; tests/continuum/test_model_selection.py enforces it).
 All numbers come from one run of this script, so the ratios are comparable.
 """
 from __future__ import annotations

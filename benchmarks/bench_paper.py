@@ -253,10 +253,10 @@ def _best(fn, repeat: int) -> float:
 
 def per_impact(repeat: int, resolution: str = "standard") -> dict:
     """Seconds per rough impact: driver + kernel, driver + Python stepper, kernel alone (the floor)."""
-    from continuum.numerics.compiled_contact import run_compiled
     from continuum.dynamics.driver import DriverSettings, simulate
     from continuum.dynamics.impact import first_impact_speed
     from continuum.model import select_law
+    from continuum.numerics.compiled_contact import run_compiled
     from continuum.scene import resolve_scene
 
     resolved = resolve_scene(ROOT / "inputs" / "scenes" / "rough_silica.toml", params="paper",
@@ -284,7 +284,8 @@ def per_impact(repeat: int, resolution: str = "standard") -> dict:
                             has_history=True, samples_per_step=3)
 
     out = kernel()
-    return {"compiled": _best(lambda: driver(True), repeat), "python": _best(lambda: driver(False), max(1, repeat // 2)),
+    return {"compiled": _best(lambda: driver(True), repeat),
+            "python": _best(lambda: driver(False), max(1, repeat // 2)),
             "floor": _best(kernel, repeat), "table_nodes": law.table_points, "samples": len(out.samples),
             "restitution": run.bounces[0].restitution, "stuck": run.stuck}
 
@@ -372,7 +373,8 @@ def main(argv=None):
               f"{1e3 * c['floor']:9.3f} {c['compiled'] / c['floor']:13.1f} {c['python'] / c['floor']:13.0f} "
               f"{c['samples']:8d}")
 
-    print(f"\n## Whole run against the number of bounces (rough_silica, silicon set; best of {max(1, args.repeat // 2)})")
+    print("\n## Whole run against the number of bounces (rough_silica, silicon set; "
+          f"best of {max(1, args.repeat // 2)})")
     print(f"{'bounces':>8s} {'wall s':>8s} {'per bounce ms':>14s} {'each bounce after the first ms':>31s}")
     rows = per_bounce(max(1, args.repeat // 2))
     first = rows[0][1]
@@ -396,7 +398,8 @@ def main(argv=None):
             ratio = [(base[s][0] / now[s][0], base[s][1] / now[s][1]) for s in sets]
             tot = (sum(v[0] for v in base.values()) / sum(v[0] for v in now.values()),
                    sum(v[1] for v in base.values()) / sum(v[1] for v in now.values()))
-            print(f"{'speed-up':24s} " + " ".join(f"{a:11.1f} {b:10.1f}" for a, b in ratio) + f" {tot[0]:9.1f} {tot[1]:8.1f}")
+            print(f"{'speed-up':24s} " + " ".join(f"{a:11.1f} {b:10.1f}" for a, b in ratio)
+                  + f" {tot[0]:9.1f} {tot[1]:8.1f}")
     if args.whole:
         print(f"\n## nanoimpact paper --params {','.join(sets)} (one process, {args.workers} workers; runs, figures, "
               f"checks, summary)")

@@ -49,7 +49,7 @@ def sweep(path: Path) -> dict:
 
 
 def figure(maps: list[dict], path: Path) -> None:
-    from matplotlib.figure import Figure   # noqa: PLC0415
+    from matplotlib.figure import Figure  # noqa: PLC0415
     fig = Figure(figsize=(9.0, 3.8))
     axes = fig.subplots(1, 2)
     for k, m in enumerate(maps):

@@ -21,8 +21,8 @@ import json
 import time
 from pathlib import Path
 
-from continuum.numerics.compiled_contact import warm_up
 from continuum.dynamics.ensemble_run import run_ensemble
+from continuum.numerics.compiled_contact import warm_up
 from continuum.scene import resolve_scene
 
 

@@ -32,10 +32,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from bench_md_engine import LOOP, bench_recipe    # noqa: E402  (same folder; sys.path[0] when run as a script)
-from md import workflows as R                     # noqa: E402  (run_recipe, run_hash)
-from md.recipe import RECIPE_DIR, load_recipe     # noqa: E402
-from md.workflows import get_workflow             # noqa: E402
+from bench_md_engine import LOOP, bench_recipe  # noqa: E402  (same folder; sys.path[0] when run as a script)
+
+from md import workflows as R  # noqa: E402  (run_recipe, run_hash)
+from md.recipe import RECIPE_DIR, load_recipe  # noqa: E402
+from md.workflows import get_workflow  # noqa: E402
 
 FIDELITIES = ("smoke", "quick", "production")
 RESULTS = ROOT / "inputs" / "md" / "results"

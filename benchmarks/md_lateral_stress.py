@@ -18,8 +18,9 @@ For a slab of thickness t, S = sigma_bulk t + 2 f (f the surface stress of one f
 bulk stress sigma_bulk = dS/dt (t: the span of the Si planes, the same for both definitions up to a constant) --
 the part a lattice rescale would remove -- and the surface stress f, which no lattice constant removes. Errors:
 block averages (10 blocks) of the sampled S. ``--lattice-a`` builds the slabs at another cubic lattice constant
-(default: the builder's, ``md.build.silica.CRISTOBALITE_A``), to find the one at which the bulk stress vanishes. A script, not a test; it runs LAMMPS in this process on one core
-(about a minute per 1000 atoms and 10 000 steps on the development machine).
+(default: the builder's, ``md.build.silica.CRISTOBALITE_A``), to find the one at which the bulk stress vanishes. A
+script, not a test; it runs LAMMPS in this process on one core (about a minute per 1000 atoms and 10 000 steps on
+the development machine).
 """
 from __future__ import annotations
 
@@ -34,11 +35,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from md import units as U                                   # noqa: E402
-from md.build.common import silica_forcefield               # noqa: E402
-from md.build.silica import CRISTOBALITE_A, silica_slab     # noqa: E402
-from md.lammps_loader import new_lammps                     # noqa: E402
-from md.system.lammps_data import lammps_setup_commands, write_data   # noqa: E402
+from md import units as U  # noqa: E402
+from md.build.common import silica_forcefield  # noqa: E402
+from md.build.silica import CRISTOBALITE_A, silica_slab  # noqa: E402
+from md.lammps_loader import new_lammps  # noqa: E402
+from md.system.lammps_data import lammps_setup_commands, write_data  # noqa: E402
 
 N_BLOCKS = 10
 
@@ -106,7 +107,8 @@ def main(argv=None):
     print(f"bulk in-plane stress dS/dt = {sigma / 1e9:+.2f} +- {sigma_err / 1e9:.2f} GPa (positive: tension); "
           f"surface stress per face f = {f_surface:+.3f} N/m; review threshold 0.5 GPa")
     if args.json:
-        Path(args.json).write_text(json.dumps({"lattice_a_A": args.lattice_a or CRISTOBALITE_A, "rows": rows, "sigma_bulk_Pa": sigma, "sigma_bulk_stderr_Pa": sigma_err,
+        Path(args.json).write_text(json.dumps({"lattice_a_A": args.lattice_a or CRISTOBALITE_A, "rows": rows,
+                                               "sigma_bulk_Pa": sigma, "sigma_bulk_stderr_Pa": sigma_err,
                                                "surface_stress_N_per_m": f_surface}, indent=1))
 
 

@@ -35,15 +35,19 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from md import units as U                                                       # noqa: E402
-from md.analysis.pulloff import (SILICA_E_STAR_PA, surface_element_pull_off, tabor_parameter,  # noqa: E402
-                                 tabulated_traction, tip_height_map)
-from md.build.silica import CRISTOBALITE_A                                       # noqa: E402
-from md.recipe import RECIPE_DIR, load_recipe                                    # noqa: E402
-from md.workflows import get_workflow                                            # noqa: E402
-
-from calibration.mdset import MAPPING, VALIDATION                               # noqa: E402
-from nanoimpact.fileio import atomic_write_text                                 # noqa: E402
+from calibration.mdset import MAPPING, VALIDATION  # noqa: E402
+from md import units as U  # noqa: E402
+from md.analysis.pulloff import (  # noqa: E402
+    SILICA_E_STAR_PA,
+    surface_element_pull_off,
+    tabor_parameter,
+    tabulated_traction,
+    tip_height_map,
+)
+from md.build.silica import CRISTOBALITE_A  # noqa: E402
+from md.recipe import RECIPE_DIR, load_recipe  # noqa: E402
+from md.workflows import get_workflow  # noqa: E402
+from nanoimpact.fileio import atomic_write_text  # noqa: E402
 
 RESULTS = RECIPE_DIR / "results"
 #: the adhesion recipe whose flat-slab law stands for each surface: the one the calibration reads its W from

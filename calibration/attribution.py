@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
 
-from .mdset import _delete_nested, _get_nested, _set_nested, write_parameter_set
+from .mdset import _delete_nested, _set_nested, write_parameter_set
 
 __all__ = ["Revert", "ClaimWhy", "reverts", "revert_table", "explain_claims", "attribute_claims", "acceptance",
            "PHYSICAL_DIRECTION"]

@@ -18,10 +18,10 @@ import logging
 import sys
 from pathlib import Path
 
-from nanoimpact.cli import ArgumentParser, Command, add_verbosity, check_out_dir, positive_int, setup_logging
 from nanoimpact import __version__, data
-from nanoimpact.executors import check_executor
+from nanoimpact.cli import ArgumentParser, Command, add_verbosity, check_out_dir, positive_int, setup_logging
 from nanoimpact.errors import InputError, NanoimpactError, RunInterrupted, run_command
+from nanoimpact.executors import check_executor
 
 log = logging.getLogger("calibration.cli")      # not __name__: it is __main__ under python -m
 
@@ -39,7 +39,7 @@ def cmd_calibrate(args) -> int:
     if args.params_out is not None and Path(args.params_out).is_dir():
         raise InputError("--params-out", args.params_out, "is an existing folder; give the set's file path")
     check_executor(args.executor, args.workers, args.scheduler)
-    from calibration.pipeline import calibrate      # after the option checks: they need none of the physics
+    from calibration.pipeline import calibrate  # after the option checks: they need none of the physics
     # calibrate checks the whole recipe (pipeline.load_calibration) before any MD or paper run starts
     calibrate(args.recipe, args.out, md_fidelity=args.md_fidelity, executor_name=args.executor,
               workers=args.workers, scheduler=args.scheduler, params_out=args.params_out, md_cache=args.md_cache,

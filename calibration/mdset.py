@@ -60,16 +60,19 @@ from pathlib import Path
 
 import numpy as np
 
+from calibration.sam_layer import (
+    LAYER_QUANTITIES,
+    THICKNESS_QUANTITIES,
+    thickness_record,
+    with_layer_quantities,
+    young_with_nu,
+)
+from calibration.validation import VALIDATION, pulloff_validation
 from continuum.model.origins import check_origins
 from continuum.scene import SceneError, check_value, find_params, flatten
 from continuum.schema import FIELD_BY_PATH
-
 from nanoimpact import data
 from nanoimpact.fileio import atomic_write_text
-
-from calibration.sam_layer import (LAYER_QUANTITIES, THICKNESS_QUANTITIES, thickness_record, with_layer_quantities,
-                                   young_with_nu)
-from calibration.validation import VALIDATION, pulloff_validation
 
 #: Committed MD results shipped with the package (inputs/md/results, installed as package data).
 RESULTS_DIR = data.shipped_root() / "md" / "results"
@@ -92,9 +95,9 @@ _PULLOFF_Z0 = ("fallback: the adhesion result has no flat-slab z0; this z0 is a 
                "overestimate)")
 
 _DROPLET = ("fallback: no W_SL by thermodynamic integration (wsl_silica); this is the droplet's angle, and the quick "
-            "silica droplet keeps the angle it is started at (a pinned contact line: the committed contact_angle_silica "
-            "and contact_angle_silica_flatstart results end near their different starting angles), so it measures "
-            "the start, not the surface")
+            "silica droplet keeps the angle it is started at (a pinned contact line: the committed "
+            "contact_angle_silica and contact_angle_silica_flatstart results end near their different starting "
+            "angles), so it measures the start, not the surface")
 
 _DROPLET_OTS = ("fallback: no W_SL by thermodynamic integration (wsl_ots); this is the quick R0 = 2 nm droplet's "
                 "angle, which is not size-converged (the committed contact_angle_ots_long and "
@@ -371,7 +374,8 @@ def _to_scene_units(key: str, value: float, stderr, table: dict, res: dict):
     nu = FIELD_BY_PATH["surfaces.sam.layer_poisson_ratio"].default if nu is None else float(nu)
     e, e_err, rec = young_with_nu(value, stderr, nu, res)
     note = (f"confined modulus M = {value / 1e9:.3g} GPa (tangent at the zero-force point) converted to Young's "
-            f"modulus with nu = {rec['value']:g} ({'measured' if rec['measured'] else 'the set' + chr(39) + 's, not measured'}"
+            f"modulus with nu = {rec['value']:g} "
+            f"({'measured' if rec['measured'] else 'the set' + chr(39) + 's, not measured'}"
             f"; E = M (1 + nu)(1 - 2 nu) / (1 - nu) = {e / value:.3f} M)")
     return e, e_err, (note, rec)
 

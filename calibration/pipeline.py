@@ -19,8 +19,8 @@ Steps (each timed in the report):
    one, each group of MD values is put back to the base values alone and the paper's cases run again (no
    figures), into OUT/attribution; the claims that hold again name the value that broke them.
 4. Uncertainty: a Latin hypercube over the calibrated values (normal with their MD stderr, truncated to each
-   key's allowed range) and the user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns the recipe's
-   scene, giving first rebound heights, rebound counts and the escape velocity as median and
+   key's allowed range) and the user's ranges (uniform) from the recipe's [uncertainty] table; each sample reruns
+   the recipe's scene, giving first rebound heights, rebound counts and the escape velocity as median and
    5-95 % bands (OUT/uncertainty.csv, OUT/uncertainty.png); every band says which inputs it covers.
 5. OUT/report.md.
 """
@@ -39,19 +39,24 @@ from pathlib import Path
 
 import numpy as np
 
-from nanoimpact.executors import Failure, executor
-from nanoimpact.fileio import atomic_save_figure, atomic_write_text
-
-from .attribution import attribute_claims
-from .mdset import (build_parameter_set, committed_result, fallbacks_needed, recipes_first, recipes_needed,
-                    write_parameter_set)
-from .report import CalibrationReport, ValueRow
-
 from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
 from nanoimpact.errors import DataNotFound, InputError
+from nanoimpact.executors import Failure, executor
 from nanoimpact.fields import REQUIRED, Field, Resolved, frozen_dataclass, section_members
 from nanoimpact.fields import json_schema as json_schema_of
+from nanoimpact.fileio import atomic_save_figure, atomic_write_text
+
+from .attribution import attribute_claims
+from .mdset import (
+    build_parameter_set,
+    committed_result,
+    fallbacks_needed,
+    recipes_first,
+    recipes_needed,
+    write_parameter_set,
+)
+from .report import CalibrationReport, ValueRow
 
 log = logging.getLogger(__name__)
 
@@ -337,7 +342,6 @@ def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, wor
     """The options of `calibrate`, checked before anything runs or is written (CalibrationError, one line)."""
     from continuum.scene import SceneError, find_params
     from md.recipe import FIDELITIES
-
     from nanoimpact.executors import NAMES
 
     if Path(out).exists() and not Path(out).is_dir():
@@ -503,9 +507,8 @@ def uncertainty_sample(task: tuple) -> dict:
     from continuum.dynamics.escape import escape_velocity, single_impact
     from continuum.dynamics.impact import first_impact_speed, run_impact
     from continuum.model import select_law
-    from continuum.scene import SceneError, resolve_scene
-
     from continuum.paper.samples import row_for_scene
+    from continuum.scene import SceneError, resolve_scene
 
     try:
         # a SAM's values describe nothing on a scene without one (row_for_scene): left out and said so

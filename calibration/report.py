@@ -83,7 +83,8 @@ class CalibrationReport:
     claim_attribution: Mapping[str, Any] = field(default_factory=dict)
     """Why each claim that fails with the calibrated set fails (`calibration.attribution.attribute_claims`)."""
     validation: Mapping[str, Any] = field(default_factory=dict)
-    """Pull-off F / (2 pi R) against the flat-slab W_F per pull-off run (`calibration.validation.pulloff_validation`)."""
+    """Pull-off F / (2 pi R) against the flat-slab W_F per pull-off run
+    (`calibration.validation.pulloff_validation`)."""
     versions: Mapping[str, str] = field(default_factory=versions)
 
     @property
@@ -148,18 +149,21 @@ def _work_sentence(rows: tuple[ValueRow, ...]) -> str:
 
 
 def _validation_lines(validation: Mapping[str, Any]) -> list[str]:
-    """The pull-off check: F / (2 pi R) (DMT: an MD-scale asperity's Tabor mu, computed from the run and in [meta.validation], is small) against the flat-slab W_F
-    of the same pair, as a ratio and in combined stderrs. Nothing of it enters the set."""
+    """The pull-off check: F / (2 pi R) (DMT: an MD-scale asperity's Tabor mu, computed from the run and in
+    [meta.validation], is small) against the flat-slab W_F of the same pair, as a ratio and in combined stderrs.
+    Nothing of it enters the set."""
     if not validation:
         return []
     lines = ["", "**Pull-off validation (DMT, F = 2 pi R W; not used in the set):**", "",
-             "| pull-off run | F / (2 pi R) (J/m^2) | flat-slab W_F (J/m^2) | ratio | difference | residual drag (nN) |",
+             "| pull-off run | F / (2 pi R) (J/m^2) | flat-slab W_F (J/m^2) | ratio | difference | "
+             "residual drag (nN) |",
              "|---|---|---|---|---|---|"]
     for run, v in validation.items():
         diff = v.get("difference_in_stderr")
         drag = v.get("residual_drag_N")
         lines.append(f"| {run} (vs {v.get('adhesion_recipe')}) | {_fmt(v['F_over_2piR'])} +- "
-                     f"{_fmt(v.get('F_over_2piR_stderr'), '.2g')} | {_fmt(v['W_F'])} +- {_fmt(v.get('W_F_stderr'), '.2g')} "
+                     f"{_fmt(v.get('F_over_2piR_stderr'), '.2g')} | {_fmt(v['W_F'])} +- "
+                     f"{_fmt(v.get('W_F_stderr'), '.2g')} "
                      f"| {v['ratio']:.2f} | {'-' if diff is None else f'{diff:+.1f} sigma'} | "
                      f"{'-' if drag is None else f'{drag * 1e9:+.3f}'} |")
     lines += ["", "Each W is the flat-slab W of the interaction the pull-off runs (like for like): "
@@ -259,8 +263,8 @@ def report_markdown(rec: CalibrationReport) -> str:
              "(cached or committed runs cost nothing), paper cases "
              f"{t['paper_s']:.1f} s, uncertainty {t['uncertainty_s']:.1f} s, total "
              f"{t['total_s']:.1f} s. Set written to `{rec.set_path}`.", "",
-             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | literature range (accepted) | against the literature range "
-             "| status | why / run |", "|---|---|---|---|---|---|---|---|---|"]
+             "## MD values", "", "| scene key | MD recipe | quantity | value | stderr | literature range (accepted) | "
+             "against the literature range | status | why / run |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rec.rows:
         tgt = target_of(r.key)
         against = verdict(r.value, r.stderr, tgt).text if tgt and r.value is not None else "-"

@@ -8,11 +8,11 @@ the value and what is allowed. Nothing here writes files.
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
 import tomllib
-import dataclasses
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -437,7 +437,6 @@ def _check_law(si: dict, sam, origin: str) -> None:
         if adhesion <= 0.0:
             key = "surfaces.sam.work_of_adhesion" if sam is not None else "surfaces.work_of_adhesion"
             raise SceneError(key, adhesion, f"must be > 0 J/m^2 when physics.adhesion_law = '{law}'", origin)
-    mode = si["surfaces.roughness.mode"]
 
 
 def _check_plasticity(si: dict, sam, origin: str) -> None:

@@ -218,10 +218,11 @@ FIELDS: tuple[Field, ...] = (
     Field("surfaces.roughness.seed", int, "1", "Random seed of the discrete summit realisation; of an ensemble, "
           "the master seed its members' seeds are derived from (numpy SeedSequence).", 0, low=0, high=2**63 - 1),
     NumberOrWord("surfaces.roughness.members", int, "1", "Realisations in an ensemble (mode 'ensemble', or 'auto' "
-                 "where it runs one); 'auto' adds members in batches (continuum.dynamics.ensemble_run.AUTO_BATCH) until the "
-                 "Wilson 95 % half-width of the stick probabilities (first impact and within the run) is below "
-                 "surfaces.roughness.target_half_width, or surfaces.roughness.max_members are run; result.json -> "
-                 "ensemble.members_rule records why it stopped.", 64, low=2, high=100000, words=("auto",)),
+                 "where it runs one); 'auto' adds members in batches (continuum.dynamics.ensemble_run.AUTO_BATCH) "
+                 "until the Wilson 95 % half-width of the stick probabilities (first impact and within the run) is "
+                 "below surfaces.roughness.target_half_width, or surfaces.roughness.max_members are run; "
+                 "result.json -> ensemble.members_rule records why it stopped.", 64, low=2, high=100000,
+                 words=("auto",)),
     Field("surfaces.roughness.target_half_width", float, "1", "members = 'auto': the Wilson 95 % half-width of "
           "the stick probabilities at which the ensemble stops growing.", 0.05, low=0.0, high=0.5, low_open=True),
     Field("surfaces.roughness.max_members", int, "1", "members = 'auto': the most members run.", 512, low=2,
@@ -232,9 +233,9 @@ FIELDS: tuple[Field, ...] = (
           "threshold, continuum.rough.tail). With a map the ensemble is also run under the other model and both "
           "are reported (result.json -> ensemble.tail_models).", "gaussian", choices=("gaussian", "empirical_gpd")),
     Field("surfaces.roughness.escape_velocities", bool, "", "Of an ensemble, also bisect each member's escape "
-          "velocity (the smallest first-impact speed from which it rebounds, continuum.dynamics.escape) and report their "
-          "percentiles in result.json -> ensemble -> escape_velocity; each member then runs a dozen or more single "
-          "impacts besides its drop.", False),
+          "velocity (the smallest first-impact speed from which it rebounds, continuum.dynamics.escape) and report "
+          "their percentiles in result.json -> ensemble -> escape_velocity; each member then runs a dozen or more "
+          "single impacts besides its drop.", False),
     _OneOrList("surfaces.roughness.topography", str, "", "A measured height map (any format SurfaceTopography "
                "reads: NanoScope .di, Gwyddion .gwy, Nanosurf .nid, Asylum .ibw, matrix text, .npy), or a list of "
                "scans of one surface at different sizes (each takes part at the cutoff where it resolves it; their "
@@ -306,11 +307,11 @@ FIELDS: tuple[Field, ...] = (
     Field("physics.plasticity", str, "", "Smooth sphere: the Thornton-Ning (1998) adhesive elastic-plastic law "
           "(JKR to yield, then a limiting contact pressure from the softer partner's hardness or 2.8 x yield "
           "strength; the flattening is carried into later impacts). 'auto': on when the first impact is faster "
-          "than the yield velocity, off (recorded) when no yield key is given. Rough contact: 'auto' runs Thornton-Ning "
-          "summits where their plasticity index psi = (E*/p_y) sqrt(sigma/beta) >= 0.6 (Greenwood & Williamson "
-          "1966) or the first impact's estimated depth passes their yield approach, and they are JKR summits over a "
-          "rigid substrate without bridges, in the mean field or discrete (else elastic summits, recorded with "
-          "psi).", "auto",
+          "than the yield velocity, off (recorded) when no yield key is given. Rough contact: 'auto' runs "
+          "Thornton-Ning summits where their plasticity index psi = (E*/p_y) sqrt(sigma/beta) >= 0.6 (Greenwood & "
+          "Williamson 1966) or the first impact's estimated depth passes their yield approach, and they are JKR "
+          "summits over a rigid substrate without bridges, in the mean field or discrete (else elastic summits, "
+          "recorded with psi).", "auto",
           choices=("auto", "on", "off")),
     Field("physics.line_stiffness", str, "", "Hertz line contact: 'implicit' solves W = pi l E* delta/(2 ln(2l/b)+1) "
           "with b(W) exactly; 'constant' freezes K at the first impact's peak load (paper eq 2).",
@@ -334,7 +335,8 @@ FIELDS: tuple[Field, ...] = (
           "Szoszkiewicz & Riedo 2005: 4.2 ms at 40% RH, 299 K).", "fixed", choices=("fixed", "nucleation")),
     Field("menisci.solid_adhesion", str, "", "Solid-solid adhesion of a summit inside a bridge: 'wet' (the work "
           "of adhesion under the liquid, dgamma + 2 gamma_lv - W_1L - W_2L, Israelachvili 2011 §17.7: the bridge "
-          "replaces part of the dry pull; discrete summits take their whole law, loop included, at it) or 'additive' (the paper's eq 14: bridges add to the dry dgamma).", "wet",
+          "replaces part of the dry pull; discrete summits take their whole law, loop included, at it) or 'additive' "
+          "(the paper's eq 14: bridges add to the dry dgamma).", "wet",
           choices=("wet", "additive")),
     Field("menisci.growth_length", float, "m", "h1 in h_mw(t) = h1 ln(t/t_a), the growth of the bridgeable gap "
           "(Riedo et al. 2002). Not set: 1/(n_w d_w^2 ln(1/RH)), one water molecule's cross-section d_w^2 as the "

@@ -18,10 +18,16 @@ import math
 import sys
 from pathlib import Path
 
-from nanoimpact.cli import (ArgumentParser, Command, add_verbosity, check_out_dir, logging_ready, positive_int,
-                            setup_logging)
-from nanoimpact.errors import (EXIT_FAILED, EXIT_OK, InputError,
-                               RunInterrupted, UsageError, run_command)
+from nanoimpact.cli import (
+    ArgumentParser,
+    Command,
+    add_verbosity,
+    check_out_dir,
+    logging_ready,
+    positive_int,
+    setup_logging,
+)
+from nanoimpact.errors import EXIT_FAILED, EXIT_OK, InputError, RunInterrupted, UsageError, run_command
 
 __all__ = ["COMMANDS", "main", "run", "build_parser", "format_quantities"]
 
@@ -95,7 +101,7 @@ def run(argv: list[str]) -> int:
     verbosity = getattr(args, "verbose", 0) - getattr(args, "quiet", 0)
     if not logging_ready() or hasattr(args, "verbose") or hasattr(args, "quiet"):
         setup_logging(verbosity)
-    import md.workflows                          # run_recipe looked up at call time (tests replace it)
+    import md.workflows  # run_recipe looked up at call time (tests replace it)
     from md.engine.lammps import MDRunError
     from md.engine.provenance import describe_differences, version_differences
     from md.engine.runner import Interrupted

@@ -16,10 +16,9 @@ are checked. A few keys may appear in ``[system]`` (the paper value) and be over
 """
 from __future__ import annotations
 
-import math
-
 import hashlib
 import json
+import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -28,11 +27,11 @@ from typing import Any, Mapping
 
 from nanoimpact import data as shipped_data
 from nanoimpact import fields
-from nanoimpact.fields import REQUIRED
 from nanoimpact.errors import DataNotFound, InputError
+from nanoimpact.fields import REQUIRED
 
-__all__ = ["RecipeError", "Recipe", "Field", "RecipeField", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES", "load_recipe",
-           "parse_recipe", "schema_markdown", "RECIPE_DIR"]
+__all__ = ["RecipeError", "Recipe", "Field", "RecipeField", "FIELDS", "WORKFLOWS", "FIDELITIES", "SURFACES",
+           "load_recipe", "parse_recipe", "schema_markdown", "RECIPE_DIR"]
 
 #: The shipped MD recipes (inputs/md, installed as package data); names are looked up in the user data
 #: folder first (nanoimpact.data).
@@ -323,7 +322,8 @@ def _settings_dataclass(workflow: str) -> type:
     title = "".join(part.title() for part in workflow.split("_"))
     return fields.frozen_dataclass(
         f"{title}Settings", list(members.items()), module=__name__,
-        doc=f"The resolved settings of a recipe of the {workflow!r} workflow at one fidelity ([system] overlaid with the fidelity's "
+        doc=f"The resolved settings of a recipe of the {workflow!r} workflow at one fidelity "
+            "([system] overlaid with the fidelity's "
             "table; `Recipe.typed_settings`), in the recipe's units (file units: Å, fs, K).")
 
 
@@ -497,8 +497,8 @@ def _cross_check(wf: str, system: Mapping[str, Any], fid: Mapping[str, Any], fna
         allowed = 2 if fid["tip_positions"] > 1 else 1
         if len(speeds) > allowed and fname != "production":
             raise RecipeError(f"{p}.retract_speeds_m_s", speeds,
-                              f"a rate scan (more than one speed) is run only at production; give one speed (two "
-                              f"with tip_positions > 1)", origin)
+                              "a rate scan (more than one speed) is run only at production; give one speed (two "
+                              "with tip_positions > 1)", origin)
         if fid["flat_thermostat"] == "silica" and fid["tip_thermostat"] == "lab":
             raise RecipeError(f"{p}.flat_thermostat", fid["flat_thermostat"], "'silica' needs tip_thermostat "
                               "'comoving' or 'none' ('lab' thermostats every mobile atom together)", origin)

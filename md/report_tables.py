@@ -1,7 +1,7 @@
 """The result and cost tables of ``docs/md.md``, generated from the committed MD results.
 
 Every number in those tables is read from a committed ``inputs/md/results/<recipe>-<fidelity>/result.json``, so a
-rerun that replaces a result changes the tables with it, and ``tests/test_md_docs.py`` fails when the page and the
+rerun that replaces a result changes the tables with it, and ``tests/md/test_md_docs.py`` fails when the page and the
 results disagree. Regenerate with ``python -m md.report_tables`` (rewrites the marked blocks of ``docs/md.md``).
 
 A result is a **calibration input** when its folder holds no recipe of its own, its recipe is one of the shipped

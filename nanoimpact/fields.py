@@ -47,8 +47,8 @@ class Field:
     """One input key.
 
     `key`: the name (dotted for nested tables); `kind`: float, int, str, bool or list (then `item` is the
-    element kind, `length` the allowed lengths, if restricted, and `empty_ok` admits []); `low`/`high` bound numbers, `low_open`/
-    `high_open` make a bound strict; `choices` lists allowed strings. `default` is REQUIRED (must be given),
+    element kind, `length` the allowed lengths, if restricted, and `empty_ok` admits []); `low`/`high` bound numbers,
+    `low_open`/`high_open` make a bound strict; `choices` lists allowed strings. `default` is REQUIRED (must be given),
     None (optional: absent means "not given") or a value.
     """
 

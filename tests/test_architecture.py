@@ -235,8 +235,8 @@ def test_laws_and_model_never_probe_an_object_with_getattr(package):
 def test_both_summit_surfaces_satisfy_the_declared_protocol():
     from continuum.rough.branch_laws import make_summit_law
     from continuum.rough.gw import GWJKRSurface
-    from continuum.rough.summits import SummitStatistics
     from continuum.rough.gw_branches import GWBranchSurface
+    from continuum.rough.summits import SummitStatistics
     from continuum.rough.surface import SummitSurface
 
     stats = SummitStatistics(3e-9, 1e13, 0.2e-6)

@@ -260,7 +260,8 @@ def calibration_cases():
               ("int-key", "numerics.grid_points", [32, 64]), ("str-key", "physics.adhesion_law", [1.0, 2.0]),
               ("one-end", "surfaces.roughness.sigma", [5e-9]), ("reversed", "surfaces.roughness.sigma", [7e-9, 5e-9]),
               ("equal", "surfaces.roughness.sigma", [5e-9, 5e-9]), ("not-list", "surfaces.roughness.sigma", "x"),
-              ("bool-end", "surfaces.roughness.sigma", [True, 2.0]), ("str-end", "surfaces.roughness.sigma", ["a", 1.0])]
+              ("bool-end", "surfaces.roughness.sigma", [True, 2.0]),
+              ("str-end", "surfaces.roughness.sigma", ["a", 1.0])]
     for k, f in enumerate(FIELDS):
         if f.kind is float and f.low is not None and k % 2:
             ranges.append((f"below-{f.path}", f.path, [f.low - (abs(f.low) + 1.0), f.low + 1e-12 + abs(f.low)]))

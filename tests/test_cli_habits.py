@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
+import continuum.cli as continuum_cli
 import nanoimpact
 from calibration import cli
-import continuum.cli as continuum_cli
 from calibration.cli import main
 from nanoimpact import data
 from nanoimpact.errors import EXIT_BACKEND, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_PARTIAL, BackendUnavailable

@@ -4,8 +4,8 @@ imports the names it checks).
 * Functions stay readable: none in `continuum/`, `md/`, `calibration/` or `nanoimpact/` is over 100 lines.
 * History lives in git, not in the code: no "issue N" or "session N" narrative in library code.
 * Every cited repository path exists: the docs, the README, the inputs' READMEs and the code name files as
-  ``docs/model.md``, ``tests/test_paper.py`` or ``md/system/forcefield.py`` (prefixed by a top-level folder, or
-  relative to `inputs/`, the shipped data root), and markdown links point at files next to the page. Paths
+  ``docs/model.md``, ``tests/continuum/test_paper.py`` or ``md/system/forcefield.py`` (prefixed by a top-level folder,
+  or relative to `inputs/`, the shipped data root), and markdown links point at files next to the page. Paths
   outside the repository (``shared/...``) are not something a reader of the repository can open, so citing one
   fails too. ``NAME``-style placeholders are templates, not citations.
 * Every dotted name a text cites resolves: ``md.engine.hashing.run_hash`` in the docs, the README, the inputs'

@@ -18,7 +18,8 @@ import pytest
 from calibration import schemas
 from calibration.pipeline import FIELDS as CALIBRATION_FIELDS
 from continuum.schema import FIELDS as SCENE_FIELDS
-from md.recipe import FIELDS as RECIPE_FIELDS, RecipeError
+from md.recipe import FIELDS as RECIPE_FIELDS
+from md.recipe import RecipeError
 from nanoimpact.errors import InputError
 from nanoimpact.fields import REQUIRED, Field, json_schema
 
@@ -58,7 +59,8 @@ def _outside(f: Field) -> list:
         if f.low is not None:
             bad.append(f.low if f.low_open else (f.low - 1 if f.kind is int else f.low - max(abs(f.low), 1.0) * 1e-6))
         if f.high is not None:
-            bad.append(f.high if f.high_open else (f.high + 1 if f.kind is int else f.high + max(abs(f.high), 1.0) * 1e-6))
+            bad.append(f.high if f.high_open
+                       else (f.high + 1 if f.kind is int else f.high + max(abs(f.high), 1.0) * 1e-6))
         bad.append("1")
     if f.kind is int:
         bad.append(2.5)

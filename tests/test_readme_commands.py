@@ -11,7 +11,8 @@ DOI = "10.1243/17403499JNN101"
 
 
 def _ci_command():
-    lines = [ln for ln in (ROOT / ".ci" / "run").read_text().splitlines() if ln and not ln.startswith(("#", "set ", "cd "))]
+    lines = [ln for ln in (ROOT / ".ci" / "run").read_text().splitlines()
+             if ln and not ln.startswith(("#", "set ", "cd "))]
     assert len(lines) == 1, lines
     return lines[0]
 

@@ -14,7 +14,6 @@ bridge where the decision keeps it and of the dry law otherwise. Prints a table 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
@@ -62,7 +61,8 @@ def table(rows: list[dict]) -> str:
     head = f"{'RH':>5} {'r_K nm':>8} {'bridge':>6} {'F_po nN':>9} {'dry nN':>8} {'bridge nN':>10} {'solid nN':>9}  law"
     out = [head, "-" * len(head)]
     for r in rows:
-        out.append(f"{r['relative_humidity']:>5.2f} {r['kelvin_radius'] * 1e9:>8.3f} {'yes' if r['bridge'] else 'no':>6} "
+        out.append(f"{r['relative_humidity']:>5.2f} {r['kelvin_radius'] * 1e9:>8.3f} "
+                   f"{'yes' if r['bridge'] else 'no':>6} "
                    f"{r['pull_off_force'] * 1e9:>9.4g} {r['dry_pull_off_force'] * 1e9:>8.4g} "
                    f"{r['bridge_part'] * 1e9:>10.4g} {r['solid_part'] * 1e9:>9.4g}  {r['law']}")
     return "\n".join(out)

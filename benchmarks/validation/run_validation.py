@@ -284,7 +284,8 @@ def humidity_case(name, ds):
     first = next((rh for rh, b in zip(rhs, curves[ds["choices"]["solid_adhesion"][0]]["bridged"]) if b), None)
     row = rows["pull_off_force_small_contacts"]
     return {"case": name, "relative_humidity": rhs, "tip_radius": radius, "curves": curves,
-            "kelvin_radius": [r["kelvin_radius"] for r in runs[0]], "min_kelvin_radius": runs[0][0]["min_kelvin_radius"],
+            "kelvin_radius": [r["kelvin_radius"] for r in runs[0]],
+            "min_kelvin_radius": runs[0][0]["min_kelvin_radius"],
             "measured": float(row["value"]), "where": row["where_in_source"], "how": row["how_obtained"],
             "reading": row["reading"], "first_bridged_rh": first, "contact_angle_band": bands["contact_angle"],
             "work_of_adhesion_band": bands["work_of_adhesion"], "surface_tension": ds["liquid"]["surface_tension"]}

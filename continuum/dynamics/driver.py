@@ -44,8 +44,8 @@ class Bounce:
     following flight above the touch level (the law's `touch_gap`, where the contact starts and
     from which `simulate`'s release height is measured: a first impact from rest rebounds to
     release height - energy_lost / (m g), so a rebound above the release height would mean energy
-    created; None if the body escapes without gravity or stays stuck); `energy_lost` is the mechanical energy lost over the contact, from the motion;
-    `energy_booked` is what the law's own loss terms booked over the same contact.
+    created; None if the body escapes without gravity or stays stuck); `energy_lost` is the mechanical energy lost over
+    the contact, from the motion; `energy_booked` is what the law's own loss terms booked over the same contact.
     """
 
     index: int

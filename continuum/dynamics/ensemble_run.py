@@ -29,10 +29,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from typing import Any
 
-from .driver import DriverSettings, simulate
 from ..output.proportions import wilson_half_width
 from ..rough.ensemble import EnsembleResult, MemberOutcome, member_seeds
 from ..scene import ResolvedScene, Scene, SceneError
+from .driver import DriverSettings, simulate
 
 log = logging.getLogger(__name__)
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 import math
 from typing import Callable
 
-from .driver import DriverSettings, ImpactRun, simulate
 from ..laws.base import ContactLaw
+from .driver import DriverSettings, ImpactRun, simulate
 
 
 def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rtol: float = 1e-9) -> ImpactRun:

@@ -6,14 +6,14 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ..output import plots
-from .driver import Bounce, DriverSettings, simulate
 from ..model import dry_run_verdict, select_law
 from ..model.decisions import menisci_decision
+from ..output import plots
+from ..output.notices import audit_warnings, model_warnings, result_warnings
 from ..output.provenance import provenance
 from ..output.results import SCHEMA_VERSION, write_run
 from ..scene import ResolvedScene, SceneError
-from ..output.notices import audit_warnings, model_warnings, result_warnings
+from .driver import Bounce, DriverSettings, simulate
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:
@@ -71,12 +71,12 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     }
     if realisation is not None and realisation.mode == "ensemble":
         result["ensemble"], extra = _ensemble_record(resolved, run, executor, workers)
-        if extra is not None:           # a height map: its cutoff band and the tail models (continuum.dynamics.map_ensembles)
+        if extra is not None:  # a height map: its cutoff band and the tail models (continuum.dynamics.map_ensembles)
             result["surface"] = {**result["surface"], "cutoff_band": extra["cutoff_band"]}
             result["warnings"] += extra["warnings"]
         result["timing"]["wall_s"] = time.perf_counter() - start
     elif realisation is not None and realisation.mode == "mean_field" and (resolved.surface or {}).get("cutoff"):
-        from .map_ensembles import mean_field_band     # a map under the mean field: its first impact at each cutoff
+        from .map_ensembles import mean_field_band  # a map under the mean field: its first impact at each cutoff
         band = mean_field_band(resolved)
         result["surface"] = {**result["surface"], "cutoff_band": band["cutoff_band"]}
         result["warnings"] += band["warnings"]
@@ -91,9 +91,9 @@ def _settle_realisation(resolved: ResolvedScene):
     """(resolved scene with surfaces.roughness.mode settled, the decision); (resolved, None) for smooth contact."""
     from dataclasses import replace
 
-    from .ensemble_run import with_realisation
     from ..model.decisions import realisation_decision
     from ..model.regime import regime_of
+    from .ensemble_run import with_realisation
 
     scene = resolved.scene
     if scene.contact != "rough":
@@ -106,7 +106,8 @@ def _settle_realisation(resolved: ResolvedScene):
 
 def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> tuple[dict, dict | None]:
     """(result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them; for a
-    scene with a height map, what `continuum.dynamics.map_ensembles` adds: the tail models, the cutoff band, warnings)."""
+    scene with a height map, what `continuum.dynamics.map_ensembles` adds: the tail models, the cutoff band,
+    warnings)."""
     from .ensemble_run import open_executor, run_ensemble
     from .map_ensembles import map_ensembles
 

@@ -17,15 +17,14 @@ from __future__ import annotations
 
 import logging
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
-from .ensemble_run import open_executor, run_ensemble
 from ..rough.cutoff_band import BAND_FACTORS, band_entry, band_warning, tail_warning
 from ..rough.ensemble import EnsembleResult, first_impact_summary
-from .map_tail import _map, _pooled, _summits, map_tail
 from ..rough.tail import TAIL_MODELS, TailFitError, fit_empirical_gpd
 from ..scene import ResolvedScene, Scene
+from .ensemble_run import open_executor, run_ensemble
+from .map_tail import _map, _pooled, _summits, map_tail
 
 log = logging.getLogger(__name__)
 
@@ -104,9 +103,9 @@ def _band_point(sc: Scene, hmap, cutoff: float, factor: float, route: str, tail_
 def _mean_field_first_impact(scene: Scene) -> dict:
     """The mean-field law's first impact of `scene` (to its first rebound): a summary shaped as an ensemble's of
     one deterministic member (no interval: nothing random is sampled), with the law that ran."""
-    from .driver import DriverSettings, simulate
     from ..model import dry_run_verdict, select_law
     from ..model.regime import first_impact_speed
+    from .driver import DriverSettings, simulate
 
     speed = first_impact_speed(scene)
     law, models = select_law(scene, speed)

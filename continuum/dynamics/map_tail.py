@@ -1,8 +1,8 @@
 """A height map's summit-height tail for an ensemble: the map's own summits at a cutoff, pooled over the scans that
 take part there (`continuum.rough.map_scans`), and the `empirical_gpd` model fitted to them (`continuum.rough.tail`).
 
-Used by the ensemble runner (a scene whose tail model is `empirical_gpd`) and by `continuum.dynamics.map_ensembles` (the other
-tail model and the cutoff band), so that neither imports the other.
+Used by the ensemble runner (a scene whose tail model is `empirical_gpd`) and by `continuum.dynamics.map_ensembles` (the
+other tail model and the cutoff band), so that neither imports the other.
 """
 from __future__ import annotations
 

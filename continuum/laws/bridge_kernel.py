@@ -4,7 +4,7 @@ The wet law (`continuum.laws.wet`) evaluates this double integral (Gauss-Legendr
 roller, closed-form Gaussian moments in the summit height z) at every force evaluation after t_a:
 ~50 us of NumPy overhead on 16-48 nodes, ~60 % of a wet near-escape sweep in the paper.
 Compiled, the same arithmetic costs ~1-2 us. The NumPy form stays in `continuum.laws.wet`
-(`MeniscusBridges._integral_numpy`) as the reference `tests/test_menisci.py` compares this kernel with.
+(`MeniscusBridges._integral_numpy`) as the reference `tests/continuum/test_menisci.py` compares this kernel with.
 
 The normal CDF takes scipy's `ndtr` branches (erf near zero, erfc in the tails) with the C library's erf and
 erfc, so the two forms agree to round-off, not bit for bit.

@@ -28,7 +28,6 @@ import math
 
 import numpy as np
 
-from ..wet import menisci as men
 from .wet import MeniscusBridges
 
 

@@ -517,8 +517,8 @@ class DiscreteRoughRoller(RoughRollerBase):
             self.max_pressure = max(self.max_pressure, float(np.max(p)))
 
     def compiled(self, t0: float):
-        """The kept summits as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_DISCRETE`); None with
-        the half-space on (its coupled fixed point runs in Python)."""
+        """The kept summits as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_DISCRETE`); None
+        with the half-space on (its coupled fixed point runs in Python)."""
         from ..numerics import contact_kernel as ck
         from ..numerics.compiled_contact import EMPTY_TABLES, CompiledLaw
 
@@ -540,7 +540,8 @@ class DiscreteRoughRoller(RoughRollerBase):
         return CompiledLaw(ck.LAW_DISCRETE, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def _compiled_branches(self):
-        """`continuum.numerics.contact_kernel.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two branches."""
+        """`continuum.numerics.contact_kernel.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two
+        branches."""
         from ..numerics import contact_kernel as ck
         from ..numerics.compiled_contact import EMPTY_TABLES, CompiledLaw
 

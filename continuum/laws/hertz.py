@@ -49,7 +49,7 @@ class HertzLine(ContactLaw):
     this through Lambert's W_{-1} for arrays; the driver calls the law one scalar at a time, so
     here the same root is found by Newton's method on g(q) = q - ln q - (C - ln D) (g convex,
     g' = 1 - 1/q > 0 on the physical branch q > 1) in pure-float arithmetic, warm-started from
-    the previous call. `tests/test_laws.py` checks it against the reference to 1e-12.
+    the previous call. `tests/continuum/test_laws.py` checks it against the reference to 1e-12.
     """
 
     name = "hertz_line_implicit"

@@ -27,7 +27,7 @@ For JKR and DMT summits r_in = reach = 0.
 The driver stops a contact at the first turn while attached (stuck), so within a contact the path
 is one monotonic approach and one monotonic retreat and (h, h_min) describe it exactly. This law
 is the half-space-off counterpart of `RoughRoller` (which keeps a grid because the elastic
-deflection makes d - zeta vary across x); `tests/test_rough_laws.py` compares the two.
+deflection makes d - zeta vary across x); `tests/continuum/test_rough_laws.py` compares the two.
 """
 from __future__ import annotations
 
@@ -39,7 +39,6 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 from ..rough.surface import SummitSurface
 from .costs import _BLOCK_STATES, RESOLUTION, table_cost_refusal, table_shape
 from .roller_base import RoughRollerBase
-
 
 #: Footprint tables of quadrature surfaces shared by the rollers of one process ((`_table_key`, depth) -> tables):
 #: the runs of a parameter set meet the same summits and impact speeds again (sweeps, bundles, figures).
@@ -137,7 +136,7 @@ class RigidRoughRoller(RoughRollerBase):
         separation is below the tallest summit, has the same nodes for every window, so its states are evaluated
         for all windows at once (`GWBranchSurface.values_by_threshold`); the part beyond the tallest summit,
         s in [sqrt(-h), sqrt(max(r, reach) - h)], only meets summits within reach and is summed as `_integrate`
-        does. Both are `_integrate`'s Gauss-Legendre sums (to round-off: tests/test_rough_laws.py); a
+        does. Both are `_integrate`'s Gauss-Legendre sums (to round-off: tests/continuum/test_rough_laws.py); a
         Maugis-Dugdale table of 1e4 nodes builds in ~0.4 s instead of ~0.7 s."""
         if self.surface_kind != "generic":
             H, R = np.meshgrid(h, r, indexing="ij")
@@ -316,8 +315,8 @@ class RigidRoughRoller(RoughRollerBase):
     # ------------------------------------------------------------------ compiled form
     def compiled(self, t0: float):
         """The tables as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_RIGID_TABLE`)."""
-        from ..numerics.compiled_contact import CompiledLaw
         from ..numerics import contact_kernel as ck
+        from ..numerics.compiled_contact import CompiledLaw
 
         # the splines these arrays came from are kept with them (an identity test on live objects)
         if self._compiled_for != (self._force, self._energy, self._count):

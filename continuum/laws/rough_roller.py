@@ -87,7 +87,8 @@ class RoughRoller(RoughRollerBase):
         if seconds > MAX_RUN_SECONDS:
             from ..scene import SceneError
 
-            way = "physics.adhesion_law = 'jkr' (tabulated summits, ~10x cheaper), " if self.surface_kind == "generic" else ""
+            way = ("physics.adhesion_law = 'jkr' (tabulated summits, ~10x cheaper), "
+                   if self.surface_kind == "generic" else "")
             raise SceneError(
                 "physics.half_space", "on",
                 f"the grid law ({self.n} cells, {self.surface_kind} summits) has evaluated {self.work_states:.3g} "

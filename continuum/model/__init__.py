@@ -19,10 +19,26 @@ and ``select`` runs them: `select_law` (the whole scene) and `rough_law` (the ro
 """
 from __future__ import annotations
 
-from .decisions import (LAW_NAMES, NEGLIGIBLE_DEFLECTION, NEGLIGIBLE_LOSS, NEGLIGIBLE_PULL, TABOR_DMT, TABOR_JKR,
-                        AdhesionDecision, DryRunVerdict, HalfSpaceDecision, MenisciDecision, PlasticityDecision,
-                        adhesion_decision, dry_run_verdict, half_space_decision, loop_per_summit, menisci_decision,
-                        plasticity_decision, summit_law)
+from .decisions import (
+                        LAW_NAMES,
+                        NEGLIGIBLE_DEFLECTION,
+                        NEGLIGIBLE_LOSS,
+                        NEGLIGIBLE_PULL,
+                        TABOR_DMT,
+                        TABOR_JKR,
+                        AdhesionDecision,
+                        DryRunVerdict,
+                        HalfSpaceDecision,
+                        MenisciDecision,
+                        PlasticityDecision,
+                        adhesion_decision,
+                        dry_run_verdict,
+                        half_space_decision,
+                        loop_per_summit,
+                        menisci_decision,
+                        plasticity_decision,
+                        summit_law,
+)
 from .regime import Regime, coated_summits, meniscus_parameters, regime_of, summit_e_star
 from .select import FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, LARGE_TABLE_SECONDS, rough_law, select_law
 

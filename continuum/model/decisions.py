@@ -22,11 +22,11 @@ form before t_a, so if no contact of the dry run lasts t_a, the wet run is ident
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from ..wet import menisci as men
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
+from ..wet import menisci as men
 from .regime import Regime, kelvin_radius_cutoff, meniscus_parameters, summit_e_star
 
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
@@ -129,8 +129,8 @@ def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
                 fuller_tabor_theta=regime.fuller_tabor_theta)
     mu = regime.tabor_parameter
     if phys.adhesion_law != "auto":
-        return AdhesionDecision(phys.adhesion_law, "scene", f"physics.adhesion_law = '{phys.adhesion_law}' given by the "
-                                "scene or its parameter set (result.json -> scene.sources says which)", **base)
+        return AdhesionDecision(phys.adhesion_law, "scene", f"physics.adhesion_law = '{phys.adhesion_law}' given by "
+                                "the scene or its parameter set (result.json -> scene.sources says which)", **base)
     if w <= 0.0:
         return AdhesionDecision("none", "work_of_adhesion", "auto: no work of adhesion, Hertz contact", **base)
     if scene.contact == "smooth":
@@ -196,7 +196,8 @@ def half_space_decision(scene: Scene, regime: Regime) -> HalfSpaceDecision:
     numbers = dict(estimated_deflection_span=est.deflection_span if est else None,
                    deflection_over_sigma=est.deflection_span / sigma if est else None)
     if choice != "auto":
-        return HalfSpaceDecision(choice == "on", "scene", f"physics.half_space = '{choice}' set in the scene", **numbers)
+        return HalfSpaceDecision(choice == "on", "scene", f"physics.half_space = '{choice}' set in the scene",
+                                 **numbers)
     ratio = est.deflection_span / sigma
     used = ratio >= NEGLIGIBLE_DEFLECTION
     why = (f"auto: estimated deflection across the footprint {est.deflection_span:.3g} m = {ratio:.3g} sigma "
@@ -250,8 +251,8 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
     wet = men.wetting_sum(t1, t2)
     numbers = dict(wetting_sum=wet, contact_angles_deg=(math.degrees(t1), math.degrees(t2)))
     if wet <= 0.0:
-        return MenisciDecision("off", "contact_angles", f"hydrophobic: cos t1 + cos t2 = {wet:.3g} <= 0, no bridge pulls",
-                               rh, **numbers)
+        return MenisciDecision("off", "contact_angles",
+                               f"hydrophobic: cos t1 + cos t2 = {wet:.3g} <= 0, no bridge pulls", rh, **numbers)
     if sphere:
         r_k, cutoff, source = kelvin_radius_cutoff(scene)
         if r_k < cutoff:
@@ -286,7 +287,8 @@ class DryRunVerdict:
         rec: dict = {"longest_contact_s": longest, "condensation_time_s": t_a, "final_contact": self.final_contact}
         if self.rerun:
             rec["dry_run_bounces"] = self.dry_run_bounces
-            rec["why"] = f"auto: a contact of the dry run lasted {longest:.3g} s >= t_a = {t_a:.3g} s: rerun with menisci"
+            rec["why"] = (f"auto: a contact of the dry run lasted {longest:.3g} s >= t_a = {t_a:.3g} s: "
+                          "rerun with menisci")
         else:
             rec["used"] = False
             rec["why"] = (f"auto: the longest contact of the dry run lasted {longest:.3g} s < t_a = {t_a:.3g} s, so no "
@@ -307,8 +309,8 @@ def dry_run_verdict(scene: Scene, durations, status: str) -> DryRunVerdict:
 
 # ----------------------------------------------------------------------------- realisation (few summits)
 #: 'auto' runs an ensemble of discrete realisations below this many expected summits in contact at the first
-#: impact (the Hertz estimate's count, continuum.model.estimates): above it the mean field's first-impact energy loss lies
-#: within ENSEMBLE_TOLERANCE of the ensemble mean. Measured by benchmarks/bench_ensemble_threshold.py (the
+#: impact (the Hertz estimate's count, continuum.model.estimates): above it the mean field's first-impact energy loss
+#: lies within ENSEMBLE_TOLERANCE of the ensemble mean. Measured by benchmarks/bench_ensemble_threshold.py (the
 #: departure falls like A / sqrt(N_c), A = 0.45 +- 0.12; N* = (A / tolerance)^2 = 80 (47-125 within A's standard
 #: error); docs/figures/ensemble_threshold.json, docs/model.md "Few summits: ensembles").
 ENSEMBLE_BELOW_CONTACTS = 80.0
@@ -364,8 +366,9 @@ def realisation_decision(scene: Scene, regime: Regime) -> RealisationDecision:
 class PlasticityDecision:
     """Whether a smooth sphere (or the summits of rough contact, `summit_plasticity`) runs the Thornton-Ning adhesive
     elastic-plastic law, and the numbers that decided it: the softer partner's limiting contact pressure (Pa,
-    `continuum.model.limiting_pressure`) and the yield velocity (m/s, `continuum.reference.thornton_ning.yield_velocity`)
-    against the first impact's speed (m/s), or the summits' plasticity index."""
+    `continuum.model.limiting_pressure`) and the yield velocity (m/s,
+    `continuum.reference.thornton_ning.yield_velocity`) against the first impact's speed (m/s), or the summits'
+    plasticity index."""
 
     used: bool
     decided_by: str
@@ -509,8 +512,8 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
     `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key. Rough
     contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
     `depth`, m)."""
-    from .limiting_pressure import partner_limits, softer_partner
     from ..reference import thornton_ning as tn
+    from .limiting_pressure import partner_limits, softer_partner
 
     choice = scene.physics.plasticity
     if choice == "off":

@@ -124,8 +124,8 @@ def check_table_cost(*, stats, work_of_adhesion: float, summit_e_star: float, z_
             raise SceneError(
                 "surfaces.roughness.sigma", sigma_key_value,
                 f"sigma/delta_c = {1.0 / lam:.3g} (delta_c = {lam * sigma:.3g} m from the summits' radius, work of "
-                f"adhesion and modulus): the averaged model's GW tables would take ~{size['peak_bytes'] / 2**30:.3g} GiB "
-                f"and ~{seconds:.3g} s to build ({size['nodes']:.3g} nodes at '{resolution}'), above the "
+                f"adhesion and modulus): the averaged model's GW tables would take ~{size['peak_bytes'] / 2**30:.3g} "
+                f"GiB and ~{seconds:.3g} s to build ({size['nodes']:.3g} nodes at '{resolution}'), above the "
                 f"{MEMORY_BOUND_BYTES / 2**30:g} GiB / {MAX_BUILD_SECONDS:g} s bounds; use surfaces.roughness.mode = "
                 f"'discrete' (individual summits, no tables) or sigma >= ~{fit:.2g} m (or stiffer summits, less "
                 "adhesion)", origin)

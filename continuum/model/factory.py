@@ -17,9 +17,9 @@ def smooth_law(scene: Scene, adhesion: str, first_impact_speed: float,
                limiting_pressure: float | None = None) -> tuple[ContactLaw, str]:
     """The law of a smooth body under `adhesion` ('none', 'jkr', 'dmt', 'maugis_dugdale'), and what it is; with a
     `limiting_pressure` (Pa) the JKR sphere is the Thornton-Ning elastic-plastic one."""
+    from ..laws.branch_sphere import BranchSphere
     from ..laws.hertz import HertzLine, HertzSphere, LinearSpring, roller_constant_stiffness
     from ..laws.jkr import JKRSphere
-    from ..laws.branch_sphere import BranchSphere
     from ..laws.plastic_sphere import PlasticJKRSphere
 
     body, surf, phys = scene.body, scene.surfaces, scene.physics

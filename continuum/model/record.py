@@ -78,7 +78,8 @@ def rough_law_record(scene: Scene, *, datum: dict, regime: dict, surface=None, c
     if rough.mode != "discrete" and table != scene.numerics.table:
         record["table"]["why"] = (f"the '{scene.numerics.table}' preset asked for '{scene.numerics.table}' tables, "
                                   f"but sigma/delta_c < {fast_min_sigma_over_delta_c:g}, where they miss their "
-                                  "1e-6 accuracy: 'standard' tables were built (GW and, on a rigid substrate, footprint tables)")
+                                  "1e-6 accuracy: 'standard' tables were built (GW and, on a rigid substrate, "
+                                  "footprint tables)")
         record["table"]["resolution"] = table
     if rough.mode == "discrete":
         record["mode"] = "discrete"

@@ -10,10 +10,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..scene import Scene
 from ..wet import menisci as men
 from . import regimes
 from .estimates import RoughImpactEstimate, rough_impact_estimate
-from ..scene import Scene
 
 
 def substrate_e_star(scene: Scene) -> float:

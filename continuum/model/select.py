@@ -7,17 +7,30 @@ from __future__ import annotations
 
 import functools
 
-from .estimates import check_table_cost
 from ..laws.base import ContactLaw
 from ..laws.discrete_bridges import wet_discrete
 from ..reference import jkr as jkr_ref
 from ..scene import Scene, SceneError
 from . import factory
 from . import record as rec
-from .decisions import (SMOOTH_HALF_SPACE, adhesion_decision, half_space_decision,
-                        menisci_decision, plasticity_decision, summit_law)
-from .regime import (Regime, first_impact_speed, impact_estimate, meniscus_parameters, regime_of, solid_liquid_works,
-                     summit_e_star)
+from .decisions import (
+    SMOOTH_HALF_SPACE,
+    adhesion_decision,
+    half_space_decision,
+    menisci_decision,
+    plasticity_decision,
+    summit_law,
+)
+from .estimates import check_table_cost
+from .regime import (
+    Regime,
+    first_impact_speed,
+    impact_estimate,
+    meniscus_parameters,
+    regime_of,
+    solid_liquid_works,
+    summit_e_star,
+)
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0

@@ -135,14 +135,14 @@ def warm_up() -> None:
                  max_step=math.inf, t_bound=10.0, release=0.0, bound_is_final=True, has_history=False,
                  samples_per_step=1)
     STATS.__dict__.update(vars(saved))
-    from ..rough.gw_layout import _hermite2d_eval            # and the GW window tables' evaluation
+    from ..rough.gw_layout import _hermite2d_eval  # and the GW window tables' evaluation
     _hermite2d_eval(np.zeros((1, 16)), 0.0, 1.0, 1, 0.0, 1.0, 1, np.zeros(1), np.zeros(1), True)
-    from ..rough import gw_kernel as gk                      # the GW surface's values (footprint-table builds)
+    from ..rough import gw_kernel as gk  # the GW surface's values (footprint-table builds)
     P = np.zeros(gk.P_SIZE)
     P[gk.P_N1] = 1.0
     one, line, t1 = np.zeros(1), np.zeros((4, 1)), np.zeros((4, 1, 1))
     gk.integral(0, one, one, gk.log_hertz(one, P, t1), P, t1, np.zeros((1, 16)), line, line, one, one, one, one,
                 np.zeros(1, np.int8))
-    from ..laws import bridge_kernel as bk                  # the wet law's compiled bridge sum, loaded the same way
+    from ..laws import bridge_kernel as bk  # the wet law's compiled bridge sum, loaded the same way
     bk.bridge_integral(bk.KIND_FORCE, -1.0, -2.0, math.inf, False, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0,
                        np.ones(3), np.ones(3), bk._GL_X, bk._GL_W)

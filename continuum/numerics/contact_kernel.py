@@ -7,7 +7,7 @@ time limit. Stepped in Python through `scipy.integrate.DOP853`, a rough impact c
 almost all of it interpreter overhead; here the same algorithm runs compiled by numba.
 
 The algorithm is the driver's, step for step (so results agree to round-off, not just to the
-tolerance; `tests/test_contact_kernel.py` checks both):
+tolerance; `tests/continuum/test_contact_kernel.py` checks both):
 
 * Runge-Kutta: Dormand & Prince's explicit 8th-order method with its 5th- and 3rd-order error
   estimators and 7th-order dense output (E. Hairer, S. P. Norsett, G. Wanner, *Solving Ordinary
@@ -40,13 +40,51 @@ import math
 import numpy as np
 from numba import njit
 
-from .dop853_tableau import A, B, D, E3, E5
-from .kernel_laws import (BRANCH_PARAMS, DISCRETE_PARAMS, LAW_DISCRETE, LAW_DISCRETE_BRANCH, LAW_PLASTIC, LAW_POWER,
-                          LAW_RIGID_TABLE, P_ATTACH, P_B_END_GAP, P_B_IN, P_B_LOOP, P_B_LOWEST, P_B_OUT, P_B_REACH,
-                          P_D_ADHESIVE, P_D_END_GAP, P_D_ESCALE, P_D_HERTZ_K, P_D_INV_DELTA0, P_D_LOOP, P_D_LOWEST,
-                          P_D_PSCALE, P_D_RELEASE, P_END_GAP, P_H_LO, P_K, P_LOOP, P_N, P_REACH, P_RELEASE, P_R_IN,
-                          S_BEYOND_ACCEPTED, S_BEYOND_FLAG, S_COUNT_MIN, S_H_MIN, S_MAX_CONTACTS, bicubic,
-                          law_accept, law_dissipated, law_force, law_stored, ppoly3)
+from .dop853_tableau import E3, E5, A, B, D
+from .kernel_laws import (
+    BRANCH_PARAMS,
+    DISCRETE_PARAMS,
+    LAW_DISCRETE,
+    LAW_DISCRETE_BRANCH,
+    LAW_PLASTIC,
+    LAW_POWER,
+    LAW_RIGID_TABLE,
+    P_ATTACH,
+    P_B_END_GAP,
+    P_B_IN,
+    P_B_LOOP,
+    P_B_LOWEST,
+    P_B_OUT,
+    P_B_REACH,
+    P_D_ADHESIVE,
+    P_D_END_GAP,
+    P_D_ESCALE,
+    P_D_HERTZ_K,
+    P_D_INV_DELTA0,
+    P_D_LOOP,
+    P_D_LOWEST,
+    P_D_PSCALE,
+    P_D_RELEASE,
+    P_END_GAP,
+    P_H_LO,
+    P_K,
+    P_LOOP,
+    P_N,
+    P_R_IN,
+    P_REACH,
+    P_RELEASE,
+    S_BEYOND_ACCEPTED,
+    S_BEYOND_FLAG,
+    S_COUNT_MIN,
+    S_H_MIN,
+    S_MAX_CONTACTS,
+    bicubic,
+    law_accept,
+    law_dissipated,
+    law_force,
+    law_stored,
+    ppoly3,
+)
 
 __all__ = ["ABORT_BEYOND_TABLES", "ABORT_BUFFER", "ABORT_STEP", "BRANCH_PARAMS", "DISCRETE_PARAMS", "END_MAX_TIME",
            "END_RELEASE", "END_REST", "END_STOP_TIME", "END_STUCK", "INFO_SIZE", "I_BOOKED", "I_END", "I_EVALS",

@@ -6,7 +6,7 @@ law fills: `compiled()` of `continuum.laws.rough_rigid`, `continuum.laws.discret
 `continuum.laws.plastic_rough`); `law_force`, `law_stored`, `law_dissipated` and `law_accept` dispatch on the law
 kind. The closed forms are those of the Python laws (JKR: `continuum.physics.jkr_kernel`; Maugis-Dugdale and DMT
 branches: `continuum.rough.branch_laws`; elastic-plastic summits: `continuum.rough.plastic_kernel`), which the tests
-compare point by point (`tests/test_contact_kernel.py`).
+compare point by point (`tests/continuum/test_contact_kernel.py`).
 """
 from __future__ import annotations
 

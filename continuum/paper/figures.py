@@ -128,7 +128,8 @@ def fig6(impacts: dict, set_name: str, out: Path):
         rows += [(key, xx * 1e-6, pp, dd, ss) for xx, pp, dd, ss in
                  zip(x, p["pressure"], p["deflection"], p["separation"])]
     fig.suptitle(f"Fig 6 ({set_name}): rough silica, first impact", fontsize=10)
-    write_csv(out / "data" / f"fig6_{set_name}.csv", ["instant", "x_m", "pressure_Pa", "deflection_m", "separation_m"], rows)
+    write_csv(out / "data" / f"fig6_{set_name}.csv", ["instant", "x_m", "pressure_Pa", "deflection_m", "separation_m"],
+              rows)
     return axes[0, 0]
 
 

@@ -10,8 +10,8 @@ from typing import Callable
 from ..output.provenance import provenance
 from ..output.results import dumps
 from . import checks, figures
-from .run import fig4_curves, run_paper
 from .checks import NOMINAL_ONLY
+from .run import fig4_curves, run_paper
 from .sampled_claims import judged_over_samples, loop_claim
 from .samples import nominal_bundle
 from .verdict import REPRODUCTION, VERIFICATION, over_samples
@@ -50,10 +50,13 @@ def regime_lines(set_name: str, impacts: dict) -> list[str]:
         first_loss = res["bounces"][0]["energy_booked"]
         out.append(f"- `{case}`: sigma/delta_c = {_fmt(reg.get('sigma_over_delta_c'))}, Fuller-Tabor theta = "
                    f"{_fmt(reg.get('fuller_tabor_theta'))}, Tabor mu = {_fmt(reg.get('tabor_parameter'))} "
-                   f"(z0 = {reg.get('tabor_z0', 0) * 1e9:.2g} nm), summit E* = {_fmt(reg.get('summit_e_star', 0) / 1e9)} GPa; "
-                   f"hysteresis loss of the first impact / its kinetic energy = {_fmt(first_loss / ek if ek else None)}; "
+                   f"(z0 = {reg.get('tabor_z0', 0) * 1e9:.2g} nm), summit E* = "
+                   f"{_fmt(reg.get('summit_e_star', 0) / 1e9)} GPa; "
+                   "hysteresis loss of the first impact / its kinetic energy = "
+                   f"{_fmt(first_loss / ek if ek else None)}; "
                    f"summits in the footprint {_fmt(law['datum']['summits_in_footprint'])}, most attached at once "
-                   f"{_fmt(res['models'].get('diagnostics', {}).get('max_contacts'))}; z_max = {_fmt(law['z_max'] * 1e9)} nm")
+                   f"{_fmt(res['models'].get('diagnostics', {}).get('max_contacts'))}; "
+                   f"z_max = {_fmt(law['z_max'] * 1e9)} nm")
     return out
 
 

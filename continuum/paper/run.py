@@ -23,13 +23,13 @@ import numpy as np
 
 from nanoimpact.executors import executor as make_executor
 
-from ..wet import menisci as men
-from ..numerics.compiled_contact import warm_up
 from ..dynamics.escape import single_impact
 from ..dynamics.impact import first_impact_speed, run_impact, write_impact
+from ..model import menisci_decision, meniscus_parameters, select_law
+from ..numerics.compiled_contact import warm_up
 from ..output.results import write_run
-from ..model import meniscus_parameters, menisci_decision, select_law
 from ..scene import ResolvedScene, SceneError, resolve_scene
+from ..wet import menisci as men
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, low_speed_runs, seed_overrides
 from .wet_flips import BAND_EDGE, BEYOND_SCAN, FAILS, HOLDS, NO_SUBJECT, REFUSED, at_condensation_time, t_a_flips

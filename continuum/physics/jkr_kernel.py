@@ -7,7 +7,8 @@ Every JKR evaluation of the project goes through this module: the closed-form re
 `continuum.reference.jkr`'s docstring; in short, with a0 = (2 pi dgamma beta^2/E*)^{1/3},
 delta0 = a0^2/beta, s = sqrt(a/a0) and d = delta/delta0::
 
-    d = s^4 - s,   P = pi dgamma beta (8/3 s^6 - 4 s^3),   dP/d delta = (pi dgamma beta/delta0) 4 s^2 (4 s^3 - 3)/(4 s^3 - 1),
+    d = s^4 - s,   P = pi dgamma beta (8/3 s^6 - 4 s^3),
+    dP/d delta = (pi dgamma beta/delta0) 4 s^2 (4 s^3 - 3)/(4 s^3 - 1),
     U = pi dgamma beta delta0 (s - 1) h(s),   s - 1 = d/(s (s^2 + s + 1)),
     h(s) = 16/15 (s^9 + s^8 + s^7) - 8/5 (s^6 + s^5 + s^4) - 3/5 (s^3 + s^2 + s + 1),
 

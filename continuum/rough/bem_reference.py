@@ -21,7 +21,7 @@ approach follows the metastable branch until the contact snaps in and the retrac
 the hysteresis. A state in which no point is within rho of the flat, reached from a free state, is free exactly
 (zero traction, zero displacement) and is not solved (the solver's complementarity error is undefined without
 contact). Convergence and the discretisation: the Dugdale zone's edge sits on the grid, so forces carry a
-first-order error in the pixel size (measured against Maugis' closed form in tests/test_bem_reference.py); the
+first-order error in the pixel size (measured against Maugis' closed form in tests/continuum/test_bem_reference.py); the
 cohesive zone must span several pixels.
 
 Lengths are passed to Tamaas in units of `length_unit` and stresses in units of E* (the solver's tolerances are

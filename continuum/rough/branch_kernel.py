@@ -14,7 +14,7 @@ and are skipped; the panel loop ends at the state's own x_top. The interpolation
 slope times offset plus left value). Only the (at most two) panels per branch that a state's threshold or top cuts
 interpolate at their own nodes; every whole panel's nodes and values are computed once per call (`_panel_values`),
 which halves the cost per state. Only the order of the sums differs from the NumPy form (a loop here, pairwise
-there), so the two agree to round-off: tests/test_gw_branches_fast.py compares them.
+there), so the two agree to round-off: tests/continuum/test_gw_branches_fast.py compares them.
 
 `integrals_by_threshold` evaluates a grid of separations times thresholds (a rigid roller's footprint tables: the
 same deep separations for every window): each panel's approach and retreat sums once per separation, and per

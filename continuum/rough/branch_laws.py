@@ -45,7 +45,7 @@ Models (SI; E* Johnson's contact modulus, dgamma Dupre's work of adhesion)
 
 Cost: building a Maugis-Dugdale law solves Maugis' equation once at each of ~2000 contact radii (~0.1 s); JKR and
 DMT are closed form. Branches are tabulated on ~4000 points and evaluated by linear interpolation
-(measured error against the closed forms: tests/test_branch_laws.py).
+(measured error against the closed forms: tests/continuum/test_branch_laws.py).
 """
 from __future__ import annotations
 

@@ -250,7 +250,8 @@ class EnsembleResult:
         found = v[np.isfinite(v)]
         rec: dict = {"requested": True, "rel_tol": self.escape_rel_tol, "members_with_value": int(found.size),
                      "rule": "each member's smallest first-impact speed from which it rebounds: bracketed by "
-                             "halving/doubling the first-impact speed, bisected (continuum.dynamics.escape.escape_velocity)",
+                             "halving/doubling the first-impact speed, bisected "
+                             "(continuum.dynamics.escape.escape_velocity)",
                      "without_value": {str(o.seed): (o.escape or {}).get("reason", "not run")
                                        for o, x in zip(self.outcomes, v) if not math.isfinite(x)}}
         if found.size:

@@ -56,8 +56,8 @@ import time
 import numpy as np
 
 from ..physics import jkr_kernel as jk
-from ..reference import jkr as _jkr
 from ..physics.jkr_kernel import reduced_curve_minus_hertz as _g_of_s
+from ..reference import jkr as _jkr
 from . import gw_kernel
 from .gw_layout import _H_DEEP, _H_ZERO, _HERTZ_NU, _T_CUT, RESOLUTIONS
 from .gw_reference import table_error
@@ -233,7 +233,7 @@ class GWJKRSurface(GWTables):
 
         Values alone (the footprint tables' and most callers' case) come from the compiled kernel
         (`gw_kernel.integral`, the same arithmetic one state at a time); with `deriv` or `parts` from
-        `_integral_numpy`, which is also the reference the kernel is tested against (tests/test_gw_kernel.py).
+        `_integral_numpy`, which is also the reference the kernel is tested against (tests/continuum/test_gw_kernel.py).
         """
         if deriv or parts:
             return self._integral_numpy(j, d, zeta, deriv, parts)
@@ -309,7 +309,6 @@ class GWJKRSurface(GWTables):
         val = hs * H + As * (G + Wr * rel)
         dval = hs * dH + As * (dV[:, 1] + dV[:, 2] * rel) if deriv else None
         tens = As * (A0 + Wr * rel) if parts else None
-        lam = self._lam
         nf = np.count_nonzero(fix)
         kf = np.flatnonzero(fix) if nf else None          # threshold inside the window (d <= z_max)
         kb = None

@@ -22,7 +22,7 @@ at most sigma/4), split per state at the threshold and cut at z_max. The sums ar
 pass, ~5x faster than the NumPy form `_integrals_numpy`, which sorts states by separation and sums
 chunks of 512 over the panels their deepest member needs; the two agree to round-off).
 No tables: the rigid-substrate law tabulates the footprint integral of this surface once per set.
-Accuracy against adaptive quadrature is measured in tests/test_branch_laws.py.
+Accuracy against adaptive quadrature is measured in tests/continuum/test_branch_laws.py.
 """
 from __future__ import annotations
 
@@ -196,7 +196,8 @@ class GWBranchSurface:
     def stiffness(self, d, zeta):
         """dp/dd (Pa/m) at fixed stored zeta (central difference, step 1e-7 sigma)."""
         h = 1e-7 * self.sigma
-        return (self._integral("pressure", np.asarray(d) + h, zeta) - self._integral("pressure", np.asarray(d) - h, zeta)) / (2 * h)
+        return (self._integral("pressure", np.asarray(d) + h, zeta)
+                - self._integral("pressure", np.asarray(d) - h, zeta)) / (2 * h)
 
     def pressure_and_stiffness(self, d, zeta):
         return self.pressure(d, zeta), self.stiffness(d, zeta)

@@ -21,8 +21,8 @@ The operations are those of the NumPy form in the same order, and the exp of the
 between two compiled passes (`log_hertz`, then `integral`: `GWJKRSurface._kernel_values`). So within the tables
 the two forms agree bit for bit on the machine this was written on (the contacts' step acceptances follow the
 footprint tables to the last bit: docs/rough-gw.md); elsewhere, to round-off (below the tables the quadrature's sums
-are a loop, not BLAS; another CPU's compiler may fuse a multiply-add). tests/test_gw_kernel.py compares them branch
-by branch. NaN separations, and NaN thresholds of adhesive surfaces, give NaN (the NumPy form raises on some).
+are a loop, not BLAS; another CPU's compiler may fuse a multiply-add). tests/continuum/test_gw_kernel.py compares them
+branch by branch. NaN separations, and NaN thresholds of adhesive surfaces, give NaN (the NumPy form raises on some).
 Divisions follow NumPy's error model (inf or NaN, no exception).
 
 The surface's scalars travel in one float vector (`P_*` indices, built by `GWJKRSurface._kernel_tables`), so one

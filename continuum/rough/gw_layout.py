@@ -73,7 +73,7 @@ def _window_shape(lam, xr, ttop, scale):
 #: Peak bytes per node of the 2-D window table while it is built: node values and derivatives of three
 #: quantities (4 x 3 x 8 B), the Gaussian at the w-nodes (2 x 8 B), one quantity's Hermite blocks and
 #: monomial coefficients (2 x 16 x 8 B) and the coefficients already kept (2 x 16 x 8 B): 624 B, rounded up
-#: after measuring with tracemalloc (tests/test_extremes.py checks the estimate bounds the measured peak).
+#: after measuring with tracemalloc (tests/continuum/test_extremes.py checks the estimate bounds the measured peak).
 _BYTES_PER_NODE = 800
 #: Fixed part of the build's peak: quadrature blocks of `_BUILD_BLOCK` floats (about six arrays of them).
 _BUILD_FIXED_BYTES = 6 * 8 * 2_000_000

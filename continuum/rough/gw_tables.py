@@ -12,12 +12,29 @@ import math
 
 import numpy as np
 
-from ..physics.jkr_kernel import S_FOLD as _S_FOLD, S_LOAD as _S_LOAD, S_ZERO as _S_ZERO, dx_ds as _dx_ds
-from ..physics.jkr_kernel import reduced_curve as _q_of_s, reduced_curve_minus_hertz as _g_of_s, x_of_s as _x_of_s
-from .gw_layout import (_BUILD_BLOCK, _DH, _DT_PANEL, _GL_W, _GL_X, _H_ZERO, _HERTZ_NU, _T_CUT, _Cubic1D, _gl_nodes,
-                        _Hermite2D, _panels, _window_shape)
+from ..physics.jkr_kernel import S_FOLD as _S_FOLD
+from ..physics.jkr_kernel import S_LOAD as _S_LOAD
+from ..physics.jkr_kernel import S_ZERO as _S_ZERO
+from ..physics.jkr_kernel import dx_ds as _dx_ds
+from ..physics.jkr_kernel import reduced_curve as _q_of_s
+from ..physics.jkr_kernel import reduced_curve_minus_hertz as _g_of_s
+from ..physics.jkr_kernel import x_of_s as _x_of_s
+from .gw_layout import (
+    _BUILD_BLOCK,
+    _DH,
+    _DT_PANEL,
+    _GL_W,
+    _GL_X,
+    _H_ZERO,
+    _HERTZ_NU,
+    _T_CUT,
+    _Cubic1D,
+    _gl_nodes,
+    _Hermite2D,
+    _panels,
+    _window_shape,
+)
 from .summits import _phi, _s_of_x, gw_integral
-
 
 #: Tables built in this process, by what they are a function of (`GWTables._table_key`): a sweep, a bisection or
 #: a regime estimate builds surfaces of the same summits again and again (a dozen per run, ~10 ms each).

@@ -114,7 +114,7 @@ def _named(channels, wanted, error, key_channel, listing, warnings):
         raise error(key_channel, wanted, f"the file has channels {listing}")
     if len(found) > 1:
         warnings.append(f"{key_channel} = {wanted!r} names channels " + ", ".join(channel_label(c) for c in found)
-                        + f"; the first is taken (give the index to choose)")
+                        + "; the first is taken (give the index to choose)")
     return found[0]
 
 

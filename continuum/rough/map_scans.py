@@ -30,14 +30,25 @@ Range of validity (each check with its numbers in `surface.validity`; a warning 
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from scipy import stats as sps
 
 from .datum import tallest_summit
 from .summit_stats import areal_moments, direct_summary, profile_moments, spectral_from_moments
 from .summits import expected_max_height
-from .topography import (KEY_CUTOFF, KEY_FILE, MIN_CUTOFF_PIXELS, MIN_SUMMITS, ROUTES, HeightMap, Summits,
-                         SurfaceStatistics, TopographyError, map_summits)
+from .topography import (
+    KEY_CUTOFF,
+    KEY_FILE,
+    MIN_CUTOFF_PIXELS,
+    MIN_SUMMITS,
+    ROUTES,
+    HeightMap,
+    Summits,
+    SurfaceStatistics,
+    TopographyError,
+    map_summits,
+)
 
 __all__ = ["MIN_SPANS", "WARN_SPANS", "FEW_SUMMITS", "MAX_RADIUS_RATIO", "WARN_RADIUS_RATIO", "PooledScans",
            "pooled_statistics", "scan_record", "data_depth", "validity"]

@@ -19,7 +19,7 @@ Thornton & Ning's (1998) construction, which they built on JKR, applied to the s
 * unloading and reloading follow L about a flattened radius R_p, shifted by a residual approach delta_p, with R_p
   fixed so that L's curve of radius R_p passes through the deepest state (a*, F*): F_L(a*; R_p) = F*, and
   delta_p = delta* - delta_L(a*; R_p). For JKR this is Thornton-Ning's R_p = 4E*a*^3/(3(F* + sqrt(8 pi w E*
-  a*^3))) exactly (tests/test_plastic_branches.py checks it against `continuum.rough.plastic_summits`);
+  a*^3))) exactly (tests/continuum/test_plastic_branches.py checks it against `continuum.rough.plastic_summits`);
   F_L(a*; R) falls with R for every law (the Hertz term 4E*a^3/(3R) falls, the adhesive term does not grow), so
   R_p is unique. The flattened summit then jumps in and out at L's own jump points of radius R_p (delta_p +
   delta_in(R_p), delta_p + delta_out(R_p)), feels L's non-contact attraction (Maugis-Dugdale) on approach, and
@@ -35,7 +35,7 @@ alike, so that F = dU/d(delta) holds on the mean curve too. The jumps of the mea
 of the nodes' jump points; a summit switching branch at delta_in books U_A - U_R there and U_R - U_A at
 delta_out (the sum is the mean curve's loop; at a node each term is L's own, the first zero), so the energy
 audit is exact for the mean curve. The interpolation error against L built at R_p itself is measured in
-tests/test_plastic_branches.py.
+tests/continuum/test_plastic_branches.py.
 
 The flattening (R_p, delta_p) is a function of D = delta_max - delta_y alone, tabulated on 400 points (D^2
 spacing up to the law's table range) and interpolated linearly; the plastic work is W_in(D) - U_R(delta*; R_p)

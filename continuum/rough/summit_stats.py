@@ -7,7 +7,8 @@ direction averages m0 = M0, m2 = M2 / 2, m4 = 3 M4 / 8 (the averages of cos^2 an
 these profile moments are the ones used and recorded. With the bandwidth alpha = m0 m4 / m2^2 (>= 1.5):
 
 - summit density            eta      = m4 / (6 pi sqrt(3) m2)           (Nayak, J. Lubr. Technol. 93 (1971) 398, exact)
-- mean summit curvature     kappa    = (8/3) sqrt(m4 / pi), beta = 1/kappa   (large-alpha limit; McCool, Wear 107 (1986) 37)
+- mean summit curvature     kappa    = (8/3) sqrt(m4 / pi), beta = 1/kappa
+                                                                        (large-alpha limit; McCool, Wear 107 (1986) 37)
 - summit-height variance    sigma_s^2 = (1 - 0.8968/alpha) m0              (McCool 1986)
 - mean summit height        4 sqrt(m0 / (pi alpha)) above the mean plane    (McCool 1986)
 

@@ -24,7 +24,8 @@ from ..reference import jkr as _jkr
 __all__ = ["SummitStatistics", "expected_max_height", "gw_integral", "TENSILE_ONSET"]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
-# JKR in the reduced variable s = sqrt(a/a0): delta/delta0 = s^4 - s, delta_c/delta0 = _DC (continuum.physics.jkr_kernel).
+# JKR in the reduced variable s = sqrt(a/a0): delta/delta0 = s^4 - s, delta_c/delta0 = _DC
+# (continuum.physics.jkr_kernel).
 _DC = jk.D_C
 _S_ZERO = jk.S_ZERO                    # P = 0 on the stable branch
 #: delta/delta_c at which the stable JKR branch changes sign (P < 0 below): 1.2114...

@@ -9,9 +9,9 @@ reader guessing which one ran. `surfaces.roughness.sigma` holds the summits' hei
 sigma), so a map fills it with sigma_s, not with the surface's rms height.
 
 The map supplies statistics (to the mean-field law and to the draws of an ensemble's members,
-`continuum.dynamics.ensemble_run`): the roller's footprint may be far larger than the map, and nothing tiles the map under it.
-`topography` may list several scans of one surface (`continuum.rough.map_scans`: each takes part at the cutoff where
-it resolves it, and their summits are pooled); the block records each scan, how deep the data reach against the
+`continuum.dynamics.ensemble_run`): the roller's footprint may be far larger than the map, and nothing tiles the map
+under it. `topography` may list several scans of one surface (`continuum.rough.map_scans`: each takes part at the cutoff
+where it resolves it, and their summits are pooled); the block records each scan, how deep the data reach against the
 impact (`data_depth`), and the range-of-validity checks (`validity`, `warnings`).
 
 The cutoff is the scene's summit_cutoff (or its tip_radius, or a synthesis' short cutoff), or, with
@@ -30,8 +30,21 @@ from nanoimpact.errors import InputError
 from ..reference.hertz import effective_modulus
 from .cutoff_match import KEY_CUTOFF_FROM, scene_cutoff
 from .map_scans import PooledScans, data_depth, pooled_statistics, validity
-from .topography import (KEY_CHANNEL, KEY_CUTOFF, KEY_DETREND, KEY_FILE, KEY_SIZE, KEY_SYNTH, KEY_TIP, KEY_UNIT,
-                         HeightMap, Synthesis, TopographyError, cutoff_from_tip_radius, load_height_map)
+from .topography import (
+    KEY_CHANNEL,
+    KEY_CUTOFF,
+    KEY_DETREND,
+    KEY_FILE,
+    KEY_SIZE,
+    KEY_SYNTH,
+    KEY_TIP,
+    KEY_UNIT,
+    HeightMap,
+    Synthesis,
+    TopographyError,
+    cutoff_from_tip_radius,
+    load_height_map,
+)
 
 __all__ = ["MapStatistics", "map_statistics", "statistics_block", "find_topography", "height_map", "height_maps",
            "scene_scans", "MAP_KEYS"]

@@ -139,8 +139,9 @@ def _open_channel(path: Path, channel: int | str | None):
             reader = SurfaceTopography.open_topography(str(path))
             channels = reader.channels
     except Exception as exc:  # the readers raise many kinds; each becomes one line naming the file
-        raise TopographyError(KEY_FILE, str(path), f"SurfaceTopography cannot read it ({type(exc).__name__}: "
-                                                   f"{str(exc).splitlines()[0] if str(exc) else 'no message'})") from None
+        raise TopographyError(KEY_FILE, str(path),
+                              f"SurfaceTopography cannot read it ({type(exc).__name__}: "
+                              f"{str(exc).splitlines()[0] if str(exc) else 'no message'})") from None
     if chatter.getvalue():
         log.debug("SurfaceTopography reading %s: %s", path, chatter.getvalue().strip())
     ch, record, warnings = select_channel(channels, channel, TopographyError, KEY_FILE, KEY_CHANNEL, str(path))

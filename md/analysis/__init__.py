@@ -27,27 +27,69 @@ Sources (details and measured accuracies: ``docs/md-analysis.md``):
 
 :class:`ContactAngle` needs MDAnalysis (the ``md`` extra); everything else needs numpy and scipy only.
 """
-from md.analysis.adhesion import (force_integration_work, registry_average, registry_consistency, traction_peak,
-                                  flat_slab_range, lj_tail_between, MAUGIS_LJ93, energy_separation_work, work_from_energy_curve,
-                                  chain_correlation, window_length_check, entropic_term, grid_interval_bounds,
-                                  hysteresis)
-from md.analysis.layer_modulus import (confined_layer_modulus, sam_layer_thickness_A, young_from_confined,
-                                      tangent_confined_modulus, thickness_at_tilt_A, stress_ratio_poisson,
-                                      plane_strain_from_confined, poisson_spread, tilt_of_anneal,
-                                      small_strain_layer_record)
-from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N, ATM_A_TO_N_PER_M
-from md.analysis.contact_angle import (ContactAngle, fit_contact_angle, fit_circle, dividing_plane, wetting_bound,
-                                       work_of_adhesion_sl, cap_angle_for_base, cap_angle_for_height,
-                                       shape_check,
-                                       dispersion_tail_work, tail_antiderivative, cutoff_crossing_work)
+from md.analysis.adhesion import (
+                                  MAUGIS_LJ93,
+                                  chain_correlation,
+                                  energy_separation_work,
+                                  entropic_term,
+                                  flat_slab_range,
+                                  force_integration_work,
+                                  grid_interval_bounds,
+                                  hysteresis,
+                                  lj_tail_between,
+                                  registry_average,
+                                  registry_consistency,
+                                  traction_peak,
+                                  window_length_check,
+                                  work_from_energy_curve,
+)
+from md.analysis.common import ATM_A_TO_N_PER_M, KCALMOL_PER_A2_TO_J_PER_M2, KCALMOL_PER_A_TO_N
+from md.analysis.contact_angle import (
+                                  ContactAngle,
+                                  cap_angle_for_base,
+                                  cap_angle_for_height,
+                                  cutoff_crossing_work,
+                                  dispersion_tail_work,
+                                  dividing_plane,
+                                  fit_circle,
+                                  fit_contact_angle,
+                                  shape_check,
+                                  tail_antiderivative,
+                                  wetting_bound,
+                                  work_of_adhesion_sl,
+)
 from md.analysis.drift import block_drift
-from md.analysis.free_energy import (gauss_legendre_unit, ti_integral, ti_work_of_adhesion_sl,
-                                     angle_from_work_of_adhesion_sl, tether_correction,
-                                     film_lower_dividing_plane)
-from md.analysis.pulloff import pull_off_analysis, fit_traction_law, rate_extrapolation, paired_speed_extrapolation
-from md.analysis.stats import (block_average, block_analysis, blocking_stderr, statistical_inefficiency,
-                               detect_equilibration, timeseries_stats, student_t_factor)
-from md.analysis.surface_tension import surface_tension, lj_tail_correction, density_profile, slab_density
+from md.analysis.free_energy import (
+                                  angle_from_work_of_adhesion_sl,
+                                  film_lower_dividing_plane,
+                                  gauss_legendre_unit,
+                                  tether_correction,
+                                  ti_integral,
+                                  ti_work_of_adhesion_sl,
+)
+from md.analysis.layer_modulus import (
+                                  confined_layer_modulus,
+                                  plane_strain_from_confined,
+                                  poisson_spread,
+                                  sam_layer_thickness_A,
+                                  small_strain_layer_record,
+                                  stress_ratio_poisson,
+                                  tangent_confined_modulus,
+                                  thickness_at_tilt_A,
+                                  tilt_of_anneal,
+                                  young_from_confined,
+)
+from md.analysis.pulloff import fit_traction_law, paired_speed_extrapolation, pull_off_analysis, rate_extrapolation
+from md.analysis.stats import (
+                                  block_analysis,
+                                  block_average,
+                                  blocking_stderr,
+                                  detect_equilibration,
+                                  statistical_inefficiency,
+                                  student_t_factor,
+                                  timeseries_stats,
+)
+from md.analysis.surface_tension import density_profile, lj_tail_correction, slab_density, surface_tension
 
 __all__ = [
     "KCALMOL_PER_A2_TO_J_PER_M2", "KCALMOL_PER_A_TO_N", "ATM_A_TO_N_PER_M",
@@ -62,7 +104,8 @@ __all__ = [
     "MAUGIS_LJ93",
     "energy_separation_work", "work_from_energy_curve",
     "ContactAngle", "fit_contact_angle", "fit_circle", "dividing_plane", "wetting_bound", "block_drift",
-    "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work", "tail_antiderivative", "cutoff_crossing_work",
+    "work_of_adhesion_sl", "cap_angle_for_base", "cap_angle_for_height", "shape_check", "dispersion_tail_work",
+    "tail_antiderivative", "cutoff_crossing_work",
     "surface_tension", "lj_tail_correction", "density_profile", "slab_density",
     "gauss_legendre_unit", "ti_integral", "ti_work_of_adhesion_sl", "angle_from_work_of_adhesion_sl",
     "tether_correction", "film_lower_dividing_plane", "pull_off_analysis", "fit_traction_law", "rate_extrapolation",

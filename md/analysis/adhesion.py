@@ -8,10 +8,8 @@ import math
 import numpy as np
 
 from md import units as _units
-
-from md.analysis.stats import block_average, student_t_factor, timeseries_stats
 from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, refined_min
-
+from md.analysis.stats import block_average, student_t_factor, timeseries_stats
 
 # ------------------------------------------------------------------------------------ works of adhesion
 
@@ -165,7 +163,8 @@ def force_integration_work(separation_A, mean_force_kcal_per_molA, force_stderr_
     # PMF relative to the well's bottom: cumulative minus its (interpolated) value at the start
     # (the trapezoid value at the crossing, where f = 0; the first window without a crossing)
     c_start = float(cumulative[j]) - 0.5 * (start - d[j]) * f[j] * conv if j is not None else 0.0
-    return {"value": trap, "stderr": err, "value_pchip": pchip, "discretisation_error": max(abs(trap - pchip), grid_max),
+    return {"value": trap, "stderr": err, "value_pchip": pchip,
+            "discretisation_error": max(abs(trap - pchip), grid_max),
             "quadrature_difference": abs(trap - pchip), "grid_bound_max": grid_max,
             "interval_bounds_J_per_m2": grid["bounds_kcal_mol"] * conv, "refine_intervals_A": grid["refine_A"],
             "correlation": float(correlation), "units": "J/m^2", "separation_A": d, "cumulative_J_per_m2": cumulative,

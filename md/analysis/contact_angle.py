@@ -9,10 +9,8 @@ import warnings
 import numpy as np
 
 from md import units as _units
-
 from md.analysis.drift import block_drift
 from md.analysis.stats import timeseries_stats
-
 
 # -------------------------------------------------------------------------------------- contact angle
 

@@ -31,7 +31,7 @@ from md.analysis.stats import statistical_inefficiency, student_t_factor
 #: |slope| / stderr above which a series is reported as drifting (two-sided 95 %)
 DRIFT_Z_MAX = 2.0
 #: blocks of the block-means test: 6 degrees of freedom; on a fast oscillation plus an AR(1) whose correlation
-#: time is a fifth of a block the test keeps about its nominal false-positive rate (tests/test_md_adhesion.py),
+#: time is a fifth of a block the test keeps about its nominal false-positive rate (tests/md/test_md_adhesion.py),
 #: and more blocks would be shorter than a SAM's slow fluctuations in a 250 ps half-anneal
 DRIFT_BLOCKS = 8
 #: fewest blocks the block-means test runs on (2 degrees of freedom); shorter series get the ACF test alone
@@ -40,7 +40,8 @@ MIN_DRIFT_BLOCKS = 4
 
 def ols_trend(t, y) -> dict:
     """Ordinary least-squares line of ``y`` against ``t``: ``slope``, its white-noise ``stderr`` (residual
-    variance over n - 2 degrees of freedom), ``dof`` and the ``residuals``. Needs at least 3 points at two distinct times."""
+    variance over n - 2 degrees of freedom), ``dof`` and the ``residuals``. Needs at least 3 points at two distinct
+    times."""
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     tc = t - t.mean()

@@ -15,8 +15,9 @@ What is measured
     131909), conducting-AFM with a DMT contact ~50 GPa (Engelkes & Frisbie, J. Phys. Chem. B 110 (2006) 10011);
     MD of alkanethiol SAMs on Au(111) under uniaxial compression computes Young's moduli from stress-strain
     curves (Ramin & Jabbarzadeh, "Effect of pressure on dry and hydrated self assembled monolayers: a molecular
-    dynamics simulation study", Appl. Mech. Mater. 553 (2014) 35; its values are not quoted here, unchecked). (Patterson & Dlott, J. Phys. Chem. B 109 (2005) 5045, cited
-    here before, is an ultrafast shock-compression experiment, not an isothermal simulation: it is not a source
+    dynamics simulation study", Appl. Mech. Mater. 553 (2014) 35; its values are not quoted here, unchecked).
+    (Patterson & Dlott, J. Phys. Chem. B 109 (2005) 5045, cited here before, is an ultrafast shock-compression
+    experiment, not an isothermal simulation: it is not a source
     for this modulus.) A surface-force study of FOTS SAMs finds a viscous response while only the chain ends are
     pressed and a steep elastic rise only above ~0.2 GPa (Devaprakasam & Biswas, "Molecular damping: mechanical
     response of self-assembled monomolecular layer to compression"): the branch stiffens, so the modulus a
@@ -203,7 +204,8 @@ def tangent_confined_modulus(separation_A, mean_force_kcal_per_molA, force_stder
             "windows": int(sel.size), "strain_max": float((d0 - x.min()) / t), "thickness_A": t}
 
 
-def thickness_at_tilt_A(height_of_tilt, tilt_deg: float, tilt_spread_deg: float, layers: int = 1) -> tuple[float, float]:
+def thickness_at_tilt_A(height_of_tilt, tilt_deg: float, tilt_spread_deg: float,
+                        layers: int = 1) -> tuple[float, float]:
     """(thickness, its stderr) in A of ``layers`` identical SAMs whose chains tilt ``tilt_deg`` from the normal:
     ``layers`` x ``height_of_tilt(tilt_deg)`` (the builder's CH3 height above the anchor-O plane of an all-trans
     chain at that tilt, md.build.sam.chain_geometry), the stderr from ``tilt_spread_deg`` through the height's

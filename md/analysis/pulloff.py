@@ -7,9 +7,7 @@ import math
 import numpy as np
 
 from md import units as _units
-
 from md.analysis.common import KCALMOL_PER_A_TO_N, refined_min
-
 
 # ------------------------------------------------------------------------------------------ pull-off
 

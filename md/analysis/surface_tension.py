@@ -8,10 +8,8 @@ import math
 import numpy as np
 
 from md import units as _units
-
+from md.analysis.common import ATM_A_TO_N_PER_M, KCALMOL_PER_A2_TO_J_PER_M2
 from md.analysis.stats import block_average, timeseries_stats
-from md.analysis.common import KCALMOL_PER_A2_TO_J_PER_M2, ATM_A_TO_N_PER_M
-
 
 # ------------------------------------------------------------------------------------ surface tension
 

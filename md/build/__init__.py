@@ -18,10 +18,17 @@ from md.build.common import sam_forcefield, silica_forcefield, water_forcefield
 from md.build.dome import graft_dome
 from md.build.place import flip_upside_down, place_on
 from md.build.sam import ots_sam
-from md.build.silica import (CRISTOBALITE_A, DEFAULT_FACE, QUARTZ, SILICA_FACE, quartz_basis, silica_asperity,
-                             silica_slab)
+from md.build.silica import (
+                             CRISTOBALITE_A,
+                             DEFAULT_FACE,
+                             QUARTZ,
+                             SILICA_FACE,
+                             quartz_basis,
+                             silica_asperity,
+                             silica_slab,
+)
 from md.build.water import cap_radius, water_cap, water_cylinder, water_slab
 
-__all__ = ["silica_slab", "silica_asperity", "ots_sam", "graft_dome", "water_slab", "water_cylinder", "water_cap", "place_on",
-           "flip_upside_down", "silica_forcefield", "sam_forcefield", "water_forcefield", "cap_radius",
+__all__ = ["silica_slab", "silica_asperity", "ots_sam", "graft_dome", "water_slab", "water_cylinder", "water_cap",
+           "place_on", "flip_upside_down", "silica_forcefield", "sam_forcefield", "water_forcefield", "cap_radius",
            "CRISTOBALITE_A", "QUARTZ", "DEFAULT_FACE", "SILICA_FACE", "quartz_basis"]

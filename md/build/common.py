@@ -11,6 +11,7 @@ from md.system.atoms import to_atoms
 from md.system.forcefield import ForceField, combine, load_forcefield
 from md.system.topology import System
 
+
 def atoms_builder(build_system: Callable[..., System]):
     """The public form of a builder: the same arguments, an :class:`ase.Atoms` back (:func:`md.system.atoms.to_atoms`:
     force-field types, molecule ids, charges and masses as arrays; bonds, angles, dihedrals and groups in

@@ -154,6 +154,7 @@ def _offset_sites(asp: System, sites: np.ndarray, order: np.ndarray, n_target: i
     every head atom (head Si, its two O, the first two CH2) :data:`HEAD_CLEARANCE_A` from every heavy atom but its
     anchor O -- until ``n_target`` chains stand."""
     from scipy.spatial import cKDTree
+
     from md.build.sam import chain_geometry, head_offset_disk, head_shifts
 
     L = chain_length

@@ -7,12 +7,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from md.system.atoms import as_system
-from md.system.topology import System, merge, translate
-from md.system.topology import flip_upside_down as _flip_system
 from md.build.common import _plain, atoms_builder
 from md.build.silica import silica_slab
 from md.build.water import water_cap
+from md.system.atoms import as_system
+from md.system.topology import System, merge, translate
+from md.system.topology import flip_upside_down as _flip_system
 
 # ================================================================================================ assembly
 

@@ -11,11 +11,11 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, sam_forcefield
+from md.build.silica import silica_slab
 from md.system.atoms import as_system
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, merge, minimum_image, remove_atoms, with_bonded_terms
-from md.build.silica import silica_slab
-from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, sam_forcefield
 
 # ================================================================================================ OTS monolayer
 

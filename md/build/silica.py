@@ -41,9 +41,9 @@ from typing import Any, Callable, Mapping
 import numpy as np
 from scipy.spatial import cKDTree
 
+from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, silica_forcefield
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, minimum_image, with_bonded_terms
-from md.build.common import SOURCES, _angle_theta0, _bond_r0, _plain, _unit, atoms_builder, silica_forcefield
 
 CRISTOBALITE_A = 7.16                     #: A, idealised cubic beta-cristobalite (Wyckoff 1925)
 QUARTZ = {"a": 4.916, "c": 5.4054, "spacegroup": 154,     # P3_221
@@ -109,7 +109,8 @@ def _fill_box(lattice: np.ndarray, frac: np.ndarray, is_si: np.ndarray, rot: np.
     sel = np.all((r >= 0) & (r < box), axis=1)
     n_expect = abs(np.prod(box) / np.linalg.det(lattice)) * len(frac)
     if abs(sel.sum() - n_expect) > 1e-6:
-        raise RuntimeError(f"supercell holds {sel.sum()} atoms, expected {n_expect:.3f}: box is not a lattice supercell")
+        raise RuntimeError(f"supercell holds {sel.sum()} atoms, expected {n_expect:.3f}: "
+                           "box is not a lattice supercell")
     return r[sel], np.tile(is_si, len(grid))[sel]
 
 
@@ -449,8 +450,8 @@ def silica_slab(nx: int = 4, ny: int = 4, *, thickness: float | None = 25.0, lay
     (OH/nm^2, per face): the cut face's natural density is lowered by condensation (module docstring); if the
     achieved value is more than ``density_tolerance`` (relative) from the request, ValueError states the
     achievable range. ``face`` defaults to :data:`SILICA_FACE` = '111' (cristobalite: isolated Q3 silanols, the
-    surface every recipe uses) / '0001' (quartz); '001' gives 3.9-7.8 OH/nm^2 with geminal pairs. ``vacuum`` (A) is added
-    below and above. ``frozen_depth`` (A): atoms this close to the bottom form the group 'frozen'.
+    surface every recipe uses) / '0001' (quartz); '001' gives 3.9-7.8 OH/nm^2 with geminal pairs. ``vacuum`` (A) is
+    added below and above. ``frozen_depth`` (A): atoms this close to the bottom form the group 'frozen'.
 
     Groups: 'silica', 'slab', 'silanol_O_top', 'silanol_H_top', 'silanol_O_bottom', 'silanol_H_bottom',
     'frozen'. ``info``: counts, per-face silanol densities and achievable ranges, Q distribution, thicknesses.

@@ -13,9 +13,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from md.build.common import _angle_theta0, _bond_r0, _plain, atoms_builder, water_forcefield
 from md.system.forcefield import ForceField
 from md.system.topology import System, from_types, minimum_image, with_bonded_terms
-from md.build.common import _angle_theta0, _bond_r0, _plain, atoms_builder, water_forcefield
 from md.units import AVOGADRO, WATER_DENSITY
 
 # ================================================================================================ water

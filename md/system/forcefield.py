@@ -277,7 +277,8 @@ def _parse_atom(d: Mapping[str, Any], family: str, where: str) -> AtomType:
                                   f"{at.published_radius} -> {expect:.5f} A")
     if at.published_epsilon is not None:
         expect = epsilon_from_published(at.published_epsilon, at.published_epsilon_unit)
-        if abs(expect - at.epsilon) > EPSILON_REL_TOLERANCE * max(abs(expect), 1e-12) and abs(expect - at.epsilon) > 1e-9:
+        if (abs(expect - at.epsilon) > EPSILON_REL_TOLERANCE * max(abs(expect), 1e-12)
+                and abs(expect - at.epsilon) > 1e-9):
             raise ForceFieldError(f"{where}: epsilon {at.epsilon} disagrees with published {at.published_epsilon} "
                                   f"{at.published_epsilon_unit} -> {expect:.6f} kcal/mol")
     return at

@@ -22,8 +22,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from md.system.forcefield import ForceField, combine, lammps_pair_coeffs, lammps_type_ids, load_forcefield
 from md.system.atoms import as_system
+from md.system.forcefield import ForceField, combine, lammps_pair_coeffs, lammps_type_ids, load_forcefield
 from md.system.topology import System
 
 __all__ = ["write_data", "read_atoms", "read_back_check", "ReadBack", "lammps_setup_commands", "style_of"]
@@ -67,7 +67,7 @@ def write_data(system: System | Any, forcefield: ForceField, path: str | Path, *
     the closest images, so a bond across a periodic boundary needs none; it only warns "Inconsistent image
     flags" for such bonds. For a slab bonded across x and y the warning cannot be avoided: a bond path around
     the box adds up to a box length, so no image flags make every bond's unwrapped length its minimum-image
-    length. (tests/test_md_substrate_start.py checks that every bond is at its length under minimum image.)
+    length. (tests/md/test_md_substrate_start.py checks that every bond is at its length under minimum image.)
     """
     system = as_system(system)
     path = Path(path)
@@ -257,7 +257,7 @@ def read_back_check(path: str | Path, forcefield: ForceField | None = None, *, p
     Styles come from the force field; ``pair_coeff`` lines from :func:`md.system.forcefield.lammps_pair_coeffs`;
     ``special_bonds`` from the force field. With ``run0`` a ``run 0`` evaluates the energy terms.
     """
-    from md.lammps_loader import new_lammps   # noqa: PLC0415  (LAMMPS only when asked for)
+    from md.lammps_loader import new_lammps  # noqa: PLC0415  (LAMMPS only when asked for)
 
     path = Path(path)
     meta = _header(path)

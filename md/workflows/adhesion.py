@@ -19,8 +19,8 @@ from md import analysis as A
 from md.engine.plan import Plan
 from md.system.lammps_data import read_atoms
 from md.workflows.adhesion_analysis import _AdhesionAnalysis
-from md.workflows.adhesion_legs import _AdhesionLegs, _lifts_registries, _tail_pair_table, outward_grid, TAIL_R_MAX_A
-from md.workflows.common import derived_seed, forcefield_of, Workflow
+from md.workflows.adhesion_legs import TAIL_R_MAX_A, _AdhesionLegs, _lifts_registries, _tail_pair_table, outward_grid
+from md.workflows.common import Workflow, derived_seed, forcefield_of
 
 # ================================================================================================ adhesion
 
@@ -106,9 +106,10 @@ class Adhesion(Workflow):
         contact = legs.contact()
         windows = legs.windows(contact) if s.free_energy == "pmf" else []
         seed = int(s.seed)
-        return Plan(legs=anneal + [contact, legs.separated()] + windows, timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
-                    seeds={"structure_lower": seed, "structure_upper": seed + 10, "velocities": derived_seed(seed, 3, 1),
-                           "thermostat_base": seed},
+        return Plan(legs=anneal + [contact, legs.separated()] + windows, timestep_fs=s.timestep_fs,
+                    n_atoms=legs.system.n_atoms,
+                    seeds={"structure_lower": seed, "structure_upper": seed + 10,
+                           "velocities": derived_seed(seed, 3, 1), "thermostat_base": seed},
                     forcefield_files=self.forcefield_files(s), system_info=legs.info())
 
     # ------------------------------------------------------------------------------------------ analysis

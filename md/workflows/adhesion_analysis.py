@@ -3,18 +3,16 @@ free energy by force integration over the window chains, the flat-slab law (sigm
 reports), the SAM layer's moduli and Poisson ratio, the window checks, notes, curves and figures."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from md import analysis as A
 from md import units as U
+from md.build.sam import chain_geometry
 from md.engine.plan import Analysis
 from md.workflows import adhesion_protocol as P
-from md.build.sam import chain_geometry
 from md.workflows.adhesion_legs import MIN_WINDOW_NEFF, SAM_STRESS_COLUMNS, TAIL_R_MAX_A
 from md.workflows.common import ENERGY_NOT_FREE_ENERGY, figure_writer, quantity_record
 
@@ -59,7 +57,7 @@ class _AdhesionAnalysis:
 
     # ---- prepare: the energy route and the static tail
     def _prepare(self) -> None:
-        ctx, s, info = self.ctx, self.s, self.info
+        ctx, info = self.ctx, self.info
         self.area = area = info["area_A2"]
         self.conv = U.kcal_per_mol_A2_to_J_per_m2(1.0) / area           # kcal/mol -> J/m^2 over this interface
         con, sep = ctx.samples("contact"), ctx.samples("separated")
@@ -149,7 +147,8 @@ class _AdhesionAnalysis:
         win = self.ctx.samples(f"pmf_r{r}_{suf}")           # one read of the window's samples
         st = A.timeseries_stats(win["fz"])
         self.d_A[r, k] = float(np.mean(win["z_back"])) - self.zc
-        self.f_m[r, k], self.f_e[r, k], self.g_w[r, k], self.neff_w[r, k] = st["mean"], st["stderr"], st["g"], st["n_eff"]
+        self.f_m[r, k], self.f_e[r, k], self.g_w[r, k], self.neff_w[r, k] = (st["mean"], st["stderr"], st["g"],
+                                                                             st["n_eff"])
         if SAM_STRESS_COLUMNS[0] in win:
             for c, col in enumerate(SAM_STRESS_COLUMNS):
                 ss = A.timeseries_stats(win[col])
@@ -345,8 +344,8 @@ class _AdhesionAnalysis:
                  f"weighted quadratic through the {tg['windows']} repulsive windows, t = {rec['thickness_A']:.1f} A "
                  f"({rec['thickness_source']}); stderr: fit and thickness", thickness_m=rec["thickness_A"] * 1e-10,
             thickness_stderr_m=rec["thickness_stderr_A"] * 1e-10, thickness_per_layer_m=rec["thickness_per_layer_m"],
-            layers=rec["layers"], chord_modulus_Pa=tg["chord_modulus_Pa"], curvature_delta_chi2=tg["curvature_delta_chi2"],
-            windows=tg["windows"], strain_max=tg["strain_max"])
+            layers=rec["layers"], chord_modulus_Pa=tg["chord_modulus_Pa"],
+            curvature_delta_chi2=tg["curvature_delta_chi2"], windows=tg["windows"], strain_max=tg["strain_max"])
         self.details["sam_layer_tangent_modulus"] = {k: v for k, v in rec.items() if k != "tangent"} | {"tangent": tg}
 
     def _layer_poisson(self) -> None:
@@ -395,7 +394,8 @@ class _AdhesionAnalysis:
         self.details["pmf_windows"] = {
             "separation_A": self.dsep.tolist(), "mean_force_kcal_mol_A": self.fbar.tolist(),
             "stderr_kcal_mol_A": self.ebar.tolist(), "tail_force_kcal_mol_A": self.f_tail.tolist(), "window": suffixes,
-            "per_registry_mean_force_kcal_mol_A": self.f_m.tolist(), "per_registry_stderr_kcal_mol_A": self.f_e.tolist(),
+            "per_registry_mean_force_kcal_mol_A": self.f_m.tolist(),
+            "per_registry_stderr_kcal_mol_A": self.f_e.tolist(),
             "statistical_inefficiency": self.g_w.tolist(), "n_eff": self.neff_w.tolist(),
             "decorrelation_time_ps": ((self.g_w - 1) / 2 * s.sample_interval * self.dt * 1e-3).tolist(),
             "registry_work_J_m2": self.w_reg.tolist(), "registry_offsets_A": self.info["registry_offsets_A"],
@@ -414,7 +414,8 @@ class _AdhesionAnalysis:
         wl = A.window_length_check(self.dsep, first, second, self.estat, self.area, correlation=self.rho)
         self.w_half = [wl["first_half_J_m2"] - self.u_tail_last * self.conv,
                        wl["second_half_J_m2"] - self.u_tail_last * self.conv]
-        self.half_diff, self.half_err, self.half_ok = wl["difference_J_m2"], wl["difference_stderr_J_m2"], wl["converged"]
+        self.half_diff, self.half_err, self.half_ok = (wl["difference_J_m2"], wl["difference_stderr_J_m2"],
+                                                       wl["converged"])
         self.details["window_length_check"] = {
             "first_half_J_m2": self.w_half[0], "second_half_J_m2": self.w_half[1], "whole_J_m2": self.wf_val,
             "difference_J_m2": self.half_diff, "difference_stderr_J_m2": self.half_err, "converged": self.half_ok,

@@ -5,10 +5,9 @@ stress (``compute stress/atom``, Thompson, Plimpton & Mattson, J. Chem. Phys. 13
 C13/C33 (md.analysis.stress_ratio_poisson)."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,10 +18,25 @@ from md.system.forcefield import ForceField
 from md.system.lammps_data import write_data
 from md.system.topology import System
 from md.workflows.adhesion_registries import degenerate_registries, primitive_offsets, surface_lattice
-from md.workflows.common import (common_define, derived_seed, equilibrate_stage, forcefield_of, fresh_from_data,
-                                 intersect_ids, minimize_lines, restart_header_lines, round_up, Settings,
-                                 silica_face_of, stage_list, steps_of, surface_slab, system_summary,
-                                 thermostat_lines, TRAPPE_UA)
+from md.workflows.common import (
+    TRAPPE_UA,
+    Settings,
+    common_define,
+    derived_seed,
+    equilibrate_stage,
+    forcefield_of,
+    fresh_from_data,
+    intersect_ids,
+    minimize_lines,
+    restart_header_lines,
+    round_up,
+    silica_face_of,
+    stage_list,
+    steps_of,
+    surface_slab,
+    system_summary,
+    thermostat_lines,
+)
 
 if TYPE_CHECKING:                      # the workflow class imports this module
     from md.workflows.adhesion import Adhesion

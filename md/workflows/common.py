@@ -23,14 +23,13 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from md.build import ots_sam, silica_slab
-from md.system.atoms import as_system
-from md.system.forcefield import ForceField, combine, load_forcefield
-from md.system.lammps_data import lammps_setup_commands
 from md.engine.plan import Analysis, Plan, Stage, id_ranges
 from md.engine.store import RunContext
 from md.recipe import settings_class
+from md.system.atoms import as_system
+from md.system.forcefield import ForceField, combine, load_forcefield
+from md.system.lammps_data import lammps_setup_commands
 from md.system.topology import System
-
 
 #: A workflow's frozen settings dataclass (:func:`md.recipe.settings_class`, :meth:`Workflow.typed`): the recipe's
 #: resolved settings at one fidelity, one attribute per key.
@@ -278,7 +277,7 @@ def quantity_record(value: float, stderr: float | None, units: str, **extra) -> 
 
 def figure_writer(draw: Callable) -> Callable[[Path], None]:
     def save(path: Path) -> None:
-        from matplotlib.figure import Figure    # object API: no pyplot state, no backend switch
+        from matplotlib.figure import Figure  # object API: no pyplot state, no backend switch
         fig = Figure(figsize=(6.0, 4.2), dpi=110)
         ax = fig.subplots()
         draw(ax)

@@ -18,19 +18,42 @@ import numpy as np
 from md import analysis as A
 from md import units as U
 from md.build import place_on, water_cap
+from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
 from md.system.lammps_data import write_data
-from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.topology import System, remove_atoms
-
-from md.workflows.common import (common_define, derived_seed, equilibrate_stage, figure_writer, forcefield_of,
-                                 framed_tail_sites, fresh_from_data, held_deep, intersect_ids, leg_temperatures,
-                                 minimize_lines, minimize_water_lines, quantity_record, restart_header_lines,
-                                 shake_lines, SILANOL_OH, silica_face_of, stage_list, steps_of, substrate_water_seeds,
-                                 surface_slab, system_summary, thermostat_lines, trappe_tail_sites,
-                                 water_forcefield_names, WATER_MODELS, WATER_SOLID_COLUMNS,
-                                 water_solid_thermostat_lines, Workflow)
+from md.workflows.common import (
+    SILANOL_OH,
+    WATER_MODELS,
+    WATER_SOLID_COLUMNS,
+    Workflow,
+    common_define,
+    derived_seed,
+    equilibrate_stage,
+    figure_writer,
+    forcefield_of,
+    framed_tail_sites,
+    fresh_from_data,
+    held_deep,
+    intersect_ids,
+    leg_temperatures,
+    minimize_lines,
+    minimize_water_lines,
+    quantity_record,
+    restart_header_lines,
+    shake_lines,
+    silica_face_of,
+    stage_list,
+    steps_of,
+    substrate_water_seeds,
+    surface_slab,
+    system_summary,
+    thermostat_lines,
+    trappe_tail_sites,
+    water_forcefield_names,
+    water_solid_thermostat_lines,
+)
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
 DROPLET_GAP_A = 3.0
@@ -70,7 +93,8 @@ class ContactAngleWorkflow(Workflow):
         system, so atom ids 1..n_substrate are the same in both legs."""
         s = self.typed(s)
         seed = int(s.seed)
-        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed, silica_face_of((s.surface,), s.silica_face))
+        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed,
+                           silica_face_of((s.surface,), s.silica_face))
         R0 = float(s.droplet_radius_A)
         wff = forcefield_of(water_forcefield_names(s.water_model))
         drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s.droplet_initial_angle_deg,
@@ -140,7 +164,8 @@ class ContactAngleWorkflow(Workflow):
 
         drop_leg = Leg(name="droplet", fresh=fresh_droplet, define=define(1, True),
                        prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
-                       stages=stage_list(equilibrate_stage(s, "mobile", 1), Stage("sample", steps_of(s.sample_steps, s.sample_interval))),
+                       stages=stage_list(equilibrate_stage(s, "mobile", 1),
+                                         Stage("sample", steps_of(s.sample_steps, s.sample_interval))),
                        columns={"pe": "v_pe", "temp": "v_temp", "n_water": "v_nw"} | WATER_SOLID_COLUMNS,
                        sample_interval=s.sample_interval, chunk_steps=s.chunk_steps, n_atoms=n,
                        frames=Frames("framed", s.frame_interval or s.sample_interval))
@@ -205,7 +230,7 @@ class _DropletAnalysis:
         self.r = ca.results
 
     def _conclude(self) -> Analysis:
-        s, r = self.s, self.r
+        s = self.s
         self.model = WATER_MODELS[s.water_model]
         self.gamma = self.model["gamma_lv_N_m"]
         if abs(s.temperature_K - self.model["gamma_T_K"]) > 1.0:

@@ -32,8 +32,18 @@ from md.engine.plan import Analysis, Leg, Plan
 from md.system.atoms import as_system
 from md.system.lammps_data import read_atoms, write_data
 from md.system.topology import System
-from md.workflows.common import (derived_seed, figure_writer, forcefield_of, intersect_ids, quantity_record,
-                                 Settings, silica_face_of, surface_slab, system_summary, Workflow)
+from md.workflows.common import (
+    Settings,
+    Workflow,
+    derived_seed,
+    figure_writer,
+    forcefield_of,
+    intersect_ids,
+    quantity_record,
+    silica_face_of,
+    surface_slab,
+    system_summary,
+)
 from md.workflows.pulloff_protocol import leg_name, measures_flat, position_legs, shift_tip, tip_offsets
 
 # ================================================================================================ pull-off
@@ -107,7 +117,8 @@ class PullOff(Workflow):
         if measures_flat(s):
             info.update(flat_thermostat=s.flat_thermostat, n_flat_sam=int(len(groups.get("flat_sam", ()))))
         return Plan(legs=legs, timestep_fs=s.timestep_fs, n_atoms=n,
-                    seeds={"structure_asperity": seed, "structure_flat": seed + 20, "velocities": derived_seed(seed, 3, 1),
+                    seeds={"structure_asperity": seed, "structure_flat": seed + 20,
+                           "velocities": derived_seed(seed, 3, 1),
                            "thermostat_base": seed, **({"sam_asperity": seed + 30} if s.surface == "ots" else {})},
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
@@ -474,5 +485,6 @@ def _z0_mean(rs: list[Mapping[str, Any]]) -> dict[str, Any]:
     e = np.array([r.get("z0_stderr") or 0.0 for r in rs if r["z0"] is not None and np.isfinite(r["z0"])])
     e = np.where(np.isfinite(e), e, 0.0)
     avg = A.registry_average(z, e) if z.size >= 2 else {"mean": float(z[0]), "stderr": float(e[0]) or None}
-    return quantity_record(avg["mean"], avg["stderr"], "m", kind=f"mean z0 of the LJ 9-3 law fitted to {z.size} retraction "
-                                                    f"curves (includes the asperity's compliance)")
+    return quantity_record(avg["mean"], avg["stderr"], "m",
+                           kind=f"mean z0 of the LJ 9-3 law fitted to {z.size} retraction "
+                                f"curves (includes the asperity's compliance)")

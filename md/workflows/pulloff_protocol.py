@@ -12,8 +12,19 @@ import numpy as np
 from md import units as U
 from md.engine.plan import Leg, Stage
 from md.system.topology import System
-from md.workflows.common import (common_define, derived_seed, equilibrate_stage, fresh_from_data, minimize_lines,
-                                 restart_header_lines, round_up, Settings, stage_list, steps_of, thermostat_lines)
+from md.workflows.common import (
+    Settings,
+    common_define,
+    derived_seed,
+    equilibrate_stage,
+    fresh_from_data,
+    minimize_lines,
+    restart_header_lines,
+    round_up,
+    stage_list,
+    steps_of,
+    thermostat_lines,
+)
 
 
 def leg_name(base: str, position: int) -> str:

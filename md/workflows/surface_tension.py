@@ -8,20 +8,33 @@ surface_tension
 """
 from __future__ import annotations
 
-
 import numpy as np
 
 from md import analysis as A
 from md import units as U
 from md.build import water_slab
+from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.atoms import as_system
 from md.system.lammps_data import write_data
-from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
-
 from md.units import SPCE_WATER_MOLAR_MASS
-from md.workflows.common import (common_define, derived_seed, equilibrate_stage, figure_writer, forcefield_of,
-                                 fresh_from_data, minimize_water_lines, quantity_record, restart_header_lines,
-                                 shake_lines, stage_list, steps_of, thermostat_lines, water_forcefield_names, Workflow)
+from md.workflows.common import (
+    Workflow,
+    common_define,
+    derived_seed,
+    equilibrate_stage,
+    figure_writer,
+    forcefield_of,
+    fresh_from_data,
+    minimize_water_lines,
+    quantity_record,
+    restart_header_lines,
+    shake_lines,
+    stage_list,
+    steps_of,
+    thermostat_lines,
+    water_forcefield_names,
+)
+
 
 class SurfaceTension(Workflow):
     """SPC/E film: gamma_lv from the pressure tensor, bulk density from the profile."""
@@ -51,7 +64,8 @@ class SurfaceTension(Workflow):
 
         leg = Leg(name="film", fresh=lambda d: fresh_from_data(ff, data, s, groups), define=define,
                   prepare=lambda d: minimize_water_lines(s), restart_head=restart_header_lines(s),
-                  stages=stage_list(equilibrate_stage(s, "all", 1), Stage("sample", steps_of(s.sample_steps, s.sample_interval))),
+                  stages=stage_list(equilibrate_stage(s, "all", 1),
+                                    Stage("sample", steps_of(s.sample_steps, s.sample_interval))),
                   columns={"pe": "v_pe", "temp": "v_temp", "pxx": "v_pxx", "pyy": "v_pyy", "pzz": "v_pzz",
                            "lz": "v_lz"},
                   sample_interval=s.sample_interval, chunk_steps=s.chunk_steps, n_atoms=n,

@@ -6,7 +6,8 @@ wsl_ti
     solid-water Lennard-Jones pairs switched off through a soft core -- and the solid alone (vacuum above) goes
     through the same charge stage as the reference. On OTS the water-TraPPE dispersion beyond the cutoff is added
     statically from the film leg's framed second half, as on the OTS droplets.
-    W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which derives it), then theta from Young-Dupre, or "wets" with the spreading coefficient when W_SL >= 2 gamma_lv.
+    W_SL A = I_q(reference) - I_q(film) - I_lj(film) (:mod:`md.analysis.free_energy`, which derives it), then theta
+    from Young-Dupre, or "wets" with the spreading coefficient when W_SL >= 2 gamma_lv.
     Why: a droplet's contact line can stay pinned for the whole of a short run, so a droplet cannot say whether the
     surface wets, and its angle depends on its size; W_SL measured directly has neither problem (Leroy &
     Mueller-Plathe, Langmuir 31 (2015) 8335).
@@ -26,12 +27,36 @@ from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
 from md.system.lammps_data import write_data
 from md.system.topology import remove_atoms
-from md.workflows.common import (common_define, derived_seed, figure_writer, forcefield_of, framed_tail_sites,
-                                 fresh_from_data, held_deep, leg_temperatures, minimize_lines, minimize_water_lines,
-                                 quantity_record, restart_header_lines, shake_lines, SILANOL_OH, silica_face_of,
-                                 stage_list, steps_of, substrate_water_seeds, surface_slab, system_summary,
-                                 thermostat_lines, trappe_tail_sites, TRAPPE_UA, water_forcefield_names, WATER_MODELS,
-                                 WATER_SOLID_COLUMNS, water_solid_thermostat_lines, Workflow)
+from md.workflows.common import (
+    SILANOL_OH,
+    TRAPPE_UA,
+    WATER_MODELS,
+    WATER_SOLID_COLUMNS,
+    Workflow,
+    common_define,
+    derived_seed,
+    figure_writer,
+    forcefield_of,
+    framed_tail_sites,
+    fresh_from_data,
+    held_deep,
+    leg_temperatures,
+    minimize_lines,
+    minimize_water_lines,
+    quantity_record,
+    restart_header_lines,
+    shake_lines,
+    silica_face_of,
+    stage_list,
+    steps_of,
+    substrate_water_seeds,
+    surface_slab,
+    system_summary,
+    thermostat_lines,
+    trappe_tail_sites,
+    water_forcefield_names,
+    water_solid_thermostat_lines,
+)
 
 #: gap between the solid's highest atom and the film's lowest one when the film is placed (A)
 FILM_GAP_A = 2.5
@@ -94,7 +119,8 @@ def pppm_lines(settings, box_A) -> list[str]:
 
 
 class WslTI(Workflow):
-    """W_SL of water on silica or OTS by decoupling a film (charges, then soft-core LJ) minus the solid-alone charge stage.
+    """W_SL of water on silica or OTS by decoupling a film (charges, then soft-core LJ) minus the solid-alone charge
+    stage.
 
     Legs: *substrate* (the slab minimised with nothing held, then deep Si and bridging O held, equilibrated);
     *film* (the water film added on the substrate's last state, minimised, equilibrated at full coupling; on OTS
@@ -102,7 +128,8 @@ class WslTI(Workflow):
     *q0..* (the solid's charges at each Gauss-Legendre node, 1 -> 0, each leg continuing from the last);
     *lj0..* (solid charges 0, solid-water LJ lambda at each node, 1 -> 0); *ref_q0..* (the solid alone, the charge
     nodes again, each starting from the state its film node starts from with the water deleted). Every node
-    equilibrates ``ti_equilibrate_steps`` and samples ``ti_sample_steps``; dU/dlambda is sampled every ``sample_interval`` steps by two ``compute fep``.
+    equilibrates ``ti_equilibrate_steps`` and samples ``ti_sample_steps``; dU/dlambda is sampled every
+    ``sample_interval`` steps by two ``compute fep``.
 
     With the water present, the water and the solid's mobile atoms have a thermostat each
     (:func:`md.workflows.common.split_thermostat_lines`), and both temperatures are sampled and reported: at the
@@ -125,7 +152,8 @@ class WslTI(Workflow):
     def build(self, s):
         s = self.typed(s)
         seed = int(s.seed)
-        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed, silica_face_of((s.surface,), s.silica_face))
+        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed,
+                           silica_face_of((s.surface,), s.silica_face))
         wff = forcefield_of(water_forcefield_names(s.water_model))
         film = as_system(water_slab(float(sub.cell[0]), float(sub.cell[1]), float(s.film_thickness_A),
                                     vacuum=2.0, seed=seed + 1, forcefield=wff))
@@ -259,7 +287,8 @@ class _WslAnalysis:
                  "dewets": "180 = W_SL <= 0 (mark, not a measurement)"}
         q = {"work_of_adhesion_sl": quantity_record(
                 w["value"], w["stderr"], "J/m^2", kind="thermodynamic integration: film decoupled from the solid "
-                "(charges, then soft-core LJ) minus the solid-alone charge stage", discretisation_error=w["discretisation_error"]),
+                "(charges, then soft-core LJ) minus the solid-alone charge stage",
+                discretisation_error=w["discretisation_error"]),
              "contact_angle": quantity_record(ang["theta_deg"], self.th_stat, "deg",
                                               status=ang["status"], kind=kinds[ang["status"]],
                                               discretisation_error=self.th_disc,
@@ -272,12 +301,14 @@ class _WslAnalysis:
                  "density above it (md.analysis.dispersion_tail_work); included in work_of_adhesion_sl")}
                 if tail is not None else {}),
              "surface_tension_lv": quantity_record(gamma, None, "N/m",
-                                                   kind=f"the water model's published gamma_lv ({model['gamma_source']})")}
+                                                   kind="the water model's published gamma_lv "
+                                                        f"({model['gamma_source']})")}
         if ang["status"] == "wets":
             # W_SL - 2 sigma (statistical and quadrature together): the largest angle the run does not exclude
             bound = A.angle_from_work_of_adhesion_sl(w["value"] - 2.0 * self.w_err, 0.0, gamma)["theta_deg"]
             q["contact_angle_upper_bound"] = quantity_record(bound, None, "deg", kind="wets: theta below this "
-                                                             "bound (Young-Dupre at W_SL - 2 stderr, quadrature included)")
+                                                             "bound (Young-Dupre at W_SL - 2 stderr, "
+                                                             "quadrature included)")
         if ang["status"] == "measured":
             wl = A.work_of_adhesion_sl(gamma, ang["theta_deg"], None, ang["stderr_deg"])
             q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], wl["gamma_cos_theta_stderr"], "N/m",
@@ -291,8 +322,8 @@ class _WslAnalysis:
         return [f"window length: W_SL from the first halves of the nodes' samples {w_half[0] * 1e3:.1f}, from the "
                 f"second halves {w_half[1] * 1e3:.1f} mJ/m^2 (difference {(w_half[1] - w_half[0]) * 1e3:+.1f}, 2 sigma "
                 f"= {2 * half_sigma * 1e3:.1f}): " + ("consistent, the nodes are long enough for their decorrelation."
-                                                     if self.half_ok else "NOT consistent: the nodes still relax; longer "
-                                                     "nodes are needed."),
+                                                     if self.half_ok else "NOT consistent: the nodes still relax; "
+                                                     "longer nodes are needed."),
                 f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
                 f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
                 f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
