@@ -69,6 +69,9 @@ def overrides(sigma, release, work, modulus, max_bounces=3):
     return {"surfaces.roughness.sigma": sigma, "release_height": release,
             "surfaces.work_of_adhesion": work, "surfaces.roughness.summit_modulus": modulus,
             "physics.adhesion_law": "jkr" if work > 0 else "none", "physics.half_space": "off",
+            # the elastic JKR mean field is what this grid sweeps; the sets now give a hardness, and plastic summits
+            # (tests/continuum/test_plastic_summits.py, test_plastic_branches.py) would switch on at stiff points
+            "physics.plasticity": "off",
             "surfaces.roughness.mode": "mean_field",
             "numerics.fidelity": "standard", "numerics.max_bounces": max_bounces, "numerics.max_time": 1.0}
 
