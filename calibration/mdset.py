@@ -3,7 +3,7 @@
 Which MD quantity feeds which scene key (`MAPPING`), SI in and out; the only conversion is none:
 scene files take contact angles in degrees, as the MD results give them. Everything the MD does
 not measure (moduli, roughness statistics, SAM thickness) comes from a named base set, with the base set's
-origin ([meta.origin], continuum.model.origins); an MD value's origin is `md` with its run hash. A choice of the
+origin ([meta.origin], continuum.origins); an MD value's origin is `md` with its run hash. A choice of the
 base set that the project can replace by a measured or derived value (`REPLACED_CHOICES`: the summit modulus
 becomes the materials' E*, the adhesion law the Tabor parameter's pick, the paper's additive wet adhesion the
 wet work of adhesion) is left out of the calibrated set.
@@ -68,7 +68,7 @@ from calibration.sam_layer import (
     young_with_nu,
 )
 from calibration.validation import VALIDATION, pulloff_validation
-from continuum.model.origins import check_origins
+from continuum.origins import check_origins
 from continuum.scene import SceneError, check_value, find_params, flatten
 from continuum.schema import FIELD_BY_PATH
 from nanoimpact import data
@@ -395,7 +395,7 @@ def build_parameter_set(results: dict[str, dict], base: str, name: str, *, descr
     """The set as a TOML-ready dict and one row per mapped key (used / rejected / missing).
 
     `results` maps recipe name -> MD result.json dict. `base` is a parameter-set name or file. Every value of the
-    set carries its origin ([meta.origin], continuum.model.origins): `md` with the run hash for a value used here, the
+    set carries its origin ([meta.origin], continuum.origins): `md` with the run hash for a value used here, the
     base set's own origin for a value kept from it; the base's choices in :data:`REPLACED_CHOICES` are left out
     ([meta.replaced] says which and what replaces them).
     """

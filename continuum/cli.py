@@ -37,8 +37,8 @@ def bounce_table(bounces: list[dict]) -> str:
 
 def check_params_set(spec: str) -> Path:
     """A parameter set (name or file) that exists, parses, whose every value passes the scene checks and has an
-    origin ([meta.origin], continuum.model.origins)."""
-    from continuum.model.origins import check_origins
+    origin ([meta.origin], continuum.origins)."""
+    from continuum.origins import check_origins
     from continuum.scene import FIELD_BY_PATH, check_value, find_params, flatten, read_toml
 
     path = find_params(spec)

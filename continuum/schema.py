@@ -410,7 +410,7 @@ def json_schema() -> dict:
                                          "Required keys may come from the scene's parameter set, so none is "
                                          "required here; the loader checks the merged scene. See docs/scenes.md.")
     doc["properties"]["meta"] = {"type": "object", "description": "Parameter sets: description, provenance, and "
-                                 "[meta.origin], each value's origin (continuum.model.origins)."}
+                                 "[meta.origin], each value's origin (continuum.origins)."}
     return doc
 
 

@@ -366,7 +366,7 @@ def realisation_decision(scene: Scene, regime: Regime) -> RealisationDecision:
 class PlasticityDecision:
     """Whether a smooth sphere (or the summits of rough contact, `summit_plasticity`) runs the Thornton-Ning adhesive
     elastic-plastic law, and the numbers that decided it: the softer partner's limiting contact pressure (Pa,
-    `continuum.model.limiting_pressure`) and the yield velocity (m/s,
+    `continuum.physics.limiting_pressure`) and the yield velocity (m/s,
     `continuum.reference.thornton_ning.yield_velocity`) against the first impact's speed (m/s), or the summits'
     plasticity index."""
 
@@ -378,7 +378,7 @@ class PlasticityDecision:
     yield_velocity: float | None = None
     impact_speed: float | None = None
     partners: tuple = ()
-    """Each partner with a yield key: `continuum.model.limiting_pressure.PartnerLimit`."""
+    """Each partner with a yield key: `continuum.physics.limiting_pressure.PartnerLimit`."""
     plasticity_index: float | None = None
     """Rough contact: the summits' Greenwood-Williamson psi = (E*/p_y) sqrt(sigma/beta) (`summit_plasticity`)."""
     summits_yield: bool | None = None
@@ -450,7 +450,7 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
     ('on' and 'auto' decide alike for rough contact; 'off' is handled by `plasticity_decision`).
     A p_y below the summits' adhesive stress scale (they would yield on snap-in, outside Thornton-Ning) is refused
     naming its key."""
-    from .limiting_pressure import partner_limits, softer_partner
+    from ..physics.limiting_pressure import partner_limits, softer_partner
 
     limits = tuple(partner_limits(_yield_values(scene)))
     soft = softer_partner(list(limits))
@@ -513,7 +513,7 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
     contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
     `depth`, m)."""
     from ..reference import thornton_ning as tn
-    from .limiting_pressure import partner_limits, softer_partner
+    from ..physics.limiting_pressure import partner_limits, softer_partner
 
     choice = scene.physics.plasticity
     if choice == "off":

@@ -4,7 +4,7 @@ What it is
 ----------
 A summit is a sphere of tip radius beta with the summits' contact modulus E* and the pair's work of adhesion w,
 pressed by its approach delta against a flat (displacement control, as under a roller or a punch). Above its
-limiting contact pressure p_y (`continuum.model.limiting_pressure`) it follows the Thornton-Ning adhesive
+limiting contact pressure p_y (`continuum.physics.limiting_pressure`) it follows the Thornton-Ning adhesive
 elastic-plastic law of `continuum.reference.thornton_ning` (the same law as the smooth sphere's
 `continuum.laws.plastic_sphere`):
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from continuum.model.origins import ORIGIN_KINDS, OriginError, check_origins
+from continuum.origins import ORIGIN_KINDS, OriginError, check_origins
 from continuum.scene import flatten, resolve_scene
 
 ROOT = Path(__file__).resolve().parents[2]
