@@ -20,8 +20,8 @@ from nanoimpact import data
 from nanoimpact.errors import DataNotFound, InputError
 from nanoimpact.fields import Resolved, frozen_dataclass, resolved, section_members
 
-from .physics.limiting_pressure import check_sphere_limits, partner_limits
 from .origins import check_origins
+from .physics.limiting_pressure import check_sphere_limits, partner_limits
 from .reference.hertz import effective_modulus
 from .rough.surface_map import map_statistics, statistics_block
 from .rough.topography import KEY_FILE, KEY_SYNTH, TopographyError
@@ -441,7 +441,8 @@ def _check_law(si: dict, sam, origin: str) -> None:
 
 def _check_plasticity(si: dict, sam, origin: str) -> None:
     """The yield keys give a limiting contact pressure between the sphere's adhesive stress scale and E*
-    (`continuum.physics.limiting_pressure`); physics.plasticity = 'on' needs an adhesive smooth sphere and a yield key."""
+    (`continuum.physics.limiting_pressure`); physics.plasticity = 'on' needs an adhesive smooth sphere and a yield
+    key."""
     choice = si["physics.plasticity"]
     if choice == "off":
         return

@@ -205,7 +205,7 @@ def test_every_scene_key_lands_in_a_scene_dataclass():
                 homes.setdefault(f.metadata["key"], []).append(f"{cls.__name__}.{f.name}")
     declared = {f.path for f in SCENE_FIELDS}
     # Material holds the body's keys; the substrate's same-named keys land in the same attributes
-    for key in ("youngs_modulus", "poisson_ratio", "contact_angle"):
+    for key in ("youngs_modulus", "poisson_ratio", "contact_angle", "work_of_adhesion_sl"):
         homes[f"surfaces.substrate.{key}"] = [f"Material.{key}"]
     assert set(homes) <= declared, set(homes) - declared
     missing = declared - set(homes) - set(scene.FOLDED_KEYS)

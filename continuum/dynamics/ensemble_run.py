@@ -9,7 +9,7 @@ The decisions that do not depend on the realisation (adhesion law, half-space, t
 adhesion, the footprint strip) are made once, from the scene's regime, exactly as a single discrete run makes
 them (`continuum.model.select`); each member then only draws its summits (`continuum.laws.discrete_roller`, a few
 ms) and runs the event-driven driver (on a rigid substrate each contact runs in the compiled kernel,
-`continuum.numerics.contact_kernel.LAW_DISCRETE`). A run ends where the driver ends it: a member held by adhesion stops
+`continuum.numerics.kernel_laws.LAW_DISCRETE`). A run ends where the driver ends it: a member held by adhesion stops
 at 'stuck'. Members go to `nanoimpact.executors` (local, processes, dask): jobs are module-level and picklable.
 
 Every member is an independent realisation of the whole strip under the roller: a Poisson number of summits at

@@ -39,7 +39,7 @@ at delta = -Delta there): `on_release` books the loops of those still attached.
 Compiled form (rigid substrate only): on a rigid substrate the history rule leaves attached exactly a prefix of
 the summits sorted by effective height (those reached, e_i - z_top >= h_min, that have not let go, e_i - z_top
 >= gap - Delta), so the deepest accepted gap h_min is the whole history and a contact runs in the compiled
-kernel (`continuum.numerics.contact_kernel.LAW_DISCRETE`, the same per-summit closed forms), ~100x faster than the
+kernel (`continuum.numerics.kernel_laws.LAW_DISCRETE`, the same per-summit closed forms), ~100x faster than the
 Python stepper; a state below the kept summits hands the contact back to the Python stepper, which keeps more.
 
 Cost: each force evaluation touches only the prefix of the summits sorted by effective height
@@ -517,9 +517,9 @@ class DiscreteRoughRoller(RoughRollerBase):
             self.max_pressure = max(self.max_pressure, float(np.max(p)))
 
     def compiled(self, t0: float):
-        """The kept summits as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_DISCRETE`); None
+        """The kept summits as the compiled kernel reads them (`continuum.numerics.kernel_laws.LAW_DISCRETE`); None
         with the half-space on (its coupled fixed point runs in Python)."""
-        from ..numerics import contact_kernel as ck
+        from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import EMPTY_TABLES, CompiledLaw
 
         if self.use_half_space:
@@ -527,35 +527,35 @@ class DiscreteRoughRoller(RoughRollerBase):
         if self.slaw is not None:
             return self._compiled_branches()
         if self._compiled_for is not self.eff:
-            P = np.zeros(ck.DISCRETE_PARAMS)
-            P[ck.P_D_END_GAP], P[ck.P_D_RELEASE], P[ck.P_D_LOOP] = self.end_gap, self.release_stretch, self.loop_energy
-            P[ck.P_D_HERTZ_K], P[ck.P_D_ADHESIVE] = self._hertz_k, 1.0 if self.adhesive else 0.0
+            P = np.zeros(kl.DISCRETE_PARAMS)
+            P[kl.P_D_END_GAP], P[kl.P_D_RELEASE], P[kl.P_D_LOOP] = self.end_gap, self.release_stretch, self.loop_energy
+            P[kl.P_D_HERTZ_K], P[kl.P_D_ADHESIVE] = self._hertz_k, 1.0 if self.adhesive else 0.0
             if self.adhesive:
-                P[ck.P_D_INV_DELTA0], P[ck.P_D_PSCALE] = self._inv_delta0, self._pscale
-                P[ck.P_D_ESCALE] = self._pscale * self._delta0
-            P[ck.P_D_LOWEST] = -self.depth_keep
+                P[kl.P_D_INV_DELTA0], P[kl.P_D_PSCALE] = self._inv_delta0, self._pscale
+                P[kl.P_D_ESCALE] = self._pscale * self._delta0
+            P[kl.P_D_LOWEST] = -self.depth_keep
             self._compiled_tables = (P, (np.ascontiguousarray(self.eff - self.z_top),) + EMPTY_TABLES[1:])
             self._compiled_for = self.eff
         P, T = self._compiled_tables
-        return CompiledLaw(ck.LAW_DISCRETE, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+        return CompiledLaw(kl.LAW_DISCRETE, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def _compiled_branches(self):
-        """`continuum.numerics.contact_kernel.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two
+        """`continuum.numerics.kernel_laws.LAW_DISCRETE_BRANCH`: the kept summits and the summit law's two
         branches."""
-        from ..numerics import contact_kernel as ck
+        from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import EMPTY_TABLES, CompiledLaw
 
         if self._compiled_for is not self.eff:
-            P = np.zeros(ck.BRANCH_PARAMS)
-            P[ck.P_B_END_GAP], P[ck.P_B_IN], P[ck.P_B_OUT] = self.end_gap, self._delta_in, -self.release_stretch
-            P[ck.P_B_REACH], P[ck.P_B_LOOP], P[ck.P_B_LOWEST] = self._reach, self.loop_energy, -self.depth_keep
+            P = np.zeros(kl.BRANCH_PARAMS)
+            P[kl.P_B_END_GAP], P[kl.P_B_IN], P[kl.P_B_OUT] = self.end_gap, self._delta_in, -self.release_stretch
+            P[kl.P_B_REACH], P[kl.P_B_LOOP], P[kl.P_B_LOWEST] = self._reach, self.loop_energy, -self.depth_keep
             a, r = self.slaw.approach, self.slaw.retreat
             tables = tuple(np.ascontiguousarray(x, float) for x in
                            (self.eff - self.z_top, a.delta, a.force, a.energy, r.delta, r.force, r.energy))
             self._compiled_tables = (P, tables + EMPTY_TABLES[7:])
             self._compiled_for = self.eff
         P, T = self._compiled_tables
-        return CompiledLaw(ck.LAW_DISCRETE_BRANCH, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+        return CompiledLaw(kl.LAW_DISCRETE_BRANCH, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def compiled_commit(self, state, last_accept: float) -> None:
         """Take back a compiled contact: the summits reached at its deepest gap h_min are the history (the detach

@@ -244,12 +244,12 @@ class PlasticSummitsPunch(ContactLaw):
         `PlasticBranchSummitLaw`; None for the closed-form JKR law (the Python stepper runs it)."""
         if not self.law.compiled_form:
             return None
-        from ..numerics import contact_kernel as ck
+        from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import CompiledLaw
         from ..rough.plastic_kernel import compiled_tables
         P, T = compiled_tables(self.law, self.heights - self.z_top, self.delta_max, self.release_gap(),
                                self.law.max_stretch, self._lowest)
-        return CompiledLaw(ck.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+        return CompiledLaw(kl.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def compiled_commit(self, state, last_accept: float) -> None:
         """Take back a compiled contact: its deepest gap h_min fixes which summits jumped in and how deep each went

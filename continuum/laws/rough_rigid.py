@@ -314,8 +314,8 @@ class RigidRoughRoller(RoughRollerBase):
 
     # ------------------------------------------------------------------ compiled form
     def compiled(self, t0: float):
-        """The tables as the compiled kernel reads them (`continuum.numerics.contact_kernel.LAW_RIGID_TABLE`)."""
-        from ..numerics import contact_kernel as ck
+        """The tables as the compiled kernel reads them (`continuum.numerics.kernel_laws.LAW_RIGID_TABLE`)."""
+        from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import CompiledLaw
 
         # the splines these arrays came from are kept with them (an identity test on live objects)
@@ -324,15 +324,15 @@ class RigidRoughRoller(RoughRollerBase):
             if self._force.degrees != (3, 3) or self._energy.degrees != (3, 3):
                 raise ValueError("the compiled footprint law evaluates bicubic tables only")
             P = np.zeros(7)
-            P[ck.P_END_GAP], P[ck.P_REACH], P[ck.P_ATTACH] = self.end_gap, self.reach, self.attach_stretch
-            P[ck.P_RELEASE], P[ck.P_R_IN], P[ck.P_H_LO] = self.release_stretch, self._r_in, self._h_lo
-            P[ck.P_LOOP] = float(self.surface.loop_energy)
+            P[kl.P_END_GAP], P[kl.P_REACH], P[kl.P_ATTACH] = self.end_gap, self.reach, self.attach_stretch
+            P[kl.P_RELEASE], P[kl.P_R_IN], P[kl.P_H_LO] = self.release_stretch, self._r_in, self._h_lo
+            P[kl.P_LOOP] = float(self.surface.loop_energy)
             tables = tuple(np.ascontiguousarray(a, float) for a in (ftx, fty, fc, etx, ety, ec, self._count.x))
             self._compiled_tables = (P, tables + (np.ascontiguousarray(self._count.c, float),))
             self._compiled_for = (self._force, self._energy, self._count)
         P, T = self._compiled_tables
         S = np.array([self.h_min, self.count_min, self.max_contacts, float(self.beyond_tables), 0.0])
-        return CompiledLaw(ck.LAW_RIGID_TABLE, P, T, S)
+        return CompiledLaw(kl.LAW_RIGID_TABLE, P, T, S)
 
     def compiled_commit(self, state, last_accept: float) -> None:
         self.h_min, self.count_min, self.max_contacts = float(state[0]), float(state[1]), float(state[2])

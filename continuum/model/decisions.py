@@ -512,8 +512,8 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
     `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key. Rough
     contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
     `depth`, m)."""
-    from ..reference import thornton_ning as tn
     from ..physics.limiting_pressure import partner_limits, softer_partner
+    from ..reference import thornton_ning as tn
 
     choice = scene.physics.plasticity
     if choice == "off":

@@ -151,3 +151,17 @@ def wet_summit_roller(elastic: ContactLaw, wet: ContactLaw, parameters: dict) ->
     adhesion) and outside it `elastic` (`continuum.laws.wet_summits`)."""
     from ..laws.wet_summits import wet_summit_roller as build
     return build(elastic, wet, parameters)
+
+
+def wet_roller_with_condensation_time(wet: ContactLaw, t_a: float) -> ContactLaw | None:
+    """The averaged wet roller `wet` with its bridges' condensation time set to `t_a` (s): a copy sharing the dry
+    law's tables (`continuum.laws.wet.WetRoughRoller`); None where `wet` is another law."""
+    import copy
+
+    from ..laws.wet import WetRoughRoller
+    if not isinstance(wet, WetRoughRoller):
+        return None
+    bridges = copy.copy(wet.bridges)
+    bridges.t_a = t_a
+    bridges.reset()
+    return WetRoughRoller(wet.dry, bridges, dict(wet.record, condensation_time=t_a))

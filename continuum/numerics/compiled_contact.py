@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import contact_kernel as ck
+from . import kernel_laws as kl
 
 log = logging.getLogger(__name__)
 
@@ -32,7 +33,7 @@ END_NAMES = {ck.END_RELEASE: None, ck.END_STUCK: "stuck", ck.END_REST: "rest", c
 
 @dataclass
 class CompiledLaw:
-    """A law's compiled form: `kind` (contact_kernel.LAW_*), parameters P, tables T (a tuple of 8 arrays) and
+    """A law's compiled form: `kind` (kernel_laws.LAW_*), parameters P, tables T (a tuple of 8 arrays) and
     history S (float arrays, SI); the kernel updates a copy of S, committed back to the law on success."""
 
     kind: int
@@ -123,7 +124,7 @@ def run_compiled(law_c: CompiledLaw, mass: float, gravity: float, t0: float, gap
 
 def power_law(k: float, n: float) -> CompiledLaw:
     """F = k (-h)^n for h < 0 (N; k in N/m^n), no history: Hertz sphere (n = 3/2, k = 4/3 E* sqrt(R)) for tests."""
-    return CompiledLaw(ck.LAW_POWER, np.array([k, n]), EMPTY_TABLES, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+    return CompiledLaw(kl.LAW_POWER, np.array([k, n]), EMPTY_TABLES, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
 
 def warm_up() -> None:

@@ -16,13 +16,12 @@ duration, ``sampled_claims.RUN_RTOL``).
 """
 from __future__ import annotations
 
-import copy
 import math
 from typing import Callable
 
 import numpy as np
 
-from ..laws.wet import WetRoughRoller
+from ..model import factory
 
 #: The outermost part of the t_a band (as a fraction of its width) left out of Fig 8a's t_a claim: there dry
 #: impacts outlast t_a by a vanishing time, and no finite bridge force captures an impact that ends an instant
@@ -43,12 +42,8 @@ HOLDS, FAILS, NO_SUBJECT, REFUSED, BEYOND_SCAN = "holds", "fails", "no_subject",
 def at_condensation_time(wet, t_a: float, rebuild: Callable[[float], object]):
     """The wet law `wet` with its condensation time set to `t_a`: a copy sharing the dry law's tables where it is
     the averaged wet roller, else `rebuild(t_a)` (the law selected again from the scene)."""
-    if not isinstance(wet, WetRoughRoller):
-        return rebuild(t_a)
-    bridges = copy.copy(wet.bridges)
-    bridges.t_a = t_a
-    bridges.reset()
-    return WetRoughRoller(wet.dry, bridges, dict(wet.record, condensation_time=t_a))
+    law = factory.wet_roller_with_condensation_time(wet, t_a)
+    return rebuild(t_a) if law is None else law
 
 
 def t_a_flips(state_at: Callable[[float], tuple[str, dict]], t_a: float, upper: float | None) -> dict:

@@ -1,5 +1,5 @@
 """Compiled form of discrete adhesive elastic-plastic summits (`continuum.rough.plastic_branches` under a rigid flat
-or roller, `continuum.laws.plastic_rough.PlasticSummitsPunch`): `continuum.numerics.contact_kernel.LAW_PLASTIC`.
+or roller, `continuum.laws.plastic_rough.PlasticSummitsPunch`): `continuum.numerics.kernel_laws.LAW_PLASTIC`.
 
 Within one contact (one approach, one retreat: the law's `bound_is_final`) a summit's state is fixed by its state
 before the contact (deepest approach dm0, hence R_p0, delta_p0) and the deepest gap of this contact, h_min

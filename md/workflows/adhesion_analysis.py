@@ -4,7 +4,7 @@ reports), the SAM layer's moduli and Poisson ratio, the window checks, notes, cu
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -14,10 +14,7 @@ from md.build.sam import chain_geometry
 from md.engine.plan import Analysis
 from md.workflows import adhesion_protocol as P
 from md.workflows.adhesion_legs import MIN_WINDOW_NEFF, SAM_STRESS_COLUMNS, TAIL_R_MAX_A
-from md.workflows.common import ENERGY_NOT_FREE_ENERGY, figure_writer, quantity_record
-
-if TYPE_CHECKING:                      # the workflow class imports this module
-    from md.workflows.adhesion import Adhesion
+from md.workflows.common import ENERGY_NOT_FREE_ENERGY, Workflow, figure_writer, quantity_record
 
 
 class _AdhesionAnalysis:
@@ -26,7 +23,7 @@ class _AdhesionAnalysis:
     study), :meth:`_single_window` for every window of every registry, :meth:`_conclude` (registry average, force
     integration, z0 and sigma0, the window checks, notes, curves and figures)."""
 
-    def __init__(self, wf: Adhesion, ctx):
+    def __init__(self, wf: Workflow, ctx):
         self.wf, self.ctx, self.s, self.info = wf, ctx, wf.typed(ctx.settings), ctx.plan.system_info
 
     def run(self) -> Analysis:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +20,7 @@ from md.workflows.adhesion_registries import degenerate_registries, primitive_of
 from md.workflows.common import (
     TRAPPE_UA,
     Settings,
+    Workflow,
     common_define,
     derived_seed,
     equilibrate_stage,
@@ -37,9 +37,6 @@ from md.workflows.common import (
     system_summary,
     thermostat_lines,
 )
-
-if TYPE_CHECKING:                      # the workflow class imports this module
-    from md.workflows.adhesion import Adhesion
 
 #: the upper slab's back as one rigid body, free along z only (fix aveforce would give equal forces, not equal
 #: accelerations, to atoms of different mass and tear the group apart)
@@ -66,7 +63,7 @@ class _AdhesionLegs:
     :meth:`contact` (upper back one rigid body, free along z at zero load), :meth:`separated` (both backs held,
     ``separation_A`` apart) and, for the free energy, :meth:`windows` (chains of force windows per registry)."""
 
-    def __init__(self, wf: Adhesion, s, run_dir: Path):
+    def __init__(self, wf: Workflow, s, run_dir: Path):
         self.wf, self.s, self.run_dir = wf, s, run_dir
         self.ff = forcefield_of(wf.forcefield_files(s))
         lower_kind, upper_kind = s.surfaces

@@ -25,7 +25,7 @@ from continuum.dynamics.driver import DriverSettings, simulate
 from continuum.dynamics.escape import escape_velocity, single_impact
 from continuum.dynamics.impact import first_impact_speed
 from continuum.model import select_law
-from continuum.numerics import contact_kernel as ck
+from continuum.numerics import kernel_laws as kl
 from continuum.numerics.compiled_contact import power_law, run_compiled
 from continuum.reference import hertz as ref
 from continuum.scene import resolve_scene
@@ -97,11 +97,11 @@ def test_bicubic_and_ppoly_match_scipy():
     tx, ty, c = spline.tck
     xs, ys = rng.uniform(x[0], x[-1], 300), rng.uniform(0, 1, 300)
     xs[:len(x)] = x                                            # on the knots too
-    got = np.array([ck.bicubic(tx, ty, c, a, b) for a, b in zip(xs, ys)])
+    got = np.array([kl.bicubic(tx, ty, c, a, b) for a, b in zip(xs, ys)])
     assert np.max(np.abs(got - spline.ev(xs, ys))) < 1e-12 * np.max(np.abs(z))
     cs = CubicSpline(x, z[:, 0])
     pts = np.concatenate([rng.uniform(x[0] - 0.1, x[-1] + 0.1, 200), x])
-    got = np.array([ck.ppoly3(cs.x, cs.c, a) for a in pts])
+    got = np.array([kl.ppoly3(cs.x, cs.c, a) for a in pts])
     assert np.max(np.abs(got - cs(pts))) < 1e-12 * np.max(np.abs(z))
 
 

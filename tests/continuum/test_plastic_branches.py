@@ -171,7 +171,7 @@ def test_calibrated_rough_silica_members_run_plastic_maugis_dugdale_summits_and_
     path = Path(__file__).resolve().parents[2] / "inputs" / "scenes" / "rough_silica.toml"
     scene = resolve_scene(path, params="calibrated").scene
     plan = member_plan(scene, first_impact_speed(scene))
-    _, law, _ = member_law(scene, 3, plan)
+    _, law = member_law(scene, 3, plan)
     assert law.name == "rough_roller_discrete_plastic"
     assert isinstance(law.law, PlasticBranchSummitLaw) and law.law.name == "maugis_dugdale"
     off = resolve_scene(path, params="calibrated", overrides={"physics.plasticity": "off"}).scene

@@ -334,5 +334,5 @@ def test_ensemble_members_take_the_scenes_summit_plasticity(hardness, name):
                              overrides={"surfaces.substrate.hardness": hardness, "physics.half_space": "off"})
     scene = resolved.scene
     plan = member_plan(scene, first_impact_speed(scene))
-    _, law, _ = member_law(scene, 3, plan)
+    _, law = member_law(scene, 3, plan)
     assert law.name == name
