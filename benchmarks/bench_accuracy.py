@@ -60,7 +60,13 @@ from continuum.rough.bem_convergence import (  # noqa: E402
 from continuum.rough.bem_impact import STANDARD_G, impact_at_energy, impact_outcome  # noqa: E402
 from continuum.rough.bem_reference import bem_cycle, dugdale_range  # noqa: E402
 from continuum.rough.branch_laws import make_summit_law  # noqa: E402
-from continuum.rough.cutoff_match import CUTOFF_PIXELS, discrete_loss, match_cutoff, reference_estimate  # noqa: E402
+from continuum.rough.cutoff_match import (  # noqa: E402
+    CUTOFF_PIXELS,
+    discrete_loss,
+    fourier_resample,  # noqa: E402
+    match_cutoff,
+    reference_estimate,
+)
 from continuum.rough.gw_branches import GWBranchSurface  # noqa: E402
 from continuum.rough.quasistatic import discrete_cycle, gw_cycle, separation_path  # noqa: E402
 from continuum.rough.summit_stats import direct_summary, spectral_summits  # noqa: E402
@@ -116,23 +122,10 @@ def patch(args) -> tuple[dict, dict]:
         if n >= base.shape[0]:
             grids[n] = np.asarray(periodic.interpolate_fourier((n, n)).heights()) if n > base.shape[0] else base
         else:
-            grids[n] = _truncate(base, n)
+            grids[n] = fourier_resample(base, n)   # Fourier truncation: exact for the band-limited patch
     return grids, {"source": source, "size_m": float(topo.physical_sizes[0]), "cutoff_m": float(cutoff),
                    "base_grid": list(base.shape), "rms_height_m": float(np.std(grids[n_ref])),
                    "reference_grid": n_ref, "periodic_topography": periodic}
-
-
-def _truncate(heights: np.ndarray, n: int) -> np.ndarray:
-    """A periodic map band-limited below the new grid's Nyquist wavelength, sampled on n x n points (Fourier
-    truncation: exact for such a map)."""
-    m = heights.shape[0]
-    spec = np.fft.fft2(heights)
-    k = np.fft.fftfreq(m, 1.0 / m)
-    keep = np.abs(k) < n / 2
-    kk = k[keep].astype(int) % n
-    out = np.zeros((n, n), complex)
-    out[np.ix_(kk, kk)] = spec[np.ix_(keep, keep)]
-    return np.real(np.fft.ifft2(out)) * (n * n) / (m * m)
 
 
 def summit_sets(h: np.ndarray, desc: dict) -> dict:

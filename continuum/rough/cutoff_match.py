@@ -170,7 +170,7 @@ def cache_dir(root: str | Path | None = None) -> Path:
     return (Path(env).expanduser() if env else Path("~/.cache/nanoimpact").expanduser()) / "bem"
 
 
-def _fourier_resample(heights: np.ndarray, n: int) -> np.ndarray:
+def fourier_resample(heights: np.ndarray, n: int) -> np.ndarray:
     """A periodic map on n x n points by zero-padding or truncating its spectrum (exact when band-limited below
     both grids' Nyquist wavelengths)."""
     m = heights.shape[0]
@@ -216,7 +216,7 @@ def measured_cutoff(heights, size: float, e_star: float, work_of_adhesion: float
     path = separation_path(float(h.max()) + 2 * rho, deepest, rho / 8)
     runs = []
     for n in grids:
-        cyc, stats = bem_cycle(_fourier_resample(h, n), size, e_star, work_of_adhesion, z0, path)
+        cyc, stats = bem_cycle(fourier_resample(h, n), size, e_star, work_of_adhesion, z0, path)
         runs.append(GridRun(n, size / n, cyc.pull_off_force, cyc.hysteresis_energy, stats.seconds, stats.unconverged))
         log.info("summit cutoff from the BEM: grid %d^2, loss %.4g J, %.1f s", n, cyc.hysteresis_energy, stats.seconds)
     record = convergence(runs, cohesive_zone_length(e_star, work_of_adhesion, z0), size)
