@@ -78,6 +78,23 @@ def _repulsive_branch(d: np.ndarray, f: np.ndarray) -> np.ndarray:
     return np.arange(end)
 
 
+def _sorted_branch(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA, area_A2, thickness_A):
+    """(d, f, e sorted by separation, area, thickness, indices of the repulsive branch): the inputs both modulus
+    fits check the same way."""
+    d = np.asarray(separation_A, float).ravel()
+    f = np.asarray(mean_force_kcal_per_molA, float).ravel()
+    e = np.asarray(force_stderr_kcal_per_molA, float).ravel()
+    if not (d.shape == f.shape == e.shape):
+        raise ValueError("separation, mean force and stderr must be 1-D arrays of equal length")
+    area, t = float(area_A2), float(thickness_A)
+    if not (area > 0 and t > 0):
+        raise ValueError(f"area_A2 ({area_A2}) and thickness_A ({thickness_A}) must be positive")
+    order = np.argsort(d)
+    d, f, e = d[order], f[order], e[order]
+    sel = _repulsive_branch(d, f)
+    return d, f, e, area, t, sel
+
+
 def confined_layer_modulus(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA, area_A2: float,
                            thickness_A: float) -> dict:
     """Confined modulus M (Pa) of the layers between two held flat slabs from the compression branch of their
@@ -92,17 +109,8 @@ def confined_layer_modulus(separation_A, mean_force_kcal_per_molA, force_stderr_
     MIN_WINDOWS_CHECKED windows are repulsive: a line through two points has no check of its linearity). Fewer
     than two repulsive windows, or a slope that is not a stiffening (force not rising with compression):
     ValueError."""
-    d = np.asarray(separation_A, float).ravel()
-    f = np.asarray(mean_force_kcal_per_molA, float).ravel()
-    e = np.asarray(force_stderr_kcal_per_molA, float).ravel()
-    if not (d.shape == f.shape == e.shape):
-        raise ValueError("separation, mean force and stderr must be 1-D arrays of equal length")
-    area, t = float(area_A2), float(thickness_A)
-    if not (area > 0 and t > 0):
-        raise ValueError(f"area_A2 ({area_A2}) and thickness_A ({thickness_A}) must be positive")
-    order = np.argsort(d)
-    d, f, e = d[order], f[order], e[order]
-    sel = _repulsive_branch(d, f)
+    d, f, e, area, t, sel = _sorted_branch(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA,
+                                           area_A2, thickness_A)
     if sel.size < 2:
         raise ValueError(f"{sel.size} repulsive window(s) below the zero crossing: a modulus needs at least two "
                          "(add windows pressed into the contact)")
@@ -155,17 +163,8 @@ def tangent_confined_modulus(separation_A, mean_force_kcal_per_molA, force_stder
     curvature significant at 95 %, one degree of freedom) and ``strain_max`` from d0. Needs four repulsive windows
     (a quadratic with a degree of freedom to spare); fewer, or a branch whose slope at d0 is not a stiffening:
     ValueError."""
-    d = np.asarray(separation_A, float).ravel()
-    f = np.asarray(mean_force_kcal_per_molA, float).ravel()
-    e = np.asarray(force_stderr_kcal_per_molA, float).ravel()
-    if not (d.shape == f.shape == e.shape):
-        raise ValueError("separation, mean force and stderr must be 1-D arrays of equal length")
-    area, t = float(area_A2), float(thickness_A)
-    if not (area > 0 and t > 0):
-        raise ValueError(f"area_A2 ({area_A2}) and thickness_A ({thickness_A}) must be positive")
-    order = np.argsort(d)
-    d, f, e = d[order], f[order], e[order]
-    sel = _repulsive_branch(d, f)
+    d, f, e, area, t, sel = _sorted_branch(separation_A, mean_force_kcal_per_molA, force_stderr_kcal_per_molA,
+                                           area_A2, thickness_A)
     if sel.size < 4:
         raise ValueError(f"{sel.size} repulsive window(s): a tangent from a quadratic needs at least four")
     x, y = d[sel], f[sel]

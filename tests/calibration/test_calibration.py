@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from calibration.mdset import MAPPING, build_parameter_set, recipes_needed, write_parameter_set
-from calibration.pipeline import CalibrationError, latin_hypercube, load_calibration
+from calibration.pipeline import CalibrationError, load_calibration
+from calibration.sampling import latin_hypercube
 from calibration.sweep import parse_vary, run_sweep
 from calibration.validation import VALIDATION
 from continuum.scene import SceneError, resolve_scene
@@ -504,7 +505,7 @@ def test_uncertainty_samples_stay_inside_each_keys_allowed_range():
     normal's quantiles."""
     from scipy.stats import norm
 
-    from calibration.pipeline import latin_hypercube, sample_inputs, sampling_bounds, truncation
+    from calibration.sampling import latin_hypercube, sample_inputs, sampling_bounds, truncation
 
     cal = {"surfaces.interaction_range": {"value": 0.21e-9, "stderr": 0.14e-9},
            "surfaces.work_of_adhesion": {"value": 0.196, "stderr": 0.039}}

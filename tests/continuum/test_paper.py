@@ -101,7 +101,8 @@ def test_the_calibration_judges_its_new_sets_claims_on_its_own_latin_hypercube_r
     new set's name."""
     from pathlib import Path
 
-    from calibration.pipeline import load_calibration, paper_uncertainty, sample_inputs
+    from calibration.pipeline import load_calibration, paper_uncertainty
+    from calibration.sampling import sample_inputs
 
     cal = load_calibration(Path(__file__).resolve().parents[2] / "inputs" / "calibration" / "quick.toml")
     measured = {"surfaces.work_of_adhesion": {"value": 0.196, "stderr": 0.039}}

@@ -315,7 +315,7 @@ def test_an_uncertainty_rows_sigma_does_not_move_the_sigma3_claim_off_3_nm():
 def test_a_rows_sam_values_are_left_out_on_bare_silica_and_kept_on_ots_and_the_band_sample_runs():
     """A Latin-hypercube row of a set with a measured SAM layer modulus: bare silica refuses a layer modulus
     (nothing to describe), so the row's SAM keys are left out there and said so; OTS keeps them."""
-    from calibration.pipeline import uncertainty_sample
+    from calibration.sampling import uncertainty_sample
     from continuum.paper.cases import SCENES
     from continuum.paper.samples import row_for_scene
 
