@@ -84,10 +84,11 @@ def _all_modules() -> dict[str, Path]:
     return {_module_name(p): p for package in PACKAGES for p in _modules(package)}
 
 
-def _imported_modules(path: Path, known: set[str]) -> set[tuple[str, int]]:
+def _imported_modules(path: Path, known: set[str], name: str | None = None) -> set[tuple[str, int]]:
     """Project modules a module imports anywhere (function level included): ``from a import b`` counts as
-    ``a.b`` when that is a module, else ``a``; relative imports are resolved."""
-    name = _module_name(path)
+    ``a.b`` when that is a module, else ``a``; relative imports are resolved (`name`: the module's dotted name, read
+    from its path by default)."""
+    name = name or _module_name(path)
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = set()
     for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
@@ -245,3 +246,93 @@ def test_both_summit_surfaces_satisfy_the_declared_protocol():
     for surface in (tabulated, generic):
         assert isinstance(surface, SummitSurface)
     assert (tabulated.kind, generic.kind) == ("tabulated", "generic")
+
+
+# ------------------------------------------------------------------------------------------ layer order
+#: Inside continuum and md, the layers from the bottom up; a module belongs to the layer of the longest prefix that
+#: names it. A module imports only from its own layer or below, at module level and inside functions alike (a lazy
+#: import is no licence to reach up: pass a callable in, or move the code down).
+LAYERS = {
+    "continuum": (
+        # closed forms and their kernels, the input schema and the parameter origins
+        ("continuum.physics", "continuum.reference", "continuum.schema", "continuum.origins"),
+        # the half-space, the menisci, the result's proportions; compiled bridge sums import nothing of the project
+        ("continuum.elastic", "continuum.wet", "continuum.output.proportions", "continuum.laws.bridge_kernel"),
+        ("continuum.rough",),                                  # summit statistics, GW tables, topographies
+        ("continuum.scene", "continuum.numerics"),             # the resolved scene; the compiled contact phase
+        ("continuum.laws",),                                   # contact laws
+        ("continuum.model",),                                  # which law a scene gets, regimes, estimates
+        ("continuum.output",),                                 # results, notices, figures, provenance
+        ("continuum.dynamics",),                               # the driver, one impact, ensembles, maps
+        ("continuum.paper",),                                  # the paper's cases and claims
+        ("continuum.api", "continuum.cli", "continuum"),       # the public face
+    ),
+    "md": (
+        ("md.units", "md.lammps_loader"),
+        ("md.system",),
+        ("md.build", "md.analysis"),
+        ("md.engine", "md.recipe"),
+        ("md.workflows",),
+        ("md.report_tables",),
+        ("md.cli", "md.doctor", "md"),
+    ),
+}
+
+
+def _layer(module: str, layers: tuple[tuple[str, ...], ...]) -> int | None:
+    """Index of the layer whose longest prefix names `module` (None: not in these layers)."""
+    best = (-1, None)
+    for i, prefixes in enumerate(layers):
+        for p in prefixes:
+            if (module == p or module.startswith(p + ".")) and len(p) > best[0]:
+                best = (len(p), i)
+    return best[1]
+
+
+def _function_level_lines(path: Path) -> set[int]:
+    """Lines of the import statements that sit inside a function body."""
+    lines = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            lines.update(n.lineno for n in ast.walk(node) if isinstance(n, (ast.Import, ast.ImportFrom)))
+    return lines
+
+
+def _upward_imports(modules: dict[str, Path], layers: tuple[tuple[str, ...], ...]) -> list[str]:
+    known = set(modules)
+    bad = []
+    for name, path in sorted(modules.items()):
+        own = _layer(name, layers)
+        if own is None:
+            continue
+        lazy = _function_level_lines(path)
+        for target, line in sorted(_imported_modules(path, known, name)):
+            up = _layer(target, layers)
+            if up is not None and up > own:
+                where = "inside a function" if line in lazy else "at module level"
+                bad.append(f"{name}:{line} imports {target} {where} (layer {own} -> {up})")
+    return bad
+
+
+@pytest.mark.parametrize("package", sorted(LAYERS))
+def test_no_import_goes_up_a_layer_not_even_inside_a_function(package):
+    modules = {m: p for m, p in _all_modules().items() if m == package or m.startswith(package + ".")}
+    assert all(_layer(m, LAYERS[package]) is not None for m in modules), \
+        [m for m in modules if _layer(m, LAYERS[package]) is None]
+    bad = _upward_imports(modules, LAYERS[package])
+    assert not bad, "\n".join(bad)
+
+
+def test_the_layer_scan_sees_an_upward_import_inside_a_function(tmp_path):
+    """Negative control: a reference module that imports the driver inside a function is caught; the same import
+    from the driver down to the reference, or across one layer, is not."""
+    low = tmp_path / "low.py"
+    low.write_text("import math\n\n\ndef f():\n    from continuum.dynamics import driver\n    return driver\n")
+    high = tmp_path / "high.py"
+    high.write_text("def g():\n    from continuum.reference import jkr\n    return jkr\n")
+    modules = {"continuum.reference.low": low, "continuum.dynamics.driver": high, "continuum.reference.jkr": high}
+    layers = LAYERS["continuum"]
+    assert _layer("continuum.reference.low", layers) < _layer("continuum.dynamics.driver", layers)
+    assert _layer("continuum.laws.bridge_kernel", layers) < _layer("continuum.laws.jkr", layers)
+    bad = _upward_imports(modules, layers)
+    assert len(bad) == 1 and "imports continuum.dynamics.driver inside a function" in bad[0], bad
