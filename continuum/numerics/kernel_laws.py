@@ -4,9 +4,10 @@ compiled contact phase (`continuum.numerics.contact_kernel`) integrates, with th
 Each law is a pure function of the gap and the law's parameters `P`, tables `T` and history `S` (arrays the Python
 law fills: `compiled()` of `continuum.laws.rough_rigid`, `continuum.laws.discrete_roller`,
 `continuum.laws.plastic_rough`); `law_force`, `law_stored`, `law_dissipated` and `law_accept` dispatch on the law
-kind. The closed forms are those of the Python laws (JKR: `continuum.physics.jkr_kernel`; Maugis-Dugdale and DMT
-branches: `continuum.rough.branch_laws`; elastic-plastic summits: `continuum.rough.plastic_kernel`), which the tests
-compare point by point (`tests/continuum/test_contact_kernel.py`).
+kind. The closed forms are those of the Python laws (JKR: `continuum.physics.jkr_kernel`, whose scalar root is
+compiled here from its one source; Maugis-Dugdale and DMT branches: `continuum.rough.branch_laws`; elastic-plastic
+summits: `continuum.rough.plastic_kernel`), which the tests compare point by point
+(`tests/continuum/test_contact_kernel.py`, `tests/continuum/test_jkr_forms.py`).
 """
 from __future__ import annotations
 
@@ -14,7 +15,9 @@ import math
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
+from ..physics import jkr_kernel as jk
 from ..rough import plastic_kernel as pk
 
 #: Law kinds.
@@ -41,9 +44,8 @@ DISCRETE_PARAMS = 9
 #: T = (e_i - z_top, approach delta, force, energy, retreat delta, force, energy, unused 2-D).
 (P_B_END_GAP, P_B_IN, P_B_OUT, P_B_REACH, P_B_LOOP, P_B_LOWEST) = range(6)
 BRANCH_PARAMS = 6
-#: JKR constants of `continuum.physics.jkr_kernel`: the fold d = -D_C and the Horner coefficients of h(s).
-_D_C = 0.75 * 4.0 ** (-1.0 / 3.0)
-_H_COEF = np.array((16.0 / 15.0, 16.0 / 15.0, 16.0 / 15.0, -1.6, -1.6, -1.6, -0.6, -0.6, -0.6, -0.6))
+#: The Horner coefficients of JKR's h(s) (`continuum.physics.jkr_kernel.H_COEF`) as an array numba can index.
+_H_COEF = np.array(jk.H_COEF)
 
 
 
@@ -128,20 +130,16 @@ def ppoly3(x, c, a):
 
 
 # ----------------------------------------------------------------------------- discrete summits
-@njit(cache=True)
-def _jkr_root(d):
-    """(d clamped to the fold, stable root s of s^4 - s = d): `continuum.physics.jkr_kernel.stable_root_scalar`,
-    the same closed form (Ferrari's resolvent by Cardano, one Newton polish) with np.cbrt for math.cbrt."""
-    d = max(d, -_D_C)
-    cc = np.cbrt(1.0 / 16.0 + math.sqrt(max(1.0 / 256.0 + d * d * d / 27.0, 0.0)))
-    dd = -d / (3.0 * cc)
-    w = math.sqrt(0.25 / (cc * cc + d / 3.0 + dd * dd))
-    s = 0.5 * (w + math.sqrt(max(2.0 / w - w * w, 0.0)))
-    s3 = s * s * s
-    fp = 4.0 * s3 - 1.0
-    if fp > 1e-3:
-        s -= (s3 * s - s - d) / fp
-    return d, s
+@overload(math.cbrt)
+def _math_cbrt(x):
+    """numba (0.68) has no math.cbrt; np.cbrt is the same libm cube root, so Python scalar code that calls
+    math.cbrt compiles as written."""
+    return lambda x: np.cbrt(x)
+
+
+#: (d clamped to the fold, stable root s of s^4 - s = d): `continuum.physics.jkr_kernel.stable_root_scalar`
+#: compiled, one source for the Python and the compiled discrete summits (`tests/continuum/test_jkr_forms.py`).
+_jkr_root = njit(cache=True)(jk.stable_root_scalar)
 
 
 _count_at_least = pk.count_at_least     # entries of a descending array >= a level (binary search)

@@ -16,8 +16,13 @@ delta_c = D_C delta0 (the fold, s = S_FOLD), P = -P_c at s = S_LOAD, P = 0 at s 
 root of s^4 - s = d comes in two evaluations of the same closed form (Ferrari's resolvent cubic by
 Cardano): `solve_s`, checked and polished twice (the reference), and `stable_root` /
 `stable_root_scalar`, unchecked with one polish, written in place for the discrete summits' hot loop.
-Each keeps its own order of operations: the numbers of every caller are those it had before the
-kernel was shared (bit for bit).
+Each keeps its own order of operations.
+
+Compiled forms: `stable_root_scalar` is compiled as it stands for the compiled discrete summits
+(`continuum.numerics.kernel_laws._jkr_root`); the GW tables' numba kernel carries `solve_s`'s stable branch
+and `reduced_curve_minus_hertz` in scalar form (`continuum.rough.gw_kernel._stable_s`, `_curve_minus_hertz`).
+`tests/continuum/test_jkr_forms.py` compares every form with the others over the branch and with JKR's
+closed-form pull-off and zero-load contact radius.
 
 The sphere law works in u = sqrt(a) instead (u^4 - c beta u - beta delta = 0, c = sqrt(2 pi dgamma/E*)):
 `sqrt_radius_newton` and `energy_of_radius` are its scalar forms.
@@ -174,7 +179,9 @@ def stable_force_in_place(s, scale):
 
 
 def stable_root_scalar(d: float) -> tuple[float, float]:
-    """(d clamped to >= -D_C, stable s) for one reduced approach: `stable_root` in scalar arithmetic."""
+    """(d clamped to >= -D_C, stable s) for one reduced approach: `stable_root` in scalar arithmetic.
+
+    Plain float arithmetic that numba compiles as written (`continuum.numerics.kernel_laws._jkr_root`)."""
     d = max(d, -D_C)
     cc = math.cbrt(1.0 / 16.0 + math.sqrt(max(1.0 / 256.0 + d * d * d / 27.0, 0.0)))
     dd = -d / (3.0 * cc)
