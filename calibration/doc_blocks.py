@@ -1,0 +1,124 @@
+"""Blocks of the docs pages whose numbers committed results hold, generated from those results.
+
+A page marks each block ``<!-- generated: NAME -->`` ... ``<!-- /generated -->`` (the markers of
+``md.report_tables``, which renders docs/md.md's result and cost tables); this module renders the blocks that quote
+the pull-off prediction (``docs/figures/pulloff_sei.json``, written by ``benchmarks/pulloff_sei.py``) and the
+committed pull-off results (``inputs/md/results/<recipe>-quick/result.json``). It reads files only, so the numbers
+on the page are those of the committed files, and ``tests/test_generated_docs.py`` fails when they disagree.
+
+    python -m calibration.doc_blocks            # rewrite the marked blocks in place
+    python -m calibration.doc_blocks --check    # exit 1 if a page's block differs from its files; write nothing
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+from typing import Callable
+
+from nanoimpact.fileio import atomic_write_text
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS_DIR = ROOT / "inputs" / "md" / "results"
+SEI_JSON = ROOT / "docs" / "figures" / "pulloff_sei.json"
+
+#: The pull-off runs the SEI table's second part lists, in this order: the calibration's validation runs (four tip
+#: positions) and the one-position runs they replaced.
+PULLOFF_RUNS = ("pulloff_silica_positions", "pulloff_ots_positions", "pulloff_silica", "pulloff_ots")
+
+
+def _nn(x: float) -> str:
+    """Newtons in nN, two decimals."""
+    return f"{x * 1e9:.2f}"
+
+
+def _sei_row(sei: dict) -> str:
+    """One surface's SEI row after its first cell (nN)."""
+    cut = sei["laws"]["cut"]
+    wide = next(v for v in cut["maps"].values() if v["bin_A"] == cut["central_map"]["bin_A"]
+                and v["reach_A"] > cut["central_map"]["reach_A"])
+    full = f" ({_nn(sei['laws']['full']['pull_off_force_N'])} with the tail)" if "full" in sei["laws"] else ""
+    dmt = _nn(sei["dmt_2piRW_N"]) + (" (W_F with the tail)" if "full" in sei["laws"] else "")
+    return (f"| {_nn(sei['measured']['pull_off_force_N'])} ± {_nn(sei['measured']['stderr_N'])} | "
+            f"{_nn(cut['pull_off_force_N'])}{full} | {', '.join(_nn(x) for x in cut['per_registry_N'])} | "
+            f"{_nn(wide['pull_off_force_N'])} | {dmt} | {sei['tabor_flat_slab']['mu']:.2f} "
+            f"({sei['tabor_flat_slab']['lambda']:.2f}) |")
+
+
+def _pulloff_row(recipe: str, results_dir: Path) -> str:
+    data = json.loads((results_dir / f"{recipe}-quick" / "result.json").read_text())
+    force = data["quantities"]["pull_off_force"]
+    speed = force.get("speed_m_s")
+    per = [p["max_tensile_force_N"] for p in data["details"].get("per_position", []) if p["speed_m_s"] == speed]
+    spread = f"{_nn(min(per))}–{_nn(max(per))}" if per else "one position"
+    diff = data["details"].get("speed_difference")
+    paired = (f"{diff['speeds_m_s'][1]:g} − {diff['speeds_m_s'][0]:g} m/s: {_nn(diff['mean_N'])} ± "
+              f"{_nn(diff['stderr_N'])}" if diff else "")
+    return f"| `{recipe}` | {speed:g} | {_nn(force['value'])} ± {_nn(force['stderr'])} | {spread} | {paired} |"
+
+
+def pulloff_sei(sei_json: Path = SEI_JSON, results_dir: Path = RESULTS_DIR) -> str:
+    """docs/md.md's pull-off tables: the SEI prediction per surface, then the committed pull-off runs."""
+    sei = json.loads(Path(sei_json).read_text())
+    label = {"silica": "silica", "ots": "OTS"}
+    lines = ["| surface | measured F (nN) | SEI, registry average (nN) | SEI per registry (nN) | SEI, reach 1.5× (nN) "
+             "| DMT 2πRW_F (nN) | Tabor μ (λ), flat-slab W_F, z0 |",
+             "|---|---|---|---|---|---|---|"]
+    for surface, r in sei.items():
+        lines.append(f"| {label.get(surface, surface)}, R = {r['radius_m'] * 1e9:g} nm (`{r['pulloff_recipe']}`) "
+                     + _sei_row(r))
+    lines += ["", "| run | speed (m/s) | F (nN) | per position (nN) | paired speed difference (nN) |",
+              "|---|---|---|---|---|"]
+    lines += [_pulloff_row(recipe, results_dir) for recipe in PULLOFF_RUNS]
+    return "\n".join(lines)
+
+
+#: page (relative to the repository) -> {block name: renderer}.
+BLOCKS: dict[str, dict[str, Callable[[], str]]] = {
+    "docs/md.md": {"md-pulloff-sei": pulloff_sei},
+}
+
+
+def _block_re(name: str) -> re.Pattern[str]:
+    return re.compile(rf"(<!-- generated: {re.escape(name)} -->)(.*?)(<!-- /generated -->)", re.S)
+
+
+def render(text: str, blocks: dict[str, str], page: str = "page") -> str:
+    """``text`` with each named block replaced by its content (each marker must occur exactly once)."""
+    for name, body in blocks.items():
+        pattern = _block_re(name)
+        if len(pattern.findall(text)) != 1:
+            raise ValueError(f"{page}: marker <!-- generated: {name} --> must occur exactly once")
+        text = pattern.sub(lambda m, b=body: f"{m.group(1)}\n{b}\n{m.group(3)}", text)
+    return text
+
+
+def rendered(root: Path = ROOT) -> dict[str, tuple[str, str]]:
+    """page -> (its text now, its text with every block regenerated)."""
+    out = {}
+    for page, blocks in BLOCKS.items():
+        text = (root / page).read_text()
+        out[page] = (text, render(text, {name: make() for name, make in blocks.items()}, page))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m calibration.doc_blocks", description=__doc__.splitlines()[0])
+    p.add_argument("--check", action="store_true", help="exit 1 if a page's block is stale; write nothing")
+    args = p.parse_args(argv)
+    stale = [page for page, (now, new) in rendered().items() if now != new]
+    if args.check:
+        for page in stale:
+            print(f"stale: {page} (run python -m calibration.doc_blocks)", file=sys.stderr)
+        return 1 if stale else 0
+    for page, (_, new) in rendered().items():
+        if page in stale:
+            atomic_write_text(ROOT / page, new)
+            print(page)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
