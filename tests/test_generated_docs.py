@@ -39,3 +39,12 @@ def test_a_missing_or_doubled_marker_is_an_error():
     twice = "<!-- generated: b -->\n<!-- /generated -->\n" * 2
     with pytest.raises(ValueError, match="exactly once"):
         doc_blocks.render(twice, {"b": "x"})
+
+
+def test_a_moved_benchmark_moves_the_wet_ensemble_table(tmp_path):
+    data = json.loads(doc_blocks.WET_ENSEMBLE_JSON.read_text())
+    data["rows"][-1]["cpu_ratio_to_dry"] *= 2
+    moved = tmp_path / "wet.json"
+    moved.write_text(json.dumps(data))
+    assert doc_blocks.wet_ensemble(moved) != doc_blocks.wet_ensemble()
+    assert doc_blocks._sci(1.0942e-4) == "1.1e-4"
