@@ -35,63 +35,47 @@ class JKRSphere(ContactLaw):
         else:
             self.detach_approach = float(ref.load_controlled_detach_approach(radius, work_of_adhesion, e_star))
         self.loop_energy = float(ref.loop_area(radius, work_of_adhesion, e_star, detachment=detachment))
-        # scalar fast path (the driver calls the law one value at a time); see _sqrt_radius
-        self._k = 4.0 * e_star / 3.0
-        self._adh = math.sqrt(8.0 * math.pi * work_of_adhesion * e_star)
-        self._c = math.sqrt(2.0 * math.pi * work_of_adhesion / e_star)
-        self._u_fold = (radius * self._c / 4.0) ** (1.0 / 3.0)
-        a_touch = float(ref.contact_radius_at_touch(radius, work_of_adhesion, e_star))
-        self._energy_at_touch = self._energy_of_radius(a_touch)
-        self._cache = (None, self._u_fold)
+        # scalar path (the driver calls the law one value at a time): the JKR kernel's scalar root in
+        # s = sqrt(a/a0), the one the discrete summits use (compiled there), so P, U and dP/d delta are explicit
+        self._delta0 = float(ref.approach_scale(radius, work_of_adhesion, e_star))   # the reference's, bit for bit
+        self._pscale = math.pi * work_of_adhesion * radius           # P = pscale s^3 (8/3 s^3 - 4)
+        self._cache: tuple[float | None, float, float] = (None, 0.0, 1.0)
 
     def _delta(self, gap):
         # Trial steps of the integrator may overshoot the release event slightly; the stable
         # branch ends at -delta_c, so clamp there (the event ends the contact before it matters).
         return max(-gap, -self.delta_c)
 
-    def _p(self):
-        return self.radius, self.work_of_adhesion, self.e_star
-
-    def _sqrt_radius(self, delta: float) -> float:
-        """u = sqrt(a) on the stable branch: largest root of u^4 - c beta u - beta delta = 0.
-
-        Newton's method on this convex quartic converges monotonically to the largest root from
-        any start right of the fold u_c (where d delta/da = 0), so it is warm-started from the
-        previous call. Within 1e-6 delta_c of the fold the root is double and Newton slows down:
-        there the reference's closed-form (Ferrari) solution is used instead.
-        """
-        if self._cache[0] == delta:
-            return self._cache[1]
-        if delta + self.delta_c < 1e-6 * self.delta_c:
-            u = math.sqrt(float(ref.radius_from_approach(delta, *self._p())))
-        else:
-            beta = self.radius
-            u = jk.sqrt_radius_newton(delta, beta, self._c * beta, max(self._cache[1], self._u_fold * (1.0 + 1e-3),
-                                                                      (2.0 * beta * max(delta, 0.0)) ** 0.25))
-        self._cache = (delta, u)
-        return u
+    def _root(self, delta: float) -> tuple[float, float]:
+        """(d, s) on the stable branch at approach delta (m): d = delta/delta0 clamped to the fold and
+        s = sqrt(a/a0), by `continuum.physics.jkr_kernel.stable_root_scalar` (cached for the last delta). Within
+        1e-6 delta_c of the fold, where the root is double and the scalar root skips its polish, the reference's
+        checked root (`solve_s`, two polishes) is used instead."""
+        if self._cache[0] != delta:
+            d, s = jk.stable_root_scalar(delta / self._delta0)
+            if delta + self.delta_c < 1e-6 * self.delta_c:
+                s = float(jk.solve_s(d, "stable")[0])
+            self._cache = (delta, d, s)
+        return self._cache[1], self._cache[2]
 
     def force(self, gap):
-        u = self._sqrt_radius(self._delta(gap))
-        a = u * u
-        return self._k * a * a * a / self.radius - self._adh * a * u
+        _, s = self._root(self._delta(gap))
+        s3 = s * s * s
+        return self._pscale * s3 * (8.0 / 3.0 * s3 - 4.0)
 
     def stiffness(self, gap):
         delta = self._delta(gap)
         if delta <= -self.delta_c:
             return -math.inf  # the stable branch's dP/d(delta) diverges to -inf at the fold
-        a = self._sqrt_radius(delta) ** 2
-        dp_da = 3.0 * self._k * a * a / self.radius - 1.5 * self._adh * math.sqrt(a)
-        dd_da = 2.0 * a / self.radius - 0.5 * self._c / math.sqrt(a)
-        return dp_da / dd_da
+        _, s = self._root(delta)
+        s3 = s * s * s
+        if 4.0 * s3 - 1.0 <= 0.0:   # within rounding of the fold, where the root is double
+            return -math.inf
+        return float(jk.stiffness_of_s(s, s3, self._pscale / self._delta0))
 
     def stored_energy(self, gap):
-        a = self._sqrt_radius(self._delta(gap)) ** 2
-        return self._energy_of_radius(a) - self._energy_at_touch
-
-    def _energy_of_radius(self, a: float) -> float:
-        """Antiderivative of P(a) d(delta)/da (J), `continuum.physics.jkr_kernel.energy_of_radius`."""
-        return jk.energy_of_radius(a, self.radius, self._k, self._c, self._adh, self.work_of_adhesion)
+        d, s = self._root(self._delta(gap))
+        return float(jk.energy_of_s(d, s, self._pscale * self._delta0))
 
     def release_gap(self):
         return -self.detach_approach

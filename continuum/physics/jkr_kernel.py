@@ -15,17 +15,14 @@ delta0 = a0^2/beta, s = sqrt(a/a0) and d = delta/delta0::
 delta_c = D_C delta0 (the fold, s = S_FOLD), P = -P_c at s = S_LOAD, P = 0 at s = S_ZERO. The stable
 root of s^4 - s = d comes in two evaluations of the same closed form (Ferrari's resolvent cubic by
 Cardano): `solve_s`, checked and polished twice (the reference), and `stable_root` /
-`stable_root_scalar`, unchecked with one polish, written in place for the discrete summits' hot loop.
-Each keeps its own order of operations.
+`stable_root_scalar`, unchecked with one polish, written in place for the discrete summits' hot loop (the
+scalar one also serves the sphere law, `continuum.laws.jkr`). Each keeps its own order of operations.
 
 Compiled forms: `stable_root_scalar` is compiled as it stands for the compiled discrete summits
 (`continuum.numerics.kernel_laws._jkr_root`); the GW tables' numba kernel carries `solve_s`'s stable branch
 and `reduced_curve_minus_hertz` in scalar form (`continuum.rough.gw_kernel._stable_s`, `_curve_minus_hertz`).
 `tests/continuum/test_jkr_forms.py` compares every form with the others over the branch and with JKR's
 closed-form pull-off and zero-load contact radius.
-
-The sphere law works in u = sqrt(a) instead (u^4 - c beta u - beta delta = 0, c = sqrt(2 pi dgamma/E*)):
-`sqrt_radius_newton` and `energy_of_radius` are its scalar forms.
 """
 from __future__ import annotations
 
@@ -55,8 +52,8 @@ FOLD_SNAP = 16.0 * np.finfo(float).eps
 
 # ------------------------------------------------------------------------------------ energy and slope
 def h_of_s(s):
-    """h(s) = g(s)/(s - 1) with g = 16/15 s^10 - 8/3 s^7 + s^4 + 3/5 (Horner)."""
-    acc = np.zeros_like(s) + H_COEF[0]
+    """h(s) = g(s)/(s - 1) with g = 16/15 s^10 - 8/3 s^7 + s^4 + 3/5 (Horner); a float stays a float."""
+    acc = H_COEF[0] if isinstance(s, float) else np.zeros_like(s) + H_COEF[0]
     for ck in H_COEF[1:]:
         acc = acc * s + ck
     return acc
@@ -235,31 +232,3 @@ def reduced_curve_minus_hertz_slopes(s, x):
           None, 1.0 / (4.0 * s3 - 1.0)]
     gp[1] = reduced_curve_minus_hertz(s)[0]
     return gp
-
-
-# ------------------------------------------------------------------------------------ the sphere law (u = sqrt(a))
-def sqrt_radius_newton(delta: float, beta: float, c_beta: float, u_start: float) -> float:
-    """Largest root u = sqrt(a) of u^4 - c beta u - beta delta = 0 (c_beta = c beta), Newton from `u_start`.
-
-    The quartic is convex, so from any start right of the fold the iteration converges monotonically to
-    the stable root; it stops when a step is below 2e-16 u (at most 100 steps). Slow within ~1e-6 delta_c
-    of the fold, where the root is double: use `solve_s` there."""
-    u = u_start
-    for _ in range(100):
-        f = ((u * u) * (u * u) - c_beta * u - beta * delta)
-        step = f / (4.0 * u * u * u - c_beta)
-        u -= step
-        if abs(step) <= 2e-16 * u:
-            break
-    return u
-
-
-def energy_of_radius(a: float, beta: float, k: float, c: float, adh: float, work_of_adhesion: float) -> float:
-    """Antiderivative of P(a) d(delta)/da: 2Ka^5/(5 beta^2) - (2/7) c2 a^(7/2) + pi dgamma a^2 (J).
-
-    K = 4E*/3 (Johnson's K), c = sqrt(2 pi dgamma/E*), adh = sqrt(8 pi dgamma E*),
-    c2 = K c/(2 beta) + 2 adh/beta; the a^1 term of P d(delta)/da is adh c a / 2 = 2 pi dgamma a.
-    """
-    c2 = k * c / (2.0 * beta) + 2.0 * adh / beta
-    return (2.0 * k * a**5 / (5.0 * beta * beta) - 2.0 / 7.0 * c2 * a**3.5
-            + math.pi * work_of_adhesion * a * a)

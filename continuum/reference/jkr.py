@@ -116,10 +116,11 @@ def contact_radius_at_touch(radius, work_of_adhesion, e_star):
     return _out(np.cbrt(2.0 * np.pi * g * b * b / e))
 
 
-def _delta0(radius, work_of_adhesion, e_star):
-    """delta0 = a0^2 / beta (m)."""
+def approach_scale(radius, work_of_adhesion, e_star):
+    """delta0 = a0^2 / beta = (4 pi^2 dgamma^2 beta / E*^2)^{1/3} (m): the approach unit of the reduced curve
+    delta/delta0 = s^4 - s (`continuum.physics.jkr_kernel`); delta_c = (3/4) 4^{-1/3} delta0."""
     b, g, e = _arr(radius, work_of_adhesion, e_star)
-    return np.cbrt(4.0 * np.pi**2 * g * g * b / (e * e))
+    return _out(np.cbrt(4.0 * np.pi**2 * g * g * b / (e * e)))
 
 
 def pull_off_force(radius, work_of_adhesion):
@@ -201,7 +202,7 @@ def radius_from_approach(delta, radius, work_of_adhesion, e_star, branch="stable
     radius beta (m), work_of_adhesion dgamma (J/m^2), e_star (Pa).
     """
     b, g, e = _arr(radius, work_of_adhesion, e_star)
-    d0 = _delta0(b, g, e)
+    d0 = approach_scale(b, g, e)
     a0 = np.cbrt(2.0 * np.pi * g * b * b / e)
     s, _ = _solve_s(np.asarray(delta, float) / d0, branch)
     return _out(a0 * s * s)
@@ -214,7 +215,7 @@ def force_from_approach(delta, radius, work_of_adhesion, e_star, branch="stable"
     work_of_adhesion dgamma (J/m^2), e_star (Pa).
     """
     b, g, e = _arr(radius, work_of_adhesion, e_star)
-    s, _ = _solve_s(np.asarray(delta, float) / _delta0(b, g, e), branch)
+    s, _ = _solve_s(np.asarray(delta, float) / approach_scale(b, g, e), branch)
     s3 = s**3
     return _out(np.pi * g * b * s3 * (8.0 / 3.0 * s3 - 4.0))
 
@@ -231,7 +232,7 @@ def stiffness_from_approach(delta, radius, work_of_adhesion, e_star, branch="sta
     e_star (Pa).
     """
     b, g, e = _arr(radius, work_of_adhesion, e_star)
-    d0 = _delta0(b, g, e)
+    d0 = approach_scale(b, g, e)
     s, at_fold = _solve_s(np.asarray(delta, float) / d0, branch)
     s3 = s**3
     den = 4.0 * s3 - 1.0
@@ -254,7 +255,7 @@ def energy_from_approach(delta, radius, work_of_adhesion, e_star):
     radius beta (m), work_of_adhesion dgamma (J/m^2), e_star (Pa).
     """
     b, g, e = _arr(radius, work_of_adhesion, e_star)
-    d0 = _delta0(b, g, e)
+    d0 = approach_scale(b, g, e)
     dn = np.asarray(delta, float) / d0
     s, _ = _solve_s(dn, "stable")
     return _out(_k.energy_of_s(np.maximum(dn, -_DC), s, np.pi * g * b * d0))

@@ -103,7 +103,7 @@ POINTS = [("zero load", (4.5 * math.pi * DGAMMA * BETA**2 / ESTAR) ** (1 / 3), 0
 def _discrete_one_summit(delta: float, energy: bool) -> float:
     """The compiled discrete law with one JKR summit at the datum at approach `delta`, having been pressed at least to
     touch (the history that keeps a summit attached in tension)."""
-    delta0 = float(ref._delta0(BETA, DGAMMA, ESTAR))
+    delta0 = float(ref.approach_scale(BETA, DGAMMA, ESTAR))
     pscale = math.pi * DGAMMA * BETA
     P = np.zeros(kl.DISCRETE_PARAMS)
     P[kl.P_D_INV_DELTA0], P[kl.P_D_PSCALE], P[kl.P_D_ESCALE] = 1.0 / delta0, pscale, pscale * delta0
