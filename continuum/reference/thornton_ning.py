@@ -229,16 +229,6 @@ def _jkr_energy(a, radius, w, e_star):
     return np.asarray(jkr.energy_from_radius(a, radius, w, e_star), float)
 
 
-def _jkr_force(a, radius, w, e_star):
-    """JKR load F(a) = 4E*a^3/(3R) - sqrt(8 pi w E* a^3) (N)."""
-    return 4.0 * e_star * a**3 / (3.0 * radius) - np.sqrt(8.0 * np.pi * w * e_star * a**3)
-
-
-def _jkr_approach(a, radius, w, e_star):
-    """JKR approach delta(a) = a^2/R - sqrt(2 pi w a/E*) (m)."""
-    return a * a / radius - np.sqrt(2.0 * np.pi * w * a / e_star)
-
-
 def yield_velocity(limiting_pressure, radius, work_of_adhesion, e_star, density):
     """Impact speed at which the contact first yields, V_y = sqrt(2 U_R(a_y) / m) (m/s).
 
@@ -305,7 +295,7 @@ def _elastic_max_radius(ke, radius, w, e_star):
     ke = np.asarray(ke, float)
     if w == 0.0:
         return (15.0 * ke * radius**2 / (8.0 * e_star)) ** 0.2
-    a0 = np.cbrt(2.0 * np.pi * w * radius**2 / e_star)
+    a0 = jkr.contact_radius_at_touch(radius, w, e_star)
     lo = np.full_like(ke, a0 * 1.5 ** (2.0 / 3.0))   # P = 0 at s^3 = 3/2, U minimal there
     hi = lo * 2.0
     while np.any(_jkr_energy(hi, radius, w, e_star) < ke):
@@ -322,12 +312,12 @@ def _plastic_maximum(ke, p_y, radius, w, e_star, a_y):
 
     W_in = U_R(a_y) + F_y D + pi p_y R D^2 / 2 = ke, solved for D = delta* - delta_y (quadratic).
     """
-    f_y = _jkr_force(a_y, radius, w, e_star)
+    f_y = jkr.force_from_radius(a_y, radius, w, e_star)
     k_p = np.pi * p_y * radius
     extra = ke - _jkr_energy(a_y, radius, w, e_star)
     d = 2.0 * extra / (f_y + np.sqrt(f_y * f_y + 2.0 * k_p * extra))  # cancellation-free root
     a_max = np.sqrt(a_y * a_y + radius * d)
-    return a_max, f_y + k_p * d, _jkr_approach(a_y, radius, w, e_star) + d
+    return a_max, f_y + k_p * d, jkr.approach_from_radius(a_y, radius, w, e_star) + d
 
 
 def impact(velocity, radius, work_of_adhesion, e_star, density, limiting_pressure,
@@ -352,14 +342,14 @@ def impact(velocity, radius, work_of_adhesion, e_star, density, limiting_pressur
     else:
         yielded = np.zeros_like(v, bool)
     a_max = _elastic_max_radius(np.where(yielded, 0.0, ke), r, w, e)
-    f_max = _jkr_force(a_max, r, w, e)
+    f_max = jkr.force_from_radius(a_max, r, w, e)
     r_p, delta_p = np.full_like(v, r), np.zeros_like(v)
     plastic_loss, adhesive_loss = np.zeros_like(v), np.full_like(v, loop_r)
     if np.any(yielded):
         ap, fp, dp = _plastic_maximum(ke[yielded], p_y, r, w, e, a_y)
         rp = 4.0 * e * ap**3 / (3.0 * (fp + np.sqrt(8.0 * np.pi * w * e * ap**3)))
         a_max[yielded], f_max[yielded], r_p[yielded] = ap, fp, rp
-        delta_p[yielded] = dp - _jkr_approach(ap, rp, w, e)
+        delta_p[yielded] = dp - jkr.approach_from_radius(ap, rp, w, e)
         a_det = np.minimum(_fold_or_pulloff_radius(rp, w, e, detachment), ap)
         stored = _jkr_energy(ap, rp, w, e)
         plastic_loss[yielded] = ke[yielded] - stored
