@@ -50,7 +50,7 @@ def sample_inputs(calibration: dict, ranges: dict, n: int, seed: int) -> tuple[l
 
     A calibrated value is drawn from the normal with its MD mean and stderr, truncated to the scene key's allowed
     range (:func:`sampling_bounds`; ``scipy.stats.truncnorm``): a work of adhesion or an interaction range z0 whose
-    stderr is a large fraction of its mean (z0 of bare silica, 0.21 +- 0.14 nm over three registries) would
+    stderr is a large fraction of its mean (z0 of bare silica over a few registries: `[meta.calibration]`) would
     otherwise be sampled negative, and the scene would refuse that sample, so the band would silently lose its
     low tail. Far from the bounds this is the plain normal; :func:`truncation` reports where it is not."""
     from scipy.stats import truncnorm

@@ -48,3 +48,17 @@ def test_a_moved_benchmark_moves_the_wet_ensemble_table(tmp_path):
     moved.write_text(json.dumps(data))
     assert doc_blocks.wet_ensemble(moved) != doc_blocks.wet_ensemble()
     assert doc_blocks._sci(1.0942e-4) == "1.1e-4"
+
+
+def test_the_ensemble_threshold_in_code_is_the_committed_measurement():
+    """`ENSEMBLE_BELOW_CONTACTS` is typed in `continuum.model.decisions`; docs/model.md says it is read from
+    docs/figures/ensemble_threshold.json (benchmarks/bench_ensemble_threshold.py): a rerun that moves the measured
+    threshold by more than its rounding, or a changed constant, fails here."""
+    from continuum.model.decisions import ENSEMBLE_BELOW_CONTACTS, ENSEMBLE_TOLERANCE
+
+    measured = json.loads((doc_blocks.ROOT / "docs" / "figures" / "ensemble_threshold.json").read_text())
+    assert measured["constant_in_code"] == ENSEMBLE_BELOW_CONTACTS
+    assert measured["tolerance_over_h0"] == ENSEMBLE_TOLERANCE
+    assert round(measured["threshold_expected_contacts"]) == ENSEMBLE_BELOW_CONTACTS
+    fit = measured["fit"]
+    assert measured["threshold_expected_contacts"] == pytest.approx((fit["A"] / ENSEMBLE_TOLERANCE) ** 2, rel=1e-9)

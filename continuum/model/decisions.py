@@ -311,8 +311,9 @@ def dry_run_verdict(scene: Scene, durations, status: str) -> DryRunVerdict:
 #: 'auto' runs an ensemble of discrete realisations below this many expected summits in contact at the first
 #: impact (the Hertz estimate's count, continuum.model.estimates): above it the mean field's first-impact energy loss
 #: lies within ENSEMBLE_TOLERANCE of the ensemble mean. Measured by benchmarks/bench_ensemble_threshold.py (the
-#: departure falls like A / sqrt(N_c), A = 0.45 +- 0.12; N* = (A / tolerance)^2 = 80 (47-125 within A's standard
-#: error); docs/figures/ensemble_threshold.json, docs/model.md "Few summits: ensembles").
+#: departure falls like A / sqrt(N_c), N* = (A / tolerance)^2; A, its standard error and N* are the json's `fit` and
+#: `threshold_expected_contacts`, docs/figures/ensemble_threshold.json; docs/model.md "Few summits: ensembles"),
+#: rounded to an integer here and held to the json by tests/test_generated_docs.py.
 ENSEMBLE_BELOW_CONTACTS = 80.0
 #: The relative departure of the first impact's energy loss (mean field against the ensemble mean) that 'auto'
 #: accepts. A declared choice: the departure decays only like 1/sqrt(N_c), so a tolerance at the solver's level
