@@ -3,9 +3,10 @@
 A page marks each block ``<!-- generated: NAME -->`` ... ``<!-- /generated -->`` (the markers of
 ``md.report_tables``, which renders docs/md.md's result and cost tables); this module renders the blocks that quote
 the pull-off prediction (``docs/figures/pulloff_sei.json``, written by ``benchmarks/pulloff_sei.py``), the
-committed pull-off results (``inputs/md/results/<recipe>-quick/result.json``) and the wet-ensemble benchmark
-(``docs/figures/bench_wet_ensemble.json``). It reads files only, so the numbers
-on the page are those of the committed files, and ``tests/test_generated_docs.py`` fails when they disagree.
+committed pull-off results (``inputs/md/results/<recipe>-quick/result.json``) and the benchmarks' committed jsons
+(``docs/figures/``: the wet ensemble, MD on two ranks, the silica slab's lateral stress). It reads files (and the
+builder's lattice constant), so the numbers on the page are those of the committed files, and
+``tests/test_generated_docs.py`` fails when they disagree.
 
     python -m calibration.doc_blocks            # rewrite the marked blocks in place
     python -m calibration.doc_blocks --check    # exit 1 if a page's block differs from its files; write nothing
@@ -97,10 +98,67 @@ def wet_ensemble(path: Path = WET_ENSEMBLE_JSON) -> str:
     return "\n".join(lines)
 
 
+FIGURES = ROOT / "docs" / "figures"
+RANKS_JSON = FIGURES / "md_ranks_bench.json"
+#: ``benchmarks/bench_md_ranks.py``'s case names -> the table's words.
+RANK_CASES = {"one rank": "one rank, in process", "two ranks, default grid": "two ranks, LAMMPS's default grid",
+              "two ranks, engine grid": "two ranks, the engine's grid (`processors * * 1`)"}
+
+
+def md_ranks(path: Path = RANKS_JSON) -> str:
+    """docs/benchmarks.md's processor-grid table from ``benchmarks/bench_md_ranks.py``'s json."""
+    rows = json.loads(Path(path).read_text())["rows"]
+    best = max(r["speedup_vs_one_rank"] for r in rows)
+    lines = ["| case | processor grid | dynamics `Loop time` (s) | speed-up against one rank | pair time per rank, "
+             "min / max (s, last chunk) |", "|---|---|---|---|---|"]
+    for r in rows:
+        up = f"{r['speedup_vs_one_rank']:.2f}"
+        pair = r["last_chunk_sections"]["Pair"]
+        lines.append(f"| {RANK_CASES.get(r['case'], r['case'])} | {r['grid']} | {r['dynamics_loop_s']:.2f} | "
+                     f"{f'**{up}**' if r['speedup_vs_one_rank'] == best and best > 1 else up} | "
+                     f"{pair['min_s']:.2f} / {pair['max_s']:.2f} |")
+    return "\n".join(lines)
+
+
+def _signed(x: float, digits: int) -> str:
+    return f"{x:+.{digits}f}".replace("-", "−")
+
+
+def md_lateral_stress(folder: Path = FIGURES) -> str:
+    """docs/benchmarks.md's lateral-stress table from ``benchmarks/md_lateral_stress.py``'s json per lattice constant
+    (``md_lateral_stress_a<A>.json``), then where sigma_bulk changes sign (linear between the bracketing lattices)."""
+    from md.build import CRISTOBALITE_A
+
+    runs = sorted(((float(p.stem.rpartition("_a")[2]), p.stem.rpartition("_a")[2], json.loads(p.read_text()))
+                   for p in Path(folder).glob("md_lateral_stress_a*.json")), reverse=True)
+    lines = ["| cubic a (Å) | t (Å) | atoms | S (N/m) | Sxx / Syy (N/m) | σ_bulk (GPa) |", "|---|---|---|---|---|---|"]
+    for a, label, run in runs:
+        builder = a == CRISTOBALITE_A
+        bulk = f"{_signed(run['sigma_bulk_Pa'] * 1e-9, 2)} ± {run['sigma_bulk_stderr_Pa'] * 1e-9:.2f}"
+        for i, r in enumerate(run["rows"]):
+            cells = [label + (" (the builder's)" if builder else "") if i == 0 else "", f"{r['si_span_A']:.2f}",
+                     str(r["atoms"]), f"{_signed(r['S_N_per_m'], 3)} ± {r['S_stderr_N_per_m']:.3f}",
+                     f"{_signed(r['Sxx_N_per_m'], 2)} / {_signed(r['Syy_N_per_m'], 2)}",
+                     (f"**{bulk}**" if builder else bulk) if i == 0 else ""]
+            lines.append("| " + " | ".join(cells) + " |")
+    bracket = [(lo, hi) for hi, lo in zip(runs, runs[1:]) if lo[2]["sigma_bulk_Pa"] < 0.0 <= hi[2]["sigma_bulk_Pa"]]
+    if bracket:
+        (a1, l1, r1), (a2, l2, r2) = bracket[0]
+        s1, s2 = r1["sigma_bulk_Pa"], r2["sigma_bulk_Pa"]
+        zero = a1 + (a2 - a1) * (-s1) / (s2 - s1)
+        thin = next(run for a, _, run in runs if a == CRISTOBALITE_A)["rows"][0]
+        lines += ["", f"σ_bulk = 0 by linear interpolation between {l1} and {l2} Å: a ≈ {zero:.2f} Å, "
+                  f"{100 * (1 - zero / CRISTOBALITE_A):.1f} % below the builder's {CRISTOBALITE_A:g} Å. The thinnest "
+                  f"slab at the builder's lattice ({thin['si_span_A']:.0f} Å) carries S/t = "
+                  f"{thin['S_N_per_m'] / (thin['si_span_A'] * 1e-10) * 1e-9:.1f} GPa, surface stress included."]
+    return "\n".join(lines)
+
+
 #: page (relative to the repository) -> {block name: renderer}.
 BLOCKS: dict[str, dict[str, Callable[[], str]]] = {
     "docs/md.md": {"md-pulloff-sei": pulloff_sei},
-    "docs/benchmarks.md": {"bench-wet-ensemble": wet_ensemble},
+    "docs/benchmarks.md": {"bench-wet-ensemble": wet_ensemble, "md-ranks": md_ranks,
+                           "md-lateral-stress": md_lateral_stress},
 }
 
 

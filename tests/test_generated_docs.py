@@ -62,3 +62,22 @@ def test_the_ensemble_threshold_in_code_is_the_committed_measurement():
     assert round(measured["threshold_expected_contacts"]) == ENSEMBLE_BELOW_CONTACTS
     fit = measured["fit"]
     assert measured["threshold_expected_contacts"] == pytest.approx((fit["A"] / ENSEMBLE_TOLERANCE) ** 2, rel=1e-9)
+
+
+def test_a_moved_md_benchmark_moves_its_table(tmp_path):
+    """Negative controls for the MD benchmark tables: a moved rank timing, a moved lateral stress (and with it the
+    zero crossing) change the blocks."""
+    ranks = json.loads(doc_blocks.RANKS_JSON.read_text())
+    ranks["rows"][-1]["dynamics_loop_s"] *= 1.1
+    (tmp_path / "ranks.json").write_text(json.dumps(ranks))
+    assert doc_blocks.md_ranks(tmp_path / "ranks.json") != doc_blocks.md_ranks()
+    for path in doc_blocks.FIGURES.glob("md_lateral_stress_a*.json"):
+        shutil.copy(path, tmp_path / path.name)
+    before = doc_blocks.md_lateral_stress(tmp_path)
+    assert before == doc_blocks.md_lateral_stress()
+    moved = tmp_path / "md_lateral_stress_a7.0.json"
+    data = json.loads(moved.read_text())
+    data["sigma_bulk_Pa"] *= 2.0
+    moved.write_text(json.dumps(data))
+    after = doc_blocks.md_lateral_stress(tmp_path)
+    assert after != before and after.split("a ≈ ")[1][:4] != before.split("a ≈ ")[1][:4]
