@@ -4,8 +4,8 @@ A page marks each block ``<!-- generated: NAME -->`` ... ``<!-- /generated -->``
 ``md.report_tables``, which renders docs/md.md's result and cost tables); this module renders the blocks that quote
 the pull-off prediction (``docs/figures/pulloff_sei.json``, written by ``benchmarks/pulloff_sei.py``), the
 committed pull-off results (``inputs/md/results/<recipe>-quick/result.json``) and the benchmarks' committed jsons
-(``docs/figures/``: the wet ensemble, MD on two ranks, the silica slab's lateral stress). It reads files (and the
-builder's lattice constant), so the numbers on the page are those of the committed files, and
+(``docs/figures/``: the wet ensemble, the MD engine, MD on two ranks, the silica slab's lateral stress). It reads
+files (and the builder's lattice constant), so the numbers on the page are those of the committed files, and
 ``tests/test_generated_docs.py`` fails when they disagree.
 
     python -m calibration.doc_blocks            # rewrite the marked blocks in place
@@ -100,6 +100,26 @@ def wet_ensemble(path: Path = WET_ENSEMBLE_JSON) -> str:
 
 FIGURES = ROOT / "docs" / "figures"
 RANKS_JSON = FIGURES / "md_ranks_bench.json"
+ENGINE_JSON = FIGURES / "md_engine_bench.json"
+
+
+def md_engine(path: Path = ENGINE_JSON) -> str:
+    """docs/benchmarks.md's in-process against ``lmp -in`` table from ``benchmarks/bench_md_engine.py``'s json: times
+    summed over the repeats, throughput ratio = plain time / in-process time."""
+    data = json.loads(Path(path).read_text())
+    total = {k: sum(r[k] for r in data["rows"]) for k in ("inprocess_loop_s", "plain_loop_s", "inprocess_lammps_wall_s",
+                                                          "plain_wall_s", "inprocess_run_recipe_wall_s")}
+    per = ", ".join(f"{x:.3f}" for x in data["ratio_loop_per_repeat"])
+    rows = [("dynamics (LAMMPS `Loop time`)", total["inprocess_loop_s"], total["plain_loop_s"],
+             f"**{data['ratio_loop']:.3f}** (per repeat {per})"),
+            ("all LAMMPS work (set-up, minimisation, chunk files)", total["inprocess_lammps_wall_s"],
+             total["plain_wall_s"], f"{data['ratio_lammps_wall']:.3f}"),
+            ("the whole `run_recipe` call (plus Python: sample parsing, npz frames, result.json)",
+             total["inprocess_run_recipe_wall_s"], total["plain_wall_s"], f"{data['ratio_whole_run']:.3f}")]
+    lines = [f"| measure | in process (s, {data['repeats']} repeats) | `lmp -in` (s) | throughput ratio in-process / "
+             "plain |", "|---|---|---|---|"]
+    lines += [f"| {name} | {inproc:.2f} | {plain:.2f} | {ratio} |" for name, inproc, plain, ratio in rows]
+    return "\n".join(lines)
 #: ``benchmarks/bench_md_ranks.py``'s case names -> the table's words.
 RANK_CASES = {"one rank": "one rank, in process", "two ranks, default grid": "two ranks, LAMMPS's default grid",
               "two ranks, engine grid": "two ranks, the engine's grid (`processors * * 1`)"}
@@ -157,7 +177,7 @@ def md_lateral_stress(folder: Path = FIGURES) -> str:
 #: page (relative to the repository) -> {block name: renderer}.
 BLOCKS: dict[str, dict[str, Callable[[], str]]] = {
     "docs/md.md": {"md-pulloff-sei": pulloff_sei},
-    "docs/benchmarks.md": {"bench-wet-ensemble": wet_ensemble, "md-ranks": md_ranks,
+    "docs/benchmarks.md": {"bench-wet-ensemble": wet_ensemble, "md-engine": md_engine, "md-ranks": md_ranks,
                            "md-lateral-stress": md_lateral_stress},
 }
 

@@ -65,8 +65,12 @@ def test_the_ensemble_threshold_in_code_is_the_committed_measurement():
 
 
 def test_a_moved_md_benchmark_moves_its_table(tmp_path):
-    """Negative controls for the MD benchmark tables: a moved rank timing, a moved lateral stress (and with it the
-    zero crossing) change the blocks."""
+    """Negative controls for the MD benchmark tables: a moved engine ratio, a moved rank timing, a moved lateral stress
+    (and with it the zero crossing) change the blocks."""
+    engine = json.loads(doc_blocks.ENGINE_JSON.read_text())
+    engine["ratio_loop"] *= 0.9
+    (tmp_path / "engine.json").write_text(json.dumps(engine))
+    assert doc_blocks.md_engine(tmp_path / "engine.json") != doc_blocks.md_engine()
     ranks = json.loads(doc_blocks.RANKS_JSON.read_text())
     ranks["rows"][-1]["dynamics_loop_s"] *= 1.1
     (tmp_path / "ranks.json").write_text(json.dumps(ranks))
