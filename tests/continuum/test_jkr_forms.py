@@ -149,3 +149,16 @@ def test_the_compiled_summit_energy_is_the_reference_energy():
     sphere = JKRSphere(BETA, DGAMMA, ESTAR)
     got = np.array([sphere.stored_energy(-float(x)) for x in deltas[deltas > -dc * (1 - 1e-5)]])
     assert np.all(np.abs(got - expected[deltas > -dc * (1 - 1e-5)]) <= 1e-9 * scale[deltas > -dc * (1 - 1e-5)])
+
+
+def test_the_compiled_jkr_minus_hertz_curve_meets_jkr_at_zero_load():
+    """The GW kernel's JKR-minus-Hertz quantities (compressed summits, s >= 1) plus Hertz give JKR's zero load at
+    JKR's zero-load radius (a^3 = 9 pi dgamma R^2/(2 E*)), in units of P_c and delta_c."""
+    _, a, _ = POINTS[0]
+    a0 = (2.0 * math.pi * DGAMMA * BETA**2 / ESTAR) ** (1 / 3)
+    delta_c = 0.75 * (math.pi**2 * DGAMMA**2 * BETA / ESTAR**2) ** (1 / 3)
+    s = math.sqrt(a / a0)
+    x = _jkr_delta(a) / delta_c
+    hertz_force = 16.0 / 9.0 * (x * jk.D_C) ** 1.5                        # 4/3 E* sqrt(R) delta^1.5 / P_c
+    assert gk._curve_minus_hertz(0, s) + hertz_force == pytest.approx(0.0, abs=1e-12)
+    assert gk._curve_minus_hertz(2, s) + x == pytest.approx(a * a / (BETA * delta_c), rel=1e-12)
