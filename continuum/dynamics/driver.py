@@ -35,6 +35,8 @@ from nanoimpact.interrupt import raise_if_interrupted
 
 from ..laws.base import ContactLaw
 
+_EPS = float(np.finfo(float).eps)
+
 
 @dataclass
 class Bounce:
@@ -279,16 +281,23 @@ class _ContactRun:
         self.length = law.length_scale(mass, speed)
         self.atol = np.array([settings.rtol * self.length, settings.rtol * speed]) * 0.1
         self.timed = law.time_dependent
-        self.pending_times = sorted(t0 + te for te in law.time_events()) if self.timed else []
+        self.event_times = list(law.time_events()) if self.timed else []
+        self.pending_times = sorted(t0 + te for te in self.event_times)
         self.e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
         self.pull_force, self.after_max = math.inf, False
         self.profiles: dict = {}
         self.peak_force = self.max_pen = None
 
     def at(self, s):
-        """Tell a time-dependent law the contact time of the state it evaluates next."""
+        """Tell a time-dependent law the contact time of the state it evaluates next. At a time event (absolute
+        t0 + t_e) the law gets t_e itself: s - t0 rounds to either side of it, and the law changes exactly there
+        (bridges condense on the summits in contact at t_a, and its step limit starts)."""
         if self.timed:
-            self.law.set_time(s - self.t0)
+            tc = s - self.t0
+            for e in self.event_times:
+                if abs(tc - e) <= 4.0 * _EPS * abs(s):
+                    tc = e
+            self.law.set_time(tc)
 
     def rhs(self, _t, y):
         self.at(_t)
