@@ -47,6 +47,32 @@ def case(label: str, overrides: dict, members: int, repeat: int) -> dict:
             "energy_audit_max_relative_error": rec["energy_audit_max_relative_error"]}
 
 
+_LABELS = {"dry_elastic": "dry, elastic summits (plasticity off): the reference",
+           "dry": "dry, the set's summits (silicon yields: plastic)",
+           "humid_nucleation_t_a": "humid, the set's nucleation t_a",
+           "humid_short_t_a": "humid, short t_a: plastic summits, additive bridges (LAW_BRIDGED)",
+           "humid_short_t_a_elastic": "humid, short t_a: elastic summits at W_wet in bridges (LAW_WET_DISCRETE)"}
+
+
+def markdown(result: dict) -> str:
+    """The table docs/benchmarks.md quotes (tests/continuum/test_wet_ensemble_docs.py checks it is this)."""
+    rows = ["| case | CPU s | CPU / elastic dry | per contact / elastic dry | contacts (at t_a: handed over; Python) "
+            "| members with bridges | sticks | energy audit |", "|---|---|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        n = r["contacts"]
+        rows.append(f"| {_LABELS.get(r['case'], r['case'])} | {r['cpu_seconds']:.2f} | "
+                    f"{r['cpu_ratio_to_elastic_dry']:.2f} | {r['cpu_per_contact_ratio_to_elastic_dry']:.2f} | "
+                    f"{r['contacts_run']} ({n['handed_over']}; {n['python']}) | "
+                    f"{r['members_with_bridges']}/{r['members']} | {r['stick_probability_within_run']:.2f} | "
+                    f"{r['energy_audit_max_relative_error']:.1e} |")
+    rows.append("")
+    rows.append(f"Largest CPU ratio of an ensemble with menisci to the elastic dry ensemble: "
+                f"**{result['max_cpu_ratio_with_menisci_to_elastic_dry']:.2f}×** ({result['members']} members, "
+                f"{result['max_bounces']} bounces, short t_a = {result['short_t_a_s']:.3g} s, best of "
+                f"{result['repeat']}).")
+    return "\n".join(rows)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--members", type=int, default=8)
@@ -88,6 +114,7 @@ def main() -> None:
            "short_t_a_s": a.short_ta, "repeat": a.repeat, "rows": rows,
            "max_cpu_ratio_with_menisci_to_elastic_dry": max(r["cpu_ratio_to_elastic_dry"] for r in rows
                                                             if r["case"].startswith("humid"))}
+    print(markdown(out))
     if a.json:
         a.json.write_text(json.dumps(out, indent=2))
 
