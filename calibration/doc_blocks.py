@@ -4,7 +4,7 @@ A page marks each block ``<!-- generated: NAME -->`` ... ``<!-- /generated -->``
 ``md.report_tables``, which renders docs/md.md's result and cost tables); this module renders the blocks that quote
 the pull-off prediction (``docs/figures/pulloff_sei.json``, written by ``benchmarks/pulloff_sei.py``), the
 committed pull-off results (``inputs/md/results/<recipe>-quick/result.json``) and the benchmarks' committed jsons
-(``docs/figures/``: the wet ensemble, the MD engine, MD on two ranks, the silica slab's lateral stress). It reads
+(``docs/figures/``: the MD engine, MD on two ranks, the silica slab's lateral stress). It reads
 files (and the builder's lattice constant), so the numbers on the page are those of the committed files, and
 ``tests/test_generated_docs.py`` fails when they disagree.
 
@@ -77,25 +77,6 @@ def pulloff_sei(sei_json: Path = SEI_JSON, results_dir: Path = RESULTS_DIR) -> s
     return "\n".join(lines)
 
 
-WET_ENSEMBLE_JSON = ROOT / "docs" / "figures" / "bench_wet_ensemble.json"
-
-
-def _sci(x: float) -> str:
-    """Two significant digits in e-notation without a padded exponent (1.1e-4)."""
-    mantissa, exponent = f"{x:.1e}".split("e")
-    return f"{mantissa}e{int(exponent)}"
-
-
-def wet_ensemble(path: Path = WET_ENSEMBLE_JSON) -> str:
-    """docs/benchmarks.md's wet-ensemble table from ``benchmarks/bench_wet_ensemble.py``'s json."""
-    data = json.loads(Path(path).read_text())
-    label = {"dry": "dry (RH = 0)", "humid_nucleation_t_a": "humid, the set's nucleation t_a",
-             "humid_short_t_a": f"humid, t_a = {data['short_t_a_s'] * 1e6:g} µs (bridges in every contact)"}
-    lines = ["| case | wall s | CPU s | CPU / dry | members with bridges | energy audit |", "|---|---|---|---|---|---|"]
-    lines += [f"| {label.get(r['case'], r['case'])} | {r['seconds']:#.3g} | {r['cpu_seconds']:.2f} | "
-              f"{r['cpu_ratio_to_dry']:#.3g} | {r['members_with_bridges']}/{r['members']} | "
-              f"{_sci(r['energy_audit_max_relative_error'])} |" for r in data["rows"]]
-    return "\n".join(lines)
 
 
 FIGURES = ROOT / "docs" / "figures"
@@ -177,7 +158,7 @@ def md_lateral_stress(folder: Path = FIGURES) -> str:
 #: page (relative to the repository) -> {block name: renderer}.
 BLOCKS: dict[str, dict[str, Callable[[], str]]] = {
     "docs/md.md": {"md-pulloff-sei": pulloff_sei},
-    "docs/benchmarks.md": {"bench-wet-ensemble": wet_ensemble, "md-engine": md_engine, "md-ranks": md_ranks,
+    "docs/benchmarks.md": {"md-engine": md_engine, "md-ranks": md_ranks,
                            "md-lateral-stress": md_lateral_stress},
 }
 

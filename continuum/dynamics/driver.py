@@ -35,6 +35,8 @@ from nanoimpact.interrupt import raise_if_interrupted
 
 from ..laws.base import ContactLaw
 
+_EPS = float(np.finfo(float).eps)
+
 
 @dataclass
 class Bounce:
@@ -279,16 +281,23 @@ class _ContactRun:
         self.length = law.length_scale(mass, speed)
         self.atol = np.array([settings.rtol * self.length, settings.rtol * speed]) * 0.1
         self.timed = law.time_dependent
-        self.pending_times = sorted(t0 + te for te in law.time_events()) if self.timed else []
+        self.event_times = list(law.time_events()) if self.timed else []
+        self.pending_times = sorted(t0 + te for te in self.event_times)
         self.e_mech_in = 0.5 * mass * v0 * v0 + mass * gravity * gap0
         self.pull_force, self.after_max = math.inf, False
         self.profiles: dict = {}
         self.peak_force = self.max_pen = None
 
     def at(self, s):
-        """Tell a time-dependent law the contact time of the state it evaluates next."""
+        """Tell a time-dependent law the contact time of the state it evaluates next. At a time event (absolute
+        t0 + t_e) the law gets t_e itself: s - t0 rounds to either side of it, and the law changes exactly there
+        (bridges condense on the summits in contact at t_a, and its step limit starts)."""
         if self.timed:
-            self.law.set_time(s - self.t0)
+            tc = s - self.t0
+            for e in self.event_times:
+                if abs(tc - e) <= 4.0 * _EPS * abs(s):
+                    tc = e
+            self.law.set_time(tc)
 
     def rhs(self, _t, y):
         self.at(_t)
@@ -341,9 +350,22 @@ class _ContactRun:
                                   release=law.release_gap(), bound_is_final=law.bound_is_final,
                                   has_history=law.has_history, samples_per_step=settings.samples_per_step)
         if kernel is not None:
-            done, solver = self._take_kernel(compiled, kernel)
-            if done is not None:
-                return done
+            continued = False
+            while kernel is not None:
+                done, solver = self._take_kernel(compiled, kernel, continued)
+                if done is not None:
+                    return done
+                # a time event: the law may go on compiled from there (bridges on discrete summits after t_a)
+                compiled = law.compiled(self.t0)
+                if compiled is None:
+                    break
+                continued = True
+                kernel = run_compiled(compiled, self.mass, self.gravity, solver.t, solver.y[0], solver.y[1],
+                                      rtol=settings.rtol, atol=self.atol, first_step=1e-3 * self.length / self.speed,
+                                      max_step=law.max_step(self.speed), t_bound=settings.max_time,
+                                      release=law.release_gap(), bound_is_final=law.bound_is_final,
+                                      has_history=law.has_history, samples_per_step=settings.samples_per_step,
+                                      after_max=self.after_max)
         else:
             solver = self.start(self.t0, [self.gap0, self.v0])
             self.at(self.t0)
@@ -352,22 +374,28 @@ class _ContactRun:
             self.sample(self.t0, self.gap0, self.v0)
         return self._step(solver)
 
-    def _take_kernel(self, compiled, kernel):
+    def _take_kernel(self, compiled, kernel, continued=False):
         """Take over what the compiled kernel did: its samples, the profiles the Python stepper takes (at the first
         maximum approach, and at the lowest force after it), and its end; a time event hands the contact back to
-        the Python stepper. Returns (the contact's outcome or None, the stepper to go on with or None)."""
+        the Python stepper. `continued`: the kernel went on from a time event the Python law already sampled
+        (its first sample is that one). Returns (the contact's outcome or None, the stepper to go on with)."""
         law, profiles = self.law, self.profiles
         law.compiled_commit(compiled.S, kernel.last_accept - self.t0)
-        self.record.block(kernel.samples, self.index)
-        self.peak_force, self.max_pen = kernel.peak_force, kernel.max_penetration
-        if kernel.max_approach is not None:
+        if continued:
+            self.record.block(kernel.samples[1:], self.index)
+            self.peak_force = max(self.peak_force, kernel.peak_force)
+            self.max_pen = max(self.max_pen, kernel.max_penetration)
+        else:
+            self.record.block(kernel.samples, self.index)
+            self.peak_force, self.max_pen = kernel.peak_force, kernel.max_penetration
+        if kernel.max_approach is not None and "max_approach" not in profiles:
             te, ge = kernel.max_approach
             self.at(te)
             snap = law.snapshot(ge)
             if snap is not None:
                 profiles["max_approach"] = {"t": te, "gap": ge, "force": law.force(ge), **snap}
             self.after_max = True
-        if kernel.pull_off is not None:
+        if kernel.pull_off is not None and kernel.pull_off[2] < self.pull_force:
             te, ge, fe = kernel.pull_off
             self.at(te)
             snap = law.snapshot(ge)

@@ -28,7 +28,11 @@ import math
 
 import numpy as np
 
-from .wet import MeniscusBridges
+from ..numerics import kernel_laws as kl
+from ..numerics import wet_discrete_kernel as wk
+from ..numerics.compiled_contact import CompiledLaw
+from .wet import MeniscusBridges, WetRoughRoller
+from .wet_summits_compiled import bridge_block, bridge_state, take_back_bridges
 
 
 class DiscreteBridges(MeniscusBridges):
@@ -101,14 +105,57 @@ class DiscreteBridges(MeniscusBridges):
         return int(self._integral("count", gap, s)) if math.isfinite(s) else 0
 
 
+class BridgedDiscreteRoller(WetRoughRoller):
+    """`WetRoughRoller` round a discrete summit law with `DiscreteBridges`, compiled after t_a too.
+
+    The dry law's compiled form (`compiled`) runs the contact up to t_a and stops there; its history at that point
+    (the dry kernel's S: the deepest gap of this contact, for plastic summits with their state before it) and its
+    P and T are kept, so that after the driver has accepted the state at t_a the contact goes on in
+    `continuum.numerics.wet_discrete_kernel.LAW_BRIDGED`: the same dry law, with the bridges' blocks after its own."""
+
+    def reset(self):
+        super().reset()
+        self._inner, self._issued, self._gap_acc = None, None, None
+
+    def accept(self, gap):
+        super().accept(gap)
+        self._gap_acc = gap
+
+    def compiled(self, t0: float):
+        if self.t == 0.0:                    # at touch: the dry form up to t_a
+            form = super().compiled(t0)
+            self._inner, self._issued = form, "dry"
+            return form
+        inner = getattr(self, "_inner", None)
+        if inner is None or getattr(self, "_gap_acc", None) is None:
+            return None
+        u = inner.T[0]
+        src = self.bridges.source
+        if u.size != src.eff.size or not np.array_equal(u, src.eff - src.z_top):
+            return None                     # the kept summits changed since the contact began: Python goes on
+        S = inner.S.copy()
+        kl.law_accept(inner.kind, self._gap_acc, S, inner.P, inner.T)      # the accepted state at t_a
+        B = bridge_block(self.bridges, t0)
+        B[wk.B_INNER], B[wk.B_S] = inner.kind, S.size
+        self._issued = "bridged"
+        return CompiledLaw(wk.LAW_BRIDGED, np.concatenate([inner.P, B]), inner.T,
+                           np.concatenate([S, bridge_state(self.bridges)]))
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        if getattr(self, "_issued", None) != "bridged":
+            super().compiled_commit(state, last_accept)
+            return
+        n = self._inner.S.size
+        self.dry.compiled_commit(state[:n], last_accept)
+        take_back_bridges(self, state[n:], last_accept)
+
+
 def wet_discrete(dry, source, parameters: dict):
     """`dry` (a discrete summit law: `DiscreteRoughRoller`, or plastic summits on its realisation) with a bridge on
     each of `source`'s summits (the elastic discrete law whose kept summits `dry` runs on), by the scene's meniscus
     `parameters` (`continuum.model.regime.meniscus_parameters`)."""
-    from .wet import WetRoughRoller
-
     p = parameters
     bridges = DiscreteBridges(source, p["bridge_pull_off"], p["kelvin_gap"], p["condensation_time"],
                               p["growth_length"], p.get("solid_pull", 0.0))
-    return WetRoughRoller(dry, bridges, {**p, "bridges_on": "each summit of the realisation "
-                                         "(continuum.laws.discrete_bridges)"})
+    return BridgedDiscreteRoller(dry, bridges, {**p, "bridges_on": "each summit of the realisation "
+                                                "(continuum.laws.discrete_bridges)"})

@@ -289,7 +289,10 @@ class WetRoughRoller(ContactLaw):
 
     def compiled(self, t0: float):
         """Before t_a no bridge exists and this law is its dry law: the dry law's compiled form, stopping at t_a
-        (where bridges condense on every summit in contact and this law goes on in Python)."""
+        (where bridges condense on every summit in contact and this law goes on in Python). Asked again after that
+        stop (contact time t > 0; t_a itself up to rounding), it has no compiled form: None."""
+        if self.t > 0.0:
+            return None
         dry = self.dry.compiled(t0)
         if dry is None:
             return None

@@ -21,7 +21,8 @@ dissipation like the bridges' own formation work, so E_kin + E_pot + stored + bo
 that lets go inside its bridge books its wet loop; outside, the dry one.
 
 Rigid substrate only (the bridges see rigid geometry too); before the first bridge the law is its dry law
-(`compiled`: the dry kernel, stopped at t_a by the wrapper).
+(`compiled`: the dry kernel, stopped at t_a by the wrapper), after it the compiled summits with their bridges
+(`continuum.laws.wet_summits_compiled`, `continuum.numerics.wet_discrete_kernel`: the same arithmetic).
 """
 from __future__ import annotations
 
@@ -30,6 +31,7 @@ import numpy as np
 from .discrete_bridges import DiscreteBridges
 from .discrete_roller import DiscreteRoughRoller
 from .wet import WetRoughRoller
+from .wet_summits_compiled import take_back, wet_form
 
 
 class WetSummitRoller(DiscreteRoughRoller):
@@ -242,6 +244,21 @@ class WetDiscreteRoller(WetRoughRoller):
     def accept(self, gap):
         self._sync(gap)
         super().accept(gap)
+
+    def compiled(self, t0: float):
+        """At touch the dry kernel, stopped at t_a; from t_a on (the driver asks again once it has accepted the
+        state at t_a) the summits with their bridges (`continuum.numerics.wet_discrete_kernel`)."""
+        if self.t == 0.0:                    # at touch: the dry form up to t_a
+            self._issued = "dry"
+            return super().compiled(t0)
+        self._issued = "wet"
+        return wet_form(self, t0)
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        if getattr(self, "_issued", "dry") == "wet":
+            take_back(self, state, last_accept)
+        else:
+            super().compiled_commit(state, last_accept)
 
 
 def wet_summit_roller(dry: DiscreteRoughRoller, wet: DiscreteRoughRoller, parameters: dict) -> WetDiscreteRoller:

@@ -83,8 +83,10 @@ class KernelOutcome:
 
 def run_compiled(law_c: CompiledLaw, mass: float, gravity: float, t0: float, gap0: float, v0: float, *,
                  rtol: float, atol: np.ndarray, first_step: float, max_step: float, t_bound: float, release: float,
-                 bound_is_final: bool, has_history: bool, samples_per_step: int) -> KernelOutcome | None:
-    """Integrate one contact compiled; None if the kernel could not (see the module docstring)."""
+                 bound_is_final: bool, has_history: bool, samples_per_step: int,
+                 after_max: bool = False) -> KernelOutcome | None:
+    """Integrate one contact compiled; None if the kernel could not (see the module docstring). `after_max`: the
+    contact passed its maximum approach before t0 (a continuation after a stop time)."""
     size = FIRST_BUFFER_SAMPLES
     info = np.zeros(ck.INFO_SIZE)
     while True:
@@ -94,7 +96,7 @@ def run_compiled(law_c: CompiledLaw, mass: float, gravity: float, t0: float, gap
                                        float(gap0), float(v0), float(rtol), np.asarray(atol, float),
                                        float(first_step), float(max_step), float(t_bound), float(release),
                                        bool(bound_is_final), bool(has_history), int(samples_per_step),
-                                       float(law_c.t_stop), buf, info))
+                                       float(law_c.t_stop), buf, info, bool(after_max)))
         if end == ck.ABORT_BUFFER and size < MAX_BUFFER_SAMPLES:
             size *= 4
             continue

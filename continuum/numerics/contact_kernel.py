@@ -26,7 +26,9 @@ Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid rough roller's footprint
 or, `LAW_DISCRETE_BRANCH`, of tabulated branches of any summit law; `LAW_PLASTIC`: elastic-plastic summits,
 `continuum.rough.plastic_kernel`; `LAW_POWER`: F = k (-h)^n, Hertz, to validate the integrator against closed forms)
 give parameters `P`, tables `T` (a tuple of arrays) and a history `S` that the kernel updates in place; their
-compiled force and energies live in `continuum.numerics.kernel_laws` (re-exported here).
+compiled force and energies live in `continuum.numerics.kernel_laws` (re-exported here). One law depends on time:
+`wet_discrete_kernel.LAW_WET_DISCRETE` (discrete summits with a capillary bridge each, after t_a), so the kernel
+evaluates every law at the stage's time (`_force`, ..., as SciPy's stepper calls the driver's right-hand side).
 
 Where the compiled law cannot evaluate a state (deeper than its tables, where the Python law
 evaluates its integral directly) or a buffer is full, the kernel returns a status saying so, and
@@ -40,7 +42,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .dop853_tableau import E3, E5, A, B, D
+from . import wet_discrete_kernel as wk
+from .dop853_tableau import E3, E5, A, B, C, D
 from .kernel_laws import (
     LAW_POWER,
     S_BEYOND_FLAG,
@@ -66,11 +69,50 @@ _ERROR_EXPONENT = -1.0 / 8.0          # -1/(error estimator order + 1), order 7 
 _EPS = np.finfo(float).eps
 
 
+# ----------------------------------------------------------------------------- the law at time t
+@njit(cache=True)
+def _force(kind, t, gap, S, P, T):
+    """`kernel_laws.law_force`, and the time-dependent law (`wet_discrete_kernel`) at absolute time t."""
+    if kind == wk.LAW_WET_DISCRETE:
+        return wk.wet_value(0, t, gap, S, P, T)
+    if kind == wk.LAW_BRIDGED:
+        return wk.bridged_value(0, t, gap, S, P, T)
+    return law_force(kind, gap, S, P, T)
+
+
+@njit(cache=True)
+def _stored(kind, t, gap, S, P, T):
+    if kind == wk.LAW_WET_DISCRETE:
+        return wk.wet_value(1, t, gap, S, P, T)
+    if kind == wk.LAW_BRIDGED:
+        return wk.bridged_value(1, t, gap, S, P, T)
+    return law_stored(kind, gap, S, P, T)
+
+
+@njit(cache=True)
+def _dissipated(kind, t, gap, S, P, T):
+    if kind == wk.LAW_WET_DISCRETE:
+        return wk.wet_value(2, t, gap, S, P, T)
+    if kind == wk.LAW_BRIDGED:
+        return wk.bridged_value(2, t, gap, S, P, T)
+    return law_dissipated(kind, gap, S, P, T)
+
+
+@njit(cache=True)
+def _accept(kind, t, gap, S, P, T):
+    if kind == wk.LAW_WET_DISCRETE:
+        wk.wet_accept(t, gap, S, P, T)
+    elif kind == wk.LAW_BRIDGED:
+        wk.bridged_accept(t, gap, S, P, T)
+    else:
+        law_accept(kind, gap, S, P, T)
+
+
 # ----------------------------------------------------------------------------- DOP853
 @njit(cache=True)
-def _rhs(kind, gap, v, S, P, T, mass, gravity, out, row):
+def _rhs(kind, t, gap, v, S, P, T, mass, gravity, out, row):
     out[row, 0] = v
-    out[row, 1] = law_force(kind, gap, S, P, T) / mass - gravity
+    out[row, 1] = _force(kind, t, gap, S, P, T) / mass - gravity
 
 
 @njit(cache=True)
@@ -99,7 +141,7 @@ def _step(kind, S, P, T, mass, gravity, t, y, K, h_abs, max_step, rtol, atol, t_
             for j in range(s):
                 d0 += K[j, 0] * A[s, j]
                 d1 += K[j, 1] * A[s, j]
-            _rhs(kind, y[0] + d0 * h, y[1] + d1 * h, S, P, T, mass, gravity, K, s)
+            _rhs(kind, t + C[s] * h, y[0] + d0 * h, y[1] + d1 * h, S, P, T, mass, gravity, K, s)
         b0 = 0.0
         b1 = 0.0
         for j in range(12):
@@ -107,7 +149,7 @@ def _step(kind, S, P, T, mass, gravity, t, y, K, h_abs, max_step, rtol, atol, t_
             b1 += K[j, 1] * B[j]
         y_new[0] = y[0] + h * b0
         y_new[1] = y[1] + h * b1
-        _rhs(kind, y_new[0], y_new[1], S, P, T, mass, gravity, K, 12)
+        _rhs(kind, t_new, y_new[0], y_new[1], S, P, T, mass, gravity, K, 12)
         evals += 12
         e5n = 0.0
         e3n = 0.0
@@ -145,7 +187,7 @@ def _dense_coefficients(kind, S, P, T, mass, gravity, t_old, y_old, y_new, K, h,
         for j in range(s):
             d0 += K[j, 0] * A[s, j]
             d1 += K[j, 1] * A[s, j]
-        _rhs(kind, y_old[0] + d0 * h, y_old[1] + d1 * h, S, P, T, mass, gravity, K, s)
+        _rhs(kind, t_old + C[s] * h, y_old[0] + d0 * h, y_old[1] + d1 * h, S, P, T, mass, gravity, K, s)
     for c in range(2):
         dy = y_new[c] - y_old[c]
         F[0, c] = dy
@@ -244,13 +286,13 @@ def _sample(kind, S, P, T, buf, n, t, gap, v, pull, after_max):
     """Record a sample (the driver's `sample`); track the lowest force after the maximum approach."""
     if n >= buf.shape[0]:
         return n + 1
-    f = law_force(kind, gap, S, P, T)
+    f = _force(kind, t, gap, S, P, T)
     buf[n, 0] = t
     buf[n, 1] = gap
     buf[n, 2] = v
     buf[n, 3] = f
-    buf[n, 4] = law_stored(kind, gap, S, P, T)
-    buf[n, 5] = law_dissipated(kind, gap, S, P, T)
+    buf[n, 4] = _stored(kind, t, gap, S, P, T)
+    buf[n, 5] = _dissipated(kind, t, gap, S, P, T)
     buf[n, 6] = 0.0
     if after_max and f < pull[2]:
         pull[0] = t
@@ -319,7 +361,7 @@ def _release(kind, S, P, T, buf, n, te, release, v_e, pull, after_max, info):
     """The release event: a sample at the release gap, then the instant after (no force, nothing stored, the
     law's loss booked as dissipated); the end state and the loss go to `info`. Returns the sample count."""
     n = _sample(kind, S, P, T, buf, n, te, release, v_e, pull, after_max)
-    loss = law_dissipated(kind, release, S, P, T)
+    loss = _dissipated(kind, te, release, S, P, T)
     if n < buf.shape[0]:
         buf[n, 0] = te
         buf[n, 1] = release
@@ -355,7 +397,7 @@ def _on_events(kind, S, P, T, mass, gravity, F, t_prev, h, y_old, ne_, ev_t, ev_
             break
         if kind_e == 0 or kind_e == 3:
             max_pen = max(max_pen, -g_e)
-            peak = max(peak, law_force(kind, g_e, S, P, T))
+            peak = max(peak, _force(kind, te, g_e, S, P, T))
             n = _sample(kind, S, P, T, buf, n, te, g_e, 0.0, pull, after_max)
             if kind_e == 0 and info[I_HAS_MAX] == 0.0:
                 info[I_MAX_T] = te
@@ -363,18 +405,18 @@ def _on_events(kind, S, P, T, mass, gravity, F, t_prev, h, y_old, ne_, ev_t, ev_
                 info[I_HAS_MAX] = 1.0
             if kind_e == 0:
                 after_max = True
-            law_accept(kind, g_e, S, P, T)
+            _accept(kind, te, g_e, S, P, T)
             last_accept = te
             if has_history:
                 restart = True
                 rt, rg = te, g_e
         if kind_e == 3 and bound_is_final:
-            if law_force(kind, g_e, S, P, T) < mass * gravity or gravity == 0.0:
+            if _force(kind, te, g_e, S, P, T) < mass * gravity or gravity == 0.0:
                 end = END_STUCK
             else:
                 end = END_REST
             info[I_T], info[I_GAP], info[I_V] = te, g_e, 0.0
-            info[I_BOOKED] = law_dissipated(kind, g_e, S, P, T)
+            info[I_BOOKED] = _dissipated(kind, te, g_e, S, P, T)
             break
         if kind_e == 1:
             n = _release(kind, S, P, T, buf, n, te, release, v_e, pull, after_max, info)
@@ -387,13 +429,14 @@ def _on_events(kind, S, P, T, mass, gravity, F, t_prev, h, y_old, ne_, ev_t, ev_
 
 @njit(cache=True)
 def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, first_step, max_step, t_bound,
-                      release, bound_is_final, has_history, samples_per_step, t_stop, buf, info):
+                      release, bound_is_final, has_history, samples_per_step, t_stop, buf, info, after_max0):
     """One contact from touch (t0, gap0, v0): the driver's `_contact` loop, compiled.
 
     Fills `buf` (samples, SAMPLE_COLUMNS) and `info` (INFO_SIZE slots: how it ended, where, peak force,
     largest approach, booked loss, the maximum approach and the pull-off sample); updates the law's
     history S. `t_stop` (absolute s, inf for none): a time at which the law's force jumps; the kernel
     returns END_STOP_TIME with the state there, unsampled and unaccepted (the caller's law does both).
+    `after_max0`: the contact went through its maximum approach before t0 (a contact continued after a stop).
     """
     K = np.zeros((16, 2))
     y = np.array([gap0, v0])
@@ -404,12 +447,12 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
     for i in range(INFO_SIZE):
         info[i] = 0.0
     S[S_BEYOND_FLAG] = 0.0 if kind != LAW_POWER else S[S_BEYOND_FLAG]
-    after_max = False
+    after_max = after_max0
     t = t0
-    _rhs(kind, y[0], y[1], S, P, T, mass, gravity, K, 0)
+    _rhs(kind, t, y[0], y[1], S, P, T, mass, gravity, K, 0)
     evals = 1
     h_abs = min(first_step, max_step)
-    peak = law_force(kind, gap0, S, P, T)
+    peak = _force(kind, t0, gap0, S, P, T)
     max_pen = -gap0
     n = _sample(kind, S, P, T, buf, 0, t0, gap0, v0, pull, after_max)
     last_accept = t0
@@ -457,14 +500,14 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
             t = rt
             y[0] = rg
             y[1] = 0.0
-            _rhs(kind, y[0], y[1], S, P, T, mass, gravity, K, 0)
+            _rhs(kind, t, y[0], y[1], S, P, T, mass, gravity, K, 0)
             evals += 1
             h_abs = min(first_step, max_step)
             continue
         max_pen = max(max_pen, -y[0])
-        peak = max(peak, law_force(kind, y[0], S, P, T))
+        peak = max(peak, _force(kind, t1, y[0], S, P, T))
         n = _sample(kind, S, P, T, buf, n, t1, y[0], y[1], pull, after_max)
-        law_accept(kind, y[0], S, P, T)
+        _accept(kind, t1, y[0], S, P, T)
         last_accept = t1
         # FSAL: the next step starts from f(t1, y1)
         K[0, 0] = K[12, 0]
