@@ -84,7 +84,8 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         result["warnings"] += band["warnings"]
     if condensation_sweep and menisci_decision(scene, regime).choice != "off":
         from .wet_sweep import condensation_sweep as sweep
-        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers, rerun=run_impact)
+        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers, rerun=run_impact,
+                                                          regime=regime)
         result["timing"]["wall_s"] = time.perf_counter() - start
     return ImpactResult.from_record(result, run.trace.arrays(), regime)
 

@@ -10,6 +10,7 @@ below `regime_of` are the derivations it is made of (pure functions of the scene
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any, Mapping
@@ -19,7 +20,7 @@ from ..rough.datum import tallest_summit
 from ..rough.summits import SummitStatistics
 from ..scene import Scene
 from ..wet import menisci as men
-from . import regimes
+from . import factory, regimes
 from .estimates import RoughImpactEstimate, rough_impact_estimate
 
 
@@ -129,10 +130,15 @@ def impact_estimate(scene: Scene, speed: float, e_star: float) -> RoughImpactEst
     deflection span."""
     body, rough = scene.body, scene.surfaces.roughness
     datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
+    start = time.perf_counter()
+    stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
+    surface = factory.averaged_surface(stats, work_of_adhesion=0.0, summit_e_star=e_star, z_max=datum["z_max"],
+                                       resolution="fast")
+    law = factory.rigid_roller(surface, body.radius, body.length, resolution="fast")
     # beyond the averaged model's range the depth search refuses the scene (SceneError, continuum.laws.costs)
-    return rough_impact_estimate(SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius),
-                                 e_star, scene.surfaces.e_star, body.radius, body.length,
-                                 datum["z_max"], body.mass, speed, scene.environment.gravity)
+    estimate = rough_impact_estimate(surface, law, scene.surfaces.e_star, body.radius, body.length, body.mass, speed,
+                                     scene.environment.gravity)
+    return replace(estimate, seconds=time.perf_counter() - start)      # the tables' build included
 
 
 def regime_of(scene: Scene, speed: float | None = None) -> Regime:
@@ -187,13 +193,14 @@ def condensation_time(scene: Scene) -> tuple[float, str]:
     return t_a, "nucleation (Szoszkiewicz & Riedo 2005)"
 
 
-def condensation_time_range(scene: Scene) -> dict:
-    """The scene's t_a (s, `condensation_time`) and the range the nucleation estimate allows at the scene's humidity
-    and temperature (`continuum.wet.menisci.nucleation_time_range`: the attempt frequency anywhere in Szoszkiewicz &
-    Riedo's 4-250 GHz), with the inputs it rests on; SI. A 'fixed' t_a is a declared choice: the range is reported
-    beside it, so a reader sees where the declared value sits."""
+def condensation_time_range(scene: Scene, regime: Regime | None = None) -> dict:
+    """The scene's t_a (s: its `regime`'s where a run derived one, else `condensation_time`) and the range the
+    nucleation estimate allows at the scene's humidity and temperature (`continuum.wet.menisci.nucleation_time_range`:
+    the attempt frequency anywhere in Szoszkiewicz & Riedo's 4-250 GHz), with the inputs it rests on; SI. A 'fixed'
+    t_a is a declared choice: the range is reported beside it, so a reader sees where the declared value sits."""
     env = scene.environment
-    t_a, source = condensation_time(scene)
+    t_a, source = (condensation_time(scene) if regime is None else
+                   (regime.condensation_time, regime.condensation_time_source))
     rh, temp = env.relative_humidity, env.temperature
     lo, hi = men.nucleation_time_range(rh, temp)
     return {"condensation_time_s": t_a, "source": source, "nucleation_s": men.nucleation_condensation_time(rh, temp),
