@@ -68,12 +68,14 @@ class Regime:
     """The coated summits' record (`coated_summits`), None without a SAM layer modulus or for smooth contact."""
     meniscus: Mapping[str, Any] | None = field(default=None, compare=False)
     """The menisci's parameters (`meniscus_record`): Kelvin gap, bridge pull, t_a, growth length, ...; None where
-    no Kelvin radius exists (RH outside (0, 1)); `meniscus_parameters` refuses that case."""
+    no Kelvin radius exists (RH outside (0, 1)) or a face has no water contact angle; `meniscus_parameters` refuses
+    that case."""
 
     def meniscus_parameters(self) -> Mapping[str, Any]:
         """The menisci's parameters; ValueError where no Kelvin radius exists (RH outside (0, 1))."""
         if self.meniscus is None:
-            raise ValueError("relative_humidity must be in (0, 1) for a finite Kelvin radius (menisci)")
+            raise ValueError("menisci need 0 < relative_humidity < 1 (a finite Kelvin radius) and both faces' water "
+                             "contact angles")
         return self.meniscus
 
 
@@ -158,7 +160,8 @@ def regime_of(scene: Scene, speed: float | None = None) -> Regime:
     t_a, t_src = condensation_time(scene)
     r_k, cutoff, cutoff_src = kelvin_radius_cutoff(scene)
     w_sl = solid_liquid_works(scene)
-    meniscus = (None if r_k is None else
+    # a bridge needs a Kelvin radius (0 < RH < 1) and both faces' water contact angles (required where menisci run)
+    meniscus = (None if r_k is None or None in surf.contact_angles else
                 MappingProxyType(meniscus_record(scene, r_k, t_a, t_src, cutoff, cutoff_src, w_sl)))
     return Regime(
         rough=rough, radius=beta, e_star=e_s, substrate_e_star=e_sub, work_of_adhesion=w, interaction_range=z0,

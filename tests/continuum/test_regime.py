@@ -125,6 +125,18 @@ def test_rough_summits_regime_is_its_closed_forms_and_the_old_derivations():
     assert (r.condensation_time, r.condensation_time_source) == regime_module.condensation_time(scene)
 
 
+def test_a_humid_scene_without_contact_angles_has_a_kelvin_radius_and_no_meniscus():
+    """jkr_sphere's `silica` set gives no water contact angles: with menisci off, humid air derives r_K but no
+    bridge (before, nothing derived them for a scene whose menisci are off)."""
+    scene = resolve_scene("jkr_sphere", overrides={"environment.relative_humidity": 0.4, "physics.menisci": "off"},
+                          override_label="test").scene
+    assert scene.surfaces.contact_angles == (None, None)
+    r = regime_module.regime_of(scene, 0.15)
+    assert r.kelvin_radius > 0 and r.meniscus is None
+    with pytest.raises(ValueError, match="contact angles"):
+        r.meniscus_parameters()
+
+
 def test_a_humid_regime_holds_the_kelvin_radius_and_the_meniscus_record():
     """afm_tip_humidity (40 % RH): r_K = gamma V_m / (R T ln(1/RH)) by hand; the meniscus record is the one the
     reader's shortcut gives."""
