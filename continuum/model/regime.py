@@ -71,12 +71,25 @@ class Regime:
     no Kelvin radius exists (RH outside (0, 1)) or a face has no water contact angle; `meniscus_parameters` refuses
     that case."""
 
+    def __reduce__(self):
+        """Pickled (an ensemble's members carry the regime to other processes) with its read-only mappings as
+        dicts, made read-only again on arrival."""
+        state = dict(vars(self))
+        state.update({k: None if state[k] is None else dict(state[k]) for k in ("coated", "meniscus")})
+        return _regime_from_state, (state,)
+
     def meniscus_parameters(self) -> Mapping[str, Any]:
         """The menisci's parameters; ValueError where no Kelvin radius exists (RH outside (0, 1))."""
         if self.meniscus is None:
             raise ValueError("menisci need 0 < relative_humidity < 1 (a finite Kelvin radius) and both faces' water "
                              "contact angles")
         return self.meniscus
+
+
+def _regime_from_state(state: dict) -> Regime:
+    """The `Regime` of a pickled `state` (`Regime.__reduce__`)."""
+    return Regime(**{**state, **{k: None if state[k] is None else MappingProxyType(state[k])
+                                 for k in ("coated", "meniscus")}})
 
 
 def substrate_e_star(scene: Scene) -> float:

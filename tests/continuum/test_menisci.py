@@ -216,7 +216,7 @@ def test_condensation_time_is_computed_once_for_every_record(rh):
     from types import SimpleNamespace
 
     from continuum.dynamics.impact import regime_numbers
-    from continuum.model.regime import condensation_time
+    from continuum.model.regime import condensation_time, regime_of
 
     scene = _scene(**{"menisci.condensation_model": "nucleation", "environment.relative_humidity": rh,
                       "impact_velocity": 1e-3,          # saturation is refused with menisci on (Kelvin radius)
@@ -228,7 +228,8 @@ def test_condensation_time_is_computed_once_for_every_record(rh):
     else:
         assert t_a == men.nucleation_condensation_time(rh, scene.environment.temperature) and math.isfinite(t_a)
     run = SimpleNamespace(bounces=[])
-    assert regime_numbers(scene, {}, run)["condensation_time_s"] == t_a
+    assert regime_of(scene).condensation_time == t_a
+    assert regime_numbers(scene, regime_of(scene), {}, run)["condensation_time_s"] == t_a
     if rh > 0.0 and rh < 1.0:
         from continuum.model.regime import meniscus_parameters
         assert meniscus_parameters(scene)["condensation_time"] == t_a

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import pickle
 import sys
 
 import pytest
@@ -123,6 +124,7 @@ def test_rough_summits_regime_is_its_closed_forms_and_the_old_derivations():
     assert (again.depth, again.contacts, again.peak_force) == (r.estimate.depth, r.estimate.contacts,
                                                                r.estimate.peak_force)   # deterministic: same code
     assert (r.condensation_time, r.condensation_time_source) == regime_module.condensation_time(scene)
+    assert pickle.loads(pickle.dumps(r)) == r
 
 
 def test_a_humid_scene_without_contact_angles_has_a_kelvin_radius_and_no_meniscus():
@@ -152,6 +154,10 @@ def test_a_humid_regime_holds_the_kelvin_radius_and_the_meniscus_record():
         regime_module.kelvin_radius_cutoff(scene)
     with pytest.raises(TypeError):
         r.meniscus["kelvin_radius"] = 0.0          # read-only: the regime is frozen through and through
+    back = pickle.loads(pickle.dumps(r))           # an ensemble's members carry it to other processes
+    assert back == r and dict(back.meniscus) == dict(r.meniscus) and back.estimate == r.estimate
+    with pytest.raises(TypeError):
+        back.meniscus["kelvin_radius"] = 0.0
 
 
 def test_run_impact_returns_the_typed_result_whose_record_is_result_json(tmp_path):
