@@ -171,3 +171,18 @@ def test_run_impact_returns_the_typed_result_whose_record_is_result_json(tmp_pat
     run.write_record(tmp_path)
     written = json.loads((tmp_path / "result.json").read_text())
     assert written == json.loads(dumps(run.to_dict()))          # the same record the command line writes
+
+
+def test_the_api_builds_a_runs_law_again_on_its_regime_without_deriving(counted):
+    """calibration's escape search: `contact_law(resolved, result.regime)` derives nothing; a single impact on it at
+    the first-impact speed is the run's first bounce (same law, same integrator)."""
+    from continuum.api import contact_law, load_scene, run_scene, single_impact
+
+    resolved = load_scene("hertz_roller", overrides={"numerics.max_bounces": 1})
+    result = run_scene(resolved)
+    assert counted["regime_of"] == 1
+    law = contact_law(resolved, result.regime)
+    assert counted["regime_of"] == 1
+    sc = resolved.scene
+    first = single_impact(law, sc.body.mass, sc.environment.gravity, result.regime.speed, sc.numerics.rtol)
+    assert first.bounces[0].restitution == pytest.approx(result.bounces[0].restitution, rel=1e-6, abs=0)
