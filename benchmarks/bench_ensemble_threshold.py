@@ -41,7 +41,7 @@ def point(height: float, members: int, executor: str) -> dict:
                              override_label="threshold sweep")
     h0 = resolved.scene.release_height
     t = time.perf_counter()
-    rec, _ = run_impact(resolved)
+    rec = run_impact(resolved).to_dict()
     t_mf = time.perf_counter() - t
     b = rec["bounces"][0]
     mf = (b["rebound_height"] or 0.0) / h0

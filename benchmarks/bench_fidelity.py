@@ -33,7 +33,7 @@ def main(argv=None):
         for preset in ("reference", "standard", "fast"):
             resolved = resolve_case(CASES[name], args.params, preset)
             start = time.perf_counter()
-            result, _ = run_impact(resolved)
+            result = run_impact(resolved).to_dict()
             runs[preset] = (result, time.perf_counter() - start)
         ref = runs["reference"][0]
         h_ref, t_ref = rebounds(ref)[0] if rebounds(ref) else None, ref["bounces"][0]["duration"]

@@ -34,7 +34,7 @@ def main(argv=None):
         times = []
         for _ in range(args.repeat):
             start = time.perf_counter()
-            result, _ = run_impact(resolved)
+            result = run_impact(resolved).to_dict()
             times.append(time.perf_counter() - start)
         n = result["n_bounces"]
         print(f"{label:40s} {n:7d} {min(times):9.4f} {statistics.median(times):9.4f} "

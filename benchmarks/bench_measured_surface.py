@@ -59,7 +59,7 @@ def main() -> None:
     load_before = os.getloadavg()[0]
     cpu, start = cpu_seconds(), time.perf_counter()
     resolved = resolve_scene("rough_topography", overrides=overrides, override_label="bench")
-    result, _ = run_impact(resolved, executor=args.executor, workers=args.workers)
+    result = run_impact(resolved, executor=args.executor, workers=args.workers).to_dict()
     wall = time.perf_counter() - start
     ens = result.get("ensemble") or {}
     band = result["surface"].get("cutoff_band") or []

@@ -35,7 +35,7 @@ def _time(path, overrides, repeat):
     best, result = float("inf"), None
     for _ in range(repeat):
         start = time.perf_counter()
-        result, _ = run_impact(resolved)
+        result = run_impact(resolved).to_dict()
         best = min(best, time.perf_counter() - start)
     return best, result
 

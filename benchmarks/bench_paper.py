@@ -303,7 +303,7 @@ def per_bounce(repeat: int) -> list[tuple[int, float, int]]:
         holder = {}
 
         def once():
-            holder["r"] = run_impact(resolved)[0]
+            holder["r"] = run_impact(resolved).to_dict()
 
         rows.append((n, _best(once, repeat), holder["r"]["n_bounces"]))
     return rows

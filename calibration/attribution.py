@@ -148,7 +148,7 @@ def _base_origin(base: str | None) -> dict:
         return {}
     import tomllib
 
-    from continuum.scene import find_params
+    from continuum.api import find_params
 
     return dict((tomllib.loads(find_params(base).read_text()).get("meta") or {}).get("origin") or {})
 
@@ -210,7 +210,7 @@ def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]]
     OUT/paper/ (no figures). Returns {"reverts": [...], "claims": [ClaimWhy.to_dict()...], "ran": bool,
     "acceptance": `acceptance`'s entries, "choices": {claim: probe}}: with `set_path` (the set's file), Fig 4's
     loop claim that fails is probed over its declared choices (continuum.paper.loop_probe)."""
-    from continuum.paper.report import make_paper
+    from continuum.api import make_paper
 
     checks = list(paper_checks)
     cal = [c for c in checks if c["set"] == set_name]
@@ -234,7 +234,7 @@ def attribute_claims(table: Mapping[str, Any], rows: Iterable[Mapping[str, Any]]
     whys = explain_claims(cal, base, by_revert, groups)
     choices = {}
     if set_path is not None and any(c["name"] == LOOP_CLAIM and not c["pass"] for c in cal):
-        from continuum.paper.loop_probe import fig4_choice_probe
+        from continuum.api import fig4_choice_probe
 
         origin = (table.get("meta") or {}).get("origin") or {}
         choices[LOOP_CLAIM] = dict(fig4_choice_probe(str(set_path)), origins={

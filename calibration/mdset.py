@@ -68,9 +68,7 @@ from calibration.sam_layer import (
     young_with_nu,
 )
 from calibration.validation import VALIDATION, pulloff_validation
-from continuum.origins import check_origins
-from continuum.scene import SceneError, check_value, find_params, flatten
-from continuum.schema import FIELD_BY_PATH
+from continuum.api import FIELD_BY_PATH, SceneError, check_origins, check_value, find_params, flatten
 from nanoimpact import data
 from nanoimpact.fileio import atomic_write_text
 

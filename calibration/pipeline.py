@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
+from continuum.api import FIELD_BY_PATH as SCENE_FIELDS
 from nanoimpact import data
 from nanoimpact.errors import DataNotFound, InputError
 from nanoimpact.executors import Failure, executor
@@ -226,7 +226,7 @@ def _read_recipe(spec: str | Path) -> tuple[Path, dict]:
 
 def _find_set(spec: str, key: str, recipe: Path) -> Path:
     """The parameter set `spec` names (found as `_locate` finds it) after checking it reads; `key` names it."""
-    from continuum.scene import SceneError, find_params, read_toml
+    from continuum.api import SceneError, find_params, read_toml
 
     try:
         found = _locate(find_params, spec, recipe)
@@ -238,7 +238,7 @@ def _find_set(spec: str, key: str, recipe: Path) -> Path:
 
 def _check_uncertainty(unc, path: Path, base: str, base_file: Path) -> Uncertainty:
     """`[uncertainty]` checked key by key, then the scene resolved at both ends of the ranges."""
-    from continuum.scene import SceneError, find_scene
+    from continuum.api import SceneError, find_scene
 
     origin = str(path)
     if not isinstance(unc, dict):
@@ -266,8 +266,7 @@ def _check_uncertainty(unc, path: Path, base: str, base_file: Path) -> Uncertain
 
 def _check_ranges(ranges: dict, origin: str) -> dict:
     """`uncertainty.ranges`: real-valued scene keys, each [low, high] with both ends allowed."""
-    from continuum.scene import SceneError, check_value
-    from continuum.schema import FIELD_BY_PATH
+    from continuum.api import FIELD_BY_PATH, SceneError, check_value
 
     for key, rng in ranges.items():
         where, f = f"uncertainty.ranges.{key}", FIELD_BY_PATH.get(key)
@@ -290,8 +289,7 @@ def _check_ranges(ranges: dict, origin: str) -> dict:
 
 def _check_overrides(overrides: dict, ranges: dict, origin: str) -> dict:
     """`uncertainty.overrides`: scene keys with allowed values, none of them the set, the bounces or a range."""
-    from continuum.scene import SceneError, check_value
-    from continuum.schema import FIELD_BY_PATH
+    from continuum.api import FIELD_BY_PATH, SceneError, check_value
 
     for key, value in overrides.items():
         where = f"uncertainty.overrides.{key}"
@@ -311,12 +309,12 @@ def _check_overrides(overrides: dict, ranges: dict, origin: str) -> dict:
 def _resolve_at_range_ends(scene_file, scene_spec, base, base_file, ranges, overrides, max_bounces, origin) -> None:
     """The uncertainty scene resolves with the base set and the overrides at both ends of the ranges, so the
     scene's cross-key rules apply to the samples too."""
-    from continuum.scene import SceneError, resolve_scene
+    from continuum.api import SceneError, load_scene
 
     for end in ((0, 1) if ranges else (0,)):
         trial = {**overrides, **{k: r[end] for k, r in ranges.items()}, "numerics.max_bounces": max_bounces}
         try:
-            resolve_scene(scene_file, params=str(base_file), overrides=trial, override_label="uncertainty")
+            load_scene(scene_file, params=str(base_file), overrides=trial, override_label="uncertainty")
         except SceneError as exc:
             at = f", ranges at their {('low', 'high')[end]} ends" if ranges else ""
             inner = "" if exc.origin in ("", "uncertainty", str(scene_file)) else f" ({exc.origin})"
@@ -341,7 +339,7 @@ def _check_md_recipes(origin: str) -> None:
 def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, workers: int | None,
                       scheduler: str | None, paper_sets) -> None:
     """The options of `calibrate`, checked before anything runs or is written (CalibrationError, one line)."""
-    from continuum.scene import SceneError, find_params
+    from continuum.api import SceneError, find_params
     from md.recipe import FIDELITIES
     from nanoimpact.executors import NAMES
 
@@ -486,8 +484,7 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
                                            params_out, progress)
         # 3. the paper's cases
         t = time.perf_counter()
-        from continuum.paper.report import make_paper
-        from continuum.paper.samples import DEFAULT_SEEDS
+        from continuum.api import DEFAULT_SEEDS, make_paper
 
         sets = [cal.base, *[s for s in paper_sets if s != cal.base], str(set_path)]
         keys, samples = sample_inputs(table["meta"].get("calibration", {}), cal.uncertainty.ranges,

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from continuum.schema import FIELD_BY_PATH as SCENE_FIELDS
+from continuum.api import FIELD_BY_PATH as SCENE_FIELDS
 
 
 def latin_hypercube(n: int, dims: int, rng: np.random.Generator) -> np.ndarray:
@@ -78,27 +78,32 @@ def sample_inputs(calibration: dict, ranges: dict, n: int, seed: int) -> tuple[l
 def uncertainty_sample(task: tuple) -> dict:
     """One sample: the scene with the set and the sampled overrides; rebounds and escape velocity. Picklable."""
     scene, params, overrides, max_bounces = task
-    from continuum.dynamics.escape import escape_velocity, single_impact
-    from continuum.dynamics.impact import first_impact_speed, run_impact
-    from continuum.model import select_law
-    from continuum.paper.samples import row_for_scene
-    from continuum.scene import SceneError, resolve_scene
+    from continuum.api import (
+        SceneError,
+        contact_law,
+        escape_velocity,
+        first_impact_speed,
+        load_scene,
+        row_for_scene,
+        run_scene,
+        single_impact,
+    )
 
     try:
         # a SAM's values describe nothing on a scene without one (row_for_scene): left out and said so
         used, left_out = row_for_scene(scene, params, {}, overrides)
         # the sample reads the mean-field trajectory: an ensemble that 'auto' would add goes unread
-        resolved = resolve_scene(scene, params=params, overrides={"surfaces.roughness.mode": "mean_field", **used,
-                                                                  "numerics.max_bounces": max_bounces},
-                                 override_label="uncertainty sample")
-        result, _ = run_impact(resolved)
+        resolved = load_scene(scene, params=params, overrides={"surfaces.roughness.mode": "mean_field", **used,
+                                                               "numerics.max_bounces": max_bounces},
+                              override_label="uncertainty sample")
+        result = run_scene(resolved)
     except (SceneError, ValueError, RuntimeError) as exc:      # refused or failed: counted and reported
         return {"overrides": overrides, "error": str(exc)}
-    h0 = result["scene"]["si"]["release_height"]
-    reb = [b["rebound_height"] or 0.0 for b in result["bounces"]]
+    h0 = result.release_height
+    reb = result.rebound_heights()
     sc = resolved.scene
     v0 = first_impact_speed(resolved)
-    law, _ = select_law(sc, v0)
+    law = contact_law(resolved, result.regime)      # the run's regime: nothing derived again
     esc, esc_error = None, None
     try:
         grid = [v0 * f for f in np.geomspace(0.05, 2.0, 8)]

@@ -26,7 +26,7 @@ SCHEMAS: dict[str, Callable[[], dict]] = {}
 
 
 def _scene() -> dict:
-    from continuum.schema import json_schema
+    from continuum.api import json_schema
     return json_schema()
 
 

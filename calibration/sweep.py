@@ -18,14 +18,13 @@ from __future__ import annotations
 import csv
 import io
 import itertools
-import json
 import logging
 import time
 from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from continuum.scene import SceneError, resolve_scene
+from continuum.api import ImpactResult, SceneError, load_scene, read_result, run_scene
 from nanoimpact.errors import EXIT_OK, EXIT_PARTIAL
 from nanoimpact.executors import Failure, Local, check_executor, executor
 from nanoimpact.fileio import atomic_write_bytes, atomic_write_json, atomic_write_text
@@ -62,23 +61,24 @@ def plan(scene: str, vary: dict[str, list], params: str | None = None) -> list[d
     keys = list(vary)
     for combo in itertools.product(*(vary[k] for k in keys)):
         overrides = dict(zip(keys, combo))
-        resolved = resolve_scene(scene, params=params, overrides=overrides, override_label="sweep")
+        resolved = load_scene(scene, params=params, overrides=overrides, override_label="sweep")
         points.append({"overrides": overrides, "hash": resolved.input_hash})
     return points
 
 
-def _row(result: dict) -> dict:
-    h0 = result["scene"]["si"]["release_height"]
-    b = result["bounces"]
-    reb = [x["rebound_height"] for x in b if x["rebound_height"] is not None]
+def _row(result: ImpactResult) -> dict:
+    h0 = result.release_height
+    b = result.bounces
+    reb = [x.rebound_height for x in b if x.rebound_height is not None]
     above = [r for r in reb if h0 is None or r > 1e-3 * h0]
-    m = result["models"]
-    return {"status": result["status"], "n_bounces": result["n_bounces"], "rebounds_above_1e-3_h0": len(above),
-            "first_rebound_height_m": reb[0] if reb else 0.0, "first_restitution": b[0]["restitution"] if b else None,
-            "longest_contact_s": m.get("regimes", {}).get("longest_contact_s"),
-            "adhesion_law": m.get("adhesion", {}).get("law"), "half_space": m.get("half_space", {}).get("used"),
-            "menisci": m.get("menisci", {}).get("used"), "input_hash": result["provenance"].get("input_hash"),
-            "error": ""}
+    m = result.models
+    adhesion, half_space, menisci = (m.get(name) for name in ("adhesion", "half_space", "menisci"))
+    return {"status": result.status, "n_bounces": result.n_bounces, "rebounds_above_1e-3_h0": len(above),
+            "first_rebound_height_m": reb[0] if reb else 0.0, "first_restitution": b[0].restitution if b else None,
+            "longest_contact_s": result.regimes.get("longest_contact_s"),
+            "adhesion_law": adhesion.numbers.get("law") if adhesion else None,
+            "half_space": half_space.used if half_space else None, "menisci": menisci.used if menisci else None,
+            "input_hash": result.input_hash, "error": ""}
 
 
 def _failed_row(input_hash: str, reason: str) -> dict:
@@ -88,13 +88,9 @@ def _failed_row(input_hash: str, reason: str) -> dict:
 def run_point(task: tuple) -> dict:
     """Run one point (module-level: picklable for process pools and Dask) and write its result.json."""
     scene, params, overrides, folder = task
-    from continuum.dynamics.impact import run_impact
-    from continuum.output.results import write_result_files
-
-    resolved = resolve_scene(scene, params=params, overrides=overrides, override_label="sweep")
-    result, _ = run_impact(resolved)
+    result = run_scene(load_scene(scene, params=params, overrides=overrides, override_label="sweep"))
     Path(folder).mkdir(parents=True, exist_ok=True)
-    write_result_files(folder, result)
+    result.write_record(folder)
     return _row(result)
 
 
@@ -121,7 +117,7 @@ def run_sweep(scene: str, vary: dict[str, list], out: str | Path, *, params: str
     for i, p in enumerate(points):
         folder = out / "points" / p["hash"][:16]
         if (folder / "result.json").is_file():
-            rows[i] = _row(json.loads((folder / "result.json").read_text()))
+            rows[i] = _row(read_result(folder))
         else:
             todo.append((i, (_absolute(scene), _absolute(params), p["overrides"], str(folder.resolve()))))
     progress(f"sweep: {len(points)} points, {len(points) - len(todo)} reused, {len(todo)} to run "

@@ -10,134 +10,58 @@ or a `ResolvedScene` from `continuum.load_scene`. `params` replaces the scene's 
 (a name or a path) and `overrides` ({dotted key: value}, file units) win over everything, as on
 the command line. The result carries the same record as `result.json` (`to_dict()`), typed views
 of it (bounces, model decisions, energy audit) and the time series in SI units.
+
+The other packages (`calibration`) reach continuum through this module and `continuum` alone
+(`tests/test_architecture.py`): besides the names above it offers the scene's keys and checks (`FIELD_BY_PATH`,
+`check_value`, `SceneError`, `find_params`, `find_scene`, `read_toml`, `flatten`, `json_schema`, `check_origins`),
+single impacts and escape velocities on a scene's law (`contact_law`, `single_impact`, `escape_velocity`,
+`first_impact_speed`) and the paper's runs (`make_paper`, `row_for_scene`, `DEFAULT_SEEDS`, `fig4_choice_probe`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-import numpy as np
-
+from .dynamics import impact
 from .dynamics.driver import Bounce
-from .dynamics.impact import run_impact, write_impact
-from .output.results import TIMESERIES_COLUMNS, load_result
+from .dynamics.escape import escape_velocity as escape_velocity
+from .dynamics.escape import single_impact as single_impact
+from .dynamics.impact import first_impact_speed as first_impact_speed
+from .laws.base import ContactLaw
+from .model.regime import Regime
+from .model.select import select_law
+from .origins import check_origins as check_origins
+from .output.impact_result import EnergyAudit, ImpactResult, ModelDecision
+from .output.results import load_result
+from .paper import loop_probe
+from .paper import report as paper_report
+from .paper.samples import DEFAULT_SEEDS as DEFAULT_SEEDS
+from .paper.samples import row_for_scene as row_for_scene
 from .rough.ensemble import EnsembleResult
 from .scene import ResolvedScene, resolve_scene
+from .scene import SceneError as SceneError
+from .scene import check_value as check_value
+from .scene import find_params as find_params
+from .scene import find_scene as find_scene
+from .scene import flatten as flatten
+from .scene import read_toml as read_toml
+from .schema import FIELD_BY_PATH as FIELD_BY_PATH
+from .schema import json_schema as json_schema
 
 __all__ = ["run_scene", "load_scene", "read_result", "ImpactResult", "ModelDecision", "EnergyAudit", "EnsembleResult"]
 
-#: Keys of a model record that say what was decided and why; every other key is a number behind it.
-_DECISION_KEYS = ("used", "decided_by", "why")
-
-
-@dataclass(frozen=True)
-class ModelDecision:
-    """One model choice (adhesion, contact law, menisci, half-space, SAM, free flight): whether it was
-    used, what decided it (`scene`, `estimate`, `geometry`, ...), why in words, and the numbers behind
-    it (Tabor parameter, estimated loss, deflection, ... in SI) as recorded in result.json."""
-
-    name: str
-    used: bool | None
-    decided_by: str | None
-    why: str
-    numbers: Mapping[str, Any] = field(default_factory=dict)
-
-    @classmethod
-    def from_record(cls, name: str, record: Mapping[str, Any]) -> "ModelDecision":
-        numbers = {k: v for k, v in record.items() if k not in _DECISION_KEYS}
-        return cls(name=name, used=record.get("used"), decided_by=record.get("decided_by"),
-                   why=str(record.get("why", "")), numbers=numbers)
-
-
-@dataclass(frozen=True)
-class EnergyAudit:
-    """The run's energy books: the largest error of (kinetic + stored + dissipated) against the first
-    impact's kinetic energy (`max_relative_error`) and against the largest energy turned over."""
-
-    max_relative_error: float
-    reference: str
-    reference_energy: float
-    dissipated_booked: float
-    max_error_over_turnover: float | None = None
-    turnover: float | None = None
-    extra: Mapping[str, Any] = field(default_factory=dict)
-
-    @classmethod
-    def from_record(cls, record: Mapping[str, Any]) -> "EnergyAudit":
-        known = {f.name for f in fields(cls)} - {"extra"}
-        return cls(**{k: record.get(k) for k in known}, extra={k: v for k, v in record.items() if k not in known})
-
-
-@dataclass(frozen=True)
-class ImpactResult:
-    """One impact run. `record` is exactly what result.json holds; the other fields are typed views. `ensemble`:
-    the discrete realisations' distributions where the run had an ensemble (surfaces.roughness.mode), else None;
-    the bounces and trace are then the mean-field run's."""
-
-    record: Mapping[str, Any]
-    bounces: tuple[Bounce, ...]
-    models: Mapping[str, ModelDecision]
-    regimes: Mapping[str, Any]
-    energy_audit: EnergyAudit
-    warnings: tuple[str, ...]
-    trace: Mapping[str, np.ndarray] | None = None
-    ensemble: EnsembleResult | None = None
-
-    @classmethod
-    def from_record(cls, record: Mapping[str, Any], trace: Mapping[str, np.ndarray] | None = None) -> "ImpactResult":
-        models = {name: ModelDecision.from_record(name, rec) for name, rec in record["models"].items()
-                  if name != "regimes" and isinstance(rec, Mapping)}
-        return cls(record=record, bounces=tuple(Bounce(**b) for b in record["bounces"]), models=models,
-                   regimes=dict(record["models"].get("regimes", {})),
-                   energy_audit=EnergyAudit.from_record(record["energy_audit"]),
-                   warnings=tuple(record.get("warnings", ())), trace=trace,
-                   ensemble=(EnsembleResult.from_record(record["ensemble"], record["ensemble"].get("release_height_m"))
-                             if record.get("ensemble") else None))
-
-    @property
-    def n_bounces(self) -> int:
-        return len(self.bounces)
-
-    @property
-    def status(self) -> str:
-        """How the run ended: max_bounces, stuck, rest, max_time, escaped."""
-        return self.record["status"]
-
-    @property
-    def stuck(self) -> bool:
-        return bool(self.record["stuck"])
-
-    @property
-    def scene_name(self) -> str:
-        return self.record["scene"]["values"].get("name", "scene")
-
-    def timeseries(self) -> dict[str, np.ndarray]:
-        """t, gap, velocity, force, phase, energy as NumPy arrays (SI)."""
-        if self.trace is None:
-            raise ValueError("this result has no time series (read it with read_result(DIR) from a written run)")
-        return {name: np.asarray(self.trace[name]) for name, _ in TIMESERIES_COLUMNS}
-
-    def to_dict(self) -> dict[str, Any]:
-        """The result.json record."""
-        return dict(self.record)
-
-    def write(self, out_dir: str | Path) -> Path:
-        """Write result.json, timeseries.csv, height.png and impacts.png atomically into `out_dir`."""
-        if self.trace is None:
-            raise ValueError("this result has no time series to write")
-        return write_impact(out_dir, dict(self.record), dict(self.trace))
-
 
 def load_scene(scene: str | Path | Mapping[str, Any], params: str | Path | None = None,
-               overrides: Mapping[str, Any] | None = None) -> ResolvedScene:
+               overrides: Mapping[str, Any] | None = None,
+               override_label: str = "run_scene overrides") -> ResolvedScene:
     """Read, merge and validate a scene (a shipped name, a path or a TOML table); `SceneError` names the
-    first bad key, its value and what is allowed."""
+    first bad key, its value and what is allowed. `override_label` names where the overrides come from (in error
+    messages and result.json -> scene.sources)."""
     if isinstance(scene, Mapping):
         return resolve_scene(table=dict(scene), params=None if params is None else str(params),
-                             overrides=dict(overrides or {}), override_label="run_scene overrides")
+                             overrides=dict(overrides or {}), override_label=override_label)
     return resolve_scene(scene, params=None if params is None else str(params), overrides=dict(overrides or {}),
-                         override_label="run_scene overrides")
+                         override_label=override_label)
 
 
 def run_scene(scene: str | Path | Mapping[str, Any] | ResolvedScene, params: str | Path | None = None,
@@ -153,8 +77,7 @@ def run_scene(scene: str | Path | Mapping[str, Any] | ResolvedScene, params: str
         resolved = scene
     else:
         resolved = load_scene(scene, params, overrides)
-    record, trace = run_impact(resolved, progress=progress, executor=executor, workers=workers)
-    return ImpactResult.from_record(record, trace)
+    return impact.run_impact(resolved, progress=progress, executor=executor, workers=workers)
 
 
 def read_result(folder: str | Path) -> ImpactResult:
@@ -162,3 +85,23 @@ def read_result(folder: str | Path) -> ImpactResult:
     stored = load_result(folder)
     trace = stored.timeseries() if (Path(folder) / "timeseries.csv").is_file() else None
     return ImpactResult.from_record(dict(stored), trace)
+
+
+def contact_law(resolved: ResolvedScene, regime: Regime | None = None) -> ContactLaw:
+    """The contact law a resolved scene runs at its first impact (`continuum.model.select_law`), on the scene's
+    `regime` where a run derived it already (`ImpactResult.regime`), else derived here. For single impacts at other
+    speeds (`single_impact`, `escape_velocity`)."""
+    return select_law(resolved.scene, first_impact_speed(resolved), regime=regime)[0]
+
+
+def make_paper(sets: list[str], out: str | Path, **options) -> dict:
+    """Run every case of the founding paper for every parameter set in `sets` into `out` and check its claims
+    (`continuum.paper.report.make_paper`, whose keyword `options` it takes: fidelity, executor, seeds, ...);
+    returns {"checks": [...], "wall_s": ...}."""
+    return paper_report.make_paper(sets, out, **options)
+
+
+def fig4_choice_probe(params: str, fidelity: str | None = None) -> dict:
+    """Fig 4's loop ratio under the set `params` and under its declared choices (SAM layer modulus, summit radius;
+    `continuum.paper.loop_probe.fig4_choice_probe`)."""
+    return loop_probe.fig4_choice_probe(params, fidelity)

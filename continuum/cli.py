@@ -107,7 +107,7 @@ def ensemble_summary(ens: dict, surface: dict | None = None) -> str:
 
 
 def cmd_impact(args) -> int:
-    from continuum.dynamics.impact import run_impact, write_impact
+    from continuum.dynamics.impact import run_impact
     from continuum.scene import SceneError, resolve_scene
 
     check_out_dir(args.out)
@@ -132,8 +132,7 @@ def cmd_impact(args) -> int:
             from nanoimpact.executors import executor as make_executor
             ex = make_executor(args.executor, args.workers, args.scheduler)
         try:
-            result, trace = run_impact(resolved, progress=progress, executor=ex or args.executor,
-                                       workers=args.workers)
+            run = run_impact(resolved, progress=progress, executor=ex or args.executor, workers=args.workers)
         finally:
             if ex is not None:
                 ex.close()
@@ -141,7 +140,8 @@ def cmd_impact(args) -> int:
         raise
     except ValueError as exc:            # refusals that need the model (datum, depth range): nothing written
         raise UsageError(f"refused: {exc}") from exc
-    write_impact(out, result, trace)
+    run.write(out)
+    result = run.to_dict()
     print(bounce_table(result["bounces"]))
     audit = result["energy_audit"]["max_relative_error"]
     print(f"status: {result['status']} after {result['n_bounces']} impacts; energy audit max error {audit:.2e}; "

@@ -6,6 +6,7 @@
 - inside continuum, only the model's factory (`continuum.model.factory`) imports a concrete contact law
   (a module of `continuum.laws` that defines a `ContactLaw` subclass); the laws and the model read summit
   surfaces through their declared protocol (`continuum.rough.surface.SummitSurface`), never by `getattr`;
+- calibration reaches continuum only through its public face (`continuum`, `continuum.api`);
 - no module of the project imports another in a circle (function-level imports included);
 - no library module switches matplotlib's backend (`matplotlib.use`) or draws through pyplot.
 """
@@ -168,6 +169,45 @@ def test_the_md_engine_never_imports_a_workflow_or_the_recipe():
            for m, line in _imported_modules(p, known)
            if m in ("md.recipe", "md.workflows") or m.startswith(("md.workflows.", "md.recipe."))]
     assert not bad, "\n".join(bad)
+
+
+# ------------------------------------------------------------------------------------------ public faces
+
+#: The modules of continuum another package may import: the package itself (its lazy front door) and its api.
+CONTINUUM_FACES = {"continuum", "continuum.api"}
+
+
+def _continuum_imports_below_the_face(source: str, label: str, known: set[str]) -> list[str]:
+    """`label:line imports m` for every continuum module the module's `source` imports (function level included)
+    other than the public faces."""
+    bad = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            # `from continuum import model` imports the module continuum.model; `from continuum.api import x` a name
+            names = [f"{node.module}.{a.name}" if f"{node.module}.{a.name}" in known else node.module
+                     for a in node.names]
+        else:
+            continue
+        bad += [f"{label}:{node.lineno} imports {n}" for n in names
+                if (n == "continuum" or n.startswith("continuum.")) and n not in CONTINUUM_FACES]
+    return bad
+
+
+def test_calibration_imports_continuum_only_through_its_public_face():
+    known = set(_all_modules())
+    bad = [hit for path in _modules("calibration")
+           for hit in _continuum_imports_below_the_face(path.read_text(), str(path.relative_to(ROOT)), known)]
+    assert not bad, "\n".join(bad)
+
+
+def test_the_face_scan_sees_a_deep_import_even_inside_a_function():
+    source = ("from continuum.api import run_scene\nimport continuum\nfrom continuum import api\n\n\ndef f():\n"
+              "    from continuum.dynamics.impact import run_impact\n    from continuum import model\n"
+              "    import continuum.scene\n")
+    assert sorted(_continuum_imports_below_the_face(source, "m.py", set(_all_modules()))) == [
+        "m.py:7 imports continuum.dynamics.impact", "m.py:8 imports continuum.model", "m.py:9 imports continuum.scene"]
 
 
 # ------------------------------------------------------------------------------------------ continuum laws

@@ -120,7 +120,8 @@ def test_progress_lines_go_to_stderr_through_logging_and_quiet_silences_them(tmp
     """A real (short) impact: per-impact progress on stderr by default, none with -q; the table on stdout."""
     scene = tmp_path / "short.toml"
     scene.write_text((ROOT / "inputs" / "scenes" / "jkr_sphere.toml").read_text() + "\n")
-    monkeypatch.setattr("continuum.dynamics.impact.write_impact", lambda out, result, trace: None)   # no figures: fast
+    # no figures: fast
+    monkeypatch.setattr("continuum.output.impact_result.write_impact", lambda out, result, trace: None)
     for flags, expect_progress in (([], True), (["-q"], False)):
         assert main([*flags, "impact", str(scene), "--fidelity", "fast", "--out", str(tmp_path / "o")]) == 0
         captured = capsys.readouterr()

@@ -22,7 +22,7 @@ import numpy as np
 from continuum import load_scene
 from continuum.laws.sphere_meniscus import pull_off
 from continuum.model import menisci_decision
-from continuum.model.regime import first_impact_speed, kelvin_radius_cutoff
+from continuum.model.regime import first_impact_speed, regime_of
 from continuum.model.select import select_law
 
 DEFAULT_SCENE = "afm_tip_humidity"
@@ -34,11 +34,12 @@ def pull_off_at(scene, rh: float, overrides: dict | None = None) -> dict:
     resolved = load_scene(scene, overrides={**(overrides or {}), "environment.relative_humidity": rh,
                                             "physics.menisci": "auto"})
     s = resolved.scene
-    decision = menisci_decision(s)
-    r_k, cutoff, _ = kelvin_radius_cutoff(s)
+    regime = regime_of(s, first_impact_speed(s))
+    decision = menisci_decision(s, regime)
+    r_k, cutoff = regime.kelvin_radius, regime.min_kelvin_radius
     row = {"relative_humidity": rh, "kelvin_radius": r_k, "min_kelvin_radius": cutoff,
            "bridge": decision.choice != "off", "decided_by": decision.decided_by, "why": decision.why}
-    law, models = select_law(s, first_impact_speed(s), menisci=decision.choice != "off")
+    law, models = select_law(s, regime.speed, menisci=decision.choice != "off", regime=regime)
     if row["bridge"]:
         q = models["contact_law"]["quasi_static"]
         row.update(pull_off_force=q["pull_off_force"], dry_pull_off_force=q["dry_pull_off_force"],

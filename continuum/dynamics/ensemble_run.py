@@ -74,6 +74,9 @@ class MemberPlan:
     heights: Any = None
     """The summit-height distribution members draw from (`continuum.rough.tail.EmpiricalGPD`); None: Gaussian of
     surfaces.roughness.sigma."""
+    regime: Any = None
+    """The scene's `continuum.model.regime.Regime` at `speed`, shared by every member (a realisation changes none of
+    its numbers)."""
 
 
 def member_plan(scene: Scene, speed: float, heights=None) -> MemberPlan:
@@ -90,7 +93,8 @@ def member_plan(scene: Scene, speed: float, heights=None) -> MemberPlan:
     half = strip_half_width(heights, rough.sigma, rough.summit_density, body.radius, body.length)
     w = scene.surfaces.interface_work_of_adhesion if law != "none" else 0.0
     return MemberPlan(w, regime.e_star, decisions.half_space_decision(scene, regime).used, half, speed,
-                      decisions.summit_law(law, scene) if branch_summits(law) else None, heights)
+                      decisions.summit_law(law, scene, regime.e_star) if branch_summits(law) else None, heights,
+                      regime)
 
 
 def _release(scene: Scene, z_top: float) -> float | None:
@@ -114,7 +118,7 @@ def member_law(scene: Scene, seed: int, plan: MemberPlan) -> tuple[Scene, Any]:
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
     law = factory.discrete_roller(member, stats, plan.work_of_adhesion, plan.summit_e_star, plan.half_space,
                                   plan.footprint_half_width, plan.summit_law, heights=plan.heights)
-    return member, member_summit_law(member, law, plan.speed)
+    return member, member_summit_law(member, law, plan.regime)
 
 
 def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:

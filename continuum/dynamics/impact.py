@@ -1,54 +1,56 @@
-"""Run one impact scene end to end: scene -> law -> driver -> result record (+ figures)."""
+"""Run one impact scene end to end: scene -> regime (derived once) -> law -> driver -> typed result (+ figures)."""
 from __future__ import annotations
 
-import math
 import time
-from pathlib import Path
+from dataclasses import replace
 from typing import Callable
 
 from ..model import dry_run_verdict, select_law
-from ..model.decisions import menisci_decision
-from ..output import plots
+from ..model.decisions import menisci_decision, realisation_decision
+from ..model.regime import Regime, regime_of
+from ..model.regime import first_impact_speed as scene_first_impact_speed
+from ..output.impact_result import ImpactResult
 from ..output.notices import audit_warnings, model_warnings, result_warnings
 from ..output.provenance import provenance
-from ..output.results import SCHEMA_VERSION, write_run
+from ..output.results import SCHEMA_VERSION
 from ..scene import ResolvedScene, SceneError
 from .driver import Bounce, DriverSettings, simulate
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:
-    """Speed (m/s) at the first touch: sqrt(2 g h0) for a release height, else the given velocity."""
-    s = resolved.scene
-    if s.release_height is not None:
-        return math.sqrt(2.0 * s.environment.gravity * s.release_height)
-    return s.impact_velocity
+    """Speed (m/s) at the first touch of a resolved scene (`continuum.model.regime.first_impact_speed`)."""
+    return scene_first_impact_speed(resolved.scene)
 
 
 def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | None = None,
-               executor=None, workers: int | None = None, condensation_sweep: bool = True) -> tuple[dict, dict]:
-    """Simulate a resolved scene; returns (result record for result.json, time-series arrays).
+               executor=None, workers: int | None = None, condensation_sweep: bool = True) -> ImpactResult:
+    """Simulate a resolved scene; returns its typed result (`continuum.output.impact_result.ImpactResult`: the
+    result.json record, its typed views, the time series and the scene's `Regime`).
 
-    Rough contact: surfaces.roughness.mode is settled first (`realisation_decision`; 'auto' by the expected
-    summits in contact). An ensemble runs its members on `executor` (a `nanoimpact.executors` name or an open
-    executor; None: in this process) and adds result.json -> ensemble; the trajectory (bounces, time series) is
-    then the mean-field law's, with the members' summit law, for comparison. A humid scene (menisci not 'off')
-    adds result.json -> menisci_condensation_time, its sticking against t_a over the range the estimate allows
+    The scene's regime (`continuum.model.regime.regime_of`: moduli, Tabor numbers, the first impact's estimate,
+    condensation and meniscus parameters) is derived once here and passed to every step. Rough contact:
+    surfaces.roughness.mode is settled first (`realisation_decision`; 'auto' by the expected summits in contact).
+    An ensemble runs its members on `executor` (a `nanoimpact.executors` name or an open executor; None: in this
+    process) and adds result.json -> ensemble; the trajectory (bounces, time series) is then the mean-field law's,
+    with the members' summit law, for comparison. A humid scene (menisci not 'off') adds result.json ->
+    menisci_condensation_time, its sticking against t_a over the range the estimate allows
     (`continuum.dynamics.wet_sweep`; `condensation_sweep` False leaves it out)."""
     start = time.perf_counter()
-    resolved, realisation = _settle_realisation(resolved)
+    regime = regime_of(resolved.scene, first_impact_speed(resolved))
+    resolved, realisation = _settle_realisation(resolved, regime)
     scene = resolved.scene
-    law, models = select_law(scene, first_impact_speed(resolved))
+    law, models = select_law(scene, regime.speed, regime=regime)
     if realisation is not None:
         models["realisation"] = realisation.record()
     run, release = _simulate(resolved, law, models, progress)
     if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
         # auto menisci, pending: the dry run settles it (continuum.model.decisions.dry_run_verdict)
-        verdict = dry_run_verdict(scene, [b.duration for b in run.bounces], run.status)
+        verdict = dry_run_verdict(regime, [b.duration for b in run.bounces], run.status)
         if verdict.rerun:
-            law, models = select_law(scene, first_impact_speed(resolved), menisci=True)
+            law, models = select_law(scene, regime.speed, menisci=True, regime=regime)
             run, release = _simulate(resolved, law, models, progress)
         models["menisci"].update(verdict.record())
-    models["regimes"] = regime_numbers(scene, models, run)
+    models["regimes"] = regime_numbers(scene, regime, models, run)
     wall = time.perf_counter() - start
     diagnostics = law.diagnostics()
     if diagnostics:
@@ -80,25 +82,23 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         band = mean_field_band(resolved)
         result["surface"] = {**result["surface"], "cutoff_band": band["cutoff_band"]}
         result["warnings"] += band["warnings"]
-    if condensation_sweep and menisci_decision(scene).choice != "off":
+    if condensation_sweep and menisci_decision(scene, regime).choice != "off":
         from .wet_sweep import condensation_sweep as sweep
-        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers, rerun=run_impact)
+        result["menisci_condensation_time"] = sweep(resolved, result, executor, workers, rerun=run_impact,
+                                                          regime=regime)
         result["timing"]["wall_s"] = time.perf_counter() - start
-    return result, run.trace.arrays()
+    return ImpactResult.from_record(result, run.trace.arrays(), regime)
 
 
-def _settle_realisation(resolved: ResolvedScene):
-    """(resolved scene with surfaces.roughness.mode settled, the decision); (resolved, None) for smooth contact."""
-    from dataclasses import replace
-
-    from ..model.decisions import realisation_decision
-    from ..model.regime import regime_of
+def _settle_realisation(resolved: ResolvedScene, regime: Regime):
+    """(resolved scene with surfaces.roughness.mode settled, the decision); (resolved, None) for smooth contact.
+    A realisation changes no number of the scene's `regime` (its estimate included)."""
     from .ensemble_run import with_realisation
 
     scene = resolved.scene
     if scene.contact != "rough":
         return resolved, None
-    decision = realisation_decision(scene, regime_of(scene, first_impact_speed(resolved)))
+    decision = realisation_decision(scene, regime)
     if decision.mode != scene.surfaces.roughness.mode:
         resolved = replace(resolved, scene=with_realisation(scene, decision.mode))
     return resolved, decision
@@ -124,18 +124,15 @@ def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> tuple[d
     return record, extra
 
 
-def regime_numbers(scene, models: dict, run) -> dict:
+def regime_numbers(scene, regime: Regime, models: dict, run) -> dict:
     """The numbers that place a scene (recorded whatever was decided), read from its one `Regime`
     (`continuum.model.regime`): Tabor parameter of the summits (or sphere), Fuller-Tabor theta, half-space
     deflection span / sigma, expected contacts, and the longest contact of the run against the condensation
     time t_a (SI)."""
-    from ..model.regime import condensation_time, regime_of
-
-    regime = regime_of(scene)
     rough = regime.rough
     est = models.get("estimate", {})
     longest = max((b.duration for b in run.bounces if b.duration is not None), default=0.0)
-    t_a = condensation_time(scene)[0]
+    t_a = regime.condensation_time
     return {
         "tabor_parameter": regime.tabor_parameter if regime.tabor_parameter is not None else 0.0,
         "interaction_range_z0": regime.interaction_range,
@@ -172,27 +169,3 @@ def _simulate(resolved: ResolvedScene, law, models: dict, progress):
     run = simulate(law, scene.body.mass, scene.environment.gravity, release_height=release,
                    impact_velocity=scene.impact_velocity, settings=settings, progress=progress)
     return run, release
-
-
-def write_impact(out_dir: str | Path, result: dict, trace: dict) -> Path:
-    """Write result.json, timeseries.csv, height.png and impacts.png atomically."""
-    name = result["scene"]["values"].get("name", "scene")
-
-    def draw_height(path):
-        plots.save(plots.height_vs_time(trace), path, f"{name}: height of the body")
-
-    def draw_force(path):
-        plots.save(plots.force_vs_time(trace, result["bounces"]), path, f"{name}: force during each impact")
-
-    figures = {"height.png": draw_height, "impacts.png": draw_force}
-    band = (result.get("surface") or {}).get("cutoff_band")
-    if band and "ensemble" not in result:
-        def draw_band(path):
-            plots.save(plots.cutoff_band_panel(band), path, f"{name}: first impact against the summit cutoff")
-        figures["cutoff_band.png"] = draw_band
-    if "ensemble" in result:
-        def draw_ensemble(path):
-            plots.save(plots.ensemble_spread(result["ensemble"], band=(result.get("surface") or {}).get("cutoff_band")),
-                       path, f"{name}: spread over summit realisations")
-        figures["ensemble.png"] = draw_ensemble
-    return write_run(out_dir, result, trace, figures)

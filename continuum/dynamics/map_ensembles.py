@@ -104,11 +104,12 @@ def _mean_field_first_impact(scene: Scene) -> dict:
     """The mean-field law's first impact of `scene` (to its first rebound): a summary shaped as an ensemble's of
     one deterministic member (no interval: nothing random is sampled), with the law that ran."""
     from ..model import dry_run_verdict, select_law
-    from ..model.regime import first_impact_speed
+    from ..model.regime import first_impact_speed, regime_of
     from .driver import DriverSettings, simulate
 
     speed = first_impact_speed(scene)
-    law, models = select_law(scene, speed)
+    regime = regime_of(scene, speed)
+    law, models = select_law(scene, speed, regime=regime)
     n = scene.numerics
     settings = DriverSettings(rtol=n.rtol, max_bounces=1, max_time=n.max_time, rest_fraction=n.rest_fraction,
                               samples_per_flight=2, samples_per_step=0)
@@ -121,8 +122,8 @@ def _mean_field_first_impact(scene: Scene) -> dict:
                         impact_velocity=scene.impact_velocity, settings=settings)
     out = run(law)
     if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
-        if dry_run_verdict(scene, [b.duration for b in out.bounces], out.status).rerun:
-            law, models = select_law(scene, speed, menisci=True)
+        if dry_run_verdict(regime, [b.duration for b in out.bounces], out.status).rerun:
+            law, models = select_law(scene, speed, menisci=True, regime=regime)
             out = run(law)
     first = next((b.rebound_height for b in out.bounces if b.rebound_height is not None), None)
     stuck = out.status == "stuck" and first is None

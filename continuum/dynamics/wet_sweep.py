@@ -70,15 +70,16 @@ def _single_contacts(result: dict) -> tuple[float, bool]:
 
 
 def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, workers: int | None = None, *,
-                       rerun: Callable[..., tuple[dict, Any]]) -> dict:
+                       rerun: Callable[..., Any], regime=None) -> dict:
     """result.json -> menisci_condensation_time for the humid scene `resolved` whose run gave `result`: the scene's
     t_a, the range the estimate allows, and the stick probability at each t_a of the grid (`t_a_grid`). `rerun`
-    runs a single (non-ensemble) scene again (`continuum.dynamics.impact.run_impact`, passed in by its caller)."""
+    runs a single (non-ensemble) scene again (`continuum.dynamics.impact.run_impact`, passed in by its caller);
+    `regime`: the run's (`continuum.model.regime.Regime`), whose t_a it reads."""
     from .ensemble_run import run_ensemble
     run_impact = rerun
 
     scene = resolved.scene
-    rng = condensation_time_range(scene)
+    rng = condensation_time_range(scene, regime)
     t_scene = rng["condensation_time_s"]
     ens = result.get("ensemble")
     longest, bridged = _ensemble_contacts(ens) if ens else _single_contacts(result)
@@ -96,7 +97,7 @@ def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, wor
             if ens:
                 point = _ensemble_point(run_ensemble(other, executor=executor, workers=workers).to_record())
             else:
-                point = {"stick_probability_within_run": float(run_impact(other, condensation_sweep=False)[0]["stuck"])}
+                point = {"stick_probability_within_run": float(run_impact(other, condensation_sweep=False).stuck)}
             rows.append({"condensation_time_s": t, **point, "how": "run again at this t_a"})
     values = [r["stick_probability_within_run"] for r in rows]
     lo, hi = rng["range_s"]

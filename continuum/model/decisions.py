@@ -27,7 +27,8 @@ from dataclasses import dataclass, replace
 from ..reference import jkr as jkr_ref
 from ..scene import Scene
 from ..wet import menisci as men
-from .regime import Regime, kelvin_radius_cutoff, meniscus_parameters, summit_e_star
+from . import regimes
+from .regime import Regime
 
 #: Johnson & Greenwood (1997) adhesion map, Tabor parameter bounds of the JKR and DMT regimes.
 TABOR_JKR, TABOR_DMT = 5.0, 0.1
@@ -42,39 +43,40 @@ LAW_NAMES = {"jkr": "JKR with Fuller-Tabor hysteresis", "dmt": "DMT (no hysteres
 
 
 # ----------------------------------------------------------------------------- summit laws
-def summit_law(name: str, scene: Scene):
-    """The per-summit law (continuum.rough.branch_laws) for a law name and the scene's surfaces.
+def summit_law(name: str, scene: Scene, e_star: float):
+    """The per-summit law (continuum.rough.branch_laws) for a law name, the scene's surfaces and the summits'
+    contact modulus `e_star` (Pa, `Regime.e_star`).
 
     Tabulated to a compression of 30 sigma (the rough model refuses impacts deeper than 10 sigma
     below the mean plane; the tallest summit is < 6 sigma above it)."""
     from ..rough.branch_laws import make_summit_law
 
     surf = scene.surfaces
-    beta, w, e_s = surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star(scene)
+    beta, w, e_s = surf.roughness.summit_radius, surf.interface_work_of_adhesion, e_star
     return make_summit_law(name, beta, w, e_s, z0=surf.interface_interaction_range,
                            detachment=scene.physics.detachment, delta_max=30.0 * surf.roughness.sigma)
 
 
-def loop_per_summit(name: str, scene: Scene) -> float:
-    """Energy (J) one summit loses per approach-retreat cycle under `name`."""
+def loop_per_summit(name: str, scene: Scene, e_star: float) -> float:
+    """Energy (J) one summit of contact modulus `e_star` (Pa) loses per approach-retreat cycle under `name`."""
     if name == "none":
         return 0.0
     if name == "jkr":
         surf = scene.surfaces
         return float(jkr_ref.loop_area(surf.roughness.summit_radius, surf.interface_work_of_adhesion,
-                                       summit_e_star(scene), detachment=scene.physics.detachment))
-    return float(summit_law(name, scene).loop_energy)
+                                       e_star, detachment=scene.physics.detachment))
+    return float(summit_law(name, scene, e_star).loop_energy)
 
 
-def pull_off_per_summit(name: str, scene: Scene) -> float:
-    """Pull-off force (N) of one summit under `name`."""
+def pull_off_per_summit(name: str, scene: Scene, e_star: float) -> float:
+    """Pull-off force (N) of one summit of contact modulus `e_star` (Pa) under `name`."""
     surf = scene.surfaces
     beta, w = surf.roughness.summit_radius, surf.interface_work_of_adhesion
     if name == "jkr":
         return float(jkr_ref.pull_off_force(beta, w))
     if name == "dmt":
         return 2.0 * math.pi * beta * w
-    return float(summit_law(name, scene).pull_off_force)
+    return float(summit_law(name, scene, e_star).pull_off_force)
 
 
 # ----------------------------------------------------------------------------- adhesion
@@ -145,8 +147,8 @@ def adhesion_decision(scene: Scene, regime: Regime) -> AdhesionDecision:
                                 f"{LAW_NAMES[law]}", **{**base, "on_the_map": True})
     law = "jkr" if mu > TABOR_JKR else "dmt" if mu < TABOR_DMT else "maugis_dugdale"
     base["on_the_map"] = True
-    loop = loop_per_summit(law, scene)
-    n_pull = pull_off_per_summit(law, scene)
+    loop = loop_per_summit(law, scene, regime.e_star)
+    n_pull = pull_off_per_summit(law, scene, regime.e_star)
     estimate = regime.estimate
     if estimate is not None and estimate.impact_energy > 0:        # no impact (a quasi-static curve): no loss to weigh
         loss = estimate.contacts * loop / estimate.impact_energy
@@ -235,8 +237,9 @@ class MenisciDecision:
         return rec
 
 
-def menisci_decision(scene: Scene) -> MenisciDecision:
-    """'off', 'on' or 'after_dry_run', with the numbers that decided it."""
+def menisci_decision(scene: Scene, regime: Regime) -> MenisciDecision:
+    """'off', 'on' or 'after_dry_run' for `scene` in `regime` (its Kelvin radius), with the numbers that decided
+    it."""
     choice, surf, env = scene.physics.menisci, scene.surfaces, scene.environment
     rh = env.relative_humidity
     if choice == "off":
@@ -254,7 +257,8 @@ def menisci_decision(scene: Scene) -> MenisciDecision:
         return MenisciDecision("off", "contact_angles",
                                f"hydrophobic: cos t1 + cos t2 = {wet:.3g} <= 0, no bridge pulls", rh, **numbers)
     if sphere:
-        r_k, cutoff, source = kelvin_radius_cutoff(scene)
+        r_k = regime.meniscus_parameters()["kelvin_radius"]
+        cutoff, source = regime.min_kelvin_radius, regime.min_kelvin_radius_source
         if r_k < cutoff:
             return MenisciDecision("off", "kelvin_radius", f"Kelvin radius {r_k:.3g} m < {cutoff:.3g} m ({source}): "
                                    "no continuum meniscus condenses", rh, **numbers)
@@ -296,15 +300,14 @@ class DryRunVerdict:
         return rec
 
 
-def dry_run_verdict(scene: Scene, durations, status: str) -> DryRunVerdict:
+def dry_run_verdict(regime: Regime, durations, status: str) -> DryRunVerdict:
     """Settle 'after_dry_run' from the dry run's contact `durations` (s; None for a contact that never ended)
-    and its final `status`."""
+    and its final `status`, against the condensation time of the scene's `regime`."""
     released = [d for d in durations if d is not None]
     final = (None if status not in ("stuck", "rest") else
              f"the run ended '{status}': the last contact never ends, bridges would form in it after t_a but cannot "
              "change any rebound (the body is already held)")
-    return DryRunVerdict(max(released, default=0.0), meniscus_parameters(scene)["condensation_time"], len(durations),
-                         final)
+    return DryRunVerdict(max(released, default=0.0), regime.condensation_time, len(durations), final)
 
 
 # ----------------------------------------------------------------------------- realisation (few summits)
@@ -432,10 +435,10 @@ def _summit_yield_approach(scene: Scene, limiting_pressure: float, e_s: float) -
     return float(jkr_ref.approach_from_radius(a_y, beta, w, e_s))
 
 
-def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = False, menisci: bool = False,
-                      depth: float | None = None, choice: str = "auto") -> PlasticityDecision:
+def summit_plasticity(scene: Scene, regime: Regime, adhesion: str = "jkr", half_space: bool = False,
+                      menisci: bool = False, depth: float | None = None, choice: str = "auto") -> PlasticityDecision:
     """Rough contact: do the summits yield? Greenwood & Williamson's plasticity index psi = (E*/p_y) sqrt(sigma/beta)
-    (the summits' E*, `summit_e_star`; the softer partner's limiting pressure p_y, H or 2.8 Y) decides for the
+    (the summits' E*, `Regime.e_star`; the softer partner's limiting pressure p_y, H or 2.8 Y) decides for the
     surface under any practical load; the first impact's estimated depth below the tallest summit (`depth`, m,
     `continuum.model.estimates`) beyond a summit's yield approach delta_y decides for an impact hard enough to yield
     the tallest summits of an otherwise elastic surface.
@@ -459,8 +462,8 @@ def summit_plasticity(scene: Scene, adhesion: str = "jkr", half_space: bool = Fa
         return PlasticityDecision(False, "yield_strength", "no yield key (surfaces.body or surfaces.substrate "
                                   "yield_strength or hardness): the summits are elastic")
     rough = scene.surfaces.roughness
-    e_s = summit_e_star(scene)
-    psi = e_s / soft.limiting_pressure * math.sqrt(rough.sigma / rough.summit_radius)
+    e_s = regime.e_star
+    psi = regimes.plasticity_index(e_s, soft.limiting_pressure, rough.sigma, rough.summit_radius)
     d_y = _summit_yield_approach(scene, soft.limiting_pressure, e_s)
     by_psi, by_depth = psi >= PSI_ELASTIC, depth is not None and depth > d_y
     yields = by_psi or by_depth
@@ -507,11 +510,11 @@ def _check_summit_limit(scene: Scene, soft, e_s: float) -> None:
                          f"Pa for the summits; {err.allowed}") from None
 
 
-def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space: bool = False,
+def plasticity_decision(scene: Scene, regime: Regime, adhesion: str, *, half_space: bool = False,
                         menisci: bool = False, depth: float | None = None) -> PlasticityDecision:
     """Elastic-plastic smooth sphere or not, for the adhesion law that runs (`adhesion`) and the first impact's
-    `speed` (m/s). 'auto': on when `speed` exceeds the yield velocity; off (recorded) without a yield key. Rough
-    contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
+    speed (m/s, `regime.speed`). 'auto': on when it exceeds the yield velocity; off (recorded) without a yield
+    key. Rough contact: `summit_plasticity` (with the half-space and menisci decisions and the first impact's estimated
     `depth`, m)."""
     from ..physics.limiting_pressure import partner_limits, softer_partner
     from ..reference import thornton_ning as tn
@@ -522,7 +525,7 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
         if scene.contact == "rough":     # psi is still evaluated and recorded, for the reader
             from nanoimpact.errors import InputError
             try:
-                rough = summit_plasticity(scene, adhesion, half_space, menisci, depth, "auto")
+                rough = summit_plasticity(scene, regime, adhesion, half_space, menisci, depth, "auto")
             except InputError:
                 return off
             if rough.plasticity_index is not None:
@@ -531,7 +534,7 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
                                f"{rough.plasticity_index:.3g}: {state})")
         return off
     if scene.contact == "rough":
-        return summit_plasticity(scene, adhesion, half_space, menisci, depth, choice)
+        return summit_plasticity(scene, regime, adhesion, half_space, menisci, depth, choice)
     if scene.body.shape != "sphere":
         return PlasticityDecision(False, "geometry", "the elastic-plastic law is for a smooth sphere; a smooth "
                                   "roller stays elastic (the line-contact yield warning says where it would yield)")
@@ -544,10 +547,12 @@ def plasticity_decision(scene: Scene, adhesion: str, speed: float, *, half_space
         return PlasticityDecision(False, "adhesion_law", "the elastic-plastic law here is Thornton & Ning's (1998), "
                                   f"built on JKR; under adhesion law '{adhesion}' the sphere stays elastic",
                                   partners=limits)
-    body, surf = scene.body, scene.surfaces
+    body, speed = scene.body, regime.speed
+    if speed is None:
+        raise ValueError("plasticity_decision needs the regime of a first impact (regime_of(scene, speed))")
     density = body.mass / (4.0 / 3.0 * math.pi * body.radius**3)
-    v_y = float(tn.yield_velocity(soft.limiting_pressure, body.radius, surf.interface_work_of_adhesion,
-                                  surf.e_star, density))
+    v_y = float(tn.yield_velocity(soft.limiting_pressure, body.radius, regime.work_of_adhesion, regime.e_star,
+                                  density))
     numbers = dict(limiting_pressure=soft.limiting_pressure, from_key=soft.key, yield_velocity=v_y,
                    impact_speed=speed, partners=limits)
     if choice == "on":

@@ -53,27 +53,22 @@ class RoughImpactEstimate:
     deflection_span: float
     """Largest minus smallest half-space deflection over the loaded strip (m)."""
     seconds: float
-    """Wall time of the estimate (s)."""
+    """Wall time of the estimate (s), its surface's tables included."""
 
     def to_json(self) -> dict:
         return asdict(self)
 
 
-def rough_impact_estimate(stats, summit_e_star: float, e_star: float, radius: float, length: float,
-                          z_max_sigma: float, mass: float, speed: float, gravity: float,
-                          samples: int = 513) -> RoughImpactEstimate:
+def rough_impact_estimate(surface, law, e_star: float, radius: float, length: float, mass: float, speed: float,
+                          gravity: float, samples: int = 513) -> RoughImpactEstimate:
     """Estimate a rough roller impact (see the module docstring).
 
-    stats: SummitStatistics (sigma m, density 1/m^2, summit radius m); summit_e_star and e_star (Pa):
-    the summits' and the bodies' contact moduli; radius, length (m) of the roller; z_max_sigma: the
-    truncation (tallest summit, units of sigma); mass (kg), speed (m/s) at touch, gravity (m/s^2).
+    surface: the non-adhesive summits' averaged surface (`continuum.model.factory.averaged_surface`, Hertz summits,
+    'fast' tables) and law: the rigid-substrate roller on it (`factory.rigid_roller`), both built by the caller
+    (`continuum.model.regime.impact_estimate`); e_star (Pa): the bodies' contact modulus (the half-space's);
+    radius, length (m) of the roller; mass (kg), speed (m/s) at touch, gravity (m/s^2).
     """
-    from .factory import averaged_surface, rigid_roller
-
     start = time.perf_counter()
-    surface = averaged_surface(stats, work_of_adhesion=0.0, summit_e_star=summit_e_star, z_max=z_max_sigma,
-                               resolution="fast")
-    law = rigid_roller(surface, radius, length, resolution="fast")
     energy = 0.5 * mass * speed * speed
     depth = law.quasi_static_depth(energy, mass * gravity)
     half = math.sqrt(2.0 * radius * depth)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 
 from ..scene import Scene
-from .regime import Regime, coated_summits
+from .regime import Regime
 
 #: The estimate's record says what it is.
 ESTIMATE_WHAT = ("quasi-static first approach of Hertz summits on a rigid substrate absorbing the first impact's "
@@ -24,14 +24,14 @@ def free_flight_record() -> dict:
     return dict(FREE_FLIGHT)
 
 
-def sam_record(scene: Scene) -> dict:
-    """Whether SAM layers enter, and how."""
+def sam_record(scene: Scene, regime: Regime) -> dict:
+    """Whether SAM layers enter, and how (the coated summits from the scene's `regime`)."""
     sam = scene.surfaces.sam
     if sam is None:
         return {"used": False, "why": "surfaces.sam.coverage = 'none'"}
     rec = {"used": True, "thickness": sam.thickness, "work_of_adhesion": sam.work_of_adhesion,
            "contact_angle_deg": math.degrees(sam.contact_angle) if sam.contact_angle is not None else None}
-    coated = coated_summits(scene)
+    coated = regime.coated
     if coated is None:
         why = ("no surfaces.sam.layer_modulus: a rigid uniform layer conforming to the summits shifts all gaps "
                "equally and does not enter the mechanics" if sam.layer_modulus is None else

@@ -5,8 +5,6 @@ resolution, cost checks) -> law (`factory`) -> record (`record`, result.json -> 
 """
 from __future__ import annotations
 
-import functools
-
 from ..laws.base import ContactLaw
 from ..laws.discrete_bridges import wet_discrete
 from ..reference import jkr as jkr_ref
@@ -22,15 +20,7 @@ from .decisions import (
     summit_law,
 )
 from .estimates import check_table_cost
-from .regime import (
-    Regime,
-    first_impact_speed,
-    impact_estimate,
-    meniscus_parameters,
-    regime_of,
-    solid_liquid_works,
-    summit_e_star,
-)
+from .regime import Regime, first_impact_speed, regime_of, with_estimate
 
 #: Below this sigma/delta_c the `fast` GW tables miss 1e-6 (measured, docs/rough-gw.md).
 FAST_TABLE_MIN_SIGMA_OVER_DELTA_C = 3.0
@@ -45,30 +35,28 @@ def branch_summits(adhesion: str) -> bool:
     return adhesion in ("dmt", "maugis_dugdale")
 
 
-def adhesive_range_check(scene: Scene, stats, z_max_sigma: float, speed: float) -> None:
+def adhesive_range_check(scene: Scene, stats, z_max_sigma: float, speed: float, e_star: float) -> None:
     """Refuse (SceneError, continuum.laws.costs.beyond_range) if the first impact's adhesive JKR
-    approach, integrated by quadrature over the footprint on a rigid substrate, would press the roller
-    beyond the averaged model's range; return otherwise."""
-    surface = factory.averaged_surface(stats, summit_law=summit_law("jkr", scene), z_max=z_max_sigma)
+    approach of summits of contact modulus `e_star` (Pa), integrated by quadrature over the footprint on a rigid
+    substrate, would press the roller beyond the averaged model's range; return otherwise."""
+    surface = factory.averaged_surface(stats, summit_law=summit_law("jkr", scene, e_star), z_max=z_max_sigma)
     law = factory.rigid_roller(surface, scene.body.radius, scene.body.length, resolution="fast")
     law.quasi_static_depth(0.5 * scene.body.mass * speed * speed, scene.body.mass * scene.environment.gravity)
 
 
 def _mean_field_cost(scene: Scene, adhesion: str, half_space: bool, w: float, e_s: float, stats, datum: dict,
                      table: str, est, speed: float):
-    """The mean-field rough law's table resolution, its summit law (branch summits), the impact estimate and the
-    tables' cost, checked before any table is built: a scene beyond the bounds is refused with a SceneError
-    (`continuum.model.estimates.check_table_cost`). Returns (table, summit law or None, estimate, cost)."""
+    """The mean-field rough law's table resolution, its summit law (branch summits) and the tables' cost (sized by
+    the impact estimate `est`), checked before any table is built: a scene beyond the bounds is refused with a
+    SceneError (`continuum.model.estimates.check_table_cost`). Returns (table, summit law or None, cost)."""
     rough, phys = scene.surfaces.roughness, scene.physics
     generic = branch_summits(adhesion)
     slaw = None
     if not generic and table == "fast" and w > 0 and rough.sigma < FAST_TABLE_MIN_SIGMA_OVER_DELTA_C * float(
             jkr_ref.critical_approach(rough.summit_radius, w, e_s)):
         table = "standard"      # fast tables miss 1e-6 when adhesion dominates (docs/rough-gw.md)
-    if not half_space and est is None:
-        est = impact_estimate(scene, speed)
     if generic:
-        slaw = summit_law(adhesion, scene)
+        slaw = summit_law(adhesion, scene, e_s)
         release_stretch, end_gap = max(-slaw.delta_out, 0.0), max(-slaw.delta_out, slaw.reach, 0.0)
     else:
         release_stretch = end_gap = (float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) *
@@ -85,42 +73,41 @@ def _mean_field_cost(scene: Scene, adhesion: str, half_space: bool, w: float, e_
         # roller beyond the averaged model's range, where every way out of the size refusal would be refused
         # too: say so instead (the approach branch by quadrature, no tables; < 1 s).
         if w > 0 and not generic:
-            adhesive_range_check(scene, stats, datum["z_max"], speed)
+            adhesive_range_check(scene, stats, datum["z_max"], speed, e_s)
         raise
     if w > 0 and not generic and cost.get("gw_table", {}).get("estimated_seconds", 0.0) > LARGE_TABLE_SECONDS:
         # a large table (seconds, hundreds of MB) is worth building only if the impact stays in range
-        adhesive_range_check(scene, stats, datum["z_max"], speed)
-    return table, slaw, est, cost
+        adhesive_range_check(scene, stats, datum["z_max"], speed, e_s)
+    return table, slaw, cost
 
 
 def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None = None,
-              with_menisci: bool = False, speed: float | None = None, estimate=None,
-              regime: Regime | None = None) -> tuple[ContactLaw, dict]:
+              with_menisci: bool = False, regime: Regime | None = None) -> tuple[ContactLaw, dict]:
     """GW rough roller for `scene` and the record of its datum and regime numbers.
 
+    `regime` is the scene's (`regime_of`; derived here, at the scene's first impact, where not given).
     `adhesion` (a law name) and `half_space` default to the scene's choices; where the scene says
-    'auto' they are decided as `select_law` does (with the estimate at `speed`, m/s, if given, else
-    at the scene's first impact). Before any table is built the tables' size is estimated and a
-    scene beyond the bounds is refused with a `SceneError` (`continuum.model.estimates.check_table_cost`).
+    'auto' they are decided as `select_law` does, on the regime's first-impact estimate. Before any table is
+    built the tables' size is estimated and a scene beyond the bounds is refused with a `SceneError`
+    (`continuum.model.estimates.check_table_cost`).
     """
     from ..rough.datum import tallest_summit
     from ..rough.summits import SummitStatistics
 
     body, surf, phys = scene.body, scene.surfaces, scene.physics
     rough = surf.roughness
-    if speed is None:
-        speed = first_impact_speed(scene)
-    est = estimate
-    if adhesion is None or half_space is None:
-        if est is None and "auto" in (phys.adhesion_law, phys.half_space):
-            est = impact_estimate(scene, speed)
-        decided = regime_of(scene, estimate=est)
-        if adhesion is None:
-            adhesion = adhesion_decision(scene, decided).law
-        if half_space is None:
-            half_space = half_space_decision(scene, decided).used
     if regime is None:
-        regime = regime_of(scene, estimate=est)
+        regime = regime_of(scene)
+    speed = regime.speed if regime.speed is not None else first_impact_speed(scene)
+    if (adhesion is None and phys.adhesion_law == "auto") or (half_space is None and phys.half_space == "auto"):
+        regime = with_estimate(regime, scene, speed)
+    if adhesion is None:
+        adhesion = adhesion_decision(scene, regime).law
+    if half_space is None:
+        half_space = half_space_decision(scene, regime).used
+    if rough.mode != "discrete" and not half_space:
+        regime = with_estimate(regime, scene, speed)         # sizes the rigid substrate's footprint tables
+    est = regime.estimate
     w = surf.interface_work_of_adhesion if adhesion != "none" else 0.0
     datum = tallest_summit(rough.sigma, rough.summit_density, body.radius, body.length)
     stats = SummitStatistics(rough.sigma, rough.summit_density, rough.summit_radius)
@@ -129,11 +116,11 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     generic = branch_summits(adhesion)
     cost = slaw = None
     if rough.mode != "discrete":
-        table, slaw, est, cost = _mean_field_cost(scene, adhesion, half_space, w, e_s, stats, datum, table, est, speed)
+        table, slaw, cost = _mean_field_cost(scene, adhesion, half_space, w, e_s, stats, datum, table, est, speed)
     surface = None
     if rough.mode == "discrete":
         # a seeded realisation of individual summits, same per-summit laws; no GW tables are built
-        slaw = summit_law(adhesion, scene) if generic else None
+        slaw = summit_law(adhesion, scene, e_s) if generic else None
         law = factory.discrete_roller(scene, stats, w, e_s, half_space, datum["footprint_half_width"], slaw)
         delta_c = law.delta_c
     else:
@@ -150,26 +137,25 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
         table=table, fast_min_sigma_over_delta_c=FAST_TABLE_MIN_SIGMA_OVER_DELTA_C, law=law,
         summit_law_record=(slaw.describe() if slaw is not None else adhesion) if generic else None)
     if with_menisci and rough.mode == "discrete":
-        law = discrete_menisci(scene, law, law)                     # a bridge on each summit of the realisation
+        law = discrete_menisci(scene, law, law, regime)             # a bridge on each summit of the realisation
     elif with_menisci:
-        law = factory.with_menisci(law, scene, stats, meniscus_parameters(scene))
+        law = factory.with_menisci(law, scene, stats, dict(regime.meniscus_parameters()))
     return law, record
 
 
-def _wet_solids_record(scene: Scene, plastic: bool) -> dict:
+def _wet_solids_record(scene: Scene, plastic: bool, regime: Regime) -> dict:
     """How a smooth sphere's solids adhere inside its bridge (menisci.solid_adhesion): 'wet', at the work of
-    adhesion under the liquid max(W_wet, 0) (continuum.wet.menisci.wet_work_of_adhesion), their law rebuilt at it;
-    'additive', the dry law unchanged. The summits' DMT solid pull is not used: the sphere's own law carries it."""
-    from ..wet import menisci as men
-    surf, m = scene.surfaces, scene.menisci
-    t1, t2 = surf.contact_angles
-    w = surf.interface_work_of_adhesion
-    w_wet = max(men.wet_work_of_adhesion(w, m.surface_tension, t1, t2, solid_liquid_works(scene)), 0.0)
+    adhesion under the liquid max(W_wet, 0) (continuum.wet.menisci.wet_work_of_adhesion, `Regime.meniscus`), their
+    law rebuilt at it; 'additive', the dry law unchanged. The summits' DMT solid pull is not used: the sphere's own
+    law carries it."""
+    m = scene.menisci
+    w_wet = max(regime.meniscus_parameters()["work_of_adhesion_wet"], 0.0)
     if m.solid_adhesion == "wet" and plastic:
         raise SceneError("menisci.solid_adhesion", "wet", "the wet solid adhesion rebuilds the sphere's law when "
                          "the bridge condenses, which would drop the Thornton-Ning flattening: set "
                          "menisci.solid_adhesion = 'additive' or physics.plasticity = 'off'", "scene")
-    return {"solid_pull": 0.0, "solid_work_of_adhesion": w_wet if m.solid_adhesion == "wet" else w}
+    return {"solid_pull": 0.0,
+            "solid_work_of_adhesion": w_wet if m.solid_adhesion == "wet" else regime.work_of_adhesion}
 
 
 def _with_work_of_adhesion(scene: Scene, w: float) -> Scene:
@@ -181,55 +167,46 @@ def _with_work_of_adhesion(scene: Scene, w: float) -> Scene:
     return replace(scene, surfaces=replace(surf, work_of_adhesion=w))
 
 
-@functools.lru_cache(maxsize=16)
-def _members_plasticity(scene: Scene, speed: float):
-    """The summit-plasticity decision an ensemble's members share: that of the scene (any seed, mode 'discrete') at
-    first-impact `speed` (m/s), with its adhesion, half-space and impact-estimate decisions; once per process."""
-    regime = regime_of(scene, speed)
-    estimate = regime.estimate
-    return plasticity_decision(scene, adhesion_decision(scene, regime).law, speed,
-                               half_space=half_space_decision(scene, regime).used,
-                               depth=estimate.depth if estimate is not None else None)
-
-
-def plastic_member(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
+def plastic_member(member: Scene, law: ContactLaw, regime: Regime) -> ContactLaw:
     """An ensemble member's discrete roller `law` with Thornton-Ning summits where the scene's summits yield
-    (`summit_plasticity`, decided as for the mean field), else `law` itself."""
-    from dataclasses import replace
+    (`summit_plasticity`, decided as for the mean field, on the scene's `regime` that every member shares), else
+    `law` itself."""
     surf = member.surfaces
     keys = (surf.body.yield_strength, surf.body.hardness, surf.substrate.yield_strength, surf.substrate.hardness)
     if member.contact != "rough" or member.physics.plasticity == "off" or all(k is None for k in keys):
         return law
-    rough = member.surfaces.roughness
-    shared = replace(member, surfaces=replace(member.surfaces, roughness=replace(rough, seed=0)))
-    decision = _members_plasticity(shared, float(speed))
+    estimate = regime.estimate
+    decision = plasticity_decision(member, regime, adhesion_decision(member, regime).law,
+                                   half_space=half_space_decision(member, regime).used,
+                                   depth=estimate.depth if estimate is not None else None)
     if not decision.used:
         return law
-    return factory.plastic_discrete_roller(law, member, summit_e_star(member), decision.limiting_pressure,
+    return factory.plastic_discrete_roller(law, member, regime.e_star, decision.limiting_pressure,
                                            decision.summit_law)
 
 
-def member_menisci(member: Scene, law: ContactLaw, elastic: ContactLaw) -> ContactLaw:
+def member_menisci(member: Scene, law: ContactLaw, elastic: ContactLaw, regime: Regime) -> ContactLaw:
     """An ensemble member's summit law `law` (elastic or plastic summits on the realisation of the elastic discrete
     roller `elastic`) with a capillary bridge growing on each summit where the member's humidity and contact angles
-    let bridges pull (`menisci_decision` not 'off'), else `law` itself.
+    let bridges pull (`menisci_decision` on the scene's `regime` not 'off'), else `law` itself.
 
     'auto' needs no dry run here: before t_a no bridge exists and the wet law is its dry law (compiled up to t_a,
     `continuum.laws.wet.WetRoughRoller.compiled`), so a member whose contacts all end sooner runs exactly dry."""
-    if member.contact != "rough" or menisci_decision(member).choice == "off":
+    if member.contact != "rough" or menisci_decision(member, regime).choice == "off":
         return law
-    return discrete_menisci(member, law, elastic)
+    return discrete_menisci(member, law, elastic, regime)
 
 
-def discrete_menisci(scene: Scene, law: ContactLaw, elastic) -> ContactLaw:
-    """`law` (summits on the realisation of the elastic `DiscreteRoughRoller` `elastic`) with a bridge on each summit.
+def discrete_menisci(scene: Scene, law: ContactLaw, elastic, regime: Regime) -> ContactLaw:
+    """`law` (summits on the realisation of the elastic `DiscreteRoughRoller` `elastic`) with a bridge on each summit,
+    of the meniscus parameters of the scene's `regime`.
 
     menisci.solid_adhesion = 'wet' with elastic summits on a rigid substrate: the bridged summits adhere by their
     summit law rebuilt at the wet work of adhesion max(W_wet, 0), force and loop (`continuum.laws.wet_summits`; Hertz
     where W_wet <= 0). Otherwise (the additive choice, plastic summits, the half-space) the bridges carry the mean
     field's DMT solid pull and the summits keep their dry loop (`continuum.laws.discrete_bridges.wet_discrete`);
     the record says which."""
-    params = meniscus_parameters(scene)
+    params = dict(regime.meniscus_parameters())
     if params["solid_adhesion"] != "wet" or law is not elastic or elastic.use_half_space:
         why = ("menisci.solid_adhesion = 'additive'" if params["solid_adhesion"] != "wet" else
                "plastic summits" if law is not elastic else "the half-space couples the summits")
@@ -237,36 +214,45 @@ def discrete_menisci(scene: Scene, law: ContactLaw, elastic) -> ContactLaw:
                                                                                f"(loop dry: {why})"})
     w_wet = max(params["work_of_adhesion_wet"], 0.0)
     wet_scene = _with_work_of_adhesion(scene, w_wet)
-    slaw = summit_law(elastic.slaw.name, wet_scene) if elastic.slaw is not None and w_wet > 0 else None
+    slaw = summit_law(elastic.slaw.name, wet_scene, regime.e_star) if elastic.slaw is not None and w_wet > 0 else None
     wet = factory.discrete_roller(wet_scene, elastic.stats, w_wet, elastic.summit_e_star, False,
                                   elastic.footprint_half_width, slaw, (elastic.sx, elastic.sy, elastic.sz))
     return factory.wet_summit_roller(elastic, wet, params)
 
 
-def member_summit_law(member: Scene, law: ContactLaw, speed: float) -> ContactLaw:
+def member_summit_law(member: Scene, law: ContactLaw, regime: Regime) -> ContactLaw:
     """An ensemble member's summits as every member runs them, whoever builds its realisation `law` (an elastic
     `DiscreteRoughRoller`): plastic where the scene's summits yield (`plastic_member`), with a bridge on each summit
-    where the scene is humid (`member_menisci`)."""
-    return member_menisci(member, plastic_member(member, law, speed), law)
+    where the scene is humid (`member_menisci`); `regime`: the scene's, with its first-impact estimate, shared by
+    every member (a realisation changes no number of it)."""
+    return member_menisci(member, plastic_member(member, law, regime), law, regime)
 
 
-def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None) -> tuple[ContactLaw, dict]:
+def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = None,
+               regime: Regime | None = None) -> tuple[ContactLaw, dict]:
     """The contact law for `scene` and a record of what runs, what is left out, and why.
 
+    `regime` is the scene's, derived at `first_impact_speed` (m/s) (`regime_of`; derived here where not given).
     `menisci` overrides the meniscus decision (True/False); None decides it here, where 'auto'
     with a wet, hydrophilic scene is recorded as pending (`run_impact` settles it after a dry run).
     """
-    models: dict = {}
-    m = menisci_decision(scene)
-    m_rec = m.record()
-    if scene.contact == "rough":
+    if regime is None:
         regime = regime_of(scene, first_impact_speed)
+    elif regime.speed != first_impact_speed:
+        raise ValueError(f"select_law: the regime was derived at {regime.speed!r} m/s, the law asked for at "
+                         f"{first_impact_speed!r} m/s")
+    models: dict = {}
+    m = menisci_decision(scene, regime)
+    m_rec = m.record()
+    if menisci is not None:
+        m_rec = {**m_rec, "used": menisci}
+    wet = menisci if menisci is not None else (m.choice == "on")
+    adhesion = adhesion_decision(scene, regime)
+    if scene.contact == "rough":
         estimate = regime.estimate
-        adhesion = adhesion_decision(scene, regime)
         hs = half_space_decision(scene, regime)
-        wet = menisci if menisci is not None else (m.choice == "on")
-        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, estimate=estimate, regime=regime)
-        plastic = plasticity_decision(scene, adhesion.law, first_impact_speed, half_space=hs.used, menisci=wet,
+        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, regime=regime)
+        plastic = plasticity_decision(scene, regime, adhesion.law, half_space=hs.used, menisci=wet,
                                       depth=estimate.depth if estimate is not None else None)
         if plastic.used and scene.surfaces.roughness.mode == "discrete":
             law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure,
@@ -282,29 +268,24 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         models["adhesion"] = {"used": adhesion.used, **adhesion.record()}
         models["half_space"] = hs.record()
         models["plasticity"] = plastic.record()
-        if menisci is not None:
-            m_rec = {**m_rec, "used": menisci}
         if wet:
-            m_rec.update(meniscus_parameters(scene))
+            m_rec.update(regime.meniscus_parameters())
         models["menisci"] = m_rec
-        models["sam"] = rec.sam_record(scene)
+        models["sam"] = rec.sam_record(scene, regime)
         models["free_flight"] = rec.free_flight_record()
         return law, models
-    adhesion = adhesion_decision(scene, regime_of(scene))
-    plastic = plasticity_decision(scene, adhesion.law, first_impact_speed)
+    plastic = plasticity_decision(scene, regime, adhesion.law)
     law, why = factory.smooth_law(scene, adhesion.law, first_impact_speed,
                                   plastic.limiting_pressure if plastic.used else None)
-    if menisci is not None:
-        m_rec = {**m_rec, "used": menisci}
-    if menisci if menisci is not None else m.choice == "on":
-        params = {**meniscus_parameters(scene), **_wet_solids_record(scene, plastic.used)}
-        wet = law
+    if wet:
+        params = {**regime.meniscus_parameters(), **_wet_solids_record(scene, plastic.used, regime)}
+        wet_law = law
         if params["solid_adhesion"] == "wet":
             wet_scene = _with_work_of_adhesion(scene, params["solid_work_of_adhesion"])
-            wet, _ = factory.smooth_law(wet_scene, adhesion.law if params["solid_work_of_adhesion"] > 0 else "none",
-                                        first_impact_speed)
+            wet_law, _ = factory.smooth_law(wet_scene, adhesion.law if params["solid_work_of_adhesion"] > 0
+                                            else "none", first_impact_speed)
         m_rec.update(params)
-        law = factory.with_sphere_meniscus(law, wet, params)
+        law = factory.with_sphere_meniscus(law, wet_law, params)
         why += "; one capillary bridge at the contact (continuum.laws.sphere_meniscus)"
     a_rec = adhesion.record()
     if not adhesion.used and scene.surfaces.interface_work_of_adhesion > 0 and scene.physics.adhesion_law == "none":
@@ -314,6 +295,6 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
     models["plasticity"] = plastic.record()
     models["menisci"] = m_rec
     models["half_space"] = SMOOTH_HALF_SPACE.record()
-    models["sam"] = rec.sam_record(scene)
+    models["sam"] = rec.sam_record(scene, regime)
     models["free_flight"] = rec.free_flight_record()
     return law, models

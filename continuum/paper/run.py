@@ -24,9 +24,10 @@ import numpy as np
 from nanoimpact.executors import executor as make_executor
 
 from ..dynamics.escape import single_impact
-from ..dynamics.impact import first_impact_speed, run_impact, write_impact
-from ..model import menisci_decision, meniscus_parameters, select_law
+from ..dynamics.impact import first_impact_speed, run_impact
+from ..model import menisci_decision, regime_of, select_law
 from ..numerics.compiled_contact import warm_up
+from ..output.impact_result import write_impact
 from ..output.results import write_run
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from ..wet import menisci as men
@@ -76,7 +77,8 @@ def _impact_task(case: Case, params: str, fidelity: str | None, out: str, figure
     (height.png, impacts.png: ~0.15 s of matplotlib per case, a tenth of the paper command's CPU over its 36
     runs, and no paper figure reads them) only with `figures`."""
     resolved = resolve_case(case, params, fidelity)
-    result, trace = run_impact(resolved)
+    run = run_impact(resolved)
+    result, trace = run.to_dict(), dict(run.trace)
     folder = Path(out) / "cases" / case.name / Path(params).stem
     if figures:
         write_impact(folder, result, trace)
@@ -132,11 +134,12 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     scene = resolved.scene
     v0 = first_impact_speed(resolved)
     mass, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
-    dry, _ = select_law(scene, v0, menisci=False)
-    menisci = menisci_decision(scene)
+    regime = regime_of(scene, v0)
+    dry, _ = select_law(scene, v0, menisci=False, regime=regime)
+    menisci = menisci_decision(scene, regime)
     wet_possible = menisci.choice != "off"
-    wet = select_law(scene, v0, menisci=True)[0] if wet_possible else None
-    m = meniscus_parameters(scene) if wet is not None else {}
+    wet = select_law(scene, v0, menisci=True, regime=regime)[0] if wet_possible else None
+    m = dict(regime.meniscus_parameters()) if wet is not None else {}
     t_a = m.get("condensation_time")
     grid, dry_runs, skipped = [], {}, []
     for v in fastest_first([v0 * f for f in FIG8_SPEED_FACTORS]):

@@ -95,7 +95,7 @@ def test_auto_keeps_jkr_under_load_control_and_explicit_md_refuses_it():
 
 def test_scene_runs_the_maugis_dugdale_sphere():
     from continuum.dynamics.impact import run_impact
-    result, _ = run_impact(_scene(50e-9))
+    result = run_impact(_scene(50e-9)).to_dict()
     assert result["models"]["contact_law"]["name"] == "maugis_dugdale_sphere"
     assert result["models"]["adhesion"]["law"] == "maugis_dugdale"
     loop = result["models"]["contact_law"]["loop_energy_used"]

@@ -91,6 +91,6 @@ def test_a_sam_layer_enters_the_summit_law_through_the_contact_modulus():
     assert summit_e_star(soft) == rec["e_star"] == pytest.approx(want, rel=1e-12, abs=0)
     assert rec["reference_radius"] == pytest.approx(a0, rel=1e-12, abs=0)
     beta, w = 0.2e-6, soft.surfaces.sam.work_of_adhesion
-    ratio = loop_per_summit("jkr", soft) / float(jkr_ref.loop_area(beta, w, 80e9))
+    ratio = loop_per_summit("jkr", soft, summit_e_star(soft)) / float(jkr_ref.loop_area(beta, w, 80e9))
     assert ratio == pytest.approx((want / 80e9) ** (-2.0 / 3.0), rel=1e-9, abs=0)
     assert ratio > 1.0

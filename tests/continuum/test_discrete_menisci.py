@@ -244,7 +244,7 @@ def test_a_humid_scene_reports_its_sticking_against_t_a():
     from continuum.dynamics.impact import run_impact
 
     over = {"surfaces.roughness.mode": "ensemble", "surfaces.roughness.members": 2, "numerics.max_bounces": 2}
-    result, _ = run_impact(resolve_scene("wet_silica", params="paper", overrides=over))
+    result = run_impact(resolve_scene("wet_silica", params="paper", overrides=over)).to_dict()
     block = result["menisci_condensation_time"]
     scene = resolve_scene("wet_silica", params="paper").scene
     lo, hi = block["range_s"]

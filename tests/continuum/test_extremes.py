@@ -98,7 +98,8 @@ def test_an_extreme_point_outside_the_model_is_refused_in_one_line(built, sigma,
 
 @pytest.mark.parametrize("sigma,modulus,work,release", [p for p in POINTS if p not in REFUSED])
 def test_an_extreme_point_inside_the_model_runs_within_bounds(built, sigma, modulus, work, release):
-    result, trace = run_point(sigma, modulus, work, release)
+    run = run_point(sigma, modulus, work, release)
+    result, trace = run.to_dict(), run.trace
     for key in ("t", "gap", "velocity", "force", "energy"):
         assert np.all(np.isfinite(trace[key])), key
     assert result["n_bounces"] >= 1

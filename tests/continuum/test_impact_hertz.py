@@ -93,7 +93,8 @@ def test_energy_audit_can_fail_when_the_law_misreports_its_stored_energy(spring)
 
 def test_hertz_roller_scene_runs_and_returns_to_release_height():
     resolved = resolve_scene(ROOT / "inputs" / "scenes" / "hertz_roller.toml")
-    result, trace = run_impact(resolved)
+    run = run_impact(resolved)
+    result, trace = run.to_dict(), run.trace
     assert result["n_bounces"] == 20
     assert result["energy_audit"]["max_relative_error"] < 1e-6
     for b in result["bounces"]:

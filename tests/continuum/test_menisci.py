@@ -154,9 +154,9 @@ def _scene(**ov):
 
 
 def test_bridges_cut_a_rebound_whose_contact_outlasts_t_a_and_the_books_close():
-    dry, _ = run_impact(_scene(impact_velocity=5.2e-4, **{"physics.menisci": "off"}))
-    wet, _ = run_impact(_scene(impact_velocity=5.2e-4, **{"physics.menisci": "on",
-                                                          "menisci.condensation_time": 15e-6}))
+    dry = run_impact(_scene(impact_velocity=5.2e-4, **{"physics.menisci": "off"})).to_dict()
+    wet = run_impact(_scene(impact_velocity=5.2e-4, **{"physics.menisci": "on",
+                                                          "menisci.condensation_time": 15e-6})).to_dict()
     d, w = dry["bounces"][0], wet["bounces"][0]
     assert d["duration"] > 15e-6 and d["restitution"] > 0.3
     assert w["restitution"] < 0.8 * d["restitution"]
@@ -165,8 +165,8 @@ def test_bridges_cut_a_rebound_whose_contact_outlasts_t_a_and_the_books_close():
 
 
 def test_many_bridges_pulling_the_roller_in_keep_the_energy_books():
-    wet, _ = run_impact(_scene(impact_velocity=5.2e-4, **{"physics.menisci": "on",
-                                                          "menisci.condensation_time": 5e-6}))
+    wet = run_impact(_scene(impact_velocity=5.2e-4, **{"physics.menisci": "on",
+                                                          "menisci.condensation_time": 5e-6})).to_dict()
     assert wet["status"] == "stuck"
     assert wet["models"]["diagnostics"]["menisci"]["max_bridges"] > 10
     assert wet["energy_audit"]["max_relative_error"] < 1e-3
@@ -174,8 +174,8 @@ def test_many_bridges_pulling_the_roller_in_keep_the_energy_books():
 
 
 def test_contact_shorter_than_t_a_is_exactly_the_dry_impact():
-    dry, _ = run_impact(_scene(impact_velocity=1.4e-3, **{"physics.menisci": "off"}))
-    wet, _ = run_impact(_scene(impact_velocity=1.4e-3, **{"physics.menisci": "on"}))
+    dry = run_impact(_scene(impact_velocity=1.4e-3, **{"physics.menisci": "off"})).to_dict()
+    wet = run_impact(_scene(impact_velocity=1.4e-3, **{"physics.menisci": "on"})).to_dict()
     assert dry["bounces"][0]["duration"] < 25e-6
     # no bridge can form: the only difference is the table spacing (the wet law sizes its tables
     # for the bridges' pull as well), whose interpolation error is ~1e-7 (docs/rough-gw.md)
@@ -184,15 +184,15 @@ def test_contact_shorter_than_t_a_is_exactly_the_dry_impact():
 
 
 def test_auto_menisci_records_why_they_are_left_out():
-    hydrophobic, _ = run_impact(_scene(impact_velocity=1.4e-3, **{"surfaces.body.contact_angle": 110.0,
-                                                                  "surfaces.substrate.contact_angle": 110.0}))
+    hydrophobic = run_impact(_scene(impact_velocity=1.4e-3, **{"surfaces.body.contact_angle": 110.0,
+                                                                  "surfaces.substrate.contact_angle": 110.0})).to_dict()
     assert hydrophobic["models"]["menisci"]["used"] is False
     assert hydrophobic["models"]["menisci"]["decided_by"] == "contact_angles"
-    short, _ = run_impact(_scene(impact_velocity=1.4e-3))
+    short = run_impact(_scene(impact_velocity=1.4e-3)).to_dict()
     m = short["models"]["menisci"]
     assert m["used"] is False and m["decided_by"] == "longest_contact_time"
     assert m["longest_contact_s"] < m["condensation_time_s"] == 25e-6
-    long, _ = run_impact(_scene(impact_velocity=5.2e-4, **{"menisci.condensation_time": 15e-6}))
+    long = run_impact(_scene(impact_velocity=5.2e-4, **{"menisci.condensation_time": 15e-6})).to_dict()
     assert long["models"]["menisci"]["used"] is True
     assert long["models"]["menisci"]["longest_contact_s"] >= 15e-6
 
@@ -216,7 +216,7 @@ def test_condensation_time_is_computed_once_for_every_record(rh):
     from types import SimpleNamespace
 
     from continuum.dynamics.impact import regime_numbers
-    from continuum.model.regime import condensation_time
+    from continuum.model.regime import condensation_time, regime_of
 
     scene = _scene(**{"menisci.condensation_model": "nucleation", "environment.relative_humidity": rh,
                       "impact_velocity": 1e-3,          # saturation is refused with menisci on (Kelvin radius)
@@ -228,7 +228,8 @@ def test_condensation_time_is_computed_once_for_every_record(rh):
     else:
         assert t_a == men.nucleation_condensation_time(rh, scene.environment.temperature) and math.isfinite(t_a)
     run = SimpleNamespace(bounces=[])
-    assert regime_numbers(scene, {}, run)["condensation_time_s"] == t_a
+    assert regime_of(scene).condensation_time == t_a
+    assert regime_numbers(scene, regime_of(scene), {}, run)["condensation_time_s"] == t_a
     if rh > 0.0 and rh < 1.0:
         from continuum.model.regime import meniscus_parameters
         assert meniscus_parameters(scene)["condensation_time"] == t_a

@@ -27,15 +27,15 @@ def _assert_same_rebounds(left, right, h0):
 
 
 def test_half_space_left_out_under_the_paper_roller_is_safe():
-    auto, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
+    auto = run_impact(resolve_scene(SCENES / "rough_silica.toml",
                                        overrides={"physics.half_space": "auto", "numerics.max_bounces": 6,
-                                                  "surfaces.roughness.mode": "mean_field"}))
+                                                  "surfaces.roughness.mode": "mean_field"})).to_dict()
     rec = auto["models"]["half_space"]
     assert rec["used"] is False and rec["decided_by"] == "deflection_over_sigma"
     assert rec["deflection_over_sigma"] < 1e-3
-    forced, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
+    forced = run_impact(resolve_scene(SCENES / "rough_silica.toml",
                                          overrides={"physics.half_space": "on", "numerics.max_bounces": 6,
-                                                    "surfaces.roughness.mode": "mean_field"}))
+                                                    "surfaces.roughness.mode": "mean_field"})).to_dict()
     _assert_same_rebounds(auto, forced, 100e-9)
 
 
@@ -47,11 +47,11 @@ def test_half_space_kept_where_it_deflects_a_fraction_of_sigma():
 
 
 def test_menisci_left_out_when_no_contact_lasts_t_a_is_safe():
-    auto, _ = run_impact(resolve_scene(SCENES / "wet_silica.toml", overrides={"physics.half_space": "off"}))
+    auto = run_impact(resolve_scene(SCENES / "wet_silica.toml", overrides={"physics.half_space": "off"})).to_dict()
     rec = auto["models"]["menisci"]
     assert rec["used"] is False and rec["longest_contact_s"] < rec["condensation_time_s"]
-    forced, _ = run_impact(resolve_scene(SCENES / "wet_silica.toml",
-                                         overrides={"physics.half_space": "off", "physics.menisci": "on"}))
+    forced = run_impact(resolve_scene(SCENES / "wet_silica.toml",
+                                         overrides={"physics.half_space": "off", "physics.menisci": "on"})).to_dict()
     _assert_same_rebounds(auto, forced, 100e-9)
 
 
@@ -68,7 +68,7 @@ def test_summit_law_follows_the_tabor_parameter(z0, law):
 
 
 def test_every_choice_is_recorded_with_what_decided_it():
-    result, _ = run_impact(resolve_scene(SCENES / "wet_ots.toml", overrides={"numerics.max_bounces": 2}))
+    result = run_impact(resolve_scene(SCENES / "wet_ots.toml", overrides={"numerics.max_bounces": 2})).to_dict()
     models = result["models"]
     for key in ("adhesion", "half_space", "menisci"):
         assert {"decided_by", "why"} <= set(models[key]), key
@@ -80,13 +80,13 @@ def test_every_choice_is_recorded_with_what_decided_it():
 def test_adhesion_left_out_for_stiff_weakly_adhesive_summits_is_safe():
     stiff = {"surfaces.roughness.summit_modulus": 150e9, "surfaces.work_of_adhesion": 0.01,
              "physics.half_space": "off", "numerics.max_bounces": 20}
-    auto, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
-                                       overrides={**stiff, "physics.adhesion_law": "auto"}))
+    auto = run_impact(resolve_scene(SCENES / "rough_silica.toml",
+                                       overrides={**stiff, "physics.adhesion_law": "auto"})).to_dict()
     rec = auto["models"]["adhesion"]
     assert rec["used"] is False and rec["decided_by"] == "estimated_loss_fraction"
     assert rec["tabor_parameter"] < TABOR_DMT and rec["estimated_pull_fraction"] < 1e-2
-    forced, _ = run_impact(resolve_scene(SCENES / "rough_silica.toml",
-                                       overrides={**stiff, "physics.adhesion_law": "dmt"}))
+    forced = run_impact(resolve_scene(SCENES / "rough_silica.toml",
+                                       overrides={**stiff, "physics.adhesion_law": "dmt"})).to_dict()
     assert forced["models"]["adhesion"]["used"] is True
     _assert_same_rebounds(auto, forced, 100e-9)
 
@@ -98,14 +98,14 @@ def test_the_dry_run_settles_a_pending_meniscus_decision_at_t_a():
     from continuum.scene import resolve_scene
 
     scene = resolve_scene("wet_silica", params="paper", overrides={"menisci.condensation_time": 2e-5}).scene
-    short = dry_run_verdict(scene, [1e-5, 1.99e-5, None], "stuck")
+    short = dry_run_verdict(regime_of(scene), [1e-5, 1.99e-5, None], "stuck")
     assert not short.rerun and short.longest_contact_s == 1.99e-5 and short.dry_run_bounces == 3
     assert short.record()["used"] is False and "'stuck'" in short.record()["final_contact"]
     assert "< t_a" in short.record()["why"]
-    at = dry_run_verdict(scene, [2e-5], "escaped")
+    at = dry_run_verdict(regime_of(scene), [2e-5], "escaped")
     assert at.rerun and at.final_contact is None
     assert at.record()["dry_run_bounces"] == 1 and "used" not in at.record()    # the wet run's record says used
-    assert dry_run_verdict(scene, [], "escaped").longest_contact_s == 0.0
+    assert dry_run_verdict(regime_of(scene), [], "escaped").longest_contact_s == 0.0
 
 
 def test_discrete_summits_run_the_law_the_map_picks():

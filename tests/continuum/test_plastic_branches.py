@@ -165,7 +165,7 @@ def test_calibrated_rough_silica_members_run_plastic_maugis_dugdale_summits_and_
 
     from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model import plasticity_decision
-    from continuum.model.regime import first_impact_speed, summit_e_star
+    from continuum.model.regime import first_impact_speed, regime_of, summit_e_star
     from continuum.scene import resolve_scene
 
     path = Path(__file__).resolve().parents[2] / "inputs" / "scenes" / "rough_silica.toml"
@@ -175,7 +175,7 @@ def test_calibrated_rough_silica_members_run_plastic_maugis_dugdale_summits_and_
     assert law.name == "rough_roller_discrete_plastic"
     assert isinstance(law.law, PlasticBranchSummitLaw) and law.law.name == "maugis_dugdale"
     off = resolve_scene(path, params="calibrated", overrides={"physics.plasticity": "off"}).scene
-    rec = plasticity_decision(off, "maugis_dugdale", 0.001).record()
+    rec = plasticity_decision(off, regime_of(off), "maugis_dugdale").record()
     rough = off.surfaces.roughness
     psi = summit_e_star(off) / off.surfaces.substrate.hardness * math.sqrt(rough.sigma / rough.summit_radius)
     assert not rec["used"] and rec["decided_by"] == "scene"

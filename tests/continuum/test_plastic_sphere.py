@@ -138,7 +138,7 @@ def _scene(hardness=P_Y, **overrides):
 
 def test_scene_runs_the_plastic_law_when_faster_than_the_yield_velocity():
     from continuum.dynamics.impact import run_impact
-    result, _ = run_impact(_scene())
+    result = run_impact(_scene()).to_dict()
     plastic = result["models"]["plasticity"]
     assert plastic["used"] and plastic["decided_by"] == "yield_velocity"
     assert plastic["limiting_pressure"] == P_Y and plastic["from_key"] == "surfaces.body.hardness"
@@ -150,7 +150,7 @@ def test_scene_runs_the_plastic_law_when_faster_than_the_yield_velocity():
 
 def test_scene_without_yield_key_stays_elastic_and_says_why():
     from continuum.dynamics.impact import run_impact
-    result, _ = run_impact(_scene(hardness=None))
+    result = run_impact(_scene(hardness=None)).to_dict()
     plastic = result["models"]["plasticity"]
     assert not plastic["used"] and plastic["decided_by"] == "yield_strength"
     assert result["models"]["contact_law"]["name"] == "jkr_sphere"
@@ -159,8 +159,9 @@ def test_scene_without_yield_key_stays_elastic_and_says_why():
 def test_softer_partner_sets_the_limiting_pressure():
     """A yield strength on the substrate (p_y = 2.8 Y) below the body's hardness decides."""
     from continuum.model.decisions import plasticity_decision
+    from continuum.model.regime import regime_of
     scene = _scene(**{"surfaces.substrate.yield_strength": 12e6}).scene
-    d = plasticity_decision(scene, "jkr", 20.0)
+    d = plasticity_decision(scene, regime_of(scene, 20.0), "jkr")
     assert d.from_key == "surfaces.substrate.yield_strength"
     assert d.limiting_pressure == pytest.approx(tn.TABOR_CONSTRAINT_FACTOR * 12e6)
 

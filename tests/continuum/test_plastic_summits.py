@@ -185,19 +185,19 @@ def test_auto_decides_summit_plasticity_by_the_plasticity_index(hardness, yields
     from pathlib import Path
 
     from continuum.model.decisions import plasticity_decision
-    from continuum.model.regime import summit_e_star
+    from continuum.model.regime import regime_of, summit_e_star
     from continuum.scene import resolve_scene
 
     scene = resolve_scene(Path(__file__).resolve().parents[2] / "inputs" / "scenes" / "rough_silica.toml",
                           overrides={"surfaces.substrate.hardness": hardness}).scene
-    rec = plasticity_decision(scene, "jkr", 0.1).record()
+    rec = plasticity_decision(scene, regime_of(scene), "jkr").record()
     rough = scene.surfaces.roughness
     psi = summit_e_star(scene) / hardness * math.sqrt(rough.sigma / rough.summit_radius)
     assert rec["plasticity_index"] == pytest.approx(psi, rel=1e-12)
     assert rec["decided_by"] == "plasticity_index" and rec["summits_yield"] is yields
     assert (psi > 1.0) if yields else (psi < 0.6)
     assert rec["used"] is yields     # JKR summits over a rigid substrate: the plastic mean field can run
-    blocked = plasticity_decision(scene, "jkr", 0.1, half_space=True).record()
+    blocked = plasticity_decision(scene, regime_of(scene), "jkr", half_space=True).record()
     assert blocked["used"] is False and blocked["summits_yield"] is yields
     assert ("half-space roller carries elastic summits only" in blocked["why"]) is yields
 
@@ -216,10 +216,10 @@ def test_rough_scene_runs_plastic_summits_where_they_yield(mode, names):
     path = Path(__file__).resolve().parents[2] / "inputs" / "scenes" / "rough_silica.toml"
     out = {}
     for hardness in (8.3e9, 0.25e9):
-        result, _ = run_impact(resolve_scene(path, overrides={"surfaces.substrate.hardness": hardness,
+        result = run_impact(resolve_scene(path, overrides={"surfaces.substrate.hardness": hardness,
                                                               "surfaces.roughness.mode": mode,
                                                               "physics.half_space": "off",
-                                                              "numerics.max_bounces": 1}))
+                                                              "numerics.max_bounces": 1})).to_dict()
         assert result["energy_audit"]["max_relative_error"] < 1e-5
         out[hardness] = result
     elastic, plastic = out[8.3e9], out[0.25e9]
@@ -289,7 +289,7 @@ def test_auto_takes_plastic_summits_when_the_impact_reaches_their_yield_approach
     from pathlib import Path
 
     from continuum.model.decisions import plasticity_decision
-    from continuum.model.regime import summit_e_star
+    from continuum.model.regime import regime_of, summit_e_star
     from continuum.scene import resolve_scene
 
     hardness = 3.5e9
@@ -298,8 +298,8 @@ def test_auto_takes_plastic_summits_when_the_impact_reaches_their_yield_approach
     rough, w, e_s = scene.surfaces.roughness, scene.surfaces.interface_work_of_adhesion, summit_e_star(scene)
     a_y = float(tn.yield_radius(hardness, rough.summit_radius, w, e_s))
     d_y = float(jkr.approach_from_radius(a_y, rough.summit_radius, w, e_s))
-    deep = plasticity_decision(scene, "jkr", 0.1, depth=1.5 * d_y).record()
-    shallow = plasticity_decision(scene, "jkr", 0.1, depth=0.5 * d_y).record()
+    deep = plasticity_decision(scene, regime_of(scene), "jkr", depth=1.5 * d_y).record()
+    shallow = plasticity_decision(scene, regime_of(scene), "jkr", depth=0.5 * d_y).record()
     assert deep["plasticity_index"] < 0.6 and deep["summit_yield_approach"] == pytest.approx(d_y, rel=1e-12)
     assert deep["used"] and deep["decided_by"] == "estimated_depth" and deep["estimated_depth"] == 1.5 * d_y
     assert not shallow["used"] and not shallow["summits_yield"] and shallow["decided_by"] == "plasticity_index"

@@ -71,8 +71,8 @@ def test_without_adhesion_rough_impacts_are_elastic():
 def test_half_space_matters_in_the_heavy_scene_and_not_under_the_paper_roller():
     heavy = ROOT / "inputs" / "scenes" / "rough_halfspace_heavy.toml"
     jkr = {"physics.adhesion_law": "jkr"}       # the half-space under test, with the tabulated law's audit bound
-    on, _ = run_impact(resolve_scene(heavy, overrides=jkr))
-    off, _ = run_impact(resolve_scene(heavy, overrides={**jkr, "physics.half_space": "off"}))
+    on = run_impact(resolve_scene(heavy, overrides=jkr)).to_dict()
+    off = run_impact(resolve_scene(heavy, overrides={**jkr, "physics.half_space": "off"})).to_dict()
     sigma = on["scene"]["si"]["surfaces"]["roughness"]["sigma"]
     deflection = on["models"]["diagnostics"]["max_deflection"]
     assert deflection > 0.05 * sigma
@@ -80,8 +80,8 @@ def test_half_space_matters_in_the_heavy_scene_and_not_under_the_paper_roller():
     assert abs(b_on["peak_force"] / b_off["peak_force"] - 1) > 0.01
     assert on["energy_audit"]["max_relative_error"] < 1e-5
     # the paper's roller: femtometres (~20 fm) against sigma = 6 nm
-    paper, _ = run_impact(resolve_scene(SILICA, overrides={"numerics.max_bounces": 1, "physics.half_space": "on",
-                                                               "surfaces.roughness.mode": "mean_field"}))
+    paper = run_impact(resolve_scene(SILICA, overrides={"numerics.max_bounces": 1, "physics.half_space": "on",
+                                                               "surfaces.roughness.mode": "mean_field"})).to_dict()
     assert (paper["models"]["diagnostics"]["max_deflection"]
             < 1e-4 * paper["scene"]["si"]["surfaces"]["roughness"]["sigma"])
     assert math.isfinite(paper["energy_audit"]["max_relative_error"])
@@ -89,11 +89,11 @@ def test_half_space_matters_in_the_heavy_scene_and_not_under_the_paper_roller():
 
 def test_mean_plane_datum_shifts_the_release_by_the_tallest_summit_or_refuses():
     base = {"numerics.max_bounces": 1, "physics.half_space": "off"}
-    top, _ = run_impact(resolve_scene(SILICA, overrides=base))
+    top = run_impact(resolve_scene(SILICA, overrides=base)).to_dict()
     z_top = top["models"]["contact_law"]["z_max"]
     h0 = top["scene"]["si"]["release_height"]
-    shifted, _ = run_impact(resolve_scene(SILICA, overrides={**base, "surfaces.roughness.datum": "mean_plane",
-                                                             "release_height": h0 + z_top}))
+    shifted = run_impact(resolve_scene(SILICA, overrides={**base, "surfaces.roughness.datum": "mean_plane",
+                                                             "release_height": h0 + z_top})).to_dict()
     assert shifted["bounces"][0]["v_impact"] == pytest.approx(top["bounces"][0]["v_impact"], rel=1e-9, abs=0)
     from continuum.scene import SceneError
     with pytest.raises(SceneError, match="start in contact"):

@@ -98,7 +98,8 @@ def test_a_point_outside_the_model_is_refused_in_one_line_for_its_reason(point):
 @pytest.mark.parametrize("point", [p for p in itertools.product(SIGMAS, RELEASES, WORKS, MODULI)
                                    if p not in REFUSED])
 def test_a_point_inside_the_model_runs_to_the_codes_accuracy(point):
-    result, trace = run_point(point)
+    run = run_point(point)
+    result, trace = run.to_dict(), run.trace
     for key in ("t", "gap", "velocity", "force", "energy"):
         assert np.all(np.isfinite(trace[key])), key
     assert result["n_bounces"] >= 1
@@ -120,6 +121,6 @@ def test_the_audit_tolerance_catches_a_law_that_misreports_its_energy(monkeypatc
             law.compiled = lambda t0: None
             return law, models
         monkeypatch.setattr(impact, "select_law", select_law)
-        return run_point(point, max_bounces=1)[0]["energy_audit"]["max_error_over_turnover"]
+        return run_point(point, max_bounces=1).to_dict()["energy_audit"]["max_error_over_turnover"]
 
     assert stepper(1.0) < audit_tolerance(*point) < stepper(1.0 + 1e-5)

@@ -89,7 +89,8 @@ def test_shipped_rough_scene_runs_over_its_roughness_range(name, sigma, release)
     if release is not None:
         overrides.update({"release_height": release, "numerics.max_bounces": 2})
     resolved = resolve_scene(SCENE_DIR / f"{name}.toml", overrides=overrides, override_label="scene range")
-    result, trace = run_impact(resolved)
+    run = run_impact(resolved)
+    result, trace = run.to_dict(), run.trace
     assert result["status"] in STATUSES
     assert result["n_bounces"] >= 1
     for key in ("t", "gap", "velocity", "force", "energy"):

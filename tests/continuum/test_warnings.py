@@ -10,11 +10,11 @@ ROLLER = ROOT / "inputs" / "scenes" / "hertz_roller.toml"
 
 def test_hertz_roller_warns_when_peak_pressure_passes_tresca_onset():
     # the paper roller's Hertz peak pressure is ~18 MPa: a 5 MPa yield strength must trigger the warning
-    result, _ = run_impact(resolve_scene(ROLLER, overrides={"surfaces.substrate.yield_strength": 5e6,
-                                                            "numerics.max_bounces": 1}))
+    result = run_impact(resolve_scene(ROLLER, overrides={"surfaces.substrate.yield_strength": 5e6,
+                                                            "numerics.max_bounces": 1})).to_dict()
     assert any("Tresca" in w or "von Mises" in w for w in result["warnings"])
-    result, _ = run_impact(resolve_scene(ROLLER, overrides={"surfaces.substrate.yield_strength": 1e9,
-                                                            "numerics.max_bounces": 1}))
+    result = run_impact(resolve_scene(ROLLER, overrides={"surfaces.substrate.yield_strength": 1e9,
+                                                            "numerics.max_bounces": 1})).to_dict()
     assert result["warnings"] == []
 
 
@@ -22,8 +22,8 @@ def test_rough_contact_warns_when_the_plasticity_index_says_summits_yield():
     # psi = (E*/H) sqrt(sigma/beta): paper set, summit E* 10 GPa, sigma 6 nm, beta 0.2 um -> psi = 1.73 at H = 1 GPa
     scene = ROOT / "inputs" / "scenes" / "rough_silica.toml"
     base = {"numerics.max_bounces": 1, "physics.half_space": "off", "numerics.fidelity": "fast"}
-    result, _ = run_impact(resolve_scene(scene, overrides={**base, "surfaces.substrate.hardness": 1e9}))
+    result = run_impact(resolve_scene(scene, overrides={**base, "surfaces.substrate.hardness": 1e9})).to_dict()
     assert any("plasticity index" in w and "most summits yield" in w for w in result["warnings"])
     assert result["models"]["contact_law"]["regime"]["plasticity_index"] > 1
-    result, _ = run_impact(resolve_scene(scene, overrides={**base, "surfaces.substrate.hardness": 1e11}))
+    result = run_impact(resolve_scene(scene, overrides={**base, "surfaces.substrate.hardness": 1e11})).to_dict()
     assert not any("plasticity index" in w for w in result["warnings"])
