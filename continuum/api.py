@@ -23,7 +23,6 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from .dynamics import impact
-from .dynamics.driver import Bounce
 from .dynamics.escape import escape_velocity as escape_velocity
 from .dynamics.escape import single_impact as single_impact
 from .dynamics.impact import first_impact_speed as first_impact_speed
@@ -31,6 +30,7 @@ from .laws.base import ContactLaw
 from .model.regime import Regime
 from .model.select import select_law
 from .origins import check_origins as check_origins
+from .output.bounce import Bounce
 from .output.impact_result import EnergyAudit, ImpactResult, ModelDecision
 from .output.results import load_result
 from .paper import loop_probe

@@ -9,12 +9,13 @@ from ..model import dry_run_verdict, select_law
 from ..model.decisions import menisci_decision, realisation_decision
 from ..model.regime import Regime, regime_of
 from ..model.regime import first_impact_speed as scene_first_impact_speed
+from ..output.bounce import Bounce
 from ..output.impact_result import ImpactResult
 from ..output.notices import audit_warnings, model_warnings, result_warnings
 from ..output.provenance import provenance
 from ..output.results import SCHEMA_VERSION
 from ..scene import ResolvedScene, SceneError
-from .driver import Bounce, DriverSettings, simulate
+from .driver import DriverSettings, simulate
 
 
 def first_impact_speed(resolved: ResolvedScene) -> float:

@@ -113,6 +113,12 @@ class BridgedDiscreteRoller(WetRoughRoller):
     P and T are kept, so that after the driver has accepted the state at t_a the contact goes on in
     `continuum.numerics.wet_discrete_kernel.LAW_BRIDGED`: the same dry law, with the bridges' blocks after its own."""
 
+    #: the dry law's compiled form issued at touch; which form was issued last ('dry', 'bridged'); the gap accepted
+    #: at t_a (None: not reached in this contact)
+    _inner: CompiledLaw | None = None
+    _issued: str | None = None
+    _gap_acc: float | None = None
+
     def reset(self):
         super().reset()
         self._inner, self._issued, self._gap_acc = None, None, None
@@ -126,8 +132,8 @@ class BridgedDiscreteRoller(WetRoughRoller):
             form = super().compiled(t0)
             self._inner, self._issued = form, "dry"
             return form
-        inner = getattr(self, "_inner", None)
-        if inner is None or getattr(self, "_gap_acc", None) is None:
+        inner = self._inner
+        if inner is None or self._gap_acc is None:
             return None
         u = inner.T[0]
         src = self.bridges.source
@@ -142,7 +148,7 @@ class BridgedDiscreteRoller(WetRoughRoller):
                            np.concatenate([S, bridge_state(self.bridges)]))
 
     def compiled_commit(self, state, last_accept: float) -> None:
-        if getattr(self, "_issued", None) != "bridged":
+        if self._issued != "bridged":
             super().compiled_commit(state, last_accept)
             return
         n = self._inner.S.size

@@ -222,6 +222,9 @@ class WetDiscreteRoller(WetRoughRoller):
     """`WetRoughRoller` round a `WetSummitRoller`: before each evaluation the bridges' prefix at (gap, t) is handed
     to the summits, so bridged summits adhere with W_wet."""
 
+    #: the compiled form issued last in this contact: 'dry' up to t_a, 'wet' after it
+    _issued: str = "dry"
+
     def _sync(self, gap: float) -> None:
         self.dry.set_wet_prefix(self.bridges.prefix(gap, self.t))
 
@@ -255,7 +258,7 @@ class WetDiscreteRoller(WetRoughRoller):
         return wet_form(self, t0)
 
     def compiled_commit(self, state, last_accept: float) -> None:
-        if getattr(self, "_issued", "dry") == "wet":
+        if self._issued == "wet":
             take_back(self, state, last_accept)
         else:
             super().compiled_commit(state, last_accept)

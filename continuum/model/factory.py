@@ -153,6 +153,13 @@ def wet_summit_roller(elastic: ContactLaw, wet: ContactLaw, parameters: dict) ->
     return build(elastic, wet, parameters)
 
 
+def bridged_discrete_roller(dry: ContactLaw, source: ContactLaw, parameters: dict) -> ContactLaw:
+    """`dry` (a discrete summit law, plastic summits included) with a bridge on each of `source`'s summits, by the
+    scene's meniscus `parameters` (`continuum.laws.discrete_bridges.wet_discrete`)."""
+    from ..laws.discrete_bridges import wet_discrete
+    return wet_discrete(dry, source, parameters)
+
+
 def wet_roller_with_condensation_time(wet: ContactLaw, t_a: float) -> ContactLaw | None:
     """The averaged wet roller `wet` with its bridges' condensation time set to `t_a` (s): a copy sharing the dry
     law's tables (`continuum.laws.wet.WetRoughRoller`); None where `wet` is another law."""

@@ -6,7 +6,6 @@ resolution, cost checks) -> law (`factory`) -> record (`record`, result.json -> 
 from __future__ import annotations
 
 from ..laws.base import ContactLaw
-from ..laws.discrete_bridges import wet_discrete
 from ..reference import jkr as jkr_ref
 from ..scene import Scene, SceneError
 from . import factory
@@ -210,8 +209,8 @@ def discrete_menisci(scene: Scene, law: ContactLaw, elastic, regime: Regime) -> 
     if params["solid_adhesion"] != "wet" or law is not elastic or elastic.use_half_space:
         why = ("menisci.solid_adhesion = 'additive'" if params["solid_adhesion"] != "wet" else
                "plastic summits" if law is not elastic else "the half-space couples the summits")
-        return wet_discrete(law, elastic, {**params, "solids_inside_bridges": f"dry summit law, DMT solid pull "
-                                                                               f"(loop dry: {why})"})
+        inside = f"dry summit law, DMT solid pull (loop dry: {why})"
+        return factory.bridged_discrete_roller(law, elastic, {**params, "solids_inside_bridges": inside})
     w_wet = max(params["work_of_adhesion_wet"], 0.0)
     wet_scene = _with_work_of_adhesion(scene, w_wet)
     slaw = summit_law(elastic.slaw.name, wet_scene, regime.e_star) if elastic.slaw is not None and w_wet > 0 else None

@@ -13,10 +13,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..dynamics.driver import Bounce
 from ..model.regime import Regime
 from ..rough.ensemble import EnsembleResult
 from . import plots
+from .bounce import Bounce
 from .results import TIMESERIES_COLUMNS, write_result_files, write_run
 
 #: Keys of a model record that say what was decided and why; every other key is a number behind it.
