@@ -27,7 +27,10 @@ s_m, W = -closed_integral F ds of the table, `ForceCycle.hysteresis_energy`), bo
 """
 from __future__ import annotations
 
+from bisect import bisect_right
+
 import numpy as np
+from scipy.optimize import brentq
 
 from ..rough.quasistatic import ForceCycle
 from .base import ContactLaw
@@ -40,30 +43,33 @@ class PiecewiseLinear:
     held at the last node's value above it; with its exact integral from the first node."""
 
     def __init__(self, x, y):
-        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
-        if self.x.ndim != 1 or self.x.size < 2 or not np.all(np.diff(self.x) > 0):
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        if x.ndim != 1 or x.size < 2 or not np.all(np.diff(x) > 0):
             raise ValueError("PiecewiseLinear needs >= 2 strictly increasing nodes")
-        self.slopes = np.diff(self.y) / np.diff(self.x)
-        self.cum = np.concatenate([[0.0], np.cumsum(0.5 * (self.y[1:] + self.y[:-1]) * np.diff(self.x))])
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))])
+        # plain lists: the driver calls these one scalar at a time, where bisect beats numpy's per-call overhead
+        self.x, self.y, self.cum = x.tolist(), y.tolist(), cum.tolist()
+        self.slopes = (np.diff(y) / np.diff(x)).tolist()
+        self._last = len(self.x) - 2
 
     def _segment(self, x: float) -> int:
-        return int(np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.x.size - 2))
+        return min(max(bisect_right(self.x, x) - 1, 0), self._last)
 
     def __call__(self, x: float) -> float:
         if x >= self.x[-1]:
-            return float(self.y[-1])
+            return self.y[-1]
         k = self._segment(x)
-        return float(self.y[k] + self.slopes[k] * (x - self.x[k]))
+        return self.y[k] + self.slopes[k] * (x - self.x[k])
 
     def slope(self, x: float) -> float:
-        return 0.0 if x >= self.x[-1] else float(self.slopes[self._segment(x)])
+        return 0.0 if x >= self.x[-1] else self.slopes[self._segment(x)]
 
     def integral(self, x: float) -> float:
         """int_{x[0]}^{x} y dx' (negative below x[0])."""
         if x >= self.x[-1]:
-            return float(self.cum[-1] + self.y[-1] * (x - self.x[-1]))
+            return self.cum[-1] + self.y[-1] * (x - self.x[-1])
         k = self._segment(x)
-        return float(self.cum[k] + 0.5 * (self.y[k] + self(x)) * (x - self.x[k]))
+        return self.cum[k] + 0.5 * (self.y[k] + self(x)) * (x - self.x[k])
 
 
 class TabulatedCycleLaw(ContactLaw):
@@ -130,6 +136,19 @@ class TabulatedCycleLaw(ContactLaw):
         elif np.isfinite(self.deepest) and gap > self.deepest and not self.turned:
             self.turned = True
             self.turns.append(self.deepest)
+
+    def turn_for(self, speed: float, mass: float, gravity: float, below: float = 0.0) -> float:
+        """Gap (m) at which a body of `mass` (kg) arriving at the touch at `speed` (m/s) turns on the approach branch:
+        W_app(s) = 1/2 m v^2 + m g (s_touch - s), solved on the table's exact (piecewise quadratic) work, searched
+        down to `below` (m) under the table's deepest state (along its last segment); -inf where that does not stop
+        the body."""
+        k0 = 0.5 * mass * speed * speed
+        excess = lambda s: self._approach_work(s) - k0 - mass * gravity * (self.touch_gap - s)   # noqa: E731
+        lowest = self.s_deepest - below
+        if excess(lowest) < 0.0:
+            return -np.inf
+        scale = self.touch_gap - lowest
+        return float(brentq(excess, lowest, self.touch_gap, xtol=1e-15 * scale, rtol=4 * np.finfo(float).eps))
 
     def on_release(self) -> float:
         return self.stored_energy(self.release_gap())

@@ -44,6 +44,10 @@ def test_jkr_summit_dropped_through_the_driver_loses_the_fuller_tabor_loop(times
     run, tab, k0 = _drop(cycle)
     b = run.bounces[0]
     assert (run.status == "stuck") is stuck
+    # the turn solved on the table's exact approach work is where the driver's body turns
+    speed = math.sqrt(2 * k0 / MASS)
+    assert TabulatedCycleLaw(cycle, "c").turn_for(speed, MASS, G, below=step) == pytest.approx(-b.max_penetration,
+                                                                                     abs=1e-4 * step)
     assert abs(tab.diagnostics()["turn_shift_over_step"]) < 1e-3       # it turned where the table turns
     assert run.audit["max_relative_error"] < 1e-5
     if stuck:
