@@ -1,12 +1,13 @@
 """A body dropped on a rough patch whose contact force is a tabulated hysteretic law: the approach branch and the
 retraction branch of a quasi-static cycle (`continuum.rough.quasistatic.ForceCycle`, from the boundary-element
-reference or from a summit level). First rebound and stick, by the energy balance of a quasi-static impact.
+reference or from a summit level): the quasi-static energy balance of such an impact, and the short roller the
+benchmark drops (`Roller`, `roller_gw_cycle`). The impact itself is integrated by the project's driver on the table
+as a contact law (`continuum.dynamics.tabulated_cycle`, benchmarks/accuracy_impact.py); the balance here is its check.
 
-The body is rigid and its face is the patch's flat counter-surface (the nominal area every level shares); it
-arrives with kinetic energy K0 at the separation where the force starts. The contact force is rate-independent
-(each state an equilibrium: the impact model's own assumption, Johnson, *Contact Mechanics* (1985) 11.1, valid
-while the impact lasts much longer than the elastic waves take to cross the contact), so the motion conserves
-K + the work of the tabulated force exactly, and no integrator is needed:
+The contact force is rate-independent (each state an equilibrium: the impact model's own assumption, Johnson,
+*Contact Mechanics* (1985) 11.1, valid while the impact lasts much longer than the elastic waves take to cross the
+contact), so the motion conserves K + the work of the tabulated force exactly (gravity's work across the contact
+range, m g times a few nm, aside):
 
 * approach: K(s) = K0 - W_app(s), W_app(s) = int_s^{s_start} F_app ds' (F > 0 compressive); the body turns where
   K = 0 (`turn_for_energy`);
@@ -14,9 +15,8 @@ K + the work of the tabulated force exactly, and no integrator is needed:
   K1 = K0 - W_loop and restitution e = sqrt(K1 / K0) (e^2 = 1 - W_loop/K0) unless K reaches zero on the way out:
   then the adhesive tension holds it (stuck, the capture of Thornton & Ning, Powder Technol. 99 (1998) 154).
 
-Gravity's work across the contact range (m g times a few nm) is neglected; `gravity_work_ratio` records it against
-K0. The retraction depends on where the body turns, so a level's cycle must turn at the body's turn: the
-reference's cycle fixes K0 (the body turns at its deepest state), and a cheap level is rerun to its own turn
+The retraction depends on where the body turns, so a level's cycle must turn at the body's turn: the reference's
+cycle fixes K0 (the body turns at its deepest state), and a cheap level is rerun to its own turn
 (`impact_at_energy`).
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """A body dropped through the impact driver (continuum/dynamics/driver.py) on a tabulated hysteretic law
-(continuum/laws/tabulated_cycle.py), against closed forms: a JKR summit's displacement-controlled loop (Fuller &
+(continuum/dynamics/tabulated_cycle.py), against closed forms: a JKR summit's displacement-controlled loop (Fuller &
 Tabor; `continuum.reference.jkr.loop_area`) is what the body loses, e^2 = 1 - W/K0, and a body arriving with less
 than the loop sticks; without adhesion nothing is lost. The driver's rebound also equals the quasi-static energy
 balance through the same table (`bem_impact.impact_outcome`, exact for a rate-independent law up to gravity's work
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from continuum.dynamics.driver import DriverSettings, simulate
-from continuum.laws.tabulated_cycle import PiecewiseLinear, TabulatedCycleLaw
+from continuum.dynamics.tabulated_cycle import PiecewiseLinear, TabulatedCycleLaw
 from continuum.reference import hertz, jkr
 from continuum.rough.bem_impact import Roller, approach_work, impact_outcome, roller_gw_cycle, turn_for_energy
 from continuum.rough.branch_laws import make_summit_law

@@ -32,8 +32,8 @@ from bisect import bisect_right
 import numpy as np
 from scipy.optimize import brentq
 
+from ..laws.base import ContactLaw
 from ..rough.quasistatic import ForceCycle
-from .base import ContactLaw
 
 __all__ = ["PiecewiseLinear", "TabulatedCycleLaw"]
 
