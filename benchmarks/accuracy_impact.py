@@ -150,8 +150,9 @@ def compare(grids: dict, desc: dict, mat: dict, sets: dict, levels: dict, quick:
             "drop_height_m": speed * speed / (2 * STANDARD_G), "table_depth_m": ROLLER_DEPTH,
             "reach_band_x_over_L": roller.reach_band(grids[n_ref], float(path.min()), mat["dugdale_range"]),
             "summits_reached_at_turn": touching, "summits_on_patch": int(sets["own_heights"].size),
-            "method": "each level's quasi-static cycle under the roller, tabulated (continuum/dynamics/tabulated_cycle.py) "
-                      "and integrated by continuum/dynamics/driver.py (first impact); the speed turns the body at "
+            "method": "each level's quasi-static cycle under the roller, tabulated "
+                      "(continuum/dynamics/tabulated_cycle.py) and integrated by continuum/dynamics/driver.py (first "
+                      "impact); the speed turns the body at "
                       "the reference table's deepest state; summit levels rerun to their own turn"}
     rich = 2 * bem[n_ref].hysteresis_energy - record["grids"][str(n_ref // 2)]["hysteresis_energy_J"]
     k0 = body["impact_energy_J"]
