@@ -393,7 +393,7 @@ def markdown_bem(result: dict) -> str:
             f"the band within the cohesive range spans x/L = {body['reach_band_x_over_L'][0]:.2f}–"
             f"{body['reach_band_x_over_L'][1]:.2f}. Each level's force is its quasi-static cycle under the roller, "
             "tabulated and integrated through the impact driver (first impact). The reference's loss per roller "
-            + ", ".join(f"cycle on {n}² is {g['hysteresis_energy_J']:.3g} J" for n, g in ref["grids"].items())
+            "cycle: " + ", ".join(f"{g['hysteresis_energy_J']:.3g} J on {n}²" for n, g in ref["grids"].items())
             + f"; extrapolated to zero pixel {ref['loss_richardson_J']:.3g} J, which would give h1/h0 = "
             + (f"{e_ext ** 2:.4f}" if e_ext else "none (not positive)") + ".")
     cut = result["summit_cutoff"]

@@ -43,10 +43,10 @@ def test_the_json_holds_what_the_issue_asks_for():
 
 
 def test_the_impact_is_a_roller_through_the_driver_that_turns_where_its_tables_turn():
-    """The roller's impacts: each level's table turns where the body turns (the retraction is the table's, to a
-    millionth of a step... a thousandth allowed), the driver's energy audit closes, and the driver's rebound is the
-    quasi-static energy balance through the same table (a rate-independent law: equal up to gravity's work and the
-    turn's shift, both far below the restitution's last quoted digit); the roller reaches many summits."""
+    """The roller's impacts: each level's table turns where the body turns (within a thousandth of a step; the half
+    grid, rerun once, a hundredth), the driver's energy audit closes, and the driver's rebound is the
+    quasi-static energy balance through the same table (a rate-independent law: equal up to the driver's tolerance,
+    gravity's work and what the turn's shift moves); the roller reaches many summits."""
     body = RESULT["impact"]
     assert body["shape"].startswith("short roller") and body["summits_reached_at_turn"] >= 5
     assert 0.0 < body["reach_band_x_over_L"][0] < body["reach_band_x_over_L"][1] < 1.0
@@ -55,4 +55,7 @@ def test_the_impact_is_a_roller_through_the_driver_that_turns_where_its_tables_t
     for run in runs:
         assert abs(run["turn_shift_over_step"]) < (1e-2 if run is runs[1] else 1e-3)   # the half grid: one rerun
         assert run["energy_audit_max_relative_error"] < 1e-5
-        assert run["restitution"] ** 2 == pytest.approx(run["energy_balance_restitution"] ** 2, abs=1e-6)
+        # the balance is the table's own turn; the body's turn lies turn_shift_m away, which moves the energy the
+        # retraction starts from by at most the peak force times that shift
+        shift = abs(run["turn_shift_m"]) * run["peak_force_N"] / run["impact_energy_J"]
+        assert run["restitution"] ** 2 == pytest.approx(run["energy_balance_restitution"] ** 2, abs=1e-6 + 2 * shift)
