@@ -29,6 +29,7 @@ relative; this keeps its numbers of order one).
 """
 from __future__ import annotations
 
+import importlib
 import logging
 import time
 from dataclasses import dataclass, field
@@ -49,7 +50,7 @@ def require_solver(key: str, value) -> None:
     """InputError naming `key` and `value` (the input that asked for the reference) when Tamaas, the boundary-element
     solver, cannot be imported here: one line instead of a traceback from the first solve."""
     try:
-        import tamaas  # noqa: F401
+        importlib.import_module("tamaas")
     except ImportError as exc:
         raise InputError(key, value, "needs the boundary-element solver Tamaas (pip install tamaas; Linux/macOS "
                                      f"wheels), which is not importable here ({exc})") from None
