@@ -292,16 +292,18 @@ def reference(grids: dict, desc: dict, mat: dict, path: np.ndarray) -> tuple[dic
 
 
 def figure(result: dict, path_png: Path) -> None:
-    """Force against separation (whole cycle and the tensile part), contact area on approach, relative errors;
-    drawn from the result's curves."""
+    """Force against separation (whole cycle and the tensile part), contact area on approach, relative errors, and
+    (where the result has it) the roller's force under each level against its separation; drawn from the result's
+    curves."""
     from matplotlib.figure import Figure
 
     curves = result["curves"]
     s_nm = np.asarray(curves["separation_m"]) * 1e9
     k = int(np.argmin(s_nm)) + 1
     pull = result["reference"]["pull_off_force_N"] * 1e6
-    fig = Figure(figsize=(14, 3.8))
-    ax_f, ax_t, ax_a, ax_e = fig.subplots(1, 4)
+    roller = result.get("impact", {}).get("curves")
+    fig = Figure(figsize=(17.5 if roller else 14, 3.8))
+    ax_f, ax_t, ax_a, ax_e, *ax_r = fig.subplots(1, 5 if roller else 4)
     for name, c in curves.items():
         if name == "separation_m":
             continue
@@ -326,6 +328,17 @@ def figure(result: dict, path_png: Path) -> None:
     ax_e.set_xticks(x, names, rotation=60, ha="right", fontsize=7)
     ax_e.set(ylabel=f"error against BEM {result['reference']['grid']}^2 (%)")
     ax_e.legend(fontsize=7)
+    if roller:
+        ax = ax_r[0]
+        ax.plot(np.asarray(roller["separation_m"]) * 1e9, np.asarray(roller["bem"]) * 1e6, color="k", lw=2,
+                label="bem")
+        for name, c in roller.items():
+            if name not in ("separation_m", "bem"):
+                ax.plot(np.asarray(c["separation_m"]) * 1e9, np.asarray(c["force_N"]) * 1e6, lw=1, label=name)
+        ax.axhline(0, color="0.7", lw=0.5)
+        ax.set(xlabel="separation s (nm)", ylabel="force on the roller (uN)",
+               title="the roller's tables, to each level's turn")
+        ax.legend(fontsize=7)
     fig.tight_layout()
     atomic_save_figure(fig, path_png, dpi=110)
 
