@@ -47,6 +47,9 @@ from SurfaceTopography import Topography
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import accuracy_impact  # noqa: E402
 
 from continuum.reference.hertz import effective_modulus  # noqa: E402
 from continuum.reference.maugis import md_parameter  # noqa: E402
@@ -57,7 +60,7 @@ from continuum.rough.bem_convergence import (  # noqa: E402
     dugdale_crack_zone,
     single_summit_ladder,
 )
-from continuum.rough.bem_impact import STANDARD_G, impact_at_energy, impact_outcome  # noqa: E402
+from continuum.rough.bem_impact import Roller, roller_gw_cycle  # noqa: E402
 from continuum.rough.bem_reference import bem_cycle, dugdale_range  # noqa: E402
 from continuum.rough.branch_laws import make_summit_law  # noqa: E402
 from continuum.rough.cutoff_match import (  # noqa: E402
@@ -73,7 +76,6 @@ from continuum.rough.summit_stats import direct_summary, spectral_summits  # noq
 from continuum.rough.summits import SummitStatistics, expected_max_height  # noqa: E402
 from continuum.rough.topography import Synthesis, identify_summits, load_height_map, synthesise_height_map  # noqa: E402
 from nanoimpact import data  # noqa: E402
-from nanoimpact.errors import InputError  # noqa: E402
 from nanoimpact.fileio import atomic_save_figure, atomic_write_json  # noqa: E402
 from nanoimpact.provenance import git_commit  # noqa: E402
 
@@ -136,6 +138,7 @@ def summit_sets(h: np.ndarray, desc: dict) -> dict:
     spectral = spectral_summits(desc.pop("periodic_topography"), cutoff)
     keep = np.isfinite(summits.radius)
     return {"summits": summits, "own_radii": summits.radius[keep], "own_heights": summits.height[keep],
+            "own_x": summits.x[keep], "grid": h.shape[0],
             "direct": direct, "spectral": spectral, "area": size * size,
             "record": {"count": summits.count, "direct": vars(direct), "spectral": vars(spectral),
                        "not_convex": int((~keep).sum())}}
@@ -153,22 +156,30 @@ def path_for(h: np.ndarray, sets: dict, mat: dict, quick: bool, depth: float | N
     return separation_path(top + 2 * rho, deepest, rho / (8 if quick else 16))
 
 
-def _gw_level(route: str, law_name: str, sets: dict, mat: dict, path: np.ndarray):
-    """GW mean field of one route's statistics with one summit law; its cycle."""
+def _gw_level(route: str, law_name: str, sets: dict, mat: dict, path: np.ndarray, roller: Roller | None = None):
+    """GW mean field of one route's statistics with one summit law; its cycle, under a flat (the patch's face) or
+    under `roller` (strips across the patch, `bem_impact.roller_gw_cycle`)."""
     st = sets[route]
     stats = SummitStatistics(st.summit_height_std, st.summit_density, st.summit_radius)
     n_summits = st.summit_density * sets["area"]
     z_max = float(expected_max_height(max(n_summits, 2.0)))
-    delta_max = 1.5 * (st.mean_summit_height + z_max * stats.sigma - path.min()) + 10 * mat["z0"]
+    n = sets["grid"]
+    lowest = path.min() + (float(roller.drop(np.arange(n) * roller.size / n, n).min()) if roller else 0.0)
+    delta_max = 1.5 * (st.mean_summit_height + z_max * stats.sigma - lowest) + 10 * mat["z0"]
     law = make_summit_law(law_name, stats.radius, mat["work_of_adhesion"], mat["e_star"], z0=mat["z0"],
                           delta_max=delta_max)
     surface = GWBranchSurface(stats, law, z_max=z_max)
+    if roller is not None:
+        return roller_gw_cycle(surface, roller, n, path, st.mean_summit_height)
     return gw_cycle(surface, sets["area"], path, st.mean_summit_height)
 
 
-def _discrete_level(own_radii: bool, sets: dict, mat: dict, path: np.ndarray):
-    """The map's summits at their own heights, Maugis-Dugdale, of the mean radius or each of its own."""
+def _discrete_level(own_radii: bool, sets: dict, mat: dict, path: np.ndarray, roller: Roller | None = None):
+    """The map's summits at their own heights, Maugis-Dugdale, of the mean radius or each of its own; under a flat
+    or under `roller` (each summit lowered by the roller's drop over it)."""
     z = sets["own_heights"]
+    if roller is not None:
+        z = z - roller.drop(sets["own_x"], sets["grid"])
     delta_max = 1.5 * float(z.max() - path.min()) + 10 * mat["z0"]
     make = lambda beta: make_summit_law("maugis_dugdale", beta, mat["work_of_adhesion"], mat["e_star"],   # noqa: E731
                                         z0=mat["z0"], delta_max=delta_max)
@@ -182,57 +193,35 @@ def _discrete_level(own_radii: bool, sets: dict, mat: dict, path: np.ndarray):
 
 LEVELS = {
     "gw_direct_md": ("GW mean field, direct-route statistics, Maugis-Dugdale summits",
-                     lambda s, m, p: _gw_level("direct", "maugis_dugdale", s, m, p)),
+                     lambda s, m, p, r=None: _gw_level("direct", "maugis_dugdale", s, m, p, r)),
     "gw_spectral_md": ("GW mean field, spectral-moment statistics (Nayak), Maugis-Dugdale summits",
-                       lambda s, m, p: _gw_level("spectral", "maugis_dugdale", s, m, p)),
+                       lambda s, m, p, r=None: _gw_level("spectral", "maugis_dugdale", s, m, p, r)),
     "gw_direct_jkr": ("GW mean field, direct-route statistics, JKR summits",
-                      lambda s, m, p: _gw_level("direct", "jkr", s, m, p)),
+                      lambda s, m, p, r=None: _gw_level("direct", "jkr", s, m, p, r)),
     "discrete_md": ("the map's summits at their own heights, mean tip radius, Maugis-Dugdale",
-                    lambda s, m, p: _discrete_level(False, s, m, p)),
+                    lambda s, m, p, r=None: _discrete_level(False, s, m, p, r)),
     "discrete_md_own_radii": ("the map's summits at their own heights and tip radii, Maugis-Dugdale",
-                              lambda s, m, p: _discrete_level(True, s, m, p)),
+                              lambda s, m, p, r=None: _discrete_level(True, s, m, p, r)),
 }
 
 
-#: Density of the dropped body (kg/m^3): silicon (the calibrated set's body is polysilicon, E = 169 GPa), a choice
-#: that sets the impact speed and the drop height, not the restitution.
-BODY_DENSITY = 2330.0
-
-
-def impact_body(size: float, ref) -> dict:
-    """The dropped body: a cube of silicon of the patch's side, its face the patch's flat counter-surface, arriving
-    with the kinetic energy that turns it at the reference cycle's deepest state (`bem_impact.impact_outcome`)."""
-    mass = BODY_DENSITY * size**3
-    k0 = impact_outcome(ref).impact_energy
-    return {"shape": "cube of the patch's side, face = the patch's flat counter-surface", "density_kg_m3": BODY_DENSITY,
-            "mass_kg": mass, "impact_energy_J": k0, "impact_velocity_m_s": math.sqrt(2 * k0 / mass),
-            "drop_height_m": k0 / (mass * STANDARD_G),
-            "gravity_work_ratio": mass * STANDARD_G * float(ref.separation[0] - ref.separation[ref.turn]) / k0,
-            "method": "quasi-static energy balance through each level's tabulated approach and retraction branches "
-                      "(continuum/rough/bem_impact.py): e^2 = 1 - W_loop/K0, stuck when the way out needs more than "
-                      "the body keeps; the summit levels are rerun to their own turn"}
-
-
-def level_impact(cycle_to, body: dict, path: np.ndarray, mat: dict):
-    """A summit level's impact at the body's energy; its turn searched down to 3x the reference's depth below the
-    start. None when even that does not absorb the energy."""
-    start, deepest = float(path[0]), float(path.min())
-    try:
-        outcome, _ = impact_at_energy(cycle_to, body["impact_energy_J"], start, mat["dugdale_range"] / 8,
-                                      start - 3 * (start - deepest))
-    except InputError as exc:
-        return str(exc)
-    return outcome
-
-
-def impact_row(outcome, ref_outcome, body: dict, seconds: float) -> dict:
-    """A level's impact numbers: first-rebound height, stick, restitution, error against the reference."""
-    if isinstance(outcome, str):
-        return {"impact": {"not_run": outcome}, "impact_rel_error": math.nan, "impact_seconds": seconds}
-    h1, h1_ref = outcome.rebound_height(body["drop_height_m"]), ref_outcome.rebound_height(body["drop_height_m"])
-    return {"impact": {**outcome.to_json(), "rebound_height_m": h1}, "impact_seconds": seconds,
-            "stuck": outcome.stuck, "impact_rel_error": _rel(h1, h1_ref) if h1_ref else math.nan,
-            "impact_stick_agrees": outcome.stuck == ref_outcome.stuck}
+def _impact_rows(levels: list[dict], impact: dict, half: int) -> None:
+    """Each level's roller impact into its row: the record, first-rebound error against the reference's
+    (`impact_rel_error`) and against the rebound the reference's loss extrapolated to zero pixel gives, stick."""
+    ref = impact["reference"]
+    ref_imp, e_ext = ref["impact"], ref["restitution_at_extrapolated_loss"]
+    h0 = impact["body"]["drop_height_m"]
+    for row in levels:
+        out = ref["half_grid_impact"] if row["name"] == f"bem_half_grid_{half}" else impact["levels"][row["name"]]
+        row["impact"] = out
+        row["impact_seconds"] = out["seconds"]
+        row["impact_rel_error"] = accuracy_impact.rebound_error(out, ref_imp)
+        if "stuck" in out:
+            row["stuck"] = out["stuck"]
+            row["impact_stick_agrees"] = out["stuck"] == ref_imp["stuck"]
+        row["impact_rel_error_vs_extrapolated"] = (
+            (out["rebound_height_m"] - h0 * e_ext**2) / (h0 * e_ext**2)
+            if e_ext and "rebound_height_m" in out else math.nan)
 
 
 def cutoff_match(h: np.ndarray, desc: dict, mat: dict, path: np.ndarray, conv: dict):
@@ -303,16 +292,18 @@ def reference(grids: dict, desc: dict, mat: dict, path: np.ndarray) -> tuple[dic
 
 
 def figure(result: dict, path_png: Path) -> None:
-    """Force against separation (whole cycle and the tensile part), contact area on approach, relative errors;
-    drawn from the result's curves."""
+    """Force against separation (whole cycle and the tensile part), contact area on approach, relative errors, and
+    (where the result has it) the roller's force under each level against its separation; drawn from the result's
+    curves."""
     from matplotlib.figure import Figure
 
     curves = result["curves"]
     s_nm = np.asarray(curves["separation_m"]) * 1e9
     k = int(np.argmin(s_nm)) + 1
     pull = result["reference"]["pull_off_force_N"] * 1e6
-    fig = Figure(figsize=(14, 3.8))
-    ax_f, ax_t, ax_a, ax_e = fig.subplots(1, 4)
+    roller = result.get("impact", {}).get("curves")
+    fig = Figure(figsize=(17.5 if roller else 14, 3.8))
+    ax_f, ax_t, ax_a, ax_e, *ax_r = fig.subplots(1, 5 if roller else 4)
     for name, c in curves.items():
         if name == "separation_m":
             continue
@@ -337,6 +328,17 @@ def figure(result: dict, path_png: Path) -> None:
     ax_e.set_xticks(x, names, rotation=60, ha="right", fontsize=7)
     ax_e.set(ylabel=f"error against BEM {result['reference']['grid']}^2 (%)")
     ax_e.legend(fontsize=7)
+    if roller:
+        ax = ax_r[0]
+        ax.plot(np.asarray(roller["separation_m"]) * 1e9, np.asarray(roller["bem"]) * 1e6, color="k", lw=2,
+                label="bem")
+        for name, c in roller.items():
+            if name not in ("separation_m", "bem"):
+                ax.plot(np.asarray(c["separation_m"]) * 1e9, np.asarray(c["force_N"]) * 1e6, lw=1, label=name)
+        ax.axhline(0, color="0.7", lw=0.5)
+        ax.set(xlabel="separation s (nm)", ylabel="force on the roller (uN)",
+               title="the roller's tables, to each level's turn")
+        ax.legend(fontsize=7)
     fig.tight_layout()
     atomic_save_figure(fig, path_png, dpi=110)
 
@@ -376,23 +378,37 @@ def markdown_bem(result: dict) -> str:
                     f"{g['pixel_m'] * 1e9:.3g} nm: pull-off {g['pull_off_force_N']:.3g} N, loss "
                     f"{g['hysteresis_energy_J']:.3g} J ({g['loss_over_summit_law']:.0f}x the summit law's)"
                     for g in one["grids"]) + ".")
-    ref_e = body["reference"]["restitution"]
-    imp = ["| level | restitution e | first rebound h1/h0 = e² | energy lost 1 − e² | sticks | impact_rel_error | "
-           "vs extrapolated reference | seconds (cycle + impact) |", "|---|---|---|---|---|---|---|---|",
-           f"| `bem` {result['reference']['grid']}² (reference) | {ref_e:.4f} | {ref_e ** 2:.4f} | "
-           f"{1 - ref_e ** 2:.2g} | {'yes' if body['reference']['stuck'] else 'no'} | | | "
-           f"{result['reference']['seconds']:.1f} |"]
+    ref = body["reference"]
+    ref_i = ref["impact"]
+    n_ref = result["reference"]["grid"]
+    imp = ["| level | first rebound h1 (m) | h1/h0 = e² | sticks | impact_rel_error | vs extrapolated reference | "
+           "turn − table's turn (steps) | energy audit | seconds (cycle + impact) |",
+           "|---|---|---|---|---|---|---|---|---|",
+           f"| `bem` {n_ref}² (reference) | {ref_i['rebound_height_m']:.4g} | {ref_i['restitution'] ** 2:.4f} | "
+           f"{'yes' if ref_i['stuck'] else 'no'} | | | {ref_i['turn_shift_over_step']:+.1e} | "
+           f"{ref_i['energy_audit_max_relative_error']:.0e} | {ref['seconds']:.1f} |"]
     for r in result["levels"]:
         i = r["impact"]
         if "restitution" not in i:
-            imp.append(f"| `{r['name']}` | not run: {i['not_run']} | | | | | | |")
+            imp.append(f"| `{r['name']}` | not run: {i['not_run']} | | | | | | | |")
             continue
-        imp.append(f"| `{r['name']}` | {i['restitution']:.4f} | {i['restitution'] ** 2:.4f} | "
-                   f"{1 - i['restitution'] ** 2:.2g} | {'yes' if i['stuck'] else 'no'} | "
-                   f"{100 * r['impact_rel_error']:+.1f} % | "
+        imp.append(f"| `{r['name']}` | {i['rebound_height_m']:.4g} | {i['restitution'] ** 2:.4f} | "
+                   f"{'yes' if i['stuck'] else 'no'} | {100 * r['impact_rel_error']:+.1f} % | "
                    f"{100 * r.get('impact_rel_error_vs_extrapolated', math.nan):+.1f} % | "
+                   f"{i['turn_shift_over_step']:+.1e} | {i['energy_audit_max_relative_error']:.0e} | "
                    f"{r['seconds'] + r['impact_seconds']:.2f} |")
-    ext = body["reference_at_extrapolated_loss"]
+    e_ext = ref["restitution_at_extrapolated_loss"]
+    head = (f"Body: {body['shape']}, radius {body['radius_m'] * 1e6:.3g} µm, {body['mass_kg']:.3g} kg, at "
+            f"{body['impact_velocity_m_s']:.3g} m/s (K0 = {body['impact_energy_J']:.3g} J, drop height h0 = "
+            f"{body['drop_height_m']:.3g} m: it turns at the reference table's deepest state, "
+            f"{body['table_depth_m'] * 1e9:.3g} nm below the composite surface's top); at the turn "
+            f"{body['summits_reached_at_turn']} of the patch's {body['summits_on_patch']} summits are reached and "
+            f"the band within the cohesive range spans x/L = {body['reach_band_x_over_L'][0]:.2f}–"
+            f"{body['reach_band_x_over_L'][1]:.2f}. Each level's force is its quasi-static cycle under the roller, "
+            "tabulated and integrated through the impact driver (first impact). The reference's loss per roller "
+            "cycle: " + ", ".join(f"{g['hysteresis_energy_J']:.3g} J on {n}²" for n, g in ref["grids"].items())
+            + f"; extrapolated to zero pixel {ref['loss_richardson_J']:.3g} J, which would give h1/h0 = "
+            + (f"{e_ext ** 2:.4f}" if e_ext else "none (not positive)") + ".")
     cut = result["summit_cutoff"]
     match = result["cutoff_match"]
     ladder = ", ".join(f"{r['cutoff_m'] * 1e9:.3g} nm: {r['summits']} summits, {r['loss_J']:.2g} J"
@@ -404,10 +420,6 @@ def markdown_bem(result: dict) -> str:
                 + "); at the finest grid's loss, its upper bound: "
                 + (f"{cut['cutoff_at_upper_bound_m'] * 1e9:.3g} nm" if cut["cutoff_at_upper_bound_m"] else "none")
                 + f". Discrete loss per cycle by cutoff: {ladder}.")
-    head = (f"Body: {body['shape']}, {body['mass_kg']:.3g} kg, K0 = {body['impact_energy_J']:.3g} J "
-            f"({body['impact_velocity_m_s']:.3g} m/s; it turns at the reference's deepest state); with the "
-            f"reference's loss extrapolated to zero pixel ({ext['loss_J']:.3g} J) its restitution would be "
-            f"{ext['restitution']:.4f}.")
     load = result.get("load_average_1min", {})
     cost = (f"Whole run: {result['wall_s']:.0f} s wall, {result.get('cpu_s', math.nan):.0f} s CPU, 1-minute load "
             f"average {load.get('start', math.nan):.1f} at the start and {load.get('end', math.nan):.1f} at the end "
@@ -428,29 +440,12 @@ def run(args) -> dict:
     cycles, levels = {"bem": ref, f"bem_{half}": bem[half]}, []
     levels.append(_row(f"bem_half_grid_{half}", "the reference on the half grid (numerical error only)",
                        ref_record["half_grid"]["solver"]["seconds"], bem[half], ref, ref_record["richardson"]))
-    body = impact_body(desc["size_m"], ref)
-    ref_impact = impact_outcome(ref)
-    levels[0].update(impact_row(impact_outcome(bem[half], body["impact_energy_J"]), ref_impact, body, 0.0))
     for name, (description, build) in LEVELS.items():
         t0 = time.perf_counter()
         cycles[name] = build(sets, mat, path)
         levels.append(_row(name, description, time.perf_counter() - t0, cycles[name], ref, ref_record["richardson"]))
-        t0 = time.perf_counter()
-        outcome = level_impact(lambda p, b=build: b(sets, mat, p), body, path, mat)
-        levels[-1].update(impact_row(outcome, ref_impact, body, time.perf_counter() - t0))
-    body["reference"] = ref_impact.to_json()
-    body["reference"]["rebound_height_m"] = ref_impact.rebound_height(body["drop_height_m"])
-    body["reference_by_grid"] = {str(n): impact_outcome(c, body["impact_energy_J"]).to_json() for n, c in bem.items()}
-    est = reference_estimate(ref_record["bem_convergence"])
-    body["reference_at_extrapolated_loss"] = {
-        "loss_J": est, "restitution": math.sqrt(max(0.0, 1 - est / body["impact_energy_J"])),
-        "note": "e^2 = 1 - L/K0 with the reference's loss per cycle extrapolated to zero pixel (bem_convergence; "
-                "the finest grid's where the extrapolation is not positive): the rebound the reference would give "
-                "without its lattice-trapping term, the forces of its finest grid otherwise"}
-    for row in levels:
-        if "restitution" in row["impact"]:
-            e2 = 1 - est / body["impact_energy_J"]
-            row["impact_rel_error_vs_extrapolated"] = _rel(row["impact"]["restitution"] ** 2, e2)
+    impact = accuracy_impact.compare(grids, desc, mat, sets, {n: b for n, (_, b) in LEVELS.items()}, args.quick)
+    _impact_rows(levels, impact, half)
     match = cutoff_match(grids[n_ref], desc, mat, path, ref_record["bem_convergence"])
     ref_record["bem_convergence"]["single_summit"] = single_summit_ladder(
         sets["direct"].summit_radius, mat["e_star"], mat["work_of_adhesion"], mat["z0"],
@@ -470,7 +465,8 @@ def run(args) -> dict:
                              "command": "benchmarks/bench_accuracy.py " + " ".join(sys.argv[1:])},
               "materials": mat, "surface": surface,
               "path": {"start_m": float(path[0]), "deepest_m": float(path.min()), "states": int(path.size)},
-              "reference": ref_record, "bem_convergence": ref_record["bem_convergence"], "impact": body,
+              "reference": ref_record, "bem_convergence": ref_record["bem_convergence"],
+              "impact": {**impact["body"], "reference": impact["reference"], "curves": impact["curves"]},
               "summit_cutoff": match.origin(), "cutoff_match": match.to_json(), "levels": levels,
               "curves": {"separation_m": path.tolist(), **{n: {"force_N": c.force.tolist(),
                                                                 "contact_area_m2": c.contact_area.tolist()}
@@ -521,13 +517,15 @@ def main(argv=None):
                                           for g in conv["grids"]))
     print("converged" if conv["converged"] else f"not converged: {conv['not_converged']}")
     body = result["impact"]
-    print(f"impact: K0 {body['impact_energy_J']:.4g} J, v {body['impact_velocity_m_s']:.3g} m/s; reference "
-          f"e = {body['reference']['restitution']:.4f}, stuck {body['reference']['stuck']}")
+    ref_i = body["reference"]["impact"]
+    print(f"roller impact: R {body['radius_m']:.3g} m, K0 {body['impact_energy_J']:.4g} J, v "
+          f"{body['impact_velocity_m_s']:.3g} m/s, h0 {body['drop_height_m']:.4g} m; reference h1 "
+          f"{ref_i['rebound_height_m']:.4g} m (e = {ref_i['restitution']:.4f}), stuck {ref_i['stuck']}")
     for r in result["levels"]:
         imp = r["impact"]
-        print(f"  {r['name']:24s} " + (f"e = {imp['restitution']:.4f} stuck {imp['stuck']} rebound error "
-                                       f"{r['impact_rel_error']:+.3f} ({r['impact_seconds']:.2f} s)"
-                                       if "restitution" in imp else imp["not_run"]))
+        print(f"  {r['name']:24s} " + (f"h1 {imp['rebound_height_m']:.4g} m, e = {imp['restitution']:.4f}, stuck "
+                                       f"{imp['stuck']}, rebound error {r['impact_rel_error']:+.3f} "
+                                       f"({r['impact_seconds']:.2f} s)" if "restitution" in imp else imp["not_run"]))
     cut = result["summit_cutoff"]
     print(f"summit_cutoff (kind bem): {cut['cutoff_m']} m, match error {cut['match_error']:+.3f}; {cut['note']}")
     print(f"total {result['wall_s']:.1f} s wall, {result['cpu_s']:.1f} s CPU, load average "

@@ -1,12 +1,13 @@
 """A body dropped on a rough patch whose contact force is a tabulated hysteretic law: the approach branch and the
 retraction branch of a quasi-static cycle (`continuum.rough.quasistatic.ForceCycle`, from the boundary-element
-reference or from a summit level). First rebound and stick, by the energy balance of a quasi-static impact.
+reference or from a summit level): the quasi-static energy balance of such an impact, and the short roller the
+benchmark drops (`Roller`, `roller_gw_cycle`). The impact itself is integrated by the project's driver on the table
+as a contact law (`continuum.dynamics.tabulated_cycle`, benchmarks/accuracy_impact.py); the balance here is its check.
 
-The body is rigid and its face is the patch's flat counter-surface (the nominal area every level shares); it
-arrives with kinetic energy K0 at the separation where the force starts. The contact force is rate-independent
-(each state an equilibrium: the impact model's own assumption, Johnson, *Contact Mechanics* (1985) 11.1, valid
-while the impact lasts much longer than the elastic waves take to cross the contact), so the motion conserves
-K + the work of the tabulated force exactly, and no integrator is needed:
+The contact force is rate-independent (each state an equilibrium: the impact model's own assumption, Johnson,
+*Contact Mechanics* (1985) 11.1, valid while the impact lasts much longer than the elastic waves take to cross the
+contact), so the motion conserves K + the work of the tabulated force exactly (gravity's work across the contact
+range, m g times a few nm, aside):
 
 * approach: K(s) = K0 - W_app(s), W_app(s) = int_s^{s_start} F_app ds' (F > 0 compressive); the body turns where
   K = 0 (`turn_for_energy`);
@@ -14,9 +15,8 @@ K + the work of the tabulated force exactly, and no integrator is needed:
   K1 = K0 - W_loop and restitution e = sqrt(K1 / K0) (e^2 = 1 - W_loop/K0) unless K reaches zero on the way out:
   then the adhesive tension holds it (stuck, the capture of Thornton & Ning, Powder Technol. 99 (1998) 154).
 
-Gravity's work across the contact range (m g times a few nm) is neglected; `gravity_work_ratio` records it against
-K0. The retraction depends on where the body turns, so a level's cycle must turn at the body's turn: the
-reference's cycle fixes K0 (the body turns at its deepest state), and a cheap level is rerun to its own turn
+The retraction depends on where the body turns, so a level's cycle must turn at the body's turn: the reference's
+cycle fixes K0 (the body turns at its deepest state), and a cheap level is rerun to its own turn
 (`impact_at_energy`).
 """
 from __future__ import annotations
@@ -29,9 +29,10 @@ import numpy as np
 
 from nanoimpact.errors import InputError
 
-from .quasistatic import ForceCycle, separation_path
+from .quasistatic import ForceCycle, gw_cycle, separation_path
 
-__all__ = ["ImpactOutcome", "approach_work", "turn_for_energy", "impact_outcome", "impact_at_energy", "STANDARD_G"]
+__all__ = ["ImpactOutcome", "approach_work", "turn_for_energy", "impact_outcome", "impact_at_energy", "STANDARD_G",
+           "Roller", "roller_gw_cycle"]
 
 #: Standard gravity (m/s^2), for drop and rebound heights.
 STANDARD_G = 9.80665
@@ -128,3 +129,55 @@ def impact_at_energy(cycle_to: Callable[[np.ndarray], ForceCycle], energy: float
         raise InputError("impact_energy", energy, "> 0 J of approach work within the first step")
     cycle = cycle_to(separation_path(start, turn, step))
     return impact_outcome(cycle, energy), cycle
+
+
+# --- a short roller lying across the patch -------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Roller:
+    """A short rigid roller (a cylinder of `radius` R, m) lying across a square periodic patch of side `size` L (m):
+    its axis along the patch's second coordinate y, over x = L/2, its length the patch's side. Near its lowest line
+    the roller's surface lies drop(x) = (x - L/2)^2 / (2R) above it (the paraboloidal approximation of Hertz's
+    theory, Johnson, *Contact Mechanics* (1985) 4.1, for |x - L/2| << R). The patch is periodic across the roller's
+    length, so the roller has no ends: it is one cell of an infinite row (what a boundary element on a periodic
+    cell can hold). Against the rough patch it counts as the composite surface heights(x, y) - drop(x), the
+    rough surface and the roller's curvature in one gap; R is chosen so that the band within reach at the deepest
+    state stays inside the cell (`reach_band`), which keeps the periodic images of the contact apart."""
+
+    radius: float
+    size: float
+
+    def drop(self, x, grid: int) -> np.ndarray:
+        """drop(x) (m) less its mean over the cell's `grid` columns, so the composite surface keeps the rough
+        map's zero mean (the reference removes each map's mean: the same plane then holds for every level)."""
+        cols = np.arange(grid) * self.size / grid
+        mean = float(np.mean((cols - 0.5 * self.size) ** 2)) / (2 * self.radius)
+        return (np.asarray(x, float) - 0.5 * self.size) ** 2 / (2 * self.radius) - mean
+
+    def heights(self, h: np.ndarray) -> np.ndarray:
+        """The composite surface (m) of a rough map `h` (zero mean, axis 0 = x) under the roller."""
+        n = h.shape[0]
+        return np.asarray(h, float) - self.drop(np.arange(n) * self.size / n, n)[:, None]
+
+    def mass(self, density: float) -> float:
+        """Mass (kg) of the roller at `density` (kg/m^3): pi R^2 L."""
+        return density * math.pi * self.radius**2 * self.size
+
+    def reach_band(self, h: np.ndarray, separation: float, reach: float) -> tuple[float, float]:
+        """(x_min/L, x_max/L) of the columns of the composite surface within `reach` (m) of a flat at `separation`."""
+        c = self.heights(h)
+        cols = np.nonzero((c > separation - reach).any(axis=1))[0]
+        n = h.shape[0]
+        return (float(cols.min()) / n, float(cols.max()) / n) if cols.size else (math.nan, math.nan)
+
+
+def roller_gw_cycle(surface, roller: Roller, grid: int, path, summit_mean_height: float) -> ForceCycle:
+    """The GW mean field (`quasistatic.gw_cycle`) under the roller: the patch cut into `grid` strips parallel to its
+    axis, strip j of nominal area L^2/grid at separation path + drop(x_j) from the flat, the strips summed (no elastic
+    coupling between strips, as between summits)."""
+    path = np.asarray(path, float)
+    drops = roller.drop(np.arange(grid) * roller.size / grid, grid)
+    area = roller.size * roller.size / grid
+    cycles = [gw_cycle(surface, area, path + d, summit_mean_height) for d in drops]
+    return ForceCycle(path, np.sum([c.force for c in cycles], axis=0),
+                      np.sum([c.contact_area for c in cycles], axis=0), cycles[0].turn)

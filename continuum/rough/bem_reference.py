@@ -29,6 +29,7 @@ relative; this keeps its numbers of order one).
 """
 from __future__ import annotations
 
+import importlib
 import logging
 import time
 from dataclasses import dataclass, field
@@ -40,9 +41,19 @@ from nanoimpact.errors import InputError
 from .branch_laws import DUGDALE_FACTOR
 from .quasistatic import ForceCycle, path_turn
 
-__all__ = ["BEMContact", "BEMStats", "bem_cycle", "dugdale_range"]
+__all__ = ["BEMContact", "BEMStats", "bem_cycle", "dugdale_range", "require_solver"]
 
 log = logging.getLogger(__name__)
+
+
+def require_solver(key: str, value) -> None:
+    """InputError naming `key` and `value` (the input that asked for the reference) when Tamaas, the boundary-element
+    solver, cannot be imported here: one line instead of a traceback from the first solve."""
+    try:
+        importlib.import_module("tamaas")
+    except ImportError as exc:
+        raise InputError(key, value, "needs the boundary-element solver Tamaas (pip install tamaas; Linux/macOS "
+                                     f"wheels), which is not importable here ({exc})") from None
 
 
 def dugdale_range(work_of_adhesion: float, z0: float) -> tuple[float, float]:

@@ -36,7 +36,7 @@ from nanoimpact.errors import InputError
 from nanoimpact.fileio import atomic_write_json
 
 from .bem_convergence import GridRun, cohesive_zone_length, convergence
-from .bem_reference import bem_cycle, dugdale_range
+from .bem_reference import bem_cycle, dugdale_range, require_solver
 from .branch_laws import make_summit_law
 from .quasistatic import discrete_cycle, separation_path
 from .topography import identify_summits
@@ -209,6 +209,7 @@ def measured_cutoff(heights, size: float, e_star: float, work_of_adhesion: float
         if stored.get("key") == key:
             log.info("summit cutoff from the BEM: cached %s", path_file)
             return {**stored, "cached": True}
+    require_solver(KEY_CUTOFF_FROM, "bem")              # a cache hit needs no solver; a run does
     pixel = size / h.shape[0]
     _, rho = dugdale_range(work_of_adhesion, z0)
     base = identify_summits(h, pixel, cutoffs_pixels[0] * pixel, periodic=True)
