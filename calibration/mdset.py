@@ -74,10 +74,6 @@ from continuum.schema import FIELD_BY_PATH
 from nanoimpact import data
 from nanoimpact.fileio import atomic_write_text
 
-#: Committed MD results shipped with the package (inputs/md/results, installed as package data).
-RESULTS_DIR = data.shipped_root() / "md" / "results"
-
-
 @dataclass(frozen=True)
 class Source:
     """Scene key <- MD recipe, quantities in order of preference; ``fallback`` (another recipe) is used only
