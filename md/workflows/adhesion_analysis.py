@@ -24,7 +24,7 @@ class _AdhesionAnalysis:
     integration, z0 and sigma0, the window checks, notes, curves and figures)."""
 
     def __init__(self, wf: Workflow, ctx):
-        self.wf, self.ctx, self.s, self.info = wf, ctx, wf.typed(ctx.settings), ctx.plan.system_info
+        self.wf, self.ctx, self.s, self.info = wf, ctx, ctx.settings, ctx.plan.system_info
 
     def run(self) -> Analysis:
         self._prepare()

@@ -21,39 +21,39 @@ from md.build import place_on, water_cap
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
-from md.system.lammps_data import write_data
-from md.system.topology import System, remove_atoms
+from md.system.topology import System
 from md.workflows.common import (
-    SILANOL_OH,
     WATER_MODELS,
     WATER_SOLID_COLUMNS,
+    Settings,
     Workflow,
-    common_define,
-    derived_seed,
     equilibrate_stage,
     figure_writer,
     forcefield_of,
     framed_tail_sites,
-    fresh_from_data,
-    held_deep,
     intersect_ids,
     leg_temperatures,
-    minimize_lines,
     minimize_water_lines,
     quantity_record,
     restart_header_lines,
-    shake_lines,
     silica_face_of,
     stage_list,
     steps_of,
     substrate_water_seeds,
-    surface_slab,
     system_summary,
     thermostat_lines,
-    trappe_tail_sites,
     water_forcefield_names,
     water_solid_thermostat_lines,
 )
+from md.workflows.substrate_water import (
+    HELD,
+    held_define,
+    substrate_leg,
+    substrate_of,
+    substrate_water_forcefields,
+    write_substrate_water,
+)
+
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
 DROPLET_GAP_A = 3.0
@@ -83,18 +83,14 @@ class ContactAngleWorkflow(Workflow):
     version = 4
     yields = {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
-        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else []) + \
-            water_forcefield_names(s.water_model)
+    def _forcefield_files(self, s: Settings) -> list[str]:
+        return substrate_water_forcefields(s)
 
     def build(self, s) -> tuple[System, System, System]:
         """(substrate, droplet, both placed in one box) -- the substrate's coordinates are those of the combined
         system, so atom ids 1..n_substrate are the same in both legs."""
-        s = self.typed(s)
         seed = int(s.seed)
-        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed,
-                           silica_face_of((s.surface,), s.silica_face))
+        sub = substrate_of(s)
         R0 = float(s.droplet_radius_A)
         wff = forcefield_of(water_forcefield_names(s.water_model))
         drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s.droplet_initial_angle_deg,
@@ -102,55 +98,30 @@ class ContactAngleWorkflow(Workflow):
         system = as_system(place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0)))
         return sub, drop, system
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         ff = forcefield_of(self.forcefield_files(s))
         seed = int(s.seed)
         sub, drop, system = self.build(s)
-        substrate = system.group("substrate")
-        water = system.group("adsorbate")
-        held = np.intersect1d(held_deep(system), substrate)
-        sub_data, water_data = run_dir / "substrate.data", run_dir / "water.data"
-        write_data(system, ff, run_dir / "system.data", title="contact_angle system (reference; the legs read the "
-                   "two parts)")
-        write_data(remove_atoms(system, water), ff, sub_data, title="contact_angle substrate")
-        write_data(remove_atoms(system, substrate), ff, water_data, title="contact_angle droplet")
+        parts = write_substrate_water("contact_angle", "droplet", ff, system, run_dir)
+        water_data, water_o, tail_sites = parts.water_data, parts.water_o, parts.tail_sites
         if s.surface == "silica":
             ref = intersect_ids(system, "silanol_O_top", "substrate")
         else:
             ref = system.group("sam_ch3")
-        water_o = np.intersect1d(system.group("water_O"), water)
         # the SAM's TraPPE sites go into the frames too: the water-TraPPE dispersion beyond the cutoff is added
-        # in the analysis; their C6 with the water O (4 eps sigma^6, kcal/mol A^6)
-        tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
+        # in the analysis
         framed = np.union1d(np.union1d(water_o, ref), tail_sites)
-        n_sub, n = len(substrate), system.n_atoms
+        n_sub, n = len(parts.substrate), system.n_atoms
         dt = s.timestep_fs
-        shake = shake_lines(ff, also=SILANOL_OH)
-        sub_groups = {"substrate": substrate, "frozen": held}
-
-        def fresh_substrate(leg_dir: Path) -> list[str]:
-            # minimised with nothing held (no setforce, no exclusions): the deep layer is held only afterwards,
-            # at its relaxed positions
-            return fresh_from_data(ff, sub_data, s, sub_groups) + ["group mobile subtract all frozen"] + \
-                minimize_lines(s, leg_dir / "minimized.data")
 
         def define(salt: int, with_water: bool):
             def d(step: int) -> list[str]:
-                return common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake + \
-                    ["fix hold frozen setforce 0.0 0.0 0.0"] + \
+                return held_define(s, parts) + \
                     (["variable nw equal count(water)/3"] + water_solid_thermostat_lines(s, step, salt)
                      if with_water else thermostat_lines("mobile", s, step, salt))
             return d
 
-        t = s.temperature_K
-        sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=define(0, False), prepare=lambda d: [],
-                      restart_head=restart_header_lines(s),
-                      stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
-                                    (f"velocity mobile create {t:g} {derived_seed(seed, 3, 0)} mom yes rot no "
-                                     f"dist gaussian",), sampled=False)],
-                      columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s.sample_interval,
-                      chunk_steps=s.chunk_steps, n_atoms=n_sub)
+        sub_leg = substrate_leg(s, parts, define(0, False), restart_header_lines(s), n_sub)
         sub_dir = run_dir / "legs" / "substrate"
 
         def fresh_droplet(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
@@ -172,17 +143,17 @@ class ContactAngleWorkflow(Workflow):
         ids = lammps_type_ids(ff)
         info = {"substrate": system_summary(sub), "droplet": dict(drop.info), "box_A": system.cell.tolist(),
                 "n_substrate": int(n_sub), "n_water_molecules_built": int(len(water_o)),
-                "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
+                "held_atoms": int(len(parts.held)), "held": HELD,
                 "silica_face": silica_face_of((s.surface,), s.silica_face),
                 "water_O_ids": (water_o + 1).tolist(), "surface_ref_ids": (ref + 1).tolist(),
                 "surface_ref": "top silanol O" if s.surface == "silica" else "OTS CH3 groups",
                 "water_model": s.water_model, "type_ids": ids,
-                "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6}
+                "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": parts.c6}
         return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
                     seeds=substrate_water_seeds(seed), forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        return _DropletAnalysis(ctx, self.typed(ctx.settings)).run()
+        return _DropletAnalysis(ctx, ctx.settings).run()
 
 
 class _DropletAnalysis:

@@ -20,6 +20,7 @@ pulloff
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
@@ -64,12 +65,10 @@ class PullOff(Workflow):
     yields = {"pull_off_force": "N", "separation_at_max_tension": "m", "interaction_range_z0": "m",
               "work_of_adhesion_eff_jkr": "J/m^2", "work_of_adhesion_eff_dmt": "J/m^2"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
+    def _forcefield_files(self, s: Settings) -> list[str]:
         return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else [])
 
     def build(self, s) -> tuple[System, dict[str, Any]]:
-        s = self.typed(s)
         seed = int(s.seed)
         R = float(s.asperity_radius_A)
         face = silica_face_of((s.surface,), s.silica_face)
@@ -95,8 +94,7 @@ class PullOff(Workflow):
             info["tip_offsets_A"] = tip_offsets(s.tip_positions, (system.cell[0] / nx, system.cell[1] / ny))
         return system, info
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         ff = forcefield_of(self.forcefield_files(s))
         system, info = self.build(s)
         groups = {"flat": system.group("substrate"), "tip": system.group("adsorbate"),
@@ -123,7 +121,7 @@ class PullOff(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        return _PullOffAnalysis(ctx, self.typed(ctx.settings)).run()
+        return _PullOffAnalysis(ctx, ctx.settings).run()
 
 
 class _PullOffAnalysis:

@@ -8,6 +8,8 @@ surface_tension
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from md import analysis as A
@@ -18,6 +20,7 @@ from md.system.atoms import as_system
 from md.system.lammps_data import write_data
 from md.units import SPCE_WATER_MOLAR_MASS
 from md.workflows.common import (
+    Settings,
     Workflow,
     common_define,
     derived_seed,
@@ -42,12 +45,10 @@ class SurfaceTension(Workflow):
     version = 1
     yields = {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
+    def _forcefield_files(self, s: Settings) -> list[str]:
         return water_forcefield_names(s.water_model)
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         ff = forcefield_of(self.forcefield_files(s))
         seed = int(s.seed)
         film = as_system(water_slab(s.lx_A, s.ly_A, s.film_thickness_A, vacuum=s.vacuum_A, seed=seed))
@@ -78,7 +79,7 @@ class SurfaceTension(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        s = self.typed(ctx.settings)
+        s = ctx.settings
         info = ctx.plan.system_info
         d = ctx.samples("film")
         steps, ids, pos, box = ctx.frames("film")

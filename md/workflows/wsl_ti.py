@@ -25,38 +25,39 @@ from md.build import place_on, water_slab
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
-from md.system.lammps_data import write_data
-from md.system.topology import remove_atoms
+from md.system.topology import System
 from md.workflows.common import (
-    SILANOL_OH,
     TRAPPE_UA,
     WATER_MODELS,
     WATER_SOLID_COLUMNS,
+    Settings,
     Workflow,
-    common_define,
     derived_seed,
     figure_writer,
     forcefield_of,
     framed_tail_sites,
-    fresh_from_data,
-    held_deep,
     leg_temperatures,
-    minimize_lines,
     minimize_water_lines,
     quantity_record,
     restart_header_lines,
-    shake_lines,
     silica_face_of,
     stage_list,
     steps_of,
     substrate_water_seeds,
-    surface_slab,
     system_summary,
     thermostat_lines,
-    trappe_tail_sites,
     water_forcefield_names,
     water_solid_thermostat_lines,
 )
+from md.workflows.substrate_water import (
+    HELD,
+    held_define,
+    substrate_leg,
+    substrate_of,
+    substrate_water_forcefields,
+    write_substrate_water,
+)
+
 
 #: gap between the solid's highest atom and the film's lowest one when the film is placed (A)
 FILM_GAP_A = 2.5
@@ -144,16 +145,13 @@ class WslTI(Workflow):
     yields = {"work_of_adhesion_sl": "J/m^2", "contact_angle": "deg", "spreading_coefficient": "J/m^2",
               "surface_tension_lv": "N/m"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
-        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else []) + \
-            water_forcefield_names(s.water_model)
+    def _forcefield_files(self, s: Settings) -> list[str]:
+        return substrate_water_forcefields(s)
 
-    def build(self, s):
-        s = self.typed(s)
+    def build(self, s: Settings) -> tuple[System, System, System]:
+        """(substrate, film, both placed in one box), as :meth:`ContactAngleWorkflow.build` with a film."""
         seed = int(s.seed)
-        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed,
-                           silica_face_of((s.surface,), s.silica_face))
+        sub = substrate_of(s)
         wff = forcefield_of(water_forcefield_names(s.water_model))
         film = as_system(water_slab(float(sub.cell[0]), float(sub.cell[1]), float(s.film_thickness_A),
                                     vacuum=2.0, seed=seed + 1, forcefield=wff))
@@ -161,11 +159,9 @@ class WslTI(Workflow):
 
     @classmethod
     def nodes(cls, s) -> dict[str, np.ndarray]:
-        s = cls.typed(s)
         return {"q": A.gauss_legendre_unit(s.ti_charge_nodes)[0], "lj": A.gauss_legendre_unit(s.ti_lj_nodes)[0]}
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         legs = _WslLegs(self, s, run_dir)
         return Plan(legs=legs.all(), timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
                     seeds=substrate_water_seeds(int(s.seed)), forcefield_files=self.forcefield_files(s),
@@ -173,7 +169,7 @@ class WslTI(Workflow):
 
     # ------------------------------------------------------------------------------------------ analysis
     def analyse(self, ctx):
-        return _WslAnalysis(ctx, self.typed(ctx.settings)).run()
+        return _WslAnalysis(ctx, ctx.settings).run()
 
 
 class _WslAnalysis:
@@ -394,12 +390,9 @@ class _WslLegs:
         self.ff = ff = forcefield_of(wf.forcefield_files(s))
         self.sub, self.film, system = wf.build(s)
         self.system = system
-        self.substrate, self.water = substrate, water = system.group("substrate"), system.group("adsorbate")
-        self.held = np.intersect1d(held_deep(system), substrate)
-        self.sub_data, self.water_data = run_dir / "substrate.data", run_dir / "water.data"
-        write_data(system, ff, run_dir / "system.data", title="wsl_ti system (reference; the legs read the two parts)")
-        write_data(remove_atoms(system, water), ff, self.sub_data, title="wsl_ti substrate")
-        write_data(remove_atoms(system, substrate), ff, self.water_data, title="wsl_ti water film")
+        self.parts = parts = write_substrate_water("wsl_ti", "water film", ff, system, run_dir)
+        self.substrate, self.water, self.held = parts.substrate, parts.water, parts.held
+        self.water_data = parts.water_data
         self.ids = ids = lammps_type_ids(ff)
         self.all_types, self.charged_types = solid_types(system, ff)
         self.solid_t, self.charged_t = [ids[t] for t in self.all_types], [ids[t] for t in self.charged_types]
@@ -407,11 +400,9 @@ class _WslLegs:
         self.charge = {ids[t]: ff.atom_type(t).charge for t in self.charged_types}
         # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
         # dispersion beyond the cutoff (analysis: md.analysis.film_lower_dividing_plane + dispersion_tail_work)
-        water_o = np.intersect1d(system.group("water_O"), water)
-        self.tail_sites, self.c6 = trappe_tail_sites(system, ff, water_o)
-        self.ow = str(np.asarray(system.types)[water_o[0]])
-        self.z_film = float(system.positions[water, 2].mean())
-        self.shake = shake_lines(ff, also=SILANOL_OH)
+        self.tail_sites, self.c6 = parts.tail_sites, parts.c6
+        self.ow = str(np.asarray(system.types)[parts.water_o[0]])
+        self.z_film = float(system.positions[parts.water, 2].mean())
         self.nodes = wf.nodes(s)
         self.kspace = pppm_lines(s, system.cell)
         self.common = dict(restart_head=self.head, sample_interval=s.sample_interval, chunk_steps=s.chunk_steps)
@@ -423,8 +414,7 @@ class _WslLegs:
         """Every leg's set-up; with the water: one thermostat on the water, one on the solid's mobile atoms, each
         one's temperature sampled, and the film's tether."""
         s = self.s
-        return (common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + self.shake +
-                ["fix hold frozen setforce 0.0 0.0 0.0"] +
+        return (held_define(s, self.parts) +
                 ([f"fix tether water spring tether {TETHER_K:g} NULL NULL {self.z_film:.4f} 0.0",
                   "variable zw equal xcm(water,z)"] + water_solid_thermostat_lines(s, step, salt)
                  if with_water else thermostat_lines("mobile", s, step, salt)))
@@ -456,21 +446,10 @@ class _WslLegs:
         return cmds
 
     def substrate_leg(self) -> Leg:
-        """The slab minimised with nothing held, then deep Si and bridging O held, equilibrated."""
-        s = self.s
-        sub_groups = {"substrate": self.substrate, "frozen": self.held}
-
-        def fresh_substrate(leg_dir: Path) -> list[str]:
-            return fresh_from_data(self.ff, self.sub_data, s, sub_groups, pair="long/soft") + self.kspace + \
-                ["group mobile subtract all frozen"] + minimize_lines(s, leg_dir / "minimized.data")
-
-        t = s.temperature_K
-        return Leg(name="substrate", fresh=fresh_substrate, define=lambda step: self.base(False, step, 0),
-                   prepare=lambda d: [],
-                   stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
-                                 (f"velocity mobile create {t:g} {derived_seed(int(s.seed), 3, 0)} mom yes rot no "
-                                  f"dist gaussian",), sampled=False)],
-                   columns={"pe": "v_pe", "temp": "v_temp"}, n_atoms=self.sub.n_atoms, **self.common)
+        """The slab minimised with nothing held, then deep Si and bridging O held, equilibrated; the soft-core pair
+        style and the fixed PPPM of every leg of the run."""
+        return substrate_leg(self.s, self.parts, lambda step: self.base(False, step, 0), self.head,
+                             self.sub.n_atoms, pair="long/soft", kspace=tuple(self.kspace))
 
     def film_leg(self, sub_leg: Leg) -> Leg:
         """The water film added on the substrate's last state, minimised, equilibrated at full coupling; on OTS the
@@ -560,7 +539,7 @@ class _WslLegs:
         return {"substrate": system_summary(self.sub), "film": dict(self.film.info), "box_A": system.cell.tolist(),
                 "area_A2": float(system.cell[0] * system.cell[1]), "n_substrate": int(len(self.substrate)),
                 "n_water_molecules_built": int(len(self.water) // 3),
-                "held_atoms": int(len(self.held)), "held": "deep Si and bridging O of the builder's bottom layer",
+                "held_atoms": int(len(self.held)), "held": HELD,
                 "silica_face": silica_face_of((s.surface,), s.silica_face), "water_model": s.water_model,
                 "type_ids": self.ids, "solid_types": self.all_types,
                 "solid_charges_e": {x: ff.atom_type(x).charge for x in self.charged_types},

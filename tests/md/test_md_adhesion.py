@@ -54,11 +54,11 @@ def test_windows_are_chains_reaching_into_compression_at_every_registry(tmp_path
     assert offsets[0] == [0.0, 0.0] and len({tuple(o) for o in offsets}) == n_reg
     cell = (plan.system_info["box_A"][0] / s["nx"], plan.system_info["box_A"][1] / s["ny"])
     assert [list(o) for o in _registry_offsets(n_reg, cell)] == offsets
-    nominal = dict((suf, d) for suf, d, _ in wf.chains(s))
+    nominal = dict((suf, d) for suf, d, _ in wf.chains(wf.typed(s)))
     assert min(nominal.values()) == pytest.approx(-s["pmf_compress_A"])
     assert max(nominal.values()) == pytest.approx(s["separation_A"])
     for r, (dx, dy) in enumerate(offsets):
-        for suf, d, prev in wf.chains(s):
+        for suf, d, prev in wf.chains(wf.typed(s)):
             cmds = legs[f"pmf_r{r}_{suf}"].fresh(tmp_path / "x")
             head = cmds[0]
             move = [c for c in cmds if c.startswith("displace_atoms upper move")]
@@ -292,9 +292,9 @@ def test_adhesion_smoke_runs_the_chains_and_reports_z0_sigma0_and_the_tail(md_sm
     r = outcome.result
     s = r["settings"]
     legs = outcome.run_dir / "legs"
-    nominal = {suf: d for suf, d, _ in Adhesion.chains(s)}
+    nominal = {suf: d for suf, d, _ in Adhesion.chains(Adhesion.typed(s))}
     contact = read_samples(legs / "contact" / "samples.csv")
-    for suf, d, prev in Adhesion.chains(s):
+    for suf, d, prev in Adhesion.chains(Adhesion.typed(s)):
         w = read_samples(legs / f"pmf_r0_{suf}" / "samples.csv")
         assert np.ptp(w["z_back"]) < 1e-6                       # held
         start = contact["z_back"][-1] if prev is None else \

@@ -146,10 +146,10 @@ def test_extra_windows_enter_the_outward_grid_and_are_checked():
     grid = outward_grid(Adhesion.typed(s2))
     assert np.all(np.diff(grid) > 0) and len(grid) == len(base) + 2
     assert set(np.round(grid, 9)) == set(np.round(np.concatenate([base, extra]), 9))
-    rows = Adhesion.chains(s2)
+    rows = Adhesion.chains(Adhesion.typed(s2))
     out = [d for suf, d, _ in rows if suf.startswith("o")]
     assert out == pytest.approx(list(grid))
-    assert Adhesion().windows(s2)[-len(grid):] == pytest.approx(grid)
+    assert Adhesion().windows(Adhesion.typed(s2))[-len(grid):] == pytest.approx(grid)
     with pytest.raises(RecipeError, match=r"pmf_extra_windows_A.*strictly between 0 and separation_A"):
         recipe_with("adhesion_ots", "quick", pmf_extra_windows_A=[25.0])
     with pytest.raises(RecipeError, match=r"pmf_extra_windows_A.*within 0.05 A of another window"):
@@ -237,8 +237,8 @@ def test_return_chain_runs_back_through_the_same_windows(tmp_path):
     from md.workflows.adhesion import Adhesion
     s, plan = _plan("adhesion_ots", "quick", tmp_path, pmf_return=True)
     legs = {l.name: l for l in plan.legs}
-    out = {suf: d for suf, d, _ in Adhesion.chains(s)}
-    rows = Adhesion.return_chain(s)
+    out = {suf: d for suf, d, _ in Adhesion.chains(Adhesion.typed(s))}
+    rows = Adhesion.return_chain(Adhesion.typed(s))
     n, m = s["pmf_windows"], s["pmf_compress_windows"]
     assert len(rows) == (n - 1) + m and rows[0][2] == f"o{n - 1:02d}"
     nominal = dict(out)
@@ -251,7 +251,7 @@ def test_return_chain_runs_back_through_the_same_windows(tmp_path):
             [f"displace_atoms upper move 0.000000 0.000000 {d - nominal[prev]:.6f} units box"]
         nominal[suf] = d
     assert rows[-1][1] == pytest.approx(-s["pmf_compress_A"])
-    assert Adhesion.return_chain(settings_with("adhesion_ots", "quick")) == []
+    assert Adhesion.return_chain(Adhesion.typed(settings_with("adhesion_ots", "quick"))) == []
     assert sum(k.startswith("pmf_r") for k in legs) == s["lateral_registries"] * (n + m + len(rows))
 
 
@@ -281,7 +281,7 @@ def test_equilibrated_ots_smoke_anneals_contacts_each_registry_and_pulls_out_and
     assert math.isfinite(rc["energy_work_J_m2"]) and rc["stderr_J_m2"] > 0
     c1 = read_samples(legs / "contact_r1" / "samples.csv")
     assert read_samples(legs / "pmf_r1_o00" / "samples.csv")["z_back"][0] == pytest.approx(c1["z_back"][-1], abs=1e-4)
-    for suf, _d, _prev, rep in Adhesion.return_chain(s):
+    for suf, _d, _prev, rep in Adhesion.return_chain(Adhesion.typed(s)):
         back = read_samples(legs / f"pmf_r0_{suf}" / "samples.csv")["z_back"]
         assert back[0] == pytest.approx(read_samples(legs / f"pmf_r0_{rep}" / "samples.csv")["z_back"][0], abs=1e-4)
     q = r["quantities"]
