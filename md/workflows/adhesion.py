@@ -109,10 +109,10 @@ class Adhesion(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=legs.info())
 
     # ------------------------------------------------------------------------------------------ analysis
-    def _tail(self, ctx, mode: str, leg: str, r_max: float = TAIL_R_MAX_A, frames=None) -> dict:
-        """Static LJ interaction beyond the cutoff between the two slabs on the stored frames of ``leg``:
-        per-frame energies (kcal/mol) and forces on the upper slab along +z (kcal/mol/A)."""
-        info = ctx.plan.system_info
+    def _tail(self, ctx, n_lower: int, mode: str, leg: str, r_max: float = TAIL_R_MAX_A, frames=None) -> dict:
+        """Static LJ interaction beyond the cutoff between the two slabs (the lower one atom ids 1..``n_lower``)
+        on the stored frames of ``leg``: per-frame energies (kcal/mol) and forces on the upper slab along +z
+        (kcal/mol/A)."""
         cache = self.__dict__.setdefault("_tail_cache", {})
         if (ctx.run_dir, mode) not in cache:
             ids_all, types_all, _ = read_atoms(ctx.run_dir / "system.data")
@@ -123,7 +123,7 @@ class Adhesion(Workflow):
         if not len(steps):
             return {"energy": np.zeros(0), "force_z": np.zeros(0), "pairs": 0}
         t = np.array([type_of[int(i)] for i in ids])
-        low = ids <= info["n_lower"]
+        low = ids <= n_lower
         es, fs, pairs = [], [], 0
         for k in range(len(steps)):
             r = A.lj_tail_between(pos[k][low], t[low], pos[k][~low], t[~low], eps, sig, inc, box[k][:2],

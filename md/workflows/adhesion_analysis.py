@@ -16,6 +16,7 @@ from md.engine.plan import Analysis
 from md.workflows import adhesion_protocol as P
 from md.workflows.adhesion_legs import MIN_WINDOW_NEFF, SAM_STRESS_COLUMNS, TAIL_R_MAX_A
 from md.workflows.common import ENERGY_NOT_FREE_ENERGY, Workflow, figure_writer, quantity_record
+from md.workflows.plan_records import AdhesionPlanRecord
 
 
 @dataclass(slots=True)
@@ -89,7 +90,8 @@ class _AdhesionAnalysis:
     integration, z0 and sigma0, the window checks, notes, curves and figures)."""
 
     def __init__(self, wf: Workflow, ctx):
-        self.wf, self.ctx, self.s, self.info = wf, ctx, ctx.settings, ctx.plan.system_info
+        self.wf, self.ctx, self.s = wf, ctx, ctx.settings
+        self.plan = AdhesionPlanRecord.from_system(ctx.plan.system_info)
         self.results = _AdhesionResults()
 
     def run(self) -> Analysis:
@@ -102,7 +104,7 @@ class _AdhesionAnalysis:
             res.details["dispersion_tail"] = res.tail_det
             return self._analysis()
         res.suffixes = [c[0] for c in self.wf.chains(self.s)]
-        res.n_reg = len(self.info["registry_offsets_A"])
+        res.n_reg = len(self.plan.registry_offsets_A)
         shape = (res.n_reg, len(res.suffixes))
         res.d_A, res.f_m, res.f_e, res.g_w, res.neff_w = (np.full(shape, np.nan) for _ in range(5))
         # mean force of the first and the second half of each window's equilibrated samples (those after the
@@ -123,8 +125,8 @@ class _AdhesionAnalysis:
     # ---- prepare: the energy route and the static tail
     def _prepare(self) -> None:
         res = self.results
-        ctx, info = self.ctx, self.info
-        res.area = area = info["area_A2"]
+        ctx = self.ctx
+        res.area = area = self.plan.area_A2
         res.conv = U.kcal_per_mol_A2_to_J_per_m2(1.0) / area           # kcal/mol -> J/m^2 over this interface
         con, sep = ctx.samples("contact"), ctx.samples("separated")
         res.w = w = A.energy_separation_work(con["pe"], sep["pe"], area)
@@ -150,11 +152,11 @@ class _AdhesionAnalysis:
         (explicit sum to 20/30/40 A + smeared beyond; the TraPPE pairs, applied, and every pair, IFF included:
         reported, not applied)."""
         res = self.results
-        ctx, s, info, conv = self.ctx, self.s, self.info, res.conv
-        res.tail_on = tail_on = bool(info.get("tail_applies"))
+        ctx, s, conv = self.ctx, self.s, res.conv
+        res.tail_on = tail_on = self.plan.tail_applies
         res.w_tail_static, res.tail_det = 0.0, {"mode": s.dispersion_tail, "applied": tail_on}
         if tail_on:
-            tc = self.wf._tail(ctx, "trappe", "contact")
+            tc = self.wf._tail(ctx, self.plan.n_lower, "trappe", "contact")
             u = tc["energy"]
             kt = U.kT_kcal_per_mol(s.temperature_K)
             res.w_tail_static = -float(np.mean(u)) * conv
@@ -163,13 +165,13 @@ class _AdhesionAnalysis:
             res.tail_det.update(contact_energy_kcal=u.tolist(), static_work_J_m2=res.w_tail_static,
                                  fep_minus_mean_J_m2=float(-(fep - np.mean(u)) * conv) if len(u) else None,
                                  r_max_A=TAIL_R_MAX_A, pairs_per_frame=tc["pairs"])
-        if info.get("tail_study") and len(ctx.frames("contact")[0]):
+        if self.plan.tail_study and len(ctx.frames("contact")[0]):
             st, ids, pos, box = ctx.frames("contact")
             last = (st[-1:], ids, pos[-1:], box[-1:])
             study = {}
             for mode in ("trappe", "all"):
                 for rm in (20.0, 30.0, 40.0):
-                    e = self.wf._tail(ctx, mode, "contact", rm, frames=last)["energy"]
+                    e = self.wf._tail(ctx, self.plan.n_lower, mode, "contact", rm, frames=last)["energy"]
                     study[f"{mode}_{rm:g}A_J_m2"] = -float(e[0]) * conv
             res.tail_det["cutoff_study_last_contact_frame"] = study
 
@@ -208,7 +210,7 @@ class _AdhesionAnalysis:
             res.details["registry_contacts"] = P.registry_contacts_record(
                 self.ctx, self.ctx.samples("separated")["pe"], res.area, res.zc, res.w_tail_static)
         if self.s.free_energy == "pmf":
-            res.notes += P.degenerate_note(self.info)
+            res.notes += P.degenerate_note(self.plan)
 
     # ---- per window
     def _single_window(self, r: int, k: int, suf: str) -> None:
@@ -267,7 +269,7 @@ class _AdhesionAnalysis:
         res.u_tail_last = 0.0
         if res.tail_on:
             for k, suf in enumerate(res.suffixes):
-                tw = self.wf._tail(self.ctx, "trappe", f"pmf_r0_{suf}")
+                tw = self.wf._tail(self.ctx, self.plan.n_lower, "trappe", f"pmf_r0_{suf}")
                 if len(tw["force_z"]):
                     res.f_tail[k] = float(np.mean(tw["force_z"]))
                     if k == len(res.suffixes) - 1:
@@ -379,7 +381,7 @@ class _AdhesionAnalysis:
         nothing."""
         res = self.results
         try:
-            t, n_layers = A.sam_layer_thickness_A(self.info)
+            t, n_layers = A.sam_layer_thickness_A(self.plan.system)
         except ValueError:
             return
         self._small_strain_modulus()
@@ -409,7 +411,7 @@ class _AdhesionAnalysis:
         tilt = A.tilt_of_anneal((res.details.get("anneal") or {}).get("mean_tilt_deg") or [])
         n = int(self.s.chain_length)
         try:
-            rec = A.small_strain_layer_record(res.dsep, res.f_tot, res.ebar, res.area, self.info, tilt,
+            rec = A.small_strain_layer_record(res.dsep, res.f_tot, res.ebar, res.area, self.plan.system, tilt,
                                               lambda th: float(chain_geometry(n, th)[0][-1][2]))
         except ValueError as exc:
             res.notes.append(f"SAM small-strain modulus not measured: {exc}")
@@ -438,7 +440,7 @@ class _AdhesionAnalysis:
         if sel.sum() < 3:
             res.notes.append(f"SAM Poisson ratio not measured: {int(sel.sum())} compression windows (needs three)")
             return
-        vol = res.area * A.sam_layer_thickness_A(self.info)[0]          # A^3: stress x volume -> stress
+        vol = res.area * A.sam_layer_thickness_A(self.plan.system)[0]          # A^3: stress x volume -> stress
         to_pa = lambda a: U.atm_to_Pa(np.asarray(a, float)) / vol
         avg = [A.registry_average(res.sam_sig[c][:, sel], res.sam_sig_e[c][:, sel]) for c in range(3)]
         lat = 0.5 * (np.asarray(avg[0]["mean"]) + np.asarray(avg[1]["mean"]))
@@ -477,7 +479,7 @@ class _AdhesionAnalysis:
             "per_registry_stderr_kcal_mol_A": res.f_e.tolist(),
             "statistical_inefficiency": res.g_w.tolist(), "n_eff": res.neff_w.tolist(),
             "decorrelation_time_ps": ((res.g_w - 1) / 2 * s.sample_interval * res.dt * 1e-3).tolist(),
-            "registry_work_J_m2": res.w_reg.tolist(), "registry_offsets_A": self.info["registry_offsets_A"],
+            "registry_work_J_m2": res.w_reg.tolist(), "registry_offsets_A": self.plan.registry_offsets_A,
             "zero_force_separation_A": res.ti["zero_force_separation_A"], "repulsive_end": res.repulsive,
             "windows_with_few_samples": res.short, "cutoff_only_work_J_m2": res.ti_cut["value"],
             "registry_chi2_per_dof": cons["chi2_per_dof"].tolist(), "registries_disagree": disagree,

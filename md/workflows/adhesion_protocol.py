@@ -17,6 +17,7 @@ from md import analysis as A
 from md import units as U
 from md.analysis.drift import linear_drift
 from md.workflows.common import quantity_record
+from md.workflows.plan_records import AdhesionPlanRecord
 
 
 def chain_tilts_deg(ids, pos, box, axes) -> np.ndarray:
@@ -122,15 +123,15 @@ def registry_contacts_record(ctx, energy_separated, area_A2: float, zc: float, t
     return out
 
 
-def degenerate_note(info) -> list[str]:
+def degenerate_note(plan: AdhesionPlanRecord) -> list[str]:
     """A note naming the registries whose offset is a lattice translation of an earlier one's."""
-    deg = info.get("degenerate_registries") or []
+    deg = plan.degenerate_registries
     if not deg:
         return []
-    n = len(info["registry_offsets_A"])
-    pairs = ", ".join(f"{r} repeats {r0} (offset {info['registry_offsets_A'][r]} A)" for r, r0 in deg)
+    n = len(plan.registry_offsets_A)
+    pairs = ", ".join(f"{r} repeats {r0} (offset {plan.registry_offsets_A[r]} A)" for r, r0 in deg)
     return [f"REGISTRIES DEGENERATE: {pairs}: the offset is a lattice translation of the slabs (lattice "
-            f"{np.round(info['surface_lattice_A'], 3).tolist()} A), so {n} chains sample {n - len(deg)} distinct "
+            f"{np.round(plan.surface_lattice_A, 3).tolist()} A), so {n} chains sample {n - len(deg)} distinct "
             f"registr{'y' if n - len(deg) == 1 else 'ies'}; their spread is a replicate spread, not a registry "
             f"spread (registry_sampling = 'primitive' samples the primitive cell)."]
 

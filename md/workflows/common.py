@@ -117,15 +117,6 @@ def trappe_tail_sites(system: System, ff: ForceField, water_o) -> tuple[np.ndarr
     return sites, [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(x)) for x in np.asarray(system.types)[sites])]
 
 
-def framed_tail_sites(info: Mapping[str, Any], ids) -> tuple[np.ndarray, np.ndarray]:
-    """(mask of the frames' atom ``ids`` that are tail sites, their C6 in the frames' order) from a plan's
-    ``tail_site_ids`` (1-based) and ``tail_site_c6_kcal_A6``."""
-    site_ids = [int(i) for i in info.get("tail_site_ids") or []]
-    order = {i: k for k, i in enumerate(site_ids)}
-    is_site = np.isin(ids, site_ids)
-    return is_site, np.asarray(info.get("tail_site_c6_kcal_A6") or [], float)[[order[int(i)] for i in ids[is_site]]]
-
-
 #: sampled columns of :func:`water_solid_thermostat_lines`: the water's and the solid's mobile atoms' temperatures
 WATER_SOLID_COLUMNS = {"temp_water": "v_tw", "temp_solid": "v_ts"}
 

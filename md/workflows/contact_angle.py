@@ -32,7 +32,6 @@ from md.workflows.common import (
     equilibrate_stage,
     figure_writer,
     forcefield_of,
-    framed_tail_sites,
     intersect_ids,
     leg_temperatures,
     minimize_water_lines,
@@ -47,6 +46,7 @@ from md.workflows.common import (
     water_forcefield_names,
     water_solid_thermostat_lines,
 )
+from md.workflows.plan_records import DropletPlanRecord, TailSites
 from md.workflows.substrate_water import (
     HELD,
     held_define,
@@ -191,7 +191,8 @@ class _DropletAnalysis:
     map shows, the quantities, the checks, notes, curves and the figure)."""
 
     def __init__(self, ctx, s):
-        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+        self.ctx, self.s = ctx, s
+        self.plan = DropletPlanRecord.from_system(ctx.plan.system_info)
         self.results = _DropletResults()
 
     def run(self) -> Analysis:
@@ -207,8 +208,8 @@ class _DropletAnalysis:
         steps, ids, pos, box = self.ctx.frames("droplet")
         if not len(steps):
             raise RuntimeError("no stored configurations: sample_steps shorter than frame_interval?")
-        is_o = np.isin(ids, self.info["water_O_ids"])
-        is_ref = np.isin(ids, self.info["surface_ref_ids"])
+        is_o = np.isin(ids, self.plan.water_o_ids)
+        is_ref = np.isin(ids, self.plan.surface_ref_ids)
         res.solid_z = float(pos[:, is_ref, 2].mean())
         res.floor = res.solid_z - MAP_FLOOR_A
         opos = pos[:, is_o, :].astype(np.float32)
@@ -310,7 +311,7 @@ class _DropletAnalysis:
         returns the status ('wets' if the tail makes the water wet)."""
         res = self.results
         status, gamma = "measured", res.gamma
-        tail = _tail_correction(self.info, self.s, res.r, res.ids, res.pos, res.box, gamma, res.angle,
+        tail = _tail_correction(self.plan.tail, self.s, res.r, res.ids, res.pos, res.box, gamma, res.angle,
                                 res.angle_err)
         if tail is not None:
             q["contact_angle_as_simulated"] = dict(q["contact_angle"], kind="circle fit at the water's dividing "
@@ -375,7 +376,7 @@ class _DropletAnalysis:
         res = self.results
         s, z_ref = self.s, float(res.r.reference_z)
         return [f"angle read at the water's dividing plane z = {z_ref:.2f} A (half the bulk density under the "
-                f"droplet), {z_ref - res.solid_z:+.2f} A from the mean height of the {self.info['surface_ref']} "
+                f"droplet), {z_ref - res.solid_z:+.2f} A from the mean height of the {self.plan.surface_ref} "
                 f"({res.solid_z:.2f} A); circle fitted to the half-bulk contour above that plane + 5 A "
                 f"(md.analysis.ContactAngle, {res.r.n_frames} frames).",
                 "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
@@ -440,7 +441,7 @@ class _DropletAnalysis:
         pts = np.asarray(r.interface_points).reshape(-1, 2)
         ax.plot(pts[:, 0], pts[:, 1], "k.", ms=2, label="interface points")
         ax.axhline(z_ref, color="k", lw=0.8, label="water's dividing plane")
-        ax.axhline(res.solid_z, color="grey", lw=0.8, ls="--", label=self.info["surface_ref"])
+        ax.axhline(res.solid_z, color="grey", lw=0.8, ls="--", label=self.plan.surface_ref)
         ax.set_aspect("equal")
         ax.set_xlabel("x (Å, droplet-centred)")
         ax.set_ylabel("z (Å)")
@@ -460,7 +461,7 @@ def _truncated_gamma(s, number_density_A3: float, gamma_full: float) -> tuple[fl
     return gamma_full - tail, tail
 
 
-def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
+def _tail_correction(sites: TailSites, s, r, ids, pos, box, gamma, angle, angle_err):
     """The water-TraPPE dispersion the cutoff leaves out, on a measured angle (None where the substrate has no
     TraPPE site, or a run planned before the sites were stored). Per frame, from the sites' heights under the
     water's dividing plane (the water at its bulk density above it): the r^-6 tail beyond the cutoff
@@ -470,10 +471,9 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
     cos theta' = cos theta + dW / gamma_cut. Returns the corrected angle and its stderr (first order, the angle's
     and dW's errors independent), dW (J/m^2) with its stderr (statistical inefficiency of the per-frame series),
     a note and the details."""
-    site_ids = info.get("tail_site_ids") or []
-    if not site_ids:
+    if not sites.ids:
         return None
-    is_site, c6 = framed_tail_sites(info, ids)
+    is_site, c6 = sites.framed(ids)
     if not is_site.any():
         return None
     n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(U.WATER_MOLAR_MASS)

@@ -46,6 +46,7 @@ from md.workflows.common import (
     surface_slab,
     system_summary,
 )
+from md.workflows.plan_records import PullOffPlanRecord
 from md.workflows.pulloff_protocol import leg_name, measures_flat, position_legs, shift_tip, tip_offsets
 
 # ================================================================================================ pull-off
@@ -154,7 +155,8 @@ class _PullOffAnalysis:
     figure)."""
 
     def __init__(self, ctx, s):
-        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+        self.ctx, self.s = ctx, s
+        self.plan = PullOffPlanRecord.from_system(ctx.plan.system_info)
         self.results = _PullOffResults()
 
     def run(self) -> Analysis:
@@ -169,8 +171,8 @@ class _PullOffAnalysis:
         ctx = self.ctx
         res.R_m = U.angstrom_to_m(self.s.asperity_radius_A)
         res.origin: dict[int, tuple[float, float]] = {}
-        n_flat = self.info["n_flat"]
-        for p in range(len(self.info.get("tip_offsets_A", [0]))):
+        n_flat = self.plan.n_flat
+        for p in range(self.plan.positions):
             name = leg_name("approach", p)
             ids, _, pos = read_atoms(ctx.leg_dir(name) / "minimized.data")
             # ids 1..n_flat are the flat (place_on puts the substrate first)
@@ -246,7 +248,7 @@ class _PullOffAnalysis:
         drag_err = np.array([r["drag"]["stderr"] for r in slow["results"]])
         v_slow = U.m_per_s_to_angstrom_per_fs(slow["speed_m_s"])
         res.gamma_lab = gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(
-            self.info["tip_mobile_mass_g_mol"] * v_slow / self.s.thermostat_damping_fs)
+            self.plan.tip_mobile_mass_g_mol * v_slow / self.s.thermostat_damping_fs)
         err = lambda x: x / (2 * math.pi * R_m) if x else None
         extra = {"positions": slow["positions"]} if slow["positions"] > 1 else {}
         q = {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"],
@@ -300,7 +302,7 @@ class _PullOffAnalysis:
                  + _tabor_note(R_m, F / (2 * math.pi * R_m), q["interaction_range_z0"]["value"], s.surface),
                  f"R = {s.asperity_radius_A:g} A (the requested radius of the carved, faceted dome)."]
         if s.surface == "ots":
-            g = self.info.get("asperity_sam", {})
+            g = self.plan.asperity_sam
             notes.append(f"OTS chains on the asperity: {g.get('chains')} on dome silanols within "
                          f"graft_max_polar_deg of the apex ({g.get('chains_per_projected_nm2', float('nan')):.2f} per "
                          f"nm^2 of projected cap, lateral spacing >= {g.get('min_spacing_A', float('nan')):.2f} A); "
@@ -319,7 +321,7 @@ class _PullOffAnalysis:
                               for p in res.per_speed],
                 "per_position": [dict(pp, speed_m_s=p["speed_m_s"]) for p in res.per_speed
                                  for pp in p["per_position"]],
-                "tip_offsets_A": self.info.get("tip_offsets_A", [[0.0, 0.0]]),
+                "tip_offsets_A": self.plan.tip_offsets_A or [[0.0, 0.0]],
                 "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j, "position": r["position"],
                            "contact": leg_name("approach", r["position"]),
                            "same_contact_as": [n2 for _, _, n2, r2 in res.pulls
@@ -339,7 +341,7 @@ class _PullOffAnalysis:
                           for v, j, name, r in res.pulls],
                 "s0_A": float(res.s0), "holder_z0_A": res.zh0, "smoothing_window": res.smooth,
                 "lab_frame_drag_estimate_N": float(U.kcal_per_mol_A_to_N(-res.gamma_lab)),
-                "tip_mobile_mass_g_mol": self.info["tip_mobile_mass_g_mol"]}
+                "tip_mobile_mass_g_mol": self.plan.tip_mobile_mass_g_mol}
 
     def _draw(self, ax) -> None:
         res = self.results

@@ -37,6 +37,7 @@ from md.workflows.common import (
     thermostat_lines,
     water_forcefield_names,
 )
+from md.workflows.plan_records import SurfaceTensionPlanRecord
 
 
 class SurfaceTension(Workflow):
@@ -80,14 +81,14 @@ class SurfaceTension(Workflow):
 
     def analyse(self, ctx):
         s = ctx.settings
-        info = ctx.plan.system_info
+        plan = SurfaceTensionPlanRecord.from_system(ctx.plan.system_info)
         d = ctx.samples("film")
         steps, ids, pos, box = ctx.frames("film")
-        area = float(info["box_A"][0] * info["box_A"][1])
+        area = plan.area_A2
         nb = min(s.n_blocks, max(2, len(steps)))
         dens = A.slab_density(pos[:, :, 2], SPCE_WATER_MOLAR_MASS, area, lz_A=None, bin_A=s.bin_A, n_blocks=nb)
         rho_n = U.kg_per_m3_to_g_per_cm3(dens["value"]) * U.AVOGADRO / SPCE_WATER_MOLAR_MASS * 1e-24     # O per A^3
-        tail = A.lj_tail_correction(info["lj_epsilon_kcal"], info["lj_sigma_A"], rho_n, s.cutoff_A,
+        tail = A.lj_tail_correction(plan.lj_epsilon_kcal, plan.lj_sigma_A, rho_n, s.cutoff_A,
                                     width_A=dens["width_A"])
         st = A.surface_tension(d["pxx"], d["pyy"], d["pzz"], d["lz"], tail_correction_N_per_m=tail,
                                n_blocks=s.n_blocks)

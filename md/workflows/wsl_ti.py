@@ -37,7 +37,6 @@ from md.workflows.common import (
     derived_seed,
     figure_writer,
     forcefield_of,
-    framed_tail_sites,
     leg_temperatures,
     minimize_water_lines,
     quantity_record,
@@ -51,6 +50,7 @@ from md.workflows.common import (
     water_forcefield_names,
     water_solid_thermostat_lines,
 )
+from md.workflows.plan_records import WslPlanRecord
 from md.workflows.substrate_water import (
     HELD,
     held_define,
@@ -211,7 +211,8 @@ class _WslAnalysis:
     STAGES = (("charge_film", "q", "q"), ("lj_film", "lj", "lj"), ("charge_reference", "ref_q", "q"))
 
     def __init__(self, ctx, s):
-        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+        self.ctx, self.s = ctx, s
+        self.plan = WslPlanRecord.from_system(ctx.plan.system_info)
         self.results = _WslResults()
 
     def run(self) -> Analysis:
@@ -227,7 +228,7 @@ class _WslAnalysis:
         res = self.results
         res.model = WATER_MODELS[self.s.water_model]
         res.gamma = res.model["gamma_lv_N_m"]
-        res.nodes = {k: np.asarray(v, float) for k, v in self.info["nodes"].items()}
+        res.nodes = self.plan.nodes
         res.stages, res.per_node, res.halves = {}, {}, {0: {}, 1: {}}
         res.rows = {key: [] for key, _, _ in self.STAGES}
         res.half_means = {key: ([], []) for key, _, _ in self.STAGES}
@@ -279,18 +280,17 @@ class _WslAnalysis:
     def _work(self) -> None:
         """W_SL (J/m^2) with the tether and the dispersion-tail corrections, the halves' W_SL, and the angle."""
         res = self.results
-        info, gamma = self.info, res.gamma
+        plan, gamma = self.plan, res.gamma
         w = A.ti_work_of_adhesion_sl(res.stages["charge_film"], res.stages["lj_film"],
-                                     res.stages["charge_reference"], info["area_A2"])
+                                     res.stages["charge_reference"], plan.area_A2)
         # the tether's energy at full coupling (the film leg's second half), added back
         zf = np.asarray(self.ctx.samples("film", False).get("z_film", []), float)
-        tc = A.tether_correction(zf[zf.size // 2:], info["tether"]["z_A"], info["tether"]["k_kcal_mol_A2"],
-                                 info["area_A2"])
+        tc = A.tether_correction(zf[zf.size // 2:], plan.tether_z_A, plan.tether_k_kcal_mol_A2, plan.area_A2)
         w["value"] += tc["value"]
         w["tether_correction"] = tc
         ti_stderr = w["stderr"]           # the nodes' statistical error alone: what the window-length check tests
         # OTS: the water-TraPPE dispersion beyond the cutoff, static, at full coupling (the film leg's framed half)
-        tail = _dispersion_tail(self.ctx, info, self.s) if info.get("tail_site_ids") else None
+        tail = _dispersion_tail(self.ctx, plan, self.s) if plan.tail.ids else None
         if tail is not None:
             w["value"] += tail["value"]
             w["stderr"] = math.hypot(w["stderr"], tail["stderr"])
@@ -298,7 +298,7 @@ class _WslAnalysis:
         res.dw_tail = tail["value"] if tail is not None else 0.0
         # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
         res.w_half = [A.ti_work_of_adhesion_sl(res.halves[h]["charge_film"], res.halves[h]["lj_film"],
-                                                res.halves[h]["charge_reference"], info["area_A2"])["value"]
+                                                res.halves[h]["charge_reference"], plan.area_A2)["value"]
                        + tc["value"] + res.dw_tail for h in (0, 1)]
         # each half has sqrt(2) x the nodes' stderr, their difference 2 x. The tail and the tether enter both halves
         # alike, so their errors cancel in the difference and stay out of its tolerance (as does the quadrature's)
@@ -353,7 +353,7 @@ class _WslAnalysis:
         res = self.results
         s, w, ang, tail, tc, gamma, model = self.s, res.w, res.ang, res.tail, res.tc, res.gamma, res.model
         w_half, half_sigma = res.w_half, res.half_sigma
-        conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / self.info["area_A2"]
+        conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / self.plan.area_A2
         return [f"window length: W_SL from the first halves of the nodes' samples {w_half[0] * 1e3:.1f}, from the "
                 f"second halves {w_half[1] * 1e3:.1f} mJ/m^2 (difference {(w_half[1] - w_half[0]) * 1e3:+.1f}, 2 sigma "
                 f"= {2 * half_sigma * 1e3:.1f}): " + ("consistent, the nodes are long enough for their decorrelation."
@@ -589,7 +589,7 @@ class _WslLegs:
                 "nodes": {k: v.tolist() for k, v in self.nodes.items()}, "pppm": self.kspace[0]}
 
 
-def _dispersion_tail(ctx, info, s) -> dict | None:
+def _dispersion_tail(ctx, plan: WslPlanRecord, s) -> dict | None:
     """The water-TraPPE dispersion beyond the cutoff (J/m^2, > 0 = more adhesion) per frame of the film leg's
     framed half: the film's lower dividing plane and bulk density from all frames' water O
     (:func:`md.analysis.film_lower_dividing_plane`), each frame's TraPPE sites under it
@@ -598,8 +598,8 @@ def _dispersion_tail(ctx, info, s) -> dict | None:
     steps, ids, pos, box = ctx.frames("film")
     if not len(steps):
         return None
-    is_site, c6 = framed_tail_sites(info, ids)
-    area = float(info["area_A2"])
+    is_site, c6 = plan.tail.framed(ids)
+    area = plan.area_A2
     plane = A.film_lower_dividing_plane(pos[:, ~is_site, 2], area, len(steps))
     per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, plane["z_A"], plane["number_density_A3"],
                                                  s.cutoff_A, area) for k in range(len(steps))])

@@ -80,11 +80,13 @@ def test_rank1_second_offset_is_a_lattice_translation_and_primitive_offsets_neve
 
 def test_degenerate_registries_are_named_in_the_notes():
     from md.workflows.adhesion_protocol import degenerate_note
+    from md.workflows.plan_records import AdhesionPlanRecord
     info = {"registry_offsets_A": [[0.0, 0.0], [2.531442, 4.384587]], "degenerate_registries": [[1, 0]],
             "surface_lattice_A": [[5.06, 0.0], [2.53, 4.38]]}
-    (note,) = degenerate_note(info)
+    common = {"area_A2": 100.0, "n_lower": 10}
+    (note,) = degenerate_note(AdhesionPlanRecord.from_system({**common, **info}))
     assert note.startswith("REGISTRIES DEGENERATE") and "2 chains sample 1 distinct registry" in note
-    assert degenerate_note({**info, "degenerate_registries": []}) == []
+    assert degenerate_note(AdhesionPlanRecord.from_system({**common, **info, "degenerate_registries": []})) == []
 
 
 def _system(name, **override):

@@ -30,7 +30,8 @@ def test_calibration_imports_md_only_through_its_root():
 
 
 def test_the_scan_sees_deep_imports_at_any_level():
-    source = "from md import run_recipe\n\ndef f():\n    from md.engine.store import run_dir_for\n    import md.recipe\n"
+    source = ("from md import run_recipe\n\n"
+              "def f():\n    from md.engine.store import run_dir_for\n    import md.recipe\n")
     assert deep_md_imports(source, "m.py") == ["m.py:4: md.engine.store", "m.py:5: md.recipe"]
 
 
