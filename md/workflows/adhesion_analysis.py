@@ -248,7 +248,7 @@ class _AdhesionAnalysis:
         self._layer_modulus()
         self._window_checks()
         if self.s.pmf_return:
-            P.return_path(self, self.wf.return_chain(self.s))
+            P.return_path(self.ctx, self.results, self.wf.return_chain(self.s))
         self._flat_slab_law()
         res.tail_det.update(tail_energy_last_window_kcal=res.u_tail_last)
         res.details["dispersion_tail"] = res.tail_det
