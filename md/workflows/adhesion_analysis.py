@@ -100,7 +100,7 @@ class _AdhesionAnalysis:
         self._protocol_legs()
         if self.s.free_energy != "pmf":
             res.notes.append("free energy not estimated at this fidelity (free_energy = 'none'); the quick and "
-                              "production recipes integrate the mean force over separation to measure T dS.")
+                             "production recipes integrate the mean force over separation to measure T dS.")
             res.details["dispersion_tail"] = res.tail_det
             return self._analysis()
         res.suffixes = [c[0] for c in self.wf.chains(self.s)]
@@ -131,8 +131,8 @@ class _AdhesionAnalysis:
         con, sep = ctx.samples("contact"), ctx.samples("separated")
         res.w = w = A.energy_separation_work(con["pe"], sep["pe"], area)
         res.notes = [ENERGY_NOT_FREE_ENERGY,
-                      "every mean and stderr comes from the statistical inefficiency with automated equilibration "
-                      "detection (Chodera, J. Chem. Theory Comput. 12 (2016) 1799; md.analysis.timeseries_stats)."]
+                     "every mean and stderr comes from the statistical inefficiency with automated equilibration "
+                     "detection (Chodera, J. Chem. Theory Comput. 12 (2016) 1799; md.analysis.timeseries_stats)."]
         res.details: dict[str, Any] = {"energy": {k: v for k, v in w.items() if k not in ("value", "stderr", "units")}}
         zs = A.timeseries_stats(con["z_back"])
         res.zc = zs["mean"]
@@ -143,7 +143,7 @@ class _AdhesionAnalysis:
                                          kind="energy per area (not a free energy)" + (
                                              "; dispersion beyond the cutoff for TraPPE pairs included (static)"
                                              if tail_on else "")),
-                  "interface_area": quantity_record(U.angstrom_to_m(U.angstrom_to_m(area)), 0.0, "m^2")}
+                 "interface_area": quantity_record(U.angstrom_to_m(U.angstrom_to_m(area)), 0.0, "m^2")}
         res.details["energy"]["cutoff_only_J_m2"] = w["value"]
         self._energy_curves()
 
@@ -163,8 +163,8 @@ class _AdhesionAnalysis:
             # second-order check: the free-energy perturbation -kT ln <exp(-U/kT)> against the mean
             fep = -kt * (np.log(np.mean(np.exp(-(u - u.min()) / kt))) - u.min() / kt) if len(u) else float("nan")
             res.tail_det.update(contact_energy_kcal=u.tolist(), static_work_J_m2=res.w_tail_static,
-                                 fep_minus_mean_J_m2=float(-(fep - np.mean(u)) * conv) if len(u) else None,
-                                 r_max_A=TAIL_R_MAX_A, pairs_per_frame=tc["pairs"])
+                                fep_minus_mean_J_m2=float(-(fep - np.mean(u)) * conv) if len(u) else None,
+                                r_max_A=TAIL_R_MAX_A, pairs_per_frame=tc["pairs"])
         if self.plan.tail_study and len(ctx.frames("contact")[0]):
             st, ids, pos, box = ctx.frames("contact")
             last = (st[-1:], ids, pos[-1:], box[-1:])
@@ -183,7 +183,7 @@ class _AdhesionAnalysis:
         res.all_con, res.all_sep = self.ctx.samples("contact", False), self.ctx.samples("separated", False)
         for name, d in (("energy_contact", res.all_con), ("energy_separated", res.all_sep)):
             res.curves[name] = (["step", "time_s", "stage", "potential_energy_J", "temperature_K"],
-                                 np.column_stack([d["step"], U.fs_to_s(d["step"] * dt), d["stage"],
+                                np.column_stack([d["step"], U.fs_to_s(d["step"] * dt), d["stage"],
                                                   U.kcal_per_mol_to_J(d["pe"]), d["temp"]]))
         res.figures["energy_timeseries"] = figure_writer(self._draw_energy)
 
@@ -221,7 +221,7 @@ class _AdhesionAnalysis:
         st = A.timeseries_stats(win["fz"])
         res.d_A[r, k] = float(np.mean(win["z_back"])) - res.zc
         res.f_m[r, k], res.f_e[r, k], res.g_w[r, k], res.neff_w[r, k] = (st["mean"], st["stderr"], st["g"],
-                                                                             st["n_eff"])
+                                                                         st["n_eff"])
         if SAM_STRESS_COLUMNS[0] in win:
             for c, col in enumerate(SAM_STRESS_COLUMNS):
                 ss = A.timeseries_stats(win[col])
@@ -235,7 +235,7 @@ class _AdhesionAnalysis:
         res = self.results
         order = np.argsort(res.d_A[0])
         res.d_A, res.f_m, res.f_e, res.g_w, res.neff_w = (a[:, order] for a in (res.d_A, res.f_m, res.f_e,
-                                                                                     res.g_w, res.neff_w))
+                                                                                res.g_w, res.neff_w))
         res.halves = res.halves[:, :, order]
         res.sam_sig, res.sam_sig_e = res.sam_sig[:, :, order], res.sam_sig_e[:, :, order]
         res.suffixes = [res.suffixes[i] for i in order]
@@ -254,7 +254,7 @@ class _AdhesionAnalysis:
         res.details["dispersion_tail"] = res.tail_det
         pmf = res.ti["pmf_J_per_m2"]
         res.curves["pmf"] = (["separation_m", "mean_force_N", "mean_force_stderr_N", "tail_force_N", "pmf_J_per_m2"],
-                              np.column_stack([U.angstrom_to_m(res.dsep), U.kcal_per_mol_A_to_N(res.f_tot),
+                             np.column_stack([U.angstrom_to_m(res.dsep), U.kcal_per_mol_A_to_N(res.f_tot),
                                                U.kcal_per_mol_A_to_N(res.ebar), U.kcal_per_mol_A_to_N(res.f_tail),
                                                pmf]))
         res.notes += self._pmf_notes()
@@ -303,7 +303,7 @@ class _AdhesionAnalysis:
                                            for r, c in res.details.get("registry_contacts", {}).items()}
         res.tds_rec = A.entropic_term(e_reg, {r: (res.w_reg[r], res.w_reg_err[r]) for r in range(res.n_reg)})
         res.tds, res.tds_err = (res.tds_rec["per_registry"][0] if len(res.tds_rec["registries"]) == 1 else
-                                  (res.tds_rec["mean"], res.tds_rec["stderr"]))
+                                (res.tds_rec["mean"], res.tds_rec["stderr"]))
         res.repulsive = bool(ti["repulsive_end"])
         q, tail_on, n_reg = res.q, res.tail_on, res.n_reg
         q["work_of_adhesion_free_energy"] = quantity_record(
@@ -318,7 +318,7 @@ class _AdhesionAnalysis:
         res.energy_registries_agree = e_check is None or not bool(np.asarray(e_check["inconsistent"])[0])
         if not res.energy_registries_agree:
             res.notes.append("dE/A and T dS NOT CONVERGED: the registries' own dE/A (each zero-load contact) disagree "
-                              "beyond their stderrs (chi^2 p < 0.01); their mean is no converged number")
+                             "beyond their stderrs (chi^2 p < 0.01); their mean is no converged number")
         q["entropic_term_TdS"] = quantity_record(
             res.tds, res.tds_err, "J/m^2", discretisation_error=res.wf_disc,
             kind="T dS / A = (dE - dF) / A of registry 0: dE/A from the zero-load contact leg (registry 0) and W_F of "
@@ -494,9 +494,9 @@ class _AdhesionAnalysis:
         first, second = (np.nanmean(h, axis=0) + res.f_tail for h in res.halves)
         wl = A.window_length_check(res.dsep, first, second, res.estat, res.area, correlation=res.rho)
         res.w_half = [wl["first_half_J_m2"] - res.u_tail_last * res.conv,
-                       wl["second_half_J_m2"] - res.u_tail_last * res.conv]
+                      wl["second_half_J_m2"] - res.u_tail_last * res.conv]
         res.half_diff, res.half_err, res.half_ok = (wl["difference_J_m2"], wl["difference_stderr_J_m2"],
-                                                       wl["converged"])
+                                                    wl["converged"])
         res.details["window_length_check"] = {
             "first_half_J_m2": res.w_half[0], "second_half_J_m2": res.w_half[1], "whole_J_m2": res.wf_val,
             "difference_J_m2": res.half_diff, "difference_stderr_J_m2": res.half_err, "converged": res.half_ok,

@@ -238,8 +238,8 @@ class _DropletAnalysis:
         res.gamma = res.model["gamma_lv_N_m"]
         if abs(s.temperature_K - res.model["gamma_T_K"]) > 1.0:
             res.notes.append(f"gamma_lv = {res.gamma * 1e3:.1f} mN/m is the model's value at "
-                              f"{res.model['gamma_T_K']:g} K, not at the run's {s.temperature_K:g} K: W_SL and "
-                              f"gamma_lv cos theta carry that mismatch.")
+                             f"{res.model['gamma_T_K']:g} K, not at the run's {s.temperature_K:g} K: W_SL and "
+                             f"gamma_lv cos theta carry that mismatch.")
         q = self._angle_quantities(self._status())
         self._drift_checks(q)
         res.notes += self._protocol_notes()
@@ -265,7 +265,7 @@ class _DropletAnalysis:
         if np.isfinite(rad) and rad > 0 and (zc - z_ref) / rad > 1 and not wet["spans_box"]:
             res.angle, res.angle_err = 180.0, None
             res.notes.append(f"the fitted circle (centre {zc - z_ref:+.1f} A from the water's plane, r = {rad:.1f} A) "
-                              f"lies above the plane: the droplet is not (yet) in contact; reported as 180 deg.")
+                             f"lies above the plane: the droplet is not (yet) in contact; reported as 180 deg.")
             return "no_contact"
         res.angle, res.angle_err = 0.0, None
         return "wets"
@@ -303,8 +303,8 @@ class _DropletAnalysis:
                                       "gamma_lv (1 + cos theta_upper_bound)")
         q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], None, "N/m", kind="lower bound (wets)")
         res.notes.append(f"wets: theta < {bound:.1f} deg ({why}); W_SL >= {wl['value'] * 1e3:.1f} mJ/m^2. "
-                          f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
-                          f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
+                         f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
+                         f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
 
     def _measured_quantities(self, q: dict) -> str:
         """W_SL of a measured angle, with the water-TraPPE dispersion tail where the substrate has TraPPE sites;
@@ -350,27 +350,27 @@ class _DropletAnalysis:
                                       drifting=bool(drift["drifting"]))
         if drift["drifting"]:
             res.notes.append(f"DRIFTING: the block angles still change by {drift['slope']:+.0f} +/- "
-                              f"{drift['stderr']:.0f} deg/ns ({drift['change']:+.1f} deg over the sampled "
-                              f"{np.ptp(res.t_blocks) * 1e3:.0f} ps, |slope| > 2 stderr): not equilibrated; the "
-                              f"mean depends on where the run stopped.")
+                             f"{drift['stderr']:.0f} deg/ns ({drift['change']:+.1f} deg over the sampled "
+                             f"{np.ptp(res.t_blocks) * 1e3:.0f} ps, |slope| > 2 stderr): not equilibrated; the "
+                             f"mean depends on where the run stopped.")
         if not r.blocks_independent:
             res.notes.append(f"the droplet's shape (its water's mean height) has a statistical inefficiency of "
-                              f"{r.shape_statistical_inefficiency:.0f} frames in {r.n_frames}: the "
-                              f"{r.n_blocks_used} block maps are not independent, so the angle's stderr is a lower "
-                              f"bound; a longer run is what makes it an error bar.")
+                             f"{r.shape_statistical_inefficiency:.0f} frames in {r.n_frames}: the "
+                             f"{r.n_blocks_used} block maps are not independent, so the angle's stderr is a lower "
+                             f"bound; a longer run is what makes it an error bar.")
         res.shape = shape = A.shape_check(r.density_map, *r.edges, res.floor, r.stderr_deg)
         if shape["circular"] is False:
             by = ", ".join(f"{v:.1f} ({k} A)" for k, v in shape["angles_by_exclude_deg"].items())
             res.notes.append(f"NOT A CIRCULAR CAP: the same map reads {by} above the water's plane and "
-                              f"{shape['angle_from_height_deg']:.1f} deg from its area and height; the spread "
-                              f"{shape['spread_deg']:.1f} deg exceeds max(3 stderr, 2 deg) = "
-                              f"{shape['tolerance_deg']:.1f} deg, so the angle depends on how it is read "
-                              f"(pinned or moving contact lines, a sheared mean shape): a systematic the stderr "
-                              f"does not hold.")
+                             f"{shape['angle_from_height_deg']:.1f} deg from its area and height; the spread "
+                             f"{shape['spread_deg']:.1f} deg exceeds max(3 stderr, 2 deg) = "
+                             f"{shape['tolerance_deg']:.1f} deg, so the angle depends on how it is read "
+                             f"(pinned or moving contact lines, a sheared mean shape): a systematic the stderr "
+                             f"does not hold.")
         h = float(r.cap_height_A)
         if h < 3 * 5.0:
             res.notes.append(f"the cap is {h:.1f} A high, less than 3x the 5 A excluded layer: few interface "
-                              f"points carry the fit.")
+                             f"points carry the fit.")
 
     def _protocol_notes(self) -> list[str]:
         res = self.results

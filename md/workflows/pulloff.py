@@ -211,7 +211,7 @@ class _PullOffAnalysis:
         res = self.results
         res.d_app = d_app = self.ctx.samples("approach", False)
         res.curves["approach_curve"] = (["step", "stage", "separation_m", "force_N"],
-                                         np.column_stack([d_app["step"], d_app["stage"],
+                                        np.column_stack([d_app["step"], d_app["stage"],
                                                           U.angstrom_to_m(self.sep(d_app)),
                                                           U.kcal_per_mol_A_to_N(d_app["fz"])]))
         res.speeds = speeds = sorted({v for v, *_ in res.pulls})

@@ -255,7 +255,7 @@ class _WslAnalysis:
         res.stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
         for h in (0, 1):
             res.halves[h][key] = A.ti_integral(lam, res.half_means[key][h],
-                                                [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
+                                               [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
 
     def _conclude(self) -> Analysis:
         res = self.results
@@ -298,8 +298,8 @@ class _WslAnalysis:
         res.dw_tail = tail["value"] if tail is not None else 0.0
         # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
         res.w_half = [A.ti_work_of_adhesion_sl(res.halves[h]["charge_film"], res.halves[h]["lj_film"],
-                                                res.halves[h]["charge_reference"], plan.area_A2)["value"]
-                       + tc["value"] + res.dw_tail for h in (0, 1)]
+                                               res.halves[h]["charge_reference"], plan.area_A2)["value"]
+                      + tc["value"] + res.dw_tail for h in (0, 1)]
         # each half has sqrt(2) x the nodes' stderr, their difference 2 x. The tail and the tether enter both halves
         # alike, so their errors cancel in the difference and stay out of its tolerance (as does the quadrature's)
         res.half_sigma = ti_stderr * 2.0
