@@ -78,7 +78,7 @@ COVERING_RADIUS_A = SITE_SPACING_A / math.sqrt(3.0)
 def tip_map(recipe: str, bin_A: float, reach_A: float) -> dict:
     """Height map (m) of the asperity of ``recipe`` at quick, built by the workflow's builder."""
     wf = get_workflow("pulloff")
-    system, _ = wf.build(load_recipe(recipe).settings("quick"))
+    system, _ = wf.build(load_recipe(recipe).typed_settings("quick"))
     tip = system.group("adsorbate")
     pos = system.positions[tip]
     m = tip_height_map(pos[:, :2], pos[:, 2], system.cell[:2], bin_A, reach_A=reach_A)

@@ -128,7 +128,7 @@ def _signed(x: float, digits: int) -> str:
 def md_lateral_stress(folder: Path = FIGURES) -> str:
     """docs/benchmarks.md's lateral-stress table from ``benchmarks/md_lateral_stress.py``'s json per lattice constant
     (``md_lateral_stress_a<A>.json``), then where sigma_bulk changes sign (linear between the bracketing lattices)."""
-    from md.build import CRISTOBALITE_A
+    from md import CRISTOBALITE_A
 
     runs = sorted(((float(p.stem.rpartition("_a")[2]), p.stem.rpartition("_a")[2], json.loads(p.read_text()))
                    for p in Path(folder).glob("md_lateral_stress_a*.json")), reverse=True)

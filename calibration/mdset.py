@@ -72,9 +72,6 @@ from continuum.api import FIELD_BY_PATH, SceneError, check_origins, check_value,
 from nanoimpact import data
 from nanoimpact.fileio import atomic_write_text
 
-#: Committed MD results shipped with the package (inputs/md/results, installed as package data).
-RESULTS_DIR = data.shipped_root() / "md" / "results"
-
 
 @dataclass(frozen=True)
 class Source:
@@ -351,7 +348,7 @@ def _z0_from_reported_work(res: dict) -> dict:
     z, w, sg = q.get("interaction_range_z0"), q.get("work_of_adhesion_free_energy") or {}, q.get("peak_traction_sigma0")
     if not z or not sg or "work_of_adhesion_used" in z or w.get("value_out") is None:
         return res
-    from md.analysis import flat_slab_range
+    from md import flat_slab_range
 
     w_err = math.hypot(*[float(w[k]) for k in ("stderr", "discretisation_error", "systematic_hysteresis")
                          if w.get(k) is not None])
@@ -531,7 +528,7 @@ def _registry_energy_check(res: dict) -> dict | None:
     details.registry_contacts) agree within their stderrs (md.analysis.registry_consistency: p < 0.01 = disagree).
     Where they disagree, dE/A and T dS = dE - dF are not converged (the per-registry values in ``per_registry``).
     None with fewer than two registries."""
-    from md.analysis import registry_consistency
+    from md import registry_consistency
 
     q, contacts = res.get("quantities") or {}, (res.get("details") or {}).get("registry_contacts") or {}
     de = q.get("work_of_adhesion") or {}

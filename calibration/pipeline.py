@@ -325,7 +325,7 @@ def _resolve_at_range_ends(scene_file, scene_spec, base, base_file, ranges, over
 
 def _check_md_recipes(origin: str) -> None:
     """Every MD recipe the calibration needs loads."""
-    from md.recipe import load_recipe
+    from md import load_recipe
 
     for recipe in recipes_needed():
         try:
@@ -340,7 +340,7 @@ def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, wor
                       scheduler: str | None, paper_sets) -> None:
     """The options of `calibrate`, checked before anything runs or is written (CalibrationError, one line)."""
     from continuum.api import SceneError, find_params
-    from md.recipe import FIDELITIES
+    from md import FIDELITIES
     from nanoimpact.executors import NAMES
 
     if Path(out).exists() and not Path(out).is_dir():
@@ -363,18 +363,15 @@ def check_run_options(out: str | Path, md_fidelity: str, executor_name: str, wor
 # ----------------------------------------------------------------------------- MD jobs
 def current_hash(recipe_name: str, fidelity: str) -> str:
     """The run hash md would give `recipe_name` at `fidelity` now."""
-    from md.recipe import load_recipe
-    from md.workflows import get_workflow, run_hash
+    from md import run_hash
 
-    recipe = load_recipe(recipe_name)
-    wf = get_workflow(recipe.workflow)
-    return run_hash(recipe, fidelity, wf.forcefield_files(recipe.settings(fidelity)))[0]
+    return run_hash(recipe_name, fidelity)[0]
 
 
 def committed_if_usable(recipe_name: str, fidelity: str, results_dir, same_versions: bool) -> tuple[dict | None, str]:
     """(the committed result of `recipe_name` if its hash is current and, with `same_versions`, it was made under
     the running nanoimpact and LAMMPS versions, else None; what its versions say: 'made with ...' or '')."""
-    from md.engine import describe_differences, version_differences
+    from md import describe_differences, version_differences
 
     committed = committed_result(recipe_name, fidelity, None if results_dir is None else Path(results_dir))
     if committed is None or committed.get("run_hash") != current_hash(recipe_name, fidelity):
@@ -389,8 +386,7 @@ def md_plan(recipes, fidelity: str, cache: str | None = None, results_dir: str |
     (a committed result at the current hash, made under the running versions if `same_versions`), 'md cache'
     (a finished run in the cache), 'resumes' (an unfinished run of the current hash in the cache: it goes on from
     its last restart) or 'runs' (from the start)."""
-    from md.engine.store import run_dir_for
-    from md.recipe import load_recipe
+    from md import load_recipe, run_dir_for
 
     out = {}
     for name in recipes:
@@ -417,9 +413,7 @@ def md_job(task: tuple) -> dict:
         return {"recipe": recipe_name, "result": usable, "source": "committed" + (f" ({made})" if made else ""),
                 "wall_s": time.perf_counter() - start}
     committed = committed_result(recipe_name, fidelity, None if results_dir is None else Path(results_dir))
-    from md.engine import describe_differences, version_differences
-    from md.recipe import load_recipe
-    from md.workflows import run_recipe
+    from md import describe_differences, load_recipe, run_recipe, version_differences
 
     # resume: a run this job (or a worker that died, or an earlier calibration) left unfinished goes on from its
     # last restart instead of starting again; with nothing to resume it is a fresh run

@@ -20,8 +20,7 @@ from __future__ import annotations
 
 import math
 
-from md.analysis import poisson_spread, small_strain_layer_record, tilt_of_anneal, young_from_confined
-from md.build.sam import chain_geometry
+from md import chain_geometry, poisson_spread, small_strain_layer_record, tilt_of_anneal, young_from_confined
 
 #: where an unmeasured layer Poisson ratio may lie (a declared choice, docs/md.md "SAM layer modulus"): glassy
 #: polymers 0.3-0.4 and chain-molecule solids up to ~0.45 (a reviewer's estimate, unchecked); 0.25 below them

@@ -31,7 +31,7 @@ def _scene() -> dict:
 
 
 def _md_recipe() -> dict:
-    from md.recipe import json_schema
+    from md import json_schema
     return json_schema()
 
 

@@ -26,8 +26,7 @@ import math
 
 import numpy as np
 
-from md.analysis import paired_speed_extrapolation
-from md.analysis.pulloff import SILICA_E_STAR_PA, tabor_parameter
+from md import SILICA_E_STAR_PA, paired_speed_extrapolation, tabor_parameter
 
 #: pull-off results compared with the flat-slab work of adhesion (DMT: F = 2 pi R W): validation, not calibration
 #: (both pull-offs over four tip positions, each its own contact, so their stderr holds the geometric spread, with a

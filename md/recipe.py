@@ -314,6 +314,13 @@ def _fields(section: str, workflow: str) -> dict[str, RecipeField]:
     return out
 
 
+class RecipeSettings:
+    """What every workflow's settings dataclass is (:data:`SETTINGS_CLASSES`): a recipe's resolved settings at one
+    fidelity, one typed attribute per key. A workflow receives this object from the engine, built once
+    (:meth:`Recipe.typed_settings`)."""
+    __slots__ = ()
+
+
 def _settings_dataclass(workflow: str) -> type:
     members: dict[str, RecipeField] = {}
     for section in ("system", "fidelity"):
@@ -321,7 +328,7 @@ def _settings_dataclass(workflow: str) -> type:
             members.setdefault(key, f)
     title = "".join(part.title() for part in workflow.split("_"))
     return fields.frozen_dataclass(
-        f"{title}Settings", list(members.items()), module=__name__,
+        f"{title}Settings", list(members.items()), module=__name__, bases=(RecipeSettings,),
         doc=f"The resolved settings of a recipe of the {workflow!r} workflow at one fidelity "
             "([system] overlaid with the fidelity's "
             "table; `Recipe.typed_settings`), in the recipe's units (file units: Å, fs, K).")
@@ -375,7 +382,7 @@ class Recipe:
     def origin(self) -> str:
         return str(self.path) if self.path else self.name
 
-    def typed_settings(self, fidelity: str):
+    def typed_settings(self, fidelity: str) -> RecipeSettings:
         """`settings(fidelity)` as the workflow's frozen settings dataclass (`settings_class`): attributes typed,
         documented and defaulted from the key declarations, e.g. ``recipe.typed_settings("quick").timestep_fs``."""
         return settings_class(self.workflow)(**self.settings(fidelity))

@@ -242,13 +242,14 @@ def _attribute(member: Field | Resolved, unit: Callable[[Field], str],
 
 
 def frozen_dataclass(name: str, members: Sequence[tuple[str, Field | Resolved]], *, doc: str, module: str,
-                     namespace: dict | None = None, unit: Callable[[Field], str] = lambda f: f.unit,
+                     namespace: dict | None = None, bases: tuple[type, ...] = (),
+                     unit: Callable[[Field], str] = lambda f: f.unit,
                      default: Callable[[Field], Any] = lambda f: f.default) -> type:
     """A frozen, keyword-only dataclass with one attribute per (name, declaration) in `members`, in that order:
     typed from the declaration (``float``, ``float | None`` for an optional key, ...), defaulted from it (a
     required key has no default) and documented from it (the class docstring lists each attribute with its unit
     and the key it comes from). So a key is declared once and its dataclass follows. `Resolved` members are
-    attributes the loader computes; `namespace` adds properties and methods; `unit`/`default` map a key's file
+    attributes the loader computes; `namespace` adds properties and methods, `bases` base classes; `unit`/`default` map a key's file
     unit and default to the attribute's (angles: degrees in the file, radians in the dataclass). Each
     dataclass field carries its key, unit and doc in ``metadata``."""
     spec, lines = [], []
@@ -265,7 +266,8 @@ def frozen_dataclass(name: str, members: Sequence[tuple[str, Field | Resolved]],
         shown = f" [{attr_unit}]" if attr_unit and attr_unit != "1" else ""
         where = f", from ``{key}``" if key else ""
         lines.append(f"    {attr}{shown}{where}: {attr_doc}")
-    cls = dataclasses.make_dataclass(name, spec, namespace=dict(namespace or {}), frozen=True, kw_only=True)
+    cls = dataclasses.make_dataclass(name, spec, bases=bases, namespace=dict(namespace or {}), frozen=True,
+                                     kw_only=True)
     cls.__module__ = module             # so pickle (process pools, Dask) finds the class where it is defined
     cls.__doc__ = doc.rstrip() + "\n\n    Attributes (generated from the key declarations):\n" + "\n".join(lines) + "\n"
     return cls

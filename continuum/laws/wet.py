@@ -244,13 +244,11 @@ class WetRoughRoller(ContactLaw):
         """
         if not self.dry.has_rigid_approach:
             # a summit law without a rigid approach branch (plastic summits keep every summit they may reach)
-            self.design_pull = 0.0
             self.dry.prepare(mass, speed, gravity)
             return
         depth = self.dry.quasi_static_depth(0.5 * mass * speed * speed, mass * gravity)
         deep = -2.0 * depth
         pull = self.bridges.full_force(deep)
-        self.design_pull = pull
         self.dry.prepare(mass, speed, gravity + pull / mass)
 
     def forget_history(self):

@@ -244,10 +244,6 @@ class SummitLaw:
         """Stored energy U (J) on a branch, zero for the free summit."""
         return self._branch(branch)("energy", delta)
 
-    def loaded_radius(self, delta, branch="retreat"):
-        """Loaded radius (m): contact radius (JKR, DMT) or cohesive-zone radius (Maugis-Dugdale)."""
-        return self._branch(branch)("radius", delta)
-
     def contact_radius(self, delta, branch="retreat"):
         """True contact radius (m); 0 out of contact."""
         return self._branch(branch)("contact", delta)

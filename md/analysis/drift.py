@@ -31,8 +31,9 @@ from md.analysis.stats import statistical_inefficiency, student_t_factor
 #: |slope| / stderr above which a series is reported as drifting (two-sided 95 %)
 DRIFT_Z_MAX = 2.0
 #: blocks of the block-means test: 6 degrees of freedom; on a fast oscillation plus an AR(1) whose correlation
-#: time is a fifth of a block the test keeps about its nominal false-positive rate (tests/md/test_md_adhesion.py),
-#: and more blocks would be shorter than a SAM's slow fluctuations in a 250 ps half-anneal
+#: time is a fifth of a block the test keeps about its nominal false-positive rate
+#: (tests/md/test_md_adhesion_drift.py), and more blocks would be shorter than a SAM's slow fluctuations in a
+#: 250 ps half-anneal
 DRIFT_BLOCKS = 8
 #: fewest blocks the block-means test runs on (2 degrees of freedom); shorter series get the ACF test alone
 MIN_DRIFT_BLOCKS = 4

@@ -124,14 +124,18 @@ class Job:
     """One run as the engine sees it (:func:`md.workflows.job_for` makes it from a recipe): what names it, what
     its hash covers, what ``result.json`` records.
 
-    ``canonical`` is the recipe's resolved content at ``fidelity`` (``Recipe.canonical``); ``source`` the recipe
-    file (or name), ``file_sha256`` its bytes' hash, ``content_sha256`` the hash of ``canonical``;
-    ``workflow_version`` (the workflow's protocol version) enters the run hash."""
+    ``settings`` is the workflow's typed settings object (``Recipe.typed_settings``), built once and handed to
+    the workflow's ``plan`` and ``analyse`` as it is; ``settings_record`` the same resolved settings as the
+    recipe's mapping (its key order), which ``result.json`` records. ``canonical`` is the recipe's resolved content
+    at ``fidelity`` (``Recipe.canonical``); ``source`` the recipe file (or name), ``file_sha256`` its bytes' hash,
+    ``content_sha256`` the hash of ``canonical``; ``workflow_version`` (the workflow's protocol version) enters the
+    run hash."""
     name: str
     workflow: str
     description: str
     fidelity: str
-    settings: Mapping[str, Any]
+    settings: Any
+    settings_record: Mapping[str, Any]
     canonical: Mapping[str, Any]
     forcefield_files: tuple[str, ...]
     workflow_version: int = 1
@@ -143,7 +147,7 @@ class Job:
 class Planner(Protocol):
     """The engine's view of a workflow."""
 
-    def plan(self, settings: Mapping[str, Any], run_dir: Path) -> Plan: ...
+    def plan(self, settings: Any, run_dir: Path) -> Plan: ...
 
     def analyse(self, ctx: Any) -> Analysis: ...
 

@@ -600,7 +600,7 @@ def _analyse_and_record(job: Job, wf: Planner, digest: str, plan, run_dir: Path,
         "atom_steps_per_s": atom_steps / dyn_wall if dyn_wall > 0 else None,
         **flags,
         "seeds": plan.seeds,
-        "settings": dict(job.settings),
+        "settings": dict(job.settings_record),
         "system": plan.system_info,
         "legs": {name: {k: s.get(k) for k in ("total_steps", "n_atoms", "chunks", "dynamics_wall_s", "setup_wall_s",
                                               "resumed_from", "dropped_on_resume", "ranks", "hosts")}

@@ -14,7 +14,7 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -165,10 +165,10 @@ def write_csv(path: Path, columns: Sequence[str], rows: np.ndarray) -> None:
 
 @dataclass
 class RunContext:
-    """Handed to ``workflow.analyse``: where the legs' data are."""
+    """Handed to ``workflow.analyse``: where the legs' data are, the plan, and the job's typed settings."""
     run_dir: Path
     plan: Plan
-    settings: Mapping[str, Any]
+    settings: Any
 
     def leg_dir(self, leg: str | Leg) -> Path:
         return self.run_dir / "legs" / (leg if isinstance(leg, str) else leg.name)

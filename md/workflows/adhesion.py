@@ -13,6 +13,8 @@ adhesion
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from md import analysis as A
@@ -20,7 +22,7 @@ from md.engine.plan import Plan
 from md.system.lammps_data import read_atoms
 from md.workflows.adhesion_analysis import _AdhesionAnalysis
 from md.workflows.adhesion_legs import TAIL_R_MAX_A, _AdhesionLegs, _lifts_registries, _tail_pair_table, outward_grid
-from md.workflows.common import Workflow, derived_seed, forcefield_of
+from md.workflows.common import Settings, Workflow, derived_seed, forcefield_of
 
 # ================================================================================================ adhesion
 
@@ -45,18 +47,15 @@ class Adhesion(Workflow):
     yields = {"work_of_adhesion": "J/m^2", "work_of_adhesion_free_energy": "J/m^2",
               "entropic_term_TdS": "J/m^2", "interface_area": "m^2"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
+    def _forcefield_files(self, s: Settings) -> list[str]:
         return ["silica_interface"] + (["ots_trappe_ua"] if "ots" in s.surfaces else [])
 
-    def protocol_version(self, s) -> int:
-        s = self.typed(s)
+    def _protocol_version(self, s: Settings) -> int:
         return self.version if _lifts_registries(s) else 3
 
     def windows(self, s) -> np.ndarray:
         """Nominal separations from contact (A): the compressed chain (negative, innermost first) and the outward
         chain (0 first, quadratically spaced to separation_A)."""
-        s = self.typed(s)
         out = outward_grid(s)
         m = int(s.pmf_compress_windows)
         inward = -s.pmf_compress_A * np.arange(m, 0, -1) / m if m else np.zeros(0)
@@ -66,7 +65,6 @@ class Adhesion(Workflow):
     def chains(cls, s) -> list[tuple[str, float, str | None]]:
         """(leg-name suffix, nominal separation, suffix of the leg it continues from) in run order: the contact
         window, the inward chain, the outward chain."""
-        s = cls.typed(s)
         out = outward_grid(s)
         n, m = len(out), int(s.pmf_compress_windows)
         rows = [("o00", 0.0, None)]
@@ -85,7 +83,6 @@ class Adhesion(Workflow):
         """With ``pmf_return``: (suffix, nominal separation, suffix it continues from, the outward window it
         repeats) in run order, from the outermost outward window back through the outward grid (``bKK`` repeats
         ``oKK``) and into compression (``cKK`` repeats ``iKK``); empty without it."""
-        s = cls.typed(s)
         if not s.pmf_return:
             return []
         out = outward_grid(s)
@@ -99,8 +96,7 @@ class Adhesion(Workflow):
             prev = f"c{k:02d}"
         return rows
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         legs = _AdhesionLegs(self, s, run_dir)
         anneal = [legs.anneal()] if s.sam_anneal_steps > 0 else []
         contact = legs.contact()
@@ -113,10 +109,10 @@ class Adhesion(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=legs.info())
 
     # ------------------------------------------------------------------------------------------ analysis
-    def _tail(self, ctx, mode: str, leg: str, r_max: float = TAIL_R_MAX_A, frames=None) -> dict:
-        """Static LJ interaction beyond the cutoff between the two slabs on the stored frames of ``leg``:
-        per-frame energies (kcal/mol) and forces on the upper slab along +z (kcal/mol/A)."""
-        info = ctx.plan.system_info
+    def _tail(self, ctx, n_lower: int, mode: str, leg: str, r_max: float = TAIL_R_MAX_A, frames=None) -> dict:
+        """Static LJ interaction beyond the cutoff between the two slabs (the lower one atom ids 1..``n_lower``)
+        on the stored frames of ``leg``: per-frame energies (kcal/mol) and forces on the upper slab along +z
+        (kcal/mol/A)."""
         cache = self.__dict__.setdefault("_tail_cache", {})
         if (ctx.run_dir, mode) not in cache:
             ids_all, types_all, _ = read_atoms(ctx.run_dir / "system.data")
@@ -127,11 +123,11 @@ class Adhesion(Workflow):
         if not len(steps):
             return {"energy": np.zeros(0), "force_z": np.zeros(0), "pairs": 0}
         t = np.array([type_of[int(i)] for i in ids])
-        low = ids <= info["n_lower"]
+        low = ids <= n_lower
         es, fs, pairs = [], [], 0
         for k in range(len(steps)):
             r = A.lj_tail_between(pos[k][low], t[low], pos[k][~low], t[~low], eps, sig, inc, box[k][:2],
-                                  self.typed(ctx.settings).cutoff_A, r_max)
+                                  ctx.settings.cutoff_A, r_max)
             es.append(r["energy"])
             fs.append(r["force_z"])
             pairs = r["pairs"]

@@ -17,6 +17,7 @@ from md import analysis as A
 from md import units as U
 from md.analysis.drift import linear_drift
 from md.workflows.common import quantity_record
+from md.workflows.plan_records import AdhesionPlanRecord
 
 
 def chain_tilts_deg(ids, pos, box, axes) -> np.ndarray:
@@ -122,56 +123,56 @@ def registry_contacts_record(ctx, energy_separated, area_A2: float, zc: float, t
     return out
 
 
-def degenerate_note(info) -> list[str]:
+def degenerate_note(plan: AdhesionPlanRecord) -> list[str]:
     """A note naming the registries whose offset is a lattice translation of an earlier one's."""
-    deg = info.get("degenerate_registries") or []
+    deg = plan.degenerate_registries
     if not deg:
         return []
-    n = len(info["registry_offsets_A"])
-    pairs = ", ".join(f"{r} repeats {r0} (offset {info['registry_offsets_A'][r]} A)" for r, r0 in deg)
+    n = len(plan.registry_offsets_A)
+    pairs = ", ".join(f"{r} repeats {r0} (offset {plan.registry_offsets_A[r]} A)" for r, r0 in deg)
     return [f"REGISTRIES DEGENERATE: {pairs}: the offset is a lattice translation of the slabs (lattice "
-            f"{np.round(info['surface_lattice_A'], 3).tolist()} A), so {n} chains sample {n - len(deg)} distinct "
+            f"{np.round(plan.surface_lattice_A, 3).tolist()} A), so {n} chains sample {n - len(deg)} distinct "
             f"registr{'y' if n - len(deg) == 1 else 'ies'}; their spread is a replicate spread, not a registry "
             f"spread (registry_sampling = 'primitive' samples the primitive cell)."]
 
 
-def return_path(an, chain_rows) -> None:
+def return_path(ctx, res, chain_rows) -> None:
     """W_F of the return chain on the outward grid (the outermost window is the turning point, shared), its
     hysteresis against the outward W_F, and W_F = the mean of the two with half the hysteresis as a systematic:
-    updates the analysis ``an`` (quantities, curves, details, notes) in place."""
+    updates the adhesion analysis's results ``res`` (quantities, curves, details, notes) in place."""
     partner = {rep: suf for suf, _d, _prev, rep in chain_rows}
-    shape = (an.n_reg, len(an.suffixes))
+    shape = (res.n_reg, len(res.suffixes))
     f_m, f_e = np.full(shape, np.nan), np.full(shape, np.nan)
-    for r in range(an.n_reg):
-        for k, suf in enumerate(an.suffixes):
-            st = A.timeseries_stats(an.ctx.samples(f"pmf_r{r}_{partner.get(suf, suf)}")["fz"])
+    for r in range(res.n_reg):
+        for k, suf in enumerate(res.suffixes):
+            st = A.timeseries_stats(ctx.samples(f"pmf_r{r}_{partner.get(suf, suf)}")["fz"])
             f_m[r, k], f_e[r, k] = st["mean"], st["stderr"]
     avg = A.registry_average(f_m, f_e)
-    f_back, e_back = np.asarray(avg["mean"]) + an.f_tail, np.asarray(avg["stderr"])
-    ti = A.force_integration_work(an.dsep, f_back, e_back, an.area, correlation=an.rho)
-    w_back, err_back = ti["value"] - an.u_tail_last * an.conv, ti["stderr"]
-    if an.n_reg >= 2:
-        per = [A.force_integration_work(an.d_A[r], f_m[r] + an.f_tail, f_e[r], an.area, correlation=an.rho)
-               for r in range(an.n_reg)]
+    f_back, e_back = np.asarray(avg["mean"]) + res.f_tail, np.asarray(avg["stderr"])
+    ti = A.force_integration_work(res.dsep, f_back, e_back, res.area, correlation=res.rho)
+    w_back, err_back = ti["value"] - res.u_tail_last * res.conv, ti["stderr"]
+    if res.n_reg >= 2:
+        per = [A.force_integration_work(res.d_A[r], f_m[r] + res.f_tail, f_e[r], res.area, correlation=res.rho)
+               for r in range(res.n_reg)]
         err_back = max(err_back, A.registry_average([p["value"] for p in per], [p["stderr"] for p in per])["stderr"])
-    h = A.hysteresis(an.wf_val, an.wf_err, w_back, err_back)
-    rec = an.q["work_of_adhesion_free_energy"]
-    rec.update(value=h["value"], stderr=h["stderr"], systematic_hysteresis=h["systematic"], value_out=an.wf_val,
-               stderr_out=an.wf_err, value_back=w_back, stderr_back=err_back,
+    h = A.hysteresis(res.wf_val, res.wf_err, w_back, err_back)
+    rec = res.q["work_of_adhesion_free_energy"]
+    rec.update(value=h["value"], stderr=h["stderr"], systematic_hysteresis=h["systematic"], value_out=res.wf_val,
+               stderr_out=res.wf_err, value_back=w_back, stderr_back=err_back,
                kind=rec["kind"] + "; the mean of the outward and the return chain, half their hysteresis as a "
                                   "systematic error")
-    an.q["adhesion_hysteresis"] = quantity_record(h["hysteresis"], h["hysteresis_stderr"], "J/m^2",
-                                                  kind="W_F(out) - W_F(back): work dissipated over the out-and-back "
-                                                       "path per area")
-    an.curves["pmf_return"] = (["separation_m", "mean_force_N", "mean_force_stderr_N"],
-                               np.column_stack([U.angstrom_to_m(an.dsep), U.kcal_per_mol_A_to_N(f_back),
-                                                U.kcal_per_mol_A_to_N(e_back)]))
-    an.details["pmf_return"] = {"window": [partner.get(s, s) for s in an.suffixes],
-                                "mean_force_kcal_mol_A": f_back.tolist(), "stderr_kcal_mol_A": e_back.tolist(),
-                                "per_registry_mean_force_kcal_mol_A": f_m.tolist(), "work_J_m2": w_back,
-                                "work_stderr_J_m2": err_back, "hysteresis": h}
-    an.notes.append(
-        f"out and back: W_F(out) = {an.wf_val:.4f} +/- {an.wf_err:.4f}, W_F(back) = {w_back:.4f} +/- {err_back:.4f} "
+    res.q["adhesion_hysteresis"] = quantity_record(h["hysteresis"], h["hysteresis_stderr"], "J/m^2",
+                                                   kind="W_F(out) - W_F(back): work dissipated over the out-and-back "
+                                                        "path per area")
+    res.curves["pmf_return"] = (["separation_m", "mean_force_N", "mean_force_stderr_N"],
+                                np.column_stack([U.angstrom_to_m(res.dsep), U.kcal_per_mol_A_to_N(f_back),
+                                                 U.kcal_per_mol_A_to_N(e_back)]))
+    res.details["pmf_return"] = {"window": [partner.get(s, s) for s in res.suffixes],
+                                 "mean_force_kcal_mol_A": f_back.tolist(), "stderr_kcal_mol_A": e_back.tolist(),
+                                 "per_registry_mean_force_kcal_mol_A": f_m.tolist(), "work_J_m2": w_back,
+                                 "work_stderr_J_m2": err_back, "hysteresis": h}
+    res.notes.append(
+        f"out and back: W_F(out) = {res.wf_val:.4f} +/- {res.wf_err:.4f}, W_F(back) = {w_back:.4f} +/- {err_back:.4f} "
         f"J/m^2 over the same windows; hysteresis {h['hysteresis']:+.4f} +/- {h['hysteresis_stderr']:.4f} J/m^2. "
         f"W_F = their mean {h['value']:.4f} +/- {h['stderr']:.4f} (stat.) +/- {h['systematic']:.4f} (half the "
         f"hysteresis, systematic) J/m^2; sigma0 and T dS come from the outward curve, z0 = 1.026 W_F / sigma0 "

@@ -25,15 +25,15 @@ import numpy as np
 from md.build import ots_sam, silica_slab
 from md.engine.plan import Analysis, Plan, Stage, id_ranges
 from md.engine.store import RunContext
-from md.recipe import settings_class
+from md.recipe import RecipeSettings, settings_class
 from md.system.atoms import as_system
 from md.system.forcefield import ForceField, combine, load_forcefield
 from md.system.lammps_data import lammps_setup_commands
 from md.system.topology import System
 
-#: A workflow's frozen settings dataclass (:func:`md.recipe.settings_class`, :meth:`Workflow.typed`): the recipe's
-#: resolved settings at one fidelity, one attribute per key.
-Settings = Any
+#: A workflow's frozen settings dataclass (:func:`md.recipe.settings_class`, built once by
+#: :meth:`md.recipe.Recipe.typed_settings`): the recipe's resolved settings at one fidelity, one attribute per key.
+Settings = RecipeSettings
 
 ENERGY_NOT_FREE_ENERGY = (
     "work_of_adhesion is dE/A, the difference of mean potential energies (separated - contact) per area at "
@@ -115,15 +115,6 @@ def trappe_tail_sites(system: System, ff: ForceField, water_o) -> tuple[np.ndarr
         sites = sam[np.isin(np.asarray(system.types)[sam], TRAPPE_UA)]
     ow = str(np.asarray(system.types)[np.asarray(water_o, int)[0]])
     return sites, [4.0 * p.epsilon * p.sigma**6 for p in (ff.pair(ow, str(x)) for x in np.asarray(system.types)[sites])]
-
-
-def framed_tail_sites(info: Mapping[str, Any], ids) -> tuple[np.ndarray, np.ndarray]:
-    """(mask of the frames' atom ``ids`` that are tail sites, their C6 in the frames' order) from a plan's
-    ``tail_site_ids`` (1-based) and ``tail_site_c6_kcal_A6``."""
-    site_ids = [int(i) for i in info.get("tail_site_ids") or []]
-    order = {i: k for k, i in enumerate(site_ids)}
-    is_site = np.isin(ids, site_ids)
-    return is_site, np.asarray(info.get("tail_site_c6_kcal_A6") or [], float)[[order[int(i)] for i in ids[is_site]]]
 
 
 #: sampled columns of :func:`water_solid_thermostat_lines`: the water's and the solid's mobile atoms' temperatures
@@ -320,26 +311,41 @@ class Workflow:
     hash (:func:`md.engine.hashing.run_hash`), so raising it invalidates the workflow's cached and committed runs.
     ``protocol_version(settings)`` is the version a run with those settings follows (``version`` unless a change
     touched only some systems: then the others keep the version of their unchanged plans, and their hashes).
-    ``yields``: the quantities every result of the workflow reports (name -> SI units); some report more."""
+    ``yields``: the quantities every result of the workflow reports (name -> SI units); some report more.
+
+    The door: :meth:`plan`, :meth:`forcefield_files` and :meth:`protocol_version` take the settings object the
+    engine builds once (:meth:`md.recipe.Recipe.typed_settings`) or, from a caller that holds a recipe's resolved
+    mapping, that mapping (typed here, at the door); behind it every method takes the :data:`Settings` object, and
+    a workflow writes ``_plan``, ``_forcefield_files`` and, where its versions differ by system,
+    ``_protocol_version``. :meth:`analyse` reads the same object from ``ctx.settings``."""
     name = ""
     version: int
     yields: dict[str, str] = {}
 
     @classmethod
     def typed(cls, settings: Mapping[str, Any] | Settings) -> Settings:
-        """``settings`` (a recipe's resolved settings, the mapping the engine hands a workflow) as this workflow's
-        frozen settings dataclass (:func:`md.recipe.settings_class`: every key an attribute, typed and
-        documented); a settings dataclass is returned as it is."""
+        """``settings`` (a recipe's resolved mapping) as this workflow's frozen settings dataclass
+        (:func:`md.recipe.settings_class`: every key an attribute, typed and documented); a settings object is
+        returned as it is."""
         kind = settings_class(cls.name)
         return settings if isinstance(settings, kind) else kind(**settings)
 
-    def protocol_version(self, settings: Settings) -> int:
+    def protocol_version(self, settings: Mapping[str, Any] | Settings) -> int:
+        return self._protocol_version(self.typed(settings))
+
+    def forcefield_files(self, settings: Mapping[str, Any] | Settings) -> list[str]:
+        return self._forcefield_files(self.typed(settings))
+
+    def plan(self, settings: Mapping[str, Any] | Settings, run_dir: Path) -> Plan:
+        return self._plan(self.typed(settings), run_dir)
+
+    def _protocol_version(self, s: Settings) -> int:
         return self.version
 
-    def forcefield_files(self, settings: Settings) -> list[str]:
+    def _forcefield_files(self, s: Settings) -> list[str]:
         raise NotImplementedError
 
-    def plan(self, settings: Settings, run_dir: Path) -> Plan:
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         raise NotImplementedError
 
     def analyse(self, ctx: RunContext) -> Analysis:

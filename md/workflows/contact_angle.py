@@ -11,7 +11,9 @@ contact_angle
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -21,38 +23,37 @@ from md.build import place_on, water_cap
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage, id_ranges
 from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
-from md.system.lammps_data import write_data
-from md.system.topology import System, remove_atoms
+from md.system.topology import System
 from md.workflows.common import (
-    SILANOL_OH,
     WATER_MODELS,
     WATER_SOLID_COLUMNS,
+    Settings,
     Workflow,
-    common_define,
-    derived_seed,
     equilibrate_stage,
     figure_writer,
     forcefield_of,
-    framed_tail_sites,
-    fresh_from_data,
-    held_deep,
     intersect_ids,
     leg_temperatures,
-    minimize_lines,
     minimize_water_lines,
     quantity_record,
     restart_header_lines,
-    shake_lines,
     silica_face_of,
     stage_list,
     steps_of,
     substrate_water_seeds,
-    surface_slab,
     system_summary,
     thermostat_lines,
-    trappe_tail_sites,
     water_forcefield_names,
     water_solid_thermostat_lines,
+)
+from md.workflows.plan_records import DropletPlanRecord, TailSites
+from md.workflows.substrate_water import (
+    HELD,
+    held_define,
+    substrate_leg,
+    substrate_of,
+    substrate_water_forcefields,
+    write_substrate_water,
 )
 
 #: gap between the substrate's highest atom and the droplet's lowest one when the droplet is placed (A)
@@ -83,18 +84,14 @@ class ContactAngleWorkflow(Workflow):
     version = 4
     yields = {"contact_angle": "deg", "droplet_bulk_density": "kg/m^3", "base_half_width": "m"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
-        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else []) + \
-            water_forcefield_names(s.water_model)
+    def _forcefield_files(self, s: Settings) -> list[str]:
+        return substrate_water_forcefields(s)
 
     def build(self, s) -> tuple[System, System, System]:
         """(substrate, droplet, both placed in one box) -- the substrate's coordinates are those of the combined
         system, so atom ids 1..n_substrate are the same in both legs."""
-        s = self.typed(s)
         seed = int(s.seed)
-        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed,
-                           silica_face_of((s.surface,), s.silica_face))
+        sub = substrate_of(s)
         R0 = float(s.droplet_radius_A)
         wff = forcefield_of(water_forcefield_names(s.water_model))
         drop = as_system(water_cap(R0, float(sub.cell[1]), contact_angle_deg=s.droplet_initial_angle_deg,
@@ -102,55 +99,30 @@ class ContactAngleWorkflow(Workflow):
         system = as_system(place_on(sub, drop, gap=DROPLET_GAP_A, vacuum=max(20.0, R0)))
         return sub, drop, system
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         ff = forcefield_of(self.forcefield_files(s))
         seed = int(s.seed)
         sub, drop, system = self.build(s)
-        substrate = system.group("substrate")
-        water = system.group("adsorbate")
-        held = np.intersect1d(held_deep(system), substrate)
-        sub_data, water_data = run_dir / "substrate.data", run_dir / "water.data"
-        write_data(system, ff, run_dir / "system.data", title="contact_angle system (reference; the legs read the "
-                   "two parts)")
-        write_data(remove_atoms(system, water), ff, sub_data, title="contact_angle substrate")
-        write_data(remove_atoms(system, substrate), ff, water_data, title="contact_angle droplet")
+        parts = write_substrate_water("contact_angle", "droplet", ff, system, run_dir)
+        water_data, water_o, tail_sites = parts.water_data, parts.water_o, parts.tail_sites
         if s.surface == "silica":
             ref = intersect_ids(system, "silanol_O_top", "substrate")
         else:
             ref = system.group("sam_ch3")
-        water_o = np.intersect1d(system.group("water_O"), water)
         # the SAM's TraPPE sites go into the frames too: the water-TraPPE dispersion beyond the cutoff is added
-        # in the analysis; their C6 with the water O (4 eps sigma^6, kcal/mol A^6)
-        tail_sites, c6 = trappe_tail_sites(system, ff, water_o)
+        # in the analysis
         framed = np.union1d(np.union1d(water_o, ref), tail_sites)
-        n_sub, n = len(substrate), system.n_atoms
+        n_sub, n = len(parts.substrate), system.n_atoms
         dt = s.timestep_fs
-        shake = shake_lines(ff, also=SILANOL_OH)
-        sub_groups = {"substrate": substrate, "frozen": held}
-
-        def fresh_substrate(leg_dir: Path) -> list[str]:
-            # minimised with nothing held (no setforce, no exclusions): the deep layer is held only afterwards,
-            # at its relaxed positions
-            return fresh_from_data(ff, sub_data, s, sub_groups) + ["group mobile subtract all frozen"] + \
-                minimize_lines(s, leg_dir / "minimized.data")
 
         def define(salt: int, with_water: bool):
             def d(step: int) -> list[str]:
-                return common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + shake + \
-                    ["fix hold frozen setforce 0.0 0.0 0.0"] + \
+                return held_define(s, parts) + \
                     (["variable nw equal count(water)/3"] + water_solid_thermostat_lines(s, step, salt)
                      if with_water else thermostat_lines("mobile", s, step, salt))
             return d
 
-        t = s.temperature_K
-        sub_leg = Leg(name="substrate", fresh=fresh_substrate, define=define(0, False), prepare=lambda d: [],
-                      restart_head=restart_header_lines(s),
-                      stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
-                                    (f"velocity mobile create {t:g} {derived_seed(seed, 3, 0)} mom yes rot no "
-                                     f"dist gaussian",), sampled=False)],
-                      columns={"pe": "v_pe", "temp": "v_temp"}, sample_interval=s.sample_interval,
-                      chunk_steps=s.chunk_steps, n_atoms=n_sub)
+        sub_leg = substrate_leg(s, parts, define(0, False), restart_header_lines(s), n_sub)
         sub_dir = run_dir / "legs" / "substrate"
 
         def fresh_droplet(leg_dir: Path, _total=sub_leg.total_steps) -> list[str]:
@@ -172,17 +144,43 @@ class ContactAngleWorkflow(Workflow):
         ids = lammps_type_ids(ff)
         info = {"substrate": system_summary(sub), "droplet": dict(drop.info), "box_A": system.cell.tolist(),
                 "n_substrate": int(n_sub), "n_water_molecules_built": int(len(water_o)),
-                "held_atoms": int(len(held)), "held": "deep Si and bridging O of the builder's bottom layer",
+                "held_atoms": int(len(parts.held)), "held": HELD,
                 "silica_face": silica_face_of((s.surface,), s.silica_face),
                 "water_O_ids": (water_o + 1).tolist(), "surface_ref_ids": (ref + 1).tolist(),
                 "surface_ref": "top silanol O" if s.surface == "silica" else "OTS CH3 groups",
                 "water_model": s.water_model, "type_ids": ids,
-                "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": c6}
+                "tail_site_ids": (tail_sites + 1).tolist(), "tail_site_c6_kcal_A6": parts.c6}
         return Plan(legs=[sub_leg, drop_leg], timestep_fs=dt, n_atoms=n,
                     seeds=substrate_water_seeds(seed), forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        return _DropletAnalysis(ctx, self.typed(ctx.settings)).run()
+        return _DropletAnalysis(ctx, ctx.settings).run()
+
+
+@dataclass(slots=True)
+class _DropletResults:
+    """What :class:`_DropletAnalysis` computes, in one place, filled in as :meth:`~_DropletAnalysis.run` goes: the
+    solid's plane and the frames (:meth:`~_DropletAnalysis._prepare`), the universe and the contact-angle analysis
+    ``r``, the water model, the angle with its blocks and stderr, the dispersion tail, the status ('measured' or
+    'wets'), the drift and shape checks, the notes. Slotted: a name not declared here cannot be set."""
+    notes: list[str] = field(default_factory=list)
+    solid_z: float | None = None                 # the solid's reference plane (A)
+    floor: float | None = None                   # lowest z of the density map (A)
+    universe: Any = None                         # the frames as an in-memory MDAnalysis universe
+    steps: np.ndarray | None = None
+    ids: np.ndarray | None = None
+    pos: np.ndarray | None = None
+    box: np.ndarray | None = None
+    r: Any = None                                # md.analysis.ContactAngle's results
+    model: dict[str, Any] = field(default_factory=dict)
+    gamma: float | None = None                   # the water model's gamma_lv (N/m)
+    angle: float | None = None                   # deg
+    angle_err: float | None = None               # deg; None where not estimated
+    tail: dict[str, Any] | None = None
+    status: str | None = None                    # 'measured' or 'wets'
+    t_blocks: np.ndarray | None = None           # the blocks' mid times (ns)
+    drift: dict[str, Any] | None = None
+    shape: dict[str, Any] | None = None
 
 
 class _DropletAnalysis:
@@ -192,8 +190,9 @@ class _DropletAnalysis:
     map shows, the quantities, the checks, notes, curves and the figure)."""
 
     def __init__(self, ctx, s):
-        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
-        self.notes: list[str] = []
+        self.ctx, self.s = ctx, s
+        self.plan = DropletPlanRecord.from_system(ctx.plan.system_info)
+        self.results = _DropletResults()
 
     def run(self) -> Analysis:
         self._prepare()
@@ -201,74 +200,79 @@ class _DropletAnalysis:
         return self._conclude()
 
     def _prepare(self) -> None:
+        res = self.results
         import MDAnalysis as mda
         from MDAnalysis.coordinates.memory import MemoryReader
 
         steps, ids, pos, box = self.ctx.frames("droplet")
         if not len(steps):
             raise RuntimeError("no stored configurations: sample_steps shorter than frame_interval?")
-        is_o = np.isin(ids, self.info["water_O_ids"])
-        is_ref = np.isin(ids, self.info["surface_ref_ids"])
-        self.solid_z = float(pos[:, is_ref, 2].mean())
-        self.floor = self.solid_z - MAP_FLOOR_A
+        is_o = np.isin(ids, self.plan.water_o_ids)
+        is_ref = np.isin(ids, self.plan.surface_ref_ids)
+        res.solid_z = float(pos[:, is_ref, 2].mean())
+        res.floor = res.solid_z - MAP_FLOOR_A
         opos = pos[:, is_o, :].astype(np.float32)
         u = mda.Universe.empty(int(is_o.sum()), trajectory=False)
         u.add_TopologyAttr("type", ["OW"] * int(is_o.sum()))
         dims = np.column_stack([box, np.full((len(box), 3), 90.0)]).astype(np.float32)
         u.load_new(opos, format=MemoryReader, dimensions=dims)
-        self.universe, self.steps, self.ids, self.pos, self.box = u, steps, ids, pos, box
+        res.universe, res.steps, res.ids, res.pos, res.box = u, steps, ids, pos, box
 
     def _measure(self) -> None:
         """The circle fit to every block's density map (md.analysis.ContactAngle: one pass over the frames)."""
+        res = self.results
         s = self.s
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            ca = A.ContactAngle(self.universe.select_atoms("type OW"), surface_z=self.floor, axis="y",
-                                bin_size=s.bin_A, n_blocks=min(s.n_blocks, len(self.steps)),
+            ca = A.ContactAngle(res.universe.select_atoms("type OW"), surface_z=res.floor, axis="y",
+                                bin_size=s.bin_A, n_blocks=min(s.n_blocks, len(res.steps)),
                                 reference="dividing_surface")
             ca.run()
-        self.r = ca.results
+        res.r = ca.results
 
     def _conclude(self) -> Analysis:
+        res = self.results
         s = self.s
-        self.model = WATER_MODELS[s.water_model]
-        self.gamma = self.model["gamma_lv_N_m"]
-        if abs(s.temperature_K - self.model["gamma_T_K"]) > 1.0:
-            self.notes.append(f"gamma_lv = {self.gamma * 1e3:.1f} mN/m is the model's value at "
-                              f"{self.model['gamma_T_K']:g} K, not at the run's {s.temperature_K:g} K: W_SL and "
-                              f"gamma_lv cos theta carry that mismatch.")
+        res.model = WATER_MODELS[s.water_model]
+        res.gamma = res.model["gamma_lv_N_m"]
+        if abs(s.temperature_K - res.model["gamma_T_K"]) > 1.0:
+            res.notes.append(f"gamma_lv = {res.gamma * 1e3:.1f} mN/m is the model's value at "
+                             f"{res.model['gamma_T_K']:g} K, not at the run's {s.temperature_K:g} K: W_SL and "
+                             f"gamma_lv cos theta carry that mismatch.")
         q = self._angle_quantities(self._status())
         self._drift_checks(q)
-        self.notes += self._protocol_notes()
+        res.notes += self._protocol_notes()
         temps = leg_temperatures(self.ctx, [leg for leg in self.ctx.plan.legs if leg.name == "droplet"],
                                  s.temperature_K)
         if temps:
-            self.notes.append(temps["note"])
+            res.notes.append(temps["note"])
         details = self._details(q)
         if temps:
             details["temperatures_K"] = temps
         return Analysis(quantities=q, curves=self._curves(), figures={"density_map": figure_writer(self._draw)},
-                        notes=self.notes, details=details)
+                        notes=res.notes, details=details)
 
     def _status(self) -> str:
         """What the map shows: a measured angle, no contact yet, or a film / a cap too flat to fit ("wets")."""
-        r = self.r
+        res = self.results
+        r = res.r
         xc, zc, rad = r.circle
         z_ref, wet = float(r.reference_z), r.wetting
         if np.isfinite(r.angle_deg) and not wet["spans_box"]:
-            self.angle, self.angle_err = float(r.angle_deg), r.stderr_deg
+            res.angle, res.angle_err = float(r.angle_deg), r.stderr_deg
             return "measured"
         if np.isfinite(rad) and rad > 0 and (zc - z_ref) / rad > 1 and not wet["spans_box"]:
-            self.angle, self.angle_err = 180.0, None
-            self.notes.append(f"the fitted circle (centre {zc - z_ref:+.1f} A from the water's plane, r = {rad:.1f} A) "
-                              f"lies above the plane: the droplet is not (yet) in contact; reported as 180 deg.")
+            res.angle, res.angle_err = 180.0, None
+            res.notes.append(f"the fitted circle (centre {zc - z_ref:+.1f} A from the water's plane, r = {rad:.1f} A) "
+                             f"lies above the plane: the droplet is not (yet) in contact; reported as 180 deg.")
             return "no_contact"
-        self.angle, self.angle_err = 0.0, None
+        res.angle, res.angle_err = 0.0, None
         return "wets"
 
     def _angle_quantities(self, status: str) -> dict:
-        r, gamma = self.r, self.gamma
-        q = {"contact_angle": quantity_record(self.angle, self.angle_err, "deg",
+        res = self.results
+        r, gamma = res.r, res.gamma
+        q = {"contact_angle": quantity_record(res.angle, res.angle_err, "deg",
                                  kind={"measured": "circle fit, read at the water's dividing plane",
                                        "no_contact": "180 = no contact (mark, not a measurement)",
                                        "wets": "0 = wets (mark, not a measurement): see contact_angle_upper_bound"}
@@ -276,17 +280,18 @@ class _DropletAnalysis:
              "droplet_bulk_density": quantity_record(U.g_per_cm3_to_kg_per_m3(r.bulk_density), None, "kg/m^3"),
              "base_half_width": quantity_record(U.angstrom_to_m(r.base_half_width_A), None, "m")}
         q["surface_tension_lv"] = quantity_record(gamma, None, "N/m", kind=f"the water model's published gamma_lv "
-                                     f"({self.model['gamma_source']})")
-        self.tail = None
+                                     f"({res.model['gamma_source']})")
+        res.tail = None
         if status == "wets":
             self._wets_quantities(q)
         elif status == "measured":
             status = self._measured_quantities(q)
-        self.status = status
+        res.status = status
         return q
 
     def _wets_quantities(self, q: dict) -> None:
-        r, wet, gamma = self.r, self.r.wetting, self.gamma
+        res = self.results
+        r, wet, gamma = res.r, res.r.wetting, res.gamma
         bound, why = (wet["theta_max_deg"], "the water spans the periodic box (a film); a cap of this volume "
                       f"touches its image at {wet['theta_max_deg']:.1f} deg") if wet["spans_box"] else \
             (wet["theta_resolvable_deg"], f"no circle can be fitted above the excluded layer "
@@ -296,31 +301,32 @@ class _DropletAnalysis:
         q["work_of_adhesion_sl"] = quantity_record(wl["value"], None, "J/m^2", kind="lower bound (wets): "
                                       "gamma_lv (1 + cos theta_upper_bound)")
         q["gamma_lv_cos_theta"] = quantity_record(wl["gamma_cos_theta"], None, "N/m", kind="lower bound (wets)")
-        self.notes.append(f"wets: theta < {bound:.1f} deg ({why}); W_SL >= {wl['value'] * 1e3:.1f} mJ/m^2. "
-                          f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
-                          f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
+        res.notes.append(f"wets: theta < {bound:.1f} deg ({why}); W_SL >= {wl['value'] * 1e3:.1f} mJ/m^2. "
+                         f"A droplet cannot resolve complete wetting; the dry-surface thermodynamic integration "
+                         f"(Leroy & Mueller-Plathe, Langmuir 31 (2015) 8335) would measure W_SL directly.")
 
     def _measured_quantities(self, q: dict) -> str:
         """W_SL of a measured angle, with the water-TraPPE dispersion tail where the substrate has TraPPE sites;
         returns the status ('wets' if the tail makes the water wet)."""
-        status, gamma = "measured", self.gamma
-        tail = _tail_correction(self.info, self.s, self.r, self.ids, self.pos, self.box, gamma, self.angle,
-                                self.angle_err)
+        res = self.results
+        status, gamma = "measured", res.gamma
+        tail = _tail_correction(self.plan.tail, self.s, res.r, res.ids, res.pos, res.box, gamma, res.angle,
+                                res.angle_err)
         if tail is not None:
             q["contact_angle_as_simulated"] = dict(q["contact_angle"], kind="circle fit at the water's dividing "
                                                    "plane, LJ truncated at the cutoff (as simulated)")
             q["dispersion_tail_work_sl"] = quantity_record(tail["work"], tail["work_stderr"], "J/m^2",
                                                            kind=tail["kind"])
-            self.angle, self.angle_err = tail["angle"], tail["angle_stderr"]
+            res.angle, res.angle_err = tail["angle"], tail["angle_stderr"]
             if tail["wets"]:
                 status = "wets"
-            q["contact_angle"] = quantity_record(self.angle, self.angle_err, "deg", status=status, kind=(
+            q["contact_angle"] = quantity_record(res.angle, res.angle_err, "deg", status=status, kind=(
                 "circle fit at the water's dividing plane, plus the water-TraPPE dispersion beyond the cutoff "
                 "(static: W_SL + dW_tail, md.analysis.dispersion_tail_work)"))
-            self.notes.append(tail["note"])
+            res.notes.append(tail["note"])
             gamma = tail["details"]["gamma_cut_N_m"]     # the angle was turned through the water as simulated
-        self.tail = tail
-        wl = A.work_of_adhesion_sl(gamma, self.angle, None, self.angle_err)
+        res.tail = tail
+        wl = A.work_of_adhesion_sl(gamma, res.angle, None, res.angle_err)
         q["work_of_adhesion_sl"] = quantity_record(wl["value"], wl["stderr"], "J/m^2", kind=(
             "Young-Dupre W_SL = gamma_lv (1 + cos theta), this water model's gamma" if tail is None else
             "Young-Dupre W_SL = gamma_cut (1 + cos theta) = W_SL as simulated + dW, with the water's tension as "
@@ -331,92 +337,97 @@ class _DropletAnalysis:
 
     def _drift_checks(self, q: dict) -> None:
         """The drift of the block angles against time, the blocks' independence, the cap's shape and height."""
-        r, steps = self.r, self.steps
+        res = self.results
+        r, steps = res.r, res.steps
         dt_ns = self.ctx.plan.timestep_fs * 1e-6
-        self.t_blocks = np.interp(r.block_frames, np.arange(len(steps)), steps.astype(float)) * dt_ns
-        self.drift = drift = A.block_drift(r.block_angles_deg, self.t_blocks)
-        if self.status != "measured":
+        res.t_blocks = np.interp(r.block_frames, np.arange(len(steps)), steps.astype(float)) * dt_ns
+        res.drift = drift = A.block_drift(r.block_angles_deg, res.t_blocks)
+        if res.status != "measured":
             return
         q["contact_angle_drift"] = quantity_record(drift["slope"], drift["stderr"], "deg/ns",
                                       kind="slope of the block angles against time (OLS)",
                                       drifting=bool(drift["drifting"]))
         if drift["drifting"]:
-            self.notes.append(f"DRIFTING: the block angles still change by {drift['slope']:+.0f} +/- "
-                              f"{drift['stderr']:.0f} deg/ns ({drift['change']:+.1f} deg over the sampled "
-                              f"{np.ptp(self.t_blocks) * 1e3:.0f} ps, |slope| > 2 stderr): not equilibrated; the "
-                              f"mean depends on where the run stopped.")
+            res.notes.append(f"DRIFTING: the block angles still change by {drift['slope']:+.0f} +/- "
+                             f"{drift['stderr']:.0f} deg/ns ({drift['change']:+.1f} deg over the sampled "
+                             f"{np.ptp(res.t_blocks) * 1e3:.0f} ps, |slope| > 2 stderr): not equilibrated; the "
+                             f"mean depends on where the run stopped.")
         if not r.blocks_independent:
-            self.notes.append(f"the droplet's shape (its water's mean height) has a statistical inefficiency of "
-                              f"{r.shape_statistical_inefficiency:.0f} frames in {r.n_frames}: the "
-                              f"{r.n_blocks_used} block maps are not independent, so the angle's stderr is a lower "
-                              f"bound; a longer run is what makes it an error bar.")
-        self.shape = shape = A.shape_check(r.density_map, *r.edges, self.floor, r.stderr_deg)
+            res.notes.append(f"the droplet's shape (its water's mean height) has a statistical inefficiency of "
+                             f"{r.shape_statistical_inefficiency:.0f} frames in {r.n_frames}: the "
+                             f"{r.n_blocks_used} block maps are not independent, so the angle's stderr is a lower "
+                             f"bound; a longer run is what makes it an error bar.")
+        res.shape = shape = A.shape_check(r.density_map, *r.edges, res.floor, r.stderr_deg)
         if shape["circular"] is False:
             by = ", ".join(f"{v:.1f} ({k} A)" for k, v in shape["angles_by_exclude_deg"].items())
-            self.notes.append(f"NOT A CIRCULAR CAP: the same map reads {by} above the water's plane and "
-                              f"{shape['angle_from_height_deg']:.1f} deg from its area and height; the spread "
-                              f"{shape['spread_deg']:.1f} deg exceeds max(3 stderr, 2 deg) = "
-                              f"{shape['tolerance_deg']:.1f} deg, so the angle depends on how it is read "
-                              f"(pinned or moving contact lines, a sheared mean shape): a systematic the stderr "
-                              f"does not hold.")
+            res.notes.append(f"NOT A CIRCULAR CAP: the same map reads {by} above the water's plane and "
+                             f"{shape['angle_from_height_deg']:.1f} deg from its area and height; the spread "
+                             f"{shape['spread_deg']:.1f} deg exceeds max(3 stderr, 2 deg) = "
+                             f"{shape['tolerance_deg']:.1f} deg, so the angle depends on how it is read "
+                             f"(pinned or moving contact lines, a sheared mean shape): a systematic the stderr "
+                             f"does not hold.")
         h = float(r.cap_height_A)
         if h < 3 * 5.0:
-            self.notes.append(f"the cap is {h:.1f} A high, less than 3x the 5 A excluded layer: few interface "
-                              f"points carry the fit.")
+            res.notes.append(f"the cap is {h:.1f} A high, less than 3x the 5 A excluded layer: few interface "
+                             f"points carry the fit.")
 
     def _protocol_notes(self) -> list[str]:
-        s, z_ref = self.s, float(self.r.reference_z)
+        res = self.results
+        s, z_ref = self.s, float(res.r.reference_z)
         return [f"angle read at the water's dividing plane z = {z_ref:.2f} A (half the bulk density under the "
-                f"droplet), {z_ref - self.solid_z:+.2f} A from the mean height of the {self.info['surface_ref']} "
-                f"({self.solid_z:.2f} A); circle fitted to the half-bulk contour above that plane + 5 A "
-                f"(md.analysis.ContactAngle, {self.r.n_frames} frames).",
+                f"droplet), {z_ref - res.solid_z:+.2f} A from the mean height of the {self.plan.surface_ref} "
+                f"({res.solid_z:.2f} A); circle fitted to the half-bulk contour above that plane + 5 A "
+                f"(md.analysis.ContactAngle, {res.r.n_frames} frames).",
                 "substrate minimised with nothing held, then its deep Si and bridging O held; silanol O and H "
                 "mobile (O-H by SHAKE)" + ("; the OTS SAM equilibrated alone before the droplet was placed"
                                             if s.surface == "ots" else "") +
-                f"; water rigid {self.model['name']} (SHAKE); the droplet started as a "
+                f"; water rigid {res.model['name']} (SHAKE); the droplet started as a "
                 f"{s.droplet_initial_angle_deg:g} deg cylindrical cap.",
                 "a cylindrical droplet has a straight contact line: no line-tension correction.",
-                f"W_SL and gamma_lv cos theta use gamma_lv = {self.gamma * 1e3:.1f} mN/m of the same water model "
+                f"W_SL and gamma_lv cos theta use gamma_lv = {res.gamma * 1e3:.1f} mN/m of the same water model "
                 f"({s.water_model}); combine the angle only with a gamma_lv of that model."]
 
     def _curves(self) -> dict:
-        ue, ze = self.r.edges
-        rho = self.r.density_map
+        res = self.results
+        ue, ze = res.r.edges
+        rho = res.r.density_map
         return {"density_map": (["u_m", "z_m", "density_kg_m3"],
                                 np.column_stack([np.repeat(U.angstrom_to_m(0.5 * (ue[1:] + ue[:-1])), len(ze) - 1),
                                                  np.tile(U.angstrom_to_m(0.5 * (ze[1:] + ze[:-1])), len(ue) - 1),
                                                  U.g_per_cm3_to_kg_per_m3(rho.ravel())])),
                 "interface_points": (["u_m", "z_m"],
-                                     U.angstrom_to_m(np.asarray(self.r.interface_points).reshape(-1, 2)))}
+                                     U.angstrom_to_m(np.asarray(res.r.interface_points).reshape(-1, 2)))}
 
     def _details(self, q: dict) -> dict:
-        r, s, status = self.r, self.s, self.status
+        res = self.results
+        r, s, status = res.r, self.s, res.status
         xc, zc, rad = r.circle
         z_ref = float(r.reference_z)
         d_app = self.ctx.samples("droplet", False)
         n_water = int(round(d_app["n_water"][-1])) if len(d_app.get("n_water", [])) else None
-        block_w = [A.work_of_adhesion_sl(self.gamma, a)["value"] if np.isfinite(a) else None
+        block_w = [A.work_of_adhesion_sl(res.gamma, a)["value"] if np.isfinite(a) else None
                    for a in r.block_angles_deg]
-        details = {"status": status, "reference_z_A": z_ref, "surface_z_A": self.solid_z,
-                   "reference_above_solid_A": z_ref - self.solid_z, "circle_A": [float(xc), float(zc), float(rad)],
+        details = {"status": status, "reference_z_A": z_ref, "surface_z_A": res.solid_z,
+                   "reference_above_solid_A": z_ref - res.solid_z, "circle_A": [float(xc), float(zc), float(rad)],
                    "block_angles_deg": np.asarray(r.block_angles_deg).tolist(),
-                   "block_times_ns": self.t_blocks.tolist(), "block_work_of_adhesion_sl_J_m2": block_w,
-                   "drift": self.drift, "wetting": r.wetting, "fit_error": r.fit_error,
+                   "block_times_ns": res.t_blocks.tolist(), "block_work_of_adhesion_sl_J_m2": block_w,
+                   "drift": res.drift, "wetting": r.wetting, "fit_error": r.fit_error,
                    "cap_height_A": r.cap_height_A, "fit_rms_A": r.fit_rms_A, "n_frames": int(r.n_frames),
-                   "n_water_molecules": n_water, "water_model": s.water_model, "gamma_lv_N_m": self.gamma,
+                   "n_water_molecules": n_water, "water_model": s.water_model, "gamma_lv_N_m": res.gamma,
                    "blocks": {"n_blocks_used": int(r.n_blocks_used), "n_blocks_most": int(s.n_blocks),
                               "shape_statistical_inefficiency_frames": float(r.shape_statistical_inefficiency),
                               "independent": bool(r.blocks_independent),
                               "what": "blocks of frames sized to span 2 g of the water's mean height (g its "
                                       "statistical inefficiency), 3 at least, n_blocks at most"}}
         if status == "measured":
-            details["shape_check"] = self.shape
+            details["shape_check"] = res.shape
         if status in ("measured", "wets") and "dispersion_tail_work_sl" in q:
-            details["dispersion_tail"] = self.tail["details"]
+            details["dispersion_tail"] = res.tail["details"]
         return details
 
     def _draw(self, ax) -> None:
-        r = self.r
+        res = self.results
+        r = res.r
         xc, zc, rad = r.circle
         z_ref = float(r.reference_z)
         ue, ze = r.edges
@@ -429,12 +440,12 @@ class _DropletAnalysis:
         pts = np.asarray(r.interface_points).reshape(-1, 2)
         ax.plot(pts[:, 0], pts[:, 1], "k.", ms=2, label="interface points")
         ax.axhline(z_ref, color="k", lw=0.8, label="water's dividing plane")
-        ax.axhline(self.solid_z, color="grey", lw=0.8, ls="--", label=self.info["surface_ref"])
+        ax.axhline(res.solid_z, color="grey", lw=0.8, ls="--", label=self.plan.surface_ref)
         ax.set_aspect("equal")
         ax.set_xlabel("x (Å, droplet-centred)")
         ax.set_ylabel("z (Å)")
-        title = {"measured": f"θ = {self.angle:.1f} ± {(self.angle_err or float('nan')):.1f}°",
-                 "no_contact": "no contact", "wets": "wets"}[self.status]
+        title = {"measured": f"θ = {res.angle:.1f} ± {(res.angle_err or float('nan')):.1f}°",
+                 "no_contact": "no contact", "wets": "wets"}[res.status]
         ax.set_title(f"{title} ({self.s.surface})")
         ax.legend(fontsize=7)
 
@@ -449,7 +460,7 @@ def _truncated_gamma(s, number_density_A3: float, gamma_full: float) -> tuple[fl
     return gamma_full - tail, tail
 
 
-def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
+def _tail_correction(sites: TailSites, s, r, ids, pos, box, gamma, angle, angle_err):
     """The water-TraPPE dispersion the cutoff leaves out, on a measured angle (None where the substrate has no
     TraPPE site, or a run planned before the sites were stored). Per frame, from the sites' heights under the
     water's dividing plane (the water at its bulk density above it): the r^-6 tail beyond the cutoff
@@ -459,10 +470,9 @@ def _tail_correction(info, s, r, ids, pos, box, gamma, angle, angle_err):
     cos theta' = cos theta + dW / gamma_cut. Returns the corrected angle and its stderr (first order, the angle's
     and dW's errors independent), dW (J/m^2) with its stderr (statistical inefficiency of the per-frame series),
     a note and the details."""
-    site_ids = info.get("tail_site_ids") or []
-    if not site_ids:
+    if not sites.ids:
         return None
-    is_site, c6 = framed_tail_sites(info, ids)
+    is_site, c6 = sites.framed(ids)
     if not is_site.any():
         return None
     n_w = U.g_per_cm3_to_kg_per_m3(float(r.bulk_density)) / U.amu_per_A3_to_kg_per_m3(U.WATER_MOLAR_MASS)

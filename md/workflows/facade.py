@@ -86,9 +86,9 @@ class MDResult:
 def job_for(recipe: Recipe, fidelity: str) -> Job:
     """What the engine needs of ``recipe`` at ``fidelity``."""
     wf = get_workflow(recipe.workflow)
-    settings = recipe.settings(fidelity)
+    settings = recipe.typed_settings(fidelity)
     return Job(name=recipe.name, workflow=recipe.workflow, description=recipe.description, fidelity=fidelity,
-               settings=settings, canonical=recipe.canonical(fidelity),
+               settings=settings, settings_record=recipe.settings(fidelity), canonical=recipe.canonical(fidelity),
                forcefield_files=tuple(wf.forcefield_files(settings)), workflow_version=wf.protocol_version(settings),
                source=str(recipe.path) if recipe.path else recipe.name, file_sha256=recipe.file_sha256,
                content_sha256=recipe.canonical_sha256(fidelity))
@@ -102,10 +102,10 @@ def run_hash(recipe: Recipe | str | Path, fidelity: str,
     if not isinstance(recipe, Recipe):
         recipe = load_recipe(recipe)
     wf = get_workflow(recipe.workflow)
+    settings = recipe.typed_settings(fidelity)
     if forcefield_files is None:
-        forcefield_files = wf.forcefield_files(recipe.settings(fidelity))
-    return hashing.run_hash(recipe.canonical(fidelity), fidelity, forcefield_files,
-                            wf.protocol_version(recipe.settings(fidelity)))
+        forcefield_files = wf.forcefield_files(settings)
+    return hashing.run_hash(recipe.canonical(fidelity), fidelity, forcefield_files, wf.protocol_version(settings))
 
 
 def run_recipe(recipe: Recipe | str | Path, fidelity: str = "quick", *, out: str | Path | None = None,

@@ -20,6 +20,8 @@ pulloff
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
@@ -44,6 +46,7 @@ from md.workflows.common import (
     surface_slab,
     system_summary,
 )
+from md.workflows.plan_records import PullOffPlanRecord
 from md.workflows.pulloff_protocol import leg_name, measures_flat, position_legs, shift_tip, tip_offsets
 
 # ================================================================================================ pull-off
@@ -64,12 +67,10 @@ class PullOff(Workflow):
     yields = {"pull_off_force": "N", "separation_at_max_tension": "m", "interaction_range_z0": "m",
               "work_of_adhesion_eff_jkr": "J/m^2", "work_of_adhesion_eff_dmt": "J/m^2"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
+    def _forcefield_files(self, s: Settings) -> list[str]:
         return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else [])
 
     def build(self, s) -> tuple[System, dict[str, Any]]:
-        s = self.typed(s)
         seed = int(s.seed)
         R = float(s.asperity_radius_A)
         face = silica_face_of((s.surface,), s.silica_face)
@@ -95,8 +96,7 @@ class PullOff(Workflow):
             info["tip_offsets_A"] = tip_offsets(s.tip_positions, (system.cell[0] / nx, system.cell[1] / ny))
         return system, info
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         ff = forcefield_of(self.forcefield_files(s))
         system, info = self.build(s)
         groups = {"flat": system.group("substrate"), "tip": system.group("adsorbate"),
@@ -123,7 +123,29 @@ class PullOff(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        return _PullOffAnalysis(ctx, self.typed(ctx.settings)).run()
+        return _PullOffAnalysis(ctx, ctx.settings).run()
+
+
+@dataclass(slots=True)
+class _PullOffResults:
+    """What :class:`_PullOffAnalysis` computes, in one place, filled in as :meth:`~_PullOffAnalysis.run` goes: the
+    tip radius, each position's origin (the flat's surface, the holder's start), the pulls per speed and their
+    summaries, the approach curve, the smoothing, the force, the lab-frame drag, curves and figures. Slotted: a name
+    not declared here cannot be set."""
+    R_m: float | None = None                          # the asperity's radius (m)
+    origin: dict[int, tuple[float, float]] = field(default_factory=dict)   # position -> (flat surface, holder) A
+    s0: float | None = None
+    zh0: float | None = None
+    dt: float | None = None                           # fs
+    curves: dict[str, Any] = field(default_factory=dict)
+    figures: dict[str, Any] = field(default_factory=dict)
+    pulls: list[tuple] = field(default_factory=list)  # (speed m/s, repeat, leg, pull-off record)
+    smooth: int | None = None
+    d_app: dict[str, np.ndarray] | None = None        # the approach leg's samples
+    speeds: list[float] = field(default_factory=list)
+    per_speed: list[dict[str, Any]] = field(default_factory=list)
+    F: float | None = None                            # the slowest speed's pull-off force (kcal/mol/A)
+    gamma_lab: float | None = None
 
 
 class _PullOffAnalysis:
@@ -133,7 +155,9 @@ class _PullOffAnalysis:
     figure)."""
 
     def __init__(self, ctx, s):
-        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+        self.ctx, self.s = ctx, s
+        self.plan = PullOffPlanRecord.from_system(ctx.plan.system_info)
+        self.results = _PullOffResults()
 
     def run(self) -> Analysis:
         self._prepare()
@@ -143,60 +167,63 @@ class _PullOffAnalysis:
         return self._conclude()
 
     def _prepare(self) -> None:
+        res = self.results
         ctx = self.ctx
-        self.R_m = U.angstrom_to_m(self.s.asperity_radius_A)
-        self.origin: dict[int, tuple[float, float]] = {}
-        n_flat = self.info["n_flat"]
-        for p in range(len(self.info.get("tip_offsets_A", [0]))):
+        res.R_m = U.angstrom_to_m(self.s.asperity_radius_A)
+        res.origin: dict[int, tuple[float, float]] = {}
+        n_flat = self.plan.n_flat
+        for p in range(self.plan.positions):
             name = leg_name("approach", p)
             ids, _, pos = read_atoms(ctx.leg_dir(name) / "minimized.data")
             # ids 1..n_flat are the flat (place_on puts the substrate first)
             s0 = pos[n_flat:, 2].min() - pos[:n_flat, 2].max()
             # the holder's height at the minimised start: it does not move before the approach stage, so the first
             # sample of the equilibration has it exactly
-            self.origin[p] = (float(s0), float(ctx.samples(name, False)["z_holder"][0]))
-        self.s0, self.zh0 = self.origin[0]
-        self.dt = ctx.plan.timestep_fs
-        self.curves, self.figures, self.pulls = {}, {}, []
-        self.smooth = None
+            res.origin[p] = (float(s0), float(ctx.samples(name, False)["z_holder"][0]))
+        res.s0, res.zh0 = res.origin[0]
+        res.dt = ctx.plan.timestep_fs
+        res.curves, res.figures, res.pulls = {}, {}, []
+        res.smooth = None
 
     def sep(self, d, position: int = 0) -> np.ndarray:
         """The rigid-holder separation (A) of the samples ``d`` of tip position ``position``."""
-        s0, zh0 = self.origin[position]
+        s0, zh0 = self.results.origin[position]
         return s0 + (d["z_holder"] - zh0)
 
     def _single_retraction(self, leg) -> None:
+        res = self.results
         d = self.ctx.samples(leg)
         n = len(d["step"])
-        self.smooth = smooth = max(5, (n // 25) | 1) if n >= 15 else None
+        res.smooth = smooth = max(5, (n // 25) | 1) if n >= 15 else None
         p = int(leg.info.get("position", 0))
-        r = A.pull_off_analysis(self.sep(d, p), d["fz"], smooth=smooth, radius_m=self.R_m)
+        r = A.pull_off_analysis(self.sep(d, p), d["fz"], smooth=smooth, radius_m=res.R_m)
         r["local_noise"] = _local_noise(r, smooth)
-        r["drag"] = _residual_drag(d, self.dt)
+        r["drag"] = _residual_drag(d, res.dt)
         if "f_flat" in d:
-            r["flat_drag"] = _residual_drag(d, self.dt, side="flat")
+            r["flat_drag"] = _residual_drag(d, res.dt, side="flat")
         r["position"] = p
-        self.pulls.append((leg.info["speed_m_s"], leg.info.get("repeat", 0), leg.name, r))
-        self.curves[f"pulloff_curve_{leg.name}"] = (
+        res.pulls.append((leg.info["speed_m_s"], leg.info.get("repeat", 0), leg.name, r))
+        res.curves[f"pulloff_curve_{leg.name}"] = (
             ["separation_m", "force_N", "force_smoothed_N"],
             np.column_stack([r["curve"]["separation"], r["curve"]["force"], r["curve"]["force_smoothed"]]))
 
     def _conclude(self) -> Analysis:
-        self.d_app = d_app = self.ctx.samples("approach", False)
-        self.curves["approach_curve"] = (["step", "stage", "separation_m", "force_N"],
-                                         np.column_stack([d_app["step"], d_app["stage"],
+        res = self.results
+        res.d_app = d_app = self.ctx.samples("approach", False)
+        res.curves["approach_curve"] = (["step", "stage", "separation_m", "force_N"],
+                                        np.column_stack([d_app["step"], d_app["stage"],
                                                           U.angstrom_to_m(self.sep(d_app)),
                                                           U.kcal_per_mol_A_to_N(d_app["fz"])]))
-        self.speeds = speeds = sorted({v for v, *_ in self.pulls})
-        self.per_speed = [_speed_summary(float(v), [r for vv, _, _, r in self.pulls if vv == v]) for v in speeds]
+        res.speeds = speeds = sorted({v for v, *_ in res.pulls})
+        res.per_speed = [_speed_summary(float(v), [r for vv, _, _, r in res.pulls if vv == v]) for v in speeds]
         q = self._quantities()
         notes = self._notes(q)
         details = self._details()
-        if len(speeds) == 2 and len(self.origin) >= 2:
-            details["speed_difference"] = _paired_speed_difference(self.per_speed)
+        if len(speeds) == 2 and len(res.origin) >= 2:
+            details["speed_difference"] = _paired_speed_difference(res.per_speed)
             notes.append(_speed_difference_note(details["speed_difference"]))
         if len(speeds) >= 3:
-            ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in self.per_speed]),
+            ext = A.rate_extrapolation(np.array(speeds), np.array([p["force"] for p in res.per_speed]),
                                        target_rate=float(min(speeds)) / 10.0, temperature_K=self.s.temperature_K)
             q["pull_off_force_extrapolated"] = quantity_record(ext["F0"], ext["stderr"], "N",
                                                   kind=f"F = a + b ln(v) fitted to {len(speeds)} speeds, "
@@ -204,23 +231,24 @@ class _PullOffAnalysis:
             details["rate_extrapolation"] = ext
             notes.append("rate scan: F = a + b ln(v) (Bell-Evans) extrapolated one decade below the slowest "
                          "simulated speed; valid only while the Bell-Evans regime holds.")
-        self.figures["pulloff_curve"] = figure_writer(self._draw)
-        return Analysis(quantities=q, curves=self.curves, figures=self.figures, notes=notes, details=details)
+        res.figures["pulloff_curve"] = figure_writer(self._draw)
+        return Analysis(quantities=q, curves=res.curves, figures=res.figures, notes=notes, details=details)
 
     def _quantities(self) -> dict:
         """The slowest speed's pull-off force (mean of its pulls), z0, the effective works of adhesion and the
         residual drag on the asperity."""
-        slow = self.per_speed[0]
+        res = self.results
+        slow = res.per_speed[0]
         best = slow["results"][0]
         F, f_err = slow["force"], slow["stderr"]
-        self.F = F
-        R_m = self.R_m
+        res.F = F
+        R_m = res.R_m
         z0q = _z0_quantity(best) if len(slow["results"]) == 1 else _z0_mean([r for r in slow["results"]])
         drag = np.array([r["drag"]["value"] for r in slow["results"]])
         drag_err = np.array([r["drag"]["stderr"] for r in slow["results"]])
         v_slow = U.m_per_s_to_angstrom_per_fs(slow["speed_m_s"])
-        self.gamma_lab = gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(
-            self.info["tip_mobile_mass_g_mol"] * v_slow / self.s.thermostat_damping_fs)
+        res.gamma_lab = gamma_lab = U.g_per_mol_A_per_fs2_to_kcal_per_mol_A(
+            self.plan.tip_mobile_mass_g_mol * v_slow / self.s.thermostat_damping_fs)
         err = lambda x: x / (2 * math.pi * R_m) if x else None
         extra = {"positions": slow["positions"]} if slow["positions"] > 1 else {}
         q = {"pull_off_force": quantity_record(F, f_err, "N", speed_m_s=slow["speed_m_s"],
@@ -252,9 +280,10 @@ class _PullOffAnalysis:
         return q
 
     def _notes(self, q: dict) -> list[str]:
-        s, slow, F, R_m = self.s, self.per_speed[0], self.F, self.R_m
+        res = self.results
+        s, slow, F, R_m = self.s, res.per_speed[0], res.F, res.R_m
         notes = [f"separation = gap between the lowest asperity atom and the highest flat atom at the minimised "
-                 f"start ({self.s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
+                 f"start ({res.s0:.2f} A) plus the rigid holder's travel (no correction for the asperity's or the "
                  f"flat's deformation); force = compute group/group (asperity body vs flat, kspace yes), "
                  f"positive = repulsive.",
                  f"pull-off force at {slow['speed_m_s']:g} m/s: {slow['what']}; stderr: {slow['how']}.",
@@ -265,7 +294,7 @@ class _PullOffAnalysis:
                     "lab": " (lab frame, every mobile atom together with the flat: it drags the moving asperity)"}[
                      s.tip_thermostat]
                  + f"; residual drag measured {q['residual_drag_force']['value'] * 1e9:+.3f} nN against "
-                   f"{-self.gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
+                   f"{-res.gamma_lab * U.kcal_per_mol_A_to_N(1.0) * 1e9:.2f} nN that a lab-frame thermostat "
                    f"(gamma M v) would apply.",
                  _flat_thermostat_note(s, q.get("flat_thermostat_force")),
                  f"validation, not calibration: F / (2 pi R) = {F / (2 * math.pi * R_m):.4f} J/m^2 is the number "
@@ -273,7 +302,7 @@ class _PullOffAnalysis:
                  + _tabor_note(R_m, F / (2 * math.pi * R_m), q["interaction_range_z0"]["value"], s.surface),
                  f"R = {s.asperity_radius_A:g} A (the requested radius of the carved, faceted dome)."]
         if s.surface == "ots":
-            g = self.info.get("asperity_sam", {})
+            g = self.plan.asperity_sam
             notes.append(f"OTS chains on the asperity: {g.get('chains')} on dome silanols within "
                          f"graft_max_polar_deg of the apex ({g.get('chains_per_projected_nm2', float('nan')):.2f} per "
                          f"nm^2 of projected cap, lateral spacing >= {g.get('min_spacing_A', float('nan')):.2f} A); "
@@ -283,18 +312,19 @@ class _PullOffAnalysis:
         return notes
 
     def _details(self) -> dict:
+        res = self.results
         return {"per_speed": [{"speed_m_s": p["speed_m_s"], "max_tensile_force_N": p["force"],
                                "stderr_N": p["stderr"], "forces_N": p["forces"], "stderr_how": p["how"],
                                "positions": p["positions"], **({"t_factor": p["t_factor"],
                                                                "stderr_plain_N": p["stderr_plain"]}
                                                               if p["positions"] > 1 else {})}
-                              for p in self.per_speed],
-                "per_position": [dict(pp, speed_m_s=p["speed_m_s"]) for p in self.per_speed
+                              for p in res.per_speed],
+                "per_position": [dict(pp, speed_m_s=p["speed_m_s"]) for p in res.per_speed
                                  for pp in p["per_position"]],
-                "tip_offsets_A": self.info.get("tip_offsets_A", [[0.0, 0.0]]),
+                "tip_offsets_A": self.plan.tip_offsets_A or [[0.0, 0.0]],
                 "pulls": [{"leg": name, "speed_m_s": float(v), "repeat": j, "position": r["position"],
                            "contact": leg_name("approach", r["position"]),
-                           "same_contact_as": [n2 for _, _, n2, r2 in self.pulls
+                           "same_contact_as": [n2 for _, _, n2, r2 in res.pulls
                                                if r2["position"] == r["position"] and n2 != name],
                            "max_tensile_force_N": r["max_tensile_force"],
                            "separation_at_max_m": r["separation_at_max"], "z0_m": r["z0"],
@@ -308,22 +338,23 @@ class _PullOffAnalysis:
                                    r["flat_drag"]["stderr"]))} if "flat_drag" in r else {}),
                            "traction_fit": {k: v for k, v in r["traction_fit"].items()
                                             if isinstance(v, (int, float, str, dict))}}
-                          for v, j, name, r in self.pulls],
-                "s0_A": float(self.s0), "holder_z0_A": self.zh0, "smoothing_window": self.smooth,
-                "lab_frame_drag_estimate_N": float(U.kcal_per_mol_A_to_N(-self.gamma_lab)),
-                "tip_mobile_mass_g_mol": self.info["tip_mobile_mass_g_mol"]}
+                          for v, j, name, r in res.pulls],
+                "s0_A": float(res.s0), "holder_z0_A": res.zh0, "smoothing_window": res.smooth,
+                "lab_frame_drag_estimate_N": float(U.kcal_per_mol_A_to_N(-res.gamma_lab)),
+                "tip_mobile_mass_g_mol": self.plan.tip_mobile_mass_g_mol}
 
     def _draw(self, ax) -> None:
-        for (v, j, name, r) in self.pulls:
+        res = self.results
+        for (v, j, name, r) in res.pulls:
             c = r["curve"]
             ax.plot(c["separation"] * 1e9, c["force"] * 1e9, lw=0.5, alpha=0.5)
             ax.plot(c["separation"] * 1e9, c["force_smoothed"] * 1e9, lw=1.5, label=f"{name} {v:g} m/s")
-        ax.plot(U.angstrom_to_m(self.sep(self.d_app)) * 1e9, U.kcal_per_mol_A_to_N(self.d_app["fz"]) * 1e9, lw=0.5,
+        ax.plot(U.angstrom_to_m(self.sep(res.d_app)) * 1e9, U.kcal_per_mol_A_to_N(res.d_app["fz"]) * 1e9, lw=0.5,
                 color="grey", label="approach/hold")
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xlabel("separation (nm)")
         ax.set_ylabel("force on asperity (nN)")
-        ax.set_title(f"pull-off {self.F * 1e9:.3f} nN, R = {self.s.asperity_radius_A:g} Å")
+        ax.set_title(f"pull-off {res.F * 1e9:.3f} nN, R = {self.s.asperity_radius_A:g} Å")
         ax.legend(fontsize=7)
 
 

@@ -8,6 +8,8 @@ surface_tension
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from md import analysis as A
@@ -18,6 +20,7 @@ from md.system.atoms import as_system
 from md.system.lammps_data import write_data
 from md.units import SPCE_WATER_MOLAR_MASS
 from md.workflows.common import (
+    Settings,
     Workflow,
     common_define,
     derived_seed,
@@ -34,6 +37,7 @@ from md.workflows.common import (
     thermostat_lines,
     water_forcefield_names,
 )
+from md.workflows.plan_records import SurfaceTensionPlanRecord
 
 
 class SurfaceTension(Workflow):
@@ -42,12 +46,10 @@ class SurfaceTension(Workflow):
     version = 1
     yields = {"surface_tension": "N/m", "surface_tension_uncorrected": "N/m", "density": "kg/m^3"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
+    def _forcefield_files(self, s: Settings) -> list[str]:
         return water_forcefield_names(s.water_model)
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         ff = forcefield_of(self.forcefield_files(s))
         seed = int(s.seed)
         film = as_system(water_slab(s.lx_A, s.ly_A, s.film_thickness_A, vacuum=s.vacuum_A, seed=seed))
@@ -78,15 +80,15 @@ class SurfaceTension(Workflow):
                     forcefield_files=self.forcefield_files(s), system_info=info)
 
     def analyse(self, ctx):
-        s = self.typed(ctx.settings)
-        info = ctx.plan.system_info
+        s = ctx.settings
+        plan = SurfaceTensionPlanRecord.from_system(ctx.plan.system_info)
         d = ctx.samples("film")
         steps, ids, pos, box = ctx.frames("film")
-        area = float(info["box_A"][0] * info["box_A"][1])
+        area = plan.area_A2
         nb = min(s.n_blocks, max(2, len(steps)))
         dens = A.slab_density(pos[:, :, 2], SPCE_WATER_MOLAR_MASS, area, lz_A=None, bin_A=s.bin_A, n_blocks=nb)
         rho_n = U.kg_per_m3_to_g_per_cm3(dens["value"]) * U.AVOGADRO / SPCE_WATER_MOLAR_MASS * 1e-24     # O per A^3
-        tail = A.lj_tail_correction(info["lj_epsilon_kcal"], info["lj_sigma_A"], rho_n, s.cutoff_A,
+        tail = A.lj_tail_correction(plan.lj_epsilon_kcal, plan.lj_sigma_A, rho_n, s.cutoff_A,
                                     width_A=dens["width_A"])
         st = A.surface_tension(d["pxx"], d["pyy"], d["pzz"], d["lz"], tail_correction_N_per_m=tail,
                                n_blocks=s.n_blocks)

@@ -15,7 +15,9 @@ wsl_ti
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -25,37 +27,37 @@ from md.build import place_on, water_slab
 from md.engine.plan import Analysis, Frames, Leg, Plan, Stage
 from md.system.atoms import as_system
 from md.system.forcefield import lammps_type_ids
-from md.system.lammps_data import write_data
-from md.system.topology import remove_atoms
+from md.system.topology import System
 from md.workflows.common import (
-    SILANOL_OH,
     TRAPPE_UA,
     WATER_MODELS,
     WATER_SOLID_COLUMNS,
+    Settings,
     Workflow,
-    common_define,
     derived_seed,
     figure_writer,
     forcefield_of,
-    framed_tail_sites,
-    fresh_from_data,
-    held_deep,
     leg_temperatures,
-    minimize_lines,
     minimize_water_lines,
     quantity_record,
     restart_header_lines,
-    shake_lines,
     silica_face_of,
     stage_list,
     steps_of,
     substrate_water_seeds,
-    surface_slab,
     system_summary,
     thermostat_lines,
-    trappe_tail_sites,
     water_forcefield_names,
     water_solid_thermostat_lines,
+)
+from md.workflows.plan_records import WslPlanRecord
+from md.workflows.substrate_water import (
+    HELD,
+    held_define,
+    substrate_leg,
+    substrate_of,
+    substrate_water_forcefields,
+    write_substrate_water,
 )
 
 #: gap between the solid's highest atom and the film's lowest one when the film is placed (A)
@@ -144,16 +146,13 @@ class WslTI(Workflow):
     yields = {"work_of_adhesion_sl": "J/m^2", "contact_angle": "deg", "spreading_coefficient": "J/m^2",
               "surface_tension_lv": "N/m"}
 
-    def forcefield_files(self, s):
-        s = self.typed(s)
-        return ["silica_interface"] + (["ots_trappe_ua"] if s.surface == "ots" else []) + \
-            water_forcefield_names(s.water_model)
+    def _forcefield_files(self, s: Settings) -> list[str]:
+        return substrate_water_forcefields(s)
 
-    def build(self, s):
-        s = self.typed(s)
+    def build(self, s: Settings) -> tuple[System, System, System]:
+        """(substrate, film, both placed in one box), as :meth:`ContactAngleWorkflow.build` with a film."""
         seed = int(s.seed)
-        sub = surface_slab(s.surface, s.nx, s.ny, s.slab_thickness_A, s, seed,
-                           silica_face_of((s.surface,), s.silica_face))
+        sub = substrate_of(s)
         wff = forcefield_of(water_forcefield_names(s.water_model))
         film = as_system(water_slab(float(sub.cell[0]), float(sub.cell[1]), float(s.film_thickness_A),
                                     vacuum=2.0, seed=seed + 1, forcefield=wff))
@@ -161,11 +160,9 @@ class WslTI(Workflow):
 
     @classmethod
     def nodes(cls, s) -> dict[str, np.ndarray]:
-        s = cls.typed(s)
         return {"q": A.gauss_legendre_unit(s.ti_charge_nodes)[0], "lj": A.gauss_legendre_unit(s.ti_lj_nodes)[0]}
 
-    def plan(self, s, run_dir):
-        s = self.typed(s)
+    def _plan(self, s: Settings, run_dir: Path) -> Plan:
         legs = _WslLegs(self, s, run_dir)
         return Plan(legs=legs.all(), timestep_fs=s.timestep_fs, n_atoms=legs.system.n_atoms,
                     seeds=substrate_water_seeds(int(s.seed)), forcefield_files=self.forcefield_files(s),
@@ -173,7 +170,35 @@ class WslTI(Workflow):
 
     # ------------------------------------------------------------------------------------------ analysis
     def analyse(self, ctx):
-        return _WslAnalysis(ctx, self.typed(ctx.settings)).run()
+        return _WslAnalysis(ctx, ctx.settings).run()
+
+
+@dataclass(slots=True)
+class _WslResults:
+    """What :class:`_WslAnalysis` computes, in one place, filled in as :meth:`~_WslAnalysis.run` goes: the water
+    model and its gamma_lv, the lambda nodes, per node and per stage dU/dlambda (whole and by halves), the rows of
+    the curves, the integrals ``stages``, W_SL's parts ``w`` with its errors, the tether correction ``tc``, the
+    dispersion tail, the angle ``ang`` and its grid and statistical errors. Slotted: a name not declared here cannot
+    be set."""
+    model: dict[str, Any] = field(default_factory=dict)          # the water model (WATER_MODELS)
+    gamma: float | None = None                                   # its gamma_lv (N/m)
+    nodes: dict[str, np.ndarray] = field(default_factory=dict)   # node set ('q', 'lj') -> lambda nodes
+    stages: dict[str, Any] = field(default_factory=dict)         # stage -> its integral (ti_integral)
+    per_node: dict[str, Any] = field(default_factory=dict)       # stage -> per-node dU/dlambda records
+    halves: dict[int, dict[str, Any]] = field(default_factory=dict)   # half -> stage -> its integral
+    rows: dict[str, list] = field(default_factory=dict)          # stage -> per-node rows of the curves
+    half_means: dict[str, tuple] = field(default_factory=dict)   # stage -> (first-half, second-half) node means
+    dw_tail: float | None = None                                 # the dispersion tail on W_SL (J/m^2)
+    w_half: list[float] = field(default_factory=list)            # W_SL from each half
+    half_sigma: float | None = None
+    half_ok: bool | None = None
+    w_err: float | None = None                                   # W_SL's stderr and grid error together
+    th_disc: float | None = None                                 # the angle's grid error (deg)
+    th_stat: float | None = None                                 # its statistical error (deg)
+    w: dict[str, Any] | None = None                              # W_SL and its parts
+    tc: dict[str, Any] | None = None                             # the tether correction
+    tail: dict[str, Any] | None = None                           # the dispersion tail (OTS)
+    ang: dict[str, Any] | None = None                            # Young-Dupre: theta or 'wets'
 
 
 class _WslAnalysis:
@@ -185,60 +210,67 @@ class _WslAnalysis:
     STAGES = (("charge_film", "q", "q"), ("lj_film", "lj", "lj"), ("charge_reference", "ref_q", "q"))
 
     def __init__(self, ctx, s):
-        self.ctx, self.s, self.info = ctx, s, ctx.plan.system_info
+        self.ctx, self.s = ctx, s
+        self.plan = WslPlanRecord.from_system(ctx.plan.system_info)
+        self.results = _WslResults()
 
     def run(self) -> Analysis:
+        res = self.results
         self._prepare()
         for key, prefix, node_set in self.STAGES:
-            for k, x in enumerate(self.nodes[node_set]):
+            for k, x in enumerate(res.nodes[node_set]):
                 self._single_node(key, f"{prefix}{k}", x)
-            self._conclude_stage(key, self.nodes[node_set])
+            self._conclude_stage(key, res.nodes[node_set])
         return self._conclude()
 
     def _prepare(self) -> None:
-        self.model = WATER_MODELS[self.s.water_model]
-        self.gamma = self.model["gamma_lv_N_m"]
-        self.nodes = {k: np.asarray(v, float) for k, v in self.info["nodes"].items()}
-        self.stages, self.per_node, self.halves = {}, {}, {0: {}, 1: {}}
-        self.rows = {key: [] for key, _, _ in self.STAGES}
-        self.half_means = {key: ([], []) for key, _, _ in self.STAGES}
+        res = self.results
+        res.model = WATER_MODELS[self.s.water_model]
+        res.gamma = res.model["gamma_lv_N_m"]
+        res.nodes = self.plan.nodes
+        res.stages, res.per_node, res.halves = {}, {}, {0: {}, 1: {}}
+        res.rows = {key: [] for key, _, _ in self.STAGES}
+        res.half_means = {key: ([], []) for key, _, _ in self.STAGES}
 
     def _single_node(self, key: str, leg: str, x: float) -> None:
         """One node: the mean of dU/dlambda with its stderr (statistical inefficiency, equilibration detected), the
         film's height, and the means of the two halves of the samples the mean uses."""
+        res = self.results
         d = self.ctx.samples(leg)
         st = A.timeseries_stats(d["dudl"])
         row = {"lambda": float(x), "mean_kcal_mol": st["mean"], "stderr_kcal_mol": st["stderr"],
                "g": st["g"], "n_eff": st["n_eff"], "n": int(len(d["dudl"])), "t0": int(st["t0"])}
         if "z_film" in d and len(d["z_film"]):
             row["z_film_A"] = float(np.mean(d["z_film"]))
-        self.rows[key].append(row)
+        res.rows[key].append(row)
         used = np.asarray(d["dudl"], float)[int(st["t0"]):]          # the samples the mean uses
         for h, part in enumerate((used[:used.size // 2], used[used.size // 2:])):
-            self.half_means[key][h].append(float(np.mean(part)) if part.size else float("nan"))
+            res.half_means[key][h].append(float(np.mean(part)) if part.size else float("nan"))
 
     def _conclude_stage(self, key: str, lam: np.ndarray) -> None:
-        rows = self.rows[key]
-        self.per_node[key] = rows
-        self.stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
+        res = self.results
+        rows = res.rows[key]
+        res.per_node[key] = rows
+        res.stages[key] = A.ti_integral(lam, [r["mean_kcal_mol"] for r in rows], [r["stderr_kcal_mol"] for r in rows])
         for h in (0, 1):
-            self.halves[h][key] = A.ti_integral(lam, self.half_means[key][h],
-                                                [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
+            res.halves[h][key] = A.ti_integral(lam, res.half_means[key][h],
+                                               [r["stderr_kcal_mol"] * math.sqrt(2.0) for r in rows])
 
     def _conclude(self) -> Analysis:
+        res = self.results
         s, ctx = self.s, self.ctx
         temps = leg_temperatures(ctx, [leg for leg in ctx.plan.legs if leg.name == "film" or
                                        leg.name.startswith(("q", "lj"))], s.temperature_K, second_half=("film",))
         self._work()
         q = self._quantities()
         notes = self._notes() + ([temps["note"]] if temps else []) + self._tail_notes()
-        details = {"stages": self.stages, "nodes": self.per_node, "parts_J_m2": self.w, "angle": self.ang,
-                   "gamma_lv_N_m": self.gamma,
-                   "window_halves_J_m2": {"first": self.w_half[0], "second": self.w_half[1],
-                                          "consistent": self.half_ok, "difference_sigma": 2.0 * self.half_sigma},
+        details = {"stages": res.stages, "nodes": res.per_node, "parts_J_m2": res.w, "angle": res.ang,
+                   "gamma_lv_N_m": res.gamma,
+                   "window_halves_J_m2": {"first": res.w_half[0], "second": res.w_half[1],
+                                          "consistent": res.half_ok, "difference_sigma": 2.0 * res.half_sigma},
                    "water_model": s.water_model}
-        if self.tail is not None:
-            details["dispersion_tail"] = self.tail
+        if res.tail is not None:
+            details["dispersion_tail"] = res.tail
         if temps:
             details["temperatures_K"] = temps
         return Analysis(quantities=q, curves=self._curves(), figures={"dudl": figure_writer(self._draw)},
@@ -246,42 +278,43 @@ class _WslAnalysis:
 
     def _work(self) -> None:
         """W_SL (J/m^2) with the tether and the dispersion-tail corrections, the halves' W_SL, and the angle."""
-        info, gamma = self.info, self.gamma
-        w = A.ti_work_of_adhesion_sl(self.stages["charge_film"], self.stages["lj_film"],
-                                     self.stages["charge_reference"], info["area_A2"])
+        res = self.results
+        plan, gamma = self.plan, res.gamma
+        w = A.ti_work_of_adhesion_sl(res.stages["charge_film"], res.stages["lj_film"],
+                                     res.stages["charge_reference"], plan.area_A2)
         # the tether's energy at full coupling (the film leg's second half), added back
         zf = np.asarray(self.ctx.samples("film", False).get("z_film", []), float)
-        tc = A.tether_correction(zf[zf.size // 2:], info["tether"]["z_A"], info["tether"]["k_kcal_mol_A2"],
-                                 info["area_A2"])
+        tc = A.tether_correction(zf[zf.size // 2:], plan.tether_z_A, plan.tether_k_kcal_mol_A2, plan.area_A2)
         w["value"] += tc["value"]
         w["tether_correction"] = tc
         ti_stderr = w["stderr"]           # the nodes' statistical error alone: what the window-length check tests
         # OTS: the water-TraPPE dispersion beyond the cutoff, static, at full coupling (the film leg's framed half)
-        tail = _dispersion_tail(self.ctx, info, self.s) if info.get("tail_site_ids") else None
+        tail = _dispersion_tail(self.ctx, plan, self.s) if plan.tail.ids else None
         if tail is not None:
             w["value"] += tail["value"]
             w["stderr"] = math.hypot(w["stderr"], tail["stderr"])
             w["dispersion_tail"] = tail
-        self.dw_tail = tail["value"] if tail is not None else 0.0
+        res.dw_tail = tail["value"] if tail is not None else 0.0
         # window length: W_SL from the first half of every node's samples against the second half (the same nodes)
-        self.w_half = [A.ti_work_of_adhesion_sl(self.halves[h]["charge_film"], self.halves[h]["lj_film"],
-                                                self.halves[h]["charge_reference"], info["area_A2"])["value"]
-                       + tc["value"] + self.dw_tail for h in (0, 1)]
+        res.w_half = [A.ti_work_of_adhesion_sl(res.halves[h]["charge_film"], res.halves[h]["lj_film"],
+                                               res.halves[h]["charge_reference"], plan.area_A2)["value"]
+                      + tc["value"] + res.dw_tail for h in (0, 1)]
         # each half has sqrt(2) x the nodes' stderr, their difference 2 x. The tail and the tether enter both halves
         # alike, so their errors cancel in the difference and stay out of its tolerance (as does the quadrature's)
-        self.half_sigma = ti_stderr * 2.0
-        self.half_ok = bool(abs(self.w_half[1] - self.w_half[0]) <= 2.0 * self.half_sigma)
-        self.w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
-        ang = A.angle_from_work_of_adhesion_sl(w["value"], self.w_err, gamma)
+        res.half_sigma = ti_stderr * 2.0
+        res.half_ok = bool(abs(res.w_half[1] - res.w_half[0]) <= 2.0 * res.half_sigma)
+        res.w_err = math.hypot(w["stderr"], w["discretisation_error"])        # both count for the angle
+        ang = A.angle_from_work_of_adhesion_sl(w["value"], res.w_err, gamma)
         # the quadrature's share of the angle's error, first order (reported apart from the statistical one)
-        self.th_disc = self.th_stat = None
+        res.th_disc = res.th_stat = None
         if ang["status"] == "measured":
-            self.th_disc = math.degrees(w["discretisation_error"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
-            self.th_stat = math.degrees(w["stderr"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
-        self.w, self.tc, self.tail, self.ang = w, tc, tail, ang
+            res.th_disc = math.degrees(w["discretisation_error"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
+            res.th_stat = math.degrees(w["stderr"] / (gamma * math.sin(math.radians(ang["theta_deg"]))))
+        res.w, res.tc, res.tail, res.ang = w, tc, tail, ang
 
     def _quantities(self) -> dict:
-        w, ang, tail, gamma, model = self.w, self.ang, self.tail, self.gamma, self.model
+        res = self.results
+        w, ang, tail, gamma, model = res.w, res.ang, res.tail, res.gamma, res.model
         kinds = {"measured": "Young-Dupre from the TI W_SL: theta = arccos(W_SL / gamma_lv - 1)",
                  "wets": "0 = wets (W_SL >= 2 gamma_lv; mark, not a measurement): see spreading_coefficient",
                  "dewets": "180 = W_SL <= 0 (mark, not a measurement)"}
@@ -289,9 +322,9 @@ class _WslAnalysis:
                 w["value"], w["stderr"], "J/m^2", kind="thermodynamic integration: film decoupled from the solid "
                 "(charges, then soft-core LJ) minus the solid-alone charge stage",
                 discretisation_error=w["discretisation_error"]),
-             "contact_angle": quantity_record(ang["theta_deg"], self.th_stat, "deg",
+             "contact_angle": quantity_record(ang["theta_deg"], res.th_stat, "deg",
                                               status=ang["status"], kind=kinds[ang["status"]],
-                                              discretisation_error=self.th_disc,
+                                              discretisation_error=res.th_disc,
                                               upper_one_stderr_deg=ang["theta_upper_deg"]),
              "spreading_coefficient": quantity_record(ang["spreading_coefficient"], w["stderr"], "J/m^2",
                                                       kind="S = W_SL - 2 gamma_lv (>= 0: wets)"),
@@ -305,7 +338,7 @@ class _WslAnalysis:
                                                         f"({model['gamma_source']})")}
         if ang["status"] == "wets":
             # W_SL - 2 sigma (statistical and quadrature together): the largest angle the run does not exclude
-            bound = A.angle_from_work_of_adhesion_sl(w["value"] - 2.0 * self.w_err, 0.0, gamma)["theta_deg"]
+            bound = A.angle_from_work_of_adhesion_sl(w["value"] - 2.0 * res.w_err, 0.0, gamma)["theta_deg"]
             q["contact_angle_upper_bound"] = quantity_record(bound, None, "deg", kind="wets: theta below this "
                                                              "bound (Young-Dupre at W_SL - 2 stderr, "
                                                              "quadrature included)")
@@ -316,19 +349,20 @@ class _WslAnalysis:
         return q
 
     def _notes(self) -> list[str]:
-        s, w, ang, tail, tc, gamma, model = self.s, self.w, self.ang, self.tail, self.tc, self.gamma, self.model
-        w_half, half_sigma = self.w_half, self.half_sigma
-        conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / self.info["area_A2"]
+        res = self.results
+        s, w, ang, tail, tc, gamma, model = self.s, res.w, res.ang, res.tail, res.tc, res.gamma, res.model
+        w_half, half_sigma = res.w_half, res.half_sigma
+        conv = A.KCALMOL_PER_A2_TO_J_PER_M2 / self.plan.area_A2
         return [f"window length: W_SL from the first halves of the nodes' samples {w_half[0] * 1e3:.1f}, from the "
                 f"second halves {w_half[1] * 1e3:.1f} mJ/m^2 (difference {(w_half[1] - w_half[0]) * 1e3:+.1f}, 2 sigma "
                 f"= {2 * half_sigma * 1e3:.1f}): " + ("consistent, the nodes are long enough for their decorrelation."
-                                                     if self.half_ok else "NOT consistent: the nodes still relax; "
+                                                     if res.half_ok else "NOT consistent: the nodes still relax; "
                                                      "longer nodes are needed."),
                 f"W_SL = {w['value'] * 1e3:.1f} +/- {w['stderr'] * 1e3:.1f} mJ/m^2 (quadrature "
                 f"+/- {w['discretisation_error'] * 1e3:.1f}): electrostatic {w['electrostatic'] * 1e3:.1f} +/- "
                 f"{w['electrostatic_stderr'] * 1e3:.1f}, dispersion {w['dispersion'] * 1e3:.1f} +/- "
                 f"{w['dispersion_stderr'] * 1e3:.1f}, tether {tc['value'] * 1e3:+.1f}"
-                + (f", water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff {self.dw_tail * 1e3:+.1f} +/- "
+                + (f", water-TraPPE dispersion beyond the {s.cutoff_A:g} A cutoff {res.dw_tail * 1e3:+.1f} +/- "
                    f"{tail['stderr'] * 1e3:.1f}" if tail is not None else "") + " mJ/m^2.",
                 {"measured": f"theta = {ang['theta_deg']:.1f} deg from Young-Dupre with gamma_lv = "
                              f"{gamma * 1e3:.1f} mN/m ({model['name']}).",
@@ -349,7 +383,7 @@ class _WslAnalysis:
                 "scales the solid's charges, the reference subtracts their solid-solid part)."]
 
     def _tail_notes(self) -> list[str]:
-        tail = self.tail
+        tail = self.results.tail
         if tail is None:
             return []
         return [f"the water-TraPPE dispersion beyond the {self.s.cutoff_A:g} A cutoff (which TraPPE was fitted with) "
@@ -361,15 +395,16 @@ class _WslAnalysis:
     def _curves(self) -> dict:
         rows = []
         for key, code in (("charge_film", 0), ("lj_film", 1), ("charge_reference", 2)):
-            for r in self.per_node[key]:
+            for r in self.results.per_node[key]:
                 rows.append([code, r["lambda"], U.kcal_per_mol_to_J(r["mean_kcal_mol"]),
                              U.kcal_per_mol_to_J(r["stderr_kcal_mol"]), r["g"], r["n_eff"]])
         return {"dudl_nodes": (["stage_code", "lambda", "dudl_mean_J", "dudl_stderr_J", "g", "n_eff"],
                                np.array(rows, float))}
 
     def _draw(self, ax) -> None:
-        w, ang = self.w, self.ang
-        qf, qr, lj = self.per_node["charge_film"], self.per_node["charge_reference"], self.per_node["lj_film"]
+        res = self.results
+        w, ang = res.w, res.ang
+        qf, qr, lj = res.per_node["charge_film"], res.per_node["charge_reference"], res.per_node["lj_film"]
         ax.errorbar([r["lambda"] for r in qf], [a["mean_kcal_mol"] - b["mean_kcal_mol"] for a, b in zip(qf, qr)],
                     yerr=[np.hypot(a["stderr_kcal_mol"], b["stderr_kcal_mol"]) for a, b in zip(qf, qr)],
                     marker="o", lw=1, capsize=2, label="charges: film minus solid alone")
@@ -394,12 +429,9 @@ class _WslLegs:
         self.ff = ff = forcefield_of(wf.forcefield_files(s))
         self.sub, self.film, system = wf.build(s)
         self.system = system
-        self.substrate, self.water = substrate, water = system.group("substrate"), system.group("adsorbate")
-        self.held = np.intersect1d(held_deep(system), substrate)
-        self.sub_data, self.water_data = run_dir / "substrate.data", run_dir / "water.data"
-        write_data(system, ff, run_dir / "system.data", title="wsl_ti system (reference; the legs read the two parts)")
-        write_data(remove_atoms(system, water), ff, self.sub_data, title="wsl_ti substrate")
-        write_data(remove_atoms(system, substrate), ff, self.water_data, title="wsl_ti water film")
+        self.parts = parts = write_substrate_water("wsl_ti", "water film", ff, system, run_dir)
+        self.substrate, self.water, self.held = parts.substrate, parts.water, parts.held
+        self.water_data = parts.water_data
         self.ids = ids = lammps_type_ids(ff)
         self.all_types, self.charged_types = solid_types(system, ff)
         self.solid_t, self.charged_t = [ids[t] for t in self.all_types], [ids[t] for t in self.charged_types]
@@ -407,11 +439,9 @@ class _WslLegs:
         self.charge = {ids[t]: ff.atom_type(t).charge for t in self.charged_types}
         # OTS: the water O and the SAM's TraPPE sites are framed in the film leg's second half, for the water-TraPPE
         # dispersion beyond the cutoff (analysis: md.analysis.film_lower_dividing_plane + dispersion_tail_work)
-        water_o = np.intersect1d(system.group("water_O"), water)
-        self.tail_sites, self.c6 = trappe_tail_sites(system, ff, water_o)
-        self.ow = str(np.asarray(system.types)[water_o[0]])
-        self.z_film = float(system.positions[water, 2].mean())
-        self.shake = shake_lines(ff, also=SILANOL_OH)
+        self.tail_sites, self.c6 = parts.tail_sites, parts.c6
+        self.ow = str(np.asarray(system.types)[parts.water_o[0]])
+        self.z_film = float(system.positions[parts.water, 2].mean())
         self.nodes = wf.nodes(s)
         self.kspace = pppm_lines(s, system.cell)
         self.common = dict(restart_head=self.head, sample_interval=s.sample_interval, chunk_steps=s.chunk_steps)
@@ -423,8 +453,7 @@ class _WslLegs:
         """Every leg's set-up; with the water: one thermostat on the water, one on the solid's mobile atoms, each
         one's temperature sampled, and the film's tether."""
         s = self.s
-        return (common_define(s, "mobile") + ["neigh_modify exclude group frozen frozen"] + self.shake +
-                ["fix hold frozen setforce 0.0 0.0 0.0"] +
+        return (held_define(s, self.parts) +
                 ([f"fix tether water spring tether {TETHER_K:g} NULL NULL {self.z_film:.4f} 0.0",
                   "variable zw equal xcm(water,z)"] + water_solid_thermostat_lines(s, step, salt)
                  if with_water else thermostat_lines("mobile", s, step, salt)))
@@ -456,21 +485,10 @@ class _WslLegs:
         return cmds
 
     def substrate_leg(self) -> Leg:
-        """The slab minimised with nothing held, then deep Si and bridging O held, equilibrated."""
-        s = self.s
-        sub_groups = {"substrate": self.substrate, "frozen": self.held}
-
-        def fresh_substrate(leg_dir: Path) -> list[str]:
-            return fresh_from_data(self.ff, self.sub_data, s, sub_groups, pair="long/soft") + self.kspace + \
-                ["group mobile subtract all frozen"] + minimize_lines(s, leg_dir / "minimized.data")
-
-        t = s.temperature_K
-        return Leg(name="substrate", fresh=fresh_substrate, define=lambda step: self.base(False, step, 0),
-                   prepare=lambda d: [],
-                   stages=[Stage("equilibrate", steps_of(s.substrate_equilibrate_steps, s.sample_interval),
-                                 (f"velocity mobile create {t:g} {derived_seed(int(s.seed), 3, 0)} mom yes rot no "
-                                  f"dist gaussian",), sampled=False)],
-                   columns={"pe": "v_pe", "temp": "v_temp"}, n_atoms=self.sub.n_atoms, **self.common)
+        """The slab minimised with nothing held, then deep Si and bridging O held, equilibrated; the soft-core pair
+        style and the fixed PPPM of every leg of the run."""
+        return substrate_leg(self.s, self.parts, lambda step: self.base(False, step, 0), self.head,
+                             self.sub.n_atoms, pair="long/soft", kspace=tuple(self.kspace))
 
     def film_leg(self, sub_leg: Leg) -> Leg:
         """The water film added on the substrate's last state, minimised, equilibrated at full coupling; on OTS the
@@ -560,7 +578,7 @@ class _WslLegs:
         return {"substrate": system_summary(self.sub), "film": dict(self.film.info), "box_A": system.cell.tolist(),
                 "area_A2": float(system.cell[0] * system.cell[1]), "n_substrate": int(len(self.substrate)),
                 "n_water_molecules_built": int(len(self.water) // 3),
-                "held_atoms": int(len(self.held)), "held": "deep Si and bridging O of the builder's bottom layer",
+                "held_atoms": int(len(self.held)), "held": HELD,
                 "silica_face": silica_face_of((s.surface,), s.silica_face), "water_model": s.water_model,
                 "type_ids": self.ids, "solid_types": self.all_types,
                 "solid_charges_e": {x: ff.atom_type(x).charge for x in self.charged_types},
@@ -570,7 +588,7 @@ class _WslLegs:
                 "nodes": {k: v.tolist() for k, v in self.nodes.items()}, "pppm": self.kspace[0]}
 
 
-def _dispersion_tail(ctx, info, s) -> dict | None:
+def _dispersion_tail(ctx, plan: WslPlanRecord, s) -> dict | None:
     """The water-TraPPE dispersion beyond the cutoff (J/m^2, > 0 = more adhesion) per frame of the film leg's
     framed half: the film's lower dividing plane and bulk density from all frames' water O
     (:func:`md.analysis.film_lower_dividing_plane`), each frame's TraPPE sites under it
@@ -579,8 +597,8 @@ def _dispersion_tail(ctx, info, s) -> dict | None:
     steps, ids, pos, box = ctx.frames("film")
     if not len(steps):
         return None
-    is_site, c6 = framed_tail_sites(info, ids)
-    area = float(info["area_A2"])
+    is_site, c6 = plan.tail.framed(ids)
+    area = plan.area_A2
     plane = A.film_lower_dividing_plane(pos[:, ~is_site, 2], area, len(steps))
     per_frame = np.array([A.dispersion_tail_work(pos[k, is_site, 2], c6, plane["z_A"], plane["number_density_A3"],
                                                  s.cutoff_A, area) for k in range(len(steps))])

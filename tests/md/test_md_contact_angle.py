@@ -408,7 +408,7 @@ def test_every_silica_recipe_uses_the_same_isolated_q3_face(tmp_path):
     _, plan, _ = _plan("contact_angle_silica", tmp_path)
     assert plan.system_info["silica_face"] == "111" and plan.system_info["substrate"]["face"] == "111"
     s = load_recipe("pulloff_silica").settings("smoke")
-    system, info = PullOff().build(s)
+    system, info = PullOff().build(PullOff.typed(s))
     assert info["flat"]["face"] == "111" and info["asperity"]["face"] == "111"
     flat_top = np.intersect1d(system.group("silanol_O_top"), system.group("substrate"))
     assert min_oo(system, flat_top) > 4.0

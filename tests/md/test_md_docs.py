@@ -114,7 +114,7 @@ def test_a_cached_result_of_other_versions_is_reused_with_a_warning_or_refused(t
     from md.engine.plan import Job
     from md.engine.store import run_dir_for
 
-    job = Job(name="r", workflow="surface_tension", description="", fidelity="smoke", settings={},
+    job = Job(name="r", workflow="surface_tension", description="", fidelity="smoke", settings={}, settings_record={},
               canonical={"name": "r"}, forcefield_files=(), workflow_version=1)
     run_dir = run_dir_for("r", "smoke", hashing.run_hash(job.canonical, "smoke", (), 1)[0], tmp_path)
     run_dir.mkdir(parents=True)

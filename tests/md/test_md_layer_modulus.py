@@ -125,7 +125,7 @@ def _adhesion_ctx(recipe: str, curve, registry_scale=(1.0, 1.0), noise=0.3, drif
             out.update({k: v + rng.normal(0, scale, n) for k, v in zip(("sam_sxx", "sam_syy", "sam_szz"), sig)})
         return out
 
-    ctx = types.SimpleNamespace(settings=settings, samples=samples, run_dir=None,
+    ctx = types.SimpleNamespace(settings=Adhesion.typed(settings), samples=samples, run_dir=None,
                                 plan=types.SimpleNamespace(system_info=info, timestep_fs=1.0, legs=[]),
                                 frames=lambda leg: (np.zeros(0), None, None, None))
     return Adhesion(), ctx

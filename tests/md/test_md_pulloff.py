@@ -182,7 +182,7 @@ def test_silica_only_flat_thermostat(tmp_path):
     assert "fix integrate_flat_sam flat_sam nve" in cmds
     assert "group flat_silica subtract flat_mobile flat_sam" in cmds
     assert {"f_flat", "p_flat"} <= set(plan.legs[0].columns)
-    sys_, _ = get_workflow("pulloff").build(rec.settings("smoke"))
+    sys_, _ = get_workflow("pulloff").build(rec.typed_settings("smoke"))
     flat_sam = np.intersect1d(sys_.group("sam"), sys_.group("substrate"))
     assert flat_sam.size and set(sys_.types[flat_sam]) >= {"CH2", "CH3"}
     assert not set(sys_.types[np.setdiff1d(sys_.group("substrate"), flat_sam)]) & {"CH2", "CH3"}

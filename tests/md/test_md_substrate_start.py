@@ -135,7 +135,7 @@ def _substrates(name: str, fidelity: str):
     from md.workflows.pulloff import PullOff
     s = load_recipe(name).typed_settings(fidelity)
     if name.startswith("pulloff"):
-        system, _ = PullOff().build(s)
+        system, _ = PullOff().build(PullOff.typed(s))
         return [system], None
     kinds = s.surfaces if name.startswith("adhesion") else [s.surface]
     slabs = [surface_slab(k, s.nx, s.ny, s.slab_thickness_A, s, s.seed + 10 * i, silica_face_of(kinds, s.silica_face))
@@ -217,7 +217,7 @@ def test_the_contact_angle_box_is_the_substrates_and_the_data_file_keeps_the_bon
     from md.workflows import get_workflow
     s = load_recipe("contact_angle_silica").settings("smoke")
     wf = get_workflow("contact_angle")
-    sub, _, system = wf.build(s)
+    sub, _, system = wf.build(wf.typed(s))
     np.testing.assert_allclose(system.cell[:2], sub.cell[:2])
     wf.plan(s, tmp_path)
     for f in ("substrate.data", "system.data"):

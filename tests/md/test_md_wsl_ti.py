@@ -295,7 +295,7 @@ def _smoke_film(tmp_path):
     from md.workflows.wsl_ti import WslTI
     s = load_recipe("wsl_silica").typed_settings("smoke")
     wf = WslTI()
-    _, _, system = wf.build(s)
+    _, _, system = wf.build(wf.typed(s))
     ff = forcefield_of(wf.forcefield_files(s))
     write_data(system, ff, tmp_path / "film.data")
     return s, system, ff
