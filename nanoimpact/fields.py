@@ -249,8 +249,8 @@ def frozen_dataclass(name: str, members: Sequence[tuple[str, Field | Resolved]],
     typed from the declaration (``float``, ``float | None`` for an optional key, ...), defaulted from it (a
     required key has no default) and documented from it (the class docstring lists each attribute with its unit
     and the key it comes from). So a key is declared once and its dataclass follows. `Resolved` members are
-    attributes the loader computes; `namespace` adds properties and methods, `bases` base classes; `unit`/`default` map a key's file
-    unit and default to the attribute's (angles: degrees in the file, radians in the dataclass). Each
+    attributes the loader computes; `namespace` adds properties and methods, `bases` base classes; `unit`/`default`
+    map a key's file unit and default to the attribute's (angles: degrees in the file, radians in the dataclass). Each
     dataclass field carries its key, unit and doc in ``metadata``."""
     spec, lines = [], []
     for attr, member in members:
