@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import brentq
+from scipy.special import ndtri
 
 from ..reference import jkr
 from ..reference import thornton_ning as tn
@@ -67,6 +68,10 @@ __all__ = ["PlasticSummitLaw", "PlasticGWSurface", "RollerFootprint"]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _SQRT2PI = math.sqrt(2.0 * math.pi)
+#: Lowest summit height kept, in units of sigma: the fraction Phi(-K) of the Gaussian's summits below it is half
+#: the double-precision epsilon (K = 8.21), so it stays below the round-off of the quadrature sums (see
+#: `PlasticGWSurface`: the lower truncation and the bound it puts on the quadrature nodes).
+LOWER_TAIL = float(-ndtri(np.finfo(float).eps / 2.0))
 
 
 @dataclass(frozen=True)
@@ -205,7 +210,18 @@ class PlasticSummitLaw:
 class PlasticGWSurface:
     """GW mean field of `PlasticSummitLaw` summits: Gaussian heights of rms sigma (m), density n (1/m^2), truncated
     at z_max sigma (the tallest summit, the datum of `PlasticGWPunch`). Values per unit nominal area, functions of
-    the separation d, this contact's deepest separation d_c and the deepest ever d_p (m; d_p <= d_c)."""
+    the separation d, this contact's deepest separation d_c and the deepest ever d_p (m; d_p <= d_c).
+
+    Lower truncation and the node bound: the summits below z = -K sigma (K = `LOWER_TAIL`, Phi(-K) = eps/2) are not
+    kept. They are a fraction eps/2 of the summits and the least compressed ones (u = z - d_p is smallest there), so
+    each carries no more than the loading force of the summits at the cut, and the values they leave out are
+    below the round-off of the sums over the kept summits. Every value (force, stored energy, plastic work, loops)
+    drops the same summits, so the law is exactly that of GW truncated at both ends and the energy audit holds
+    unchanged. What it buys: the integrals in u run over at most (z_max + K) sigma whatever the separation, so
+    the quadrature has at most `node_bound((z_max + K) sigma)` nodes (a footprint's, `RollerFootprint`, grow with
+    the log of its depth). Without it a trial step of the integrator deep below the surface (a 1 TPa summit
+    modulus gives forces that send DOP853's stages kilometres down) spanned its whole range in sigma/4 panels:
+    1e11 nodes, tens of GB."""
 
     def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float):
         if not math.isfinite(z_max):
@@ -214,6 +230,17 @@ class PlasticGWSurface:
         self.z_top = float(z_max) * self.sigma
         self.delta_c = float(law.release_stretch(law.radius))
         self._first = 0.1 * max(self.delta_c, 1e-3 * self.sigma)
+        self.z_floor = -LOWER_TAIL * self.sigma
+
+    def node_bound(self, span: float) -> int:
+        """Most quadrature nodes of an integral over `span` = hi - lo (m) in u (this surface's: span <= (z_max + K)
+        sigma; a footprint's: up to the depth of its axis below z_top): 8 per panel; panels grow by 1.5 from the first (`_first`) to their cap, then (below the floor) halve the distance
+        left until sigma/4, then sigma/4 over (z_max + K) sigma, plus the split at delta_y and the end panels."""
+        q = 0.25 * self.sigma
+        below = max(span - (self.z_top - self.z_floor), 0.0)
+        ramp = math.ceil(math.log(max(max(q, 0.5 * below) / self._first, 1.0)) / math.log(1.5)) + 1
+        descent = math.ceil(math.log2(max(below / q, 1.0))) + 1
+        return 8 * (ramp + descent + math.ceil((self.z_top - self.z_floor) / q) + 3)
 
     # ------------------------------------------------------------------ summit sets
     def recovery(self, u):
@@ -246,15 +273,28 @@ class PlasticGWSurface:
     #: the weight has a square-root end at the top of the summits (a footprint's edge): last panel in u = hi - t^2
     _root_at_top = False
 
-    def _nodes(self, lo, hi):
+    #: the weight is the Gaussian's, negligible below z_floor: the summits there are dropped (`RollerFootprint`
+    #: keeps them: its axis height is not a summit's height)
+    _clip_floor = True
+
+    def _span(self, lo, d_p, hi=math.inf):
+        """(lo, hi, floor) (m, in u = z - d_p) for `_nodes`: hi <= z_top - d_p, and lo >= floor = z_floor - d_p
+        where `_clip_floor`."""
+        floor = self.z_floor - d_p
+        return (max(lo, floor) if self._clip_floor else lo), min(hi, self.z_top - d_p), floor
+
+    def _nodes(self, lo, hi, floor=-math.inf):
         """Gauss-Legendre nodes and weights on [lo, hi] (m): geometric panels from lo (split at delta_y), the first in
-        u = lo + t^2 (and with `_root_at_top` the last in u = hi - t^2)."""
+        u = lo + t^2 (and with `_root_at_top` the last in u = hi - t^2), at most sigma/4 wide above `floor` and at
+        most half their distance from it below (where the weight is smooth on that scale, `RollerFootprint`), so at
+        most `node_bound(hi - lo)` nodes."""
         if not hi > lo:
             return np.empty(0), np.empty(0)
         edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
+        quarter = 0.25 * self.sigma
         while x < hi:
             edges.append(x)
-            width = min(1.5 * width, 0.25 * self.sigma)
+            width = min(1.5 * width, max(quarter, 0.5 * (floor - x)))
             x += width
         edges.append(hi)
         d_y = self.law.yield_approach
@@ -288,7 +328,7 @@ class PlasticGWSurface:
     def state(self, d, d_c, d_p):
         """(pressure Pa (+ compressive), stored energy J/m^2, contact density 1/m^2) at separation d (m)."""
         u_met, u_held = self.bounds(d, d_c, d_p)
-        u, w = self._nodes(max(u_met, u_held, 0.0), self.z_top - d_p)
+        u, w = self._nodes(*self._span(max(u_met, u_held, 0.0), d_p))
         if u.size == 0:
             return 0.0, 0.0, 0.0
         f, en = self.law.branch(u - (d - d_p), u)
@@ -299,7 +339,7 @@ class PlasticGWSurface:
         """(pressure Pa, contacts 1/m^2) per unit nominal area at separation d (m): `state` with the Gaussian density
         whatever this surface's weight (a footprint's: its nominal pressure on the axis)."""
         u_met, u_held = self.bounds(d, d_c, d_p)
-        u, w = self._nodes(max(u_met, u_held, 0.0), self.z_top - d_p)
+        u, w = self._nodes(*self._span(max(u_met, u_held, 0.0), d_p))
         if u.size == 0:
             return 0.0, 0.0
         q = PlasticGWSurface._weight(self, u, w, d_p)
@@ -307,14 +347,14 @@ class PlasticGWSurface:
 
     def plastic_work(self, d_p):
         """Plastic work (J/m^2) of all summits after the deepest separation d_p (m)."""
-        u, w = self._nodes(max(self.law.yield_approach, 0.0), self.z_top - d_p)
+        u, w = self._nodes(*self._span(max(self.law.yield_approach, 0.0), d_p))
         return float(self._weight(u, w, d_p) @ self.law.plastic_work(u)) if u.size else 0.0
 
     def released(self, d, d_c, d_p):
         """Hysteresis (J/m^2) of the summits met in this contact that have let go at separation d (m)."""
         u_met, u_held = self.bounds(d, d_c, d_p)
         lo = max(u_met, 0.0)
-        u, w = self._nodes(lo, min(max(u_held, lo), self.z_top - d_p))
+        u, w = self._nodes(*self._span(lo, d_p, max(u_held, lo)))
         return float(self._weight(u, w, d_p) @ self.law.loop_energy(u)) if u.size else 0.0
 
     def plasticity_index(self, hardness: float) -> float:
@@ -344,6 +384,10 @@ class RollerFootprint(PlasticGWSurface):
         self._tx, self._tw = np.polynomial.legendre.leggauss(24)
 
     _root_at_top = True
+    #: summits far below the axis height still touch the roller away from its axis (K(z) falls only as
+    #: |z|^(-1/2)): none is dropped; below z_floor K is smooth on the scale of the distance to the heights' range
+    #: (K(z) = l sqrt(2R) int phi(y) (y - z)^(-1/2) dy), where the panels grow with that distance
+    _clip_floor = False
 
     def _weight(self, u, w, d_p):
         z = d_p + u
