@@ -234,8 +234,9 @@ class PlasticGWSurface:
 
     def node_bound(self, span: float) -> int:
         """Most quadrature nodes of an integral over `span` = hi - lo (m) in u (this surface's: span <= (z_max + K)
-        sigma; a footprint's: up to the depth of its axis below z_top): 8 per panel; panels grow by 1.5 from the first (`_first`) to their cap, then (below the floor) halve the distance
-        left until sigma/4, then sigma/4 over (z_max + K) sigma, plus the split at delta_y and the end panels."""
+        sigma; a footprint's: up to the depth of its axis below z_top): 8 per panel; panels grow by 1.5 from the
+        first (`_first`) to their cap, then (below the floor) halve the distance left until sigma/4, then sigma/4
+        over (z_max + K) sigma, plus the split at delta_y and the end panels."""
         q = 0.25 * self.sigma
         below = max(span - (self.z_top - self.z_floor), 0.0)
         ramp = math.ceil(math.log(max(max(q, 0.5 * below) / self._first, 1.0)) / math.log(1.5)) + 1
