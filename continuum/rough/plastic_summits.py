@@ -171,6 +171,10 @@ class PlasticSummitLaw:
         """Stretch (m) below delta_p at which a virgin summit still pulls: its fold delta_c(beta)."""
         return float(self.release_stretch(self.radius))
 
+    def reach_of(self, r_p):
+        """Stretch (m) below delta_p at which the approach branch starts to pull: 0 (zero-range adhesion)."""
+        return np.zeros_like(np.asarray(r_p, float))
+
     def jump_in(self, r_p):
         """delta_in (m, relative to delta_p): a JKR summit snaps in on touching (zero-range adhesion)."""
         return np.zeros_like(np.asarray(r_p, float))
@@ -228,7 +232,8 @@ class PlasticGWSurface:
             raise ValueError("PlasticGWSurface needs a finite truncation z_max (units of sigma): the tallest summit")
         self.law, self.sigma, self.density = law, float(sigma), float(density)
         self.z_top = float(z_max) * self.sigma
-        self.delta_c = float(law.release_stretch(law.radius))
+        # the adhesive length scale of a virgin summit: its release stretch (JKR's delta_c) or its reach
+        self.delta_c = max(-float(np.asarray(law.jump_out(np.array([law.radius])), float)[0]), law.approach_reach)
         self._first = 0.1 * max(self.delta_c, 1e-3 * self.sigma)
         self.z_floor = -LOWER_TAIL * self.sigma
 
@@ -237,11 +242,11 @@ class PlasticGWSurface:
         sigma; a footprint's: up to the depth of its axis below z_top): 8 per panel; panels grow by 1.5 from the
         first (`_first`) to their cap, then (below the floor) halve the distance left until sigma/4, then sigma/4
         over (z_max + K) sigma, plus the split at delta_y and the end panels."""
-        q = 0.25 * self.sigma
+        q = self.panel_width * self.sigma
         below = max(span - (self.z_top - self.z_floor), 0.0)
         ramp = math.ceil(math.log(max(max(q, 0.5 * below) / self._first, 1.0)) / math.log(1.5)) + 1
         descent = math.ceil(math.log2(max(below / q, 1.0))) + 1
-        return 8 * (ramp + descent + math.ceil((self.z_top - self.z_floor) / q) + 3)
+        return 8 * (ramp + descent + math.ceil((self.z_top - self.z_floor) / q) + 4)
 
     # ------------------------------------------------------------------ summit sets
     def recovery(self, u):
@@ -274,6 +279,8 @@ class PlasticGWSurface:
     #: the weight has a square-root end at the top of the summits (a footprint's edge): last panel in u = hi - t^2
     _root_at_top = False
 
+    #: widest panel (units of sigma): the JKR closed forms and the Gaussian are smooth on sigma/4
+    panel_width = 0.25
     #: the weight is the Gaussian's, negligible below z_floor: the summits there are dropped (`RollerFootprint`
     #: keeps them: its axis height is not a summit's height)
     _clip_floor = True
@@ -284,22 +291,22 @@ class PlasticGWSurface:
         floor = self.z_floor - d_p
         return (max(lo, floor) if self._clip_floor else lo), min(hi, self.z_top - d_p), floor
 
-    def _nodes(self, lo, hi, floor=-math.inf):
+    def _nodes(self, lo, hi, floor=-math.inf, breaks=()):
         """Gauss-Legendre nodes and weights on [lo, hi] (m): geometric panels from lo (split at delta_y), the first in
         u = lo + t^2 (and with `_root_at_top` the last in u = hi - t^2), at most sigma/4 wide above `floor` and at
         most half their distance from it below (where the weight is smooth on that scale, `RollerFootprint`), so at
-        most `node_bound(hi - lo)` nodes."""
+        most `node_bound(hi - lo)` nodes (plus one panel per point of `breaks`, where the integrand has a kink)."""
         if not hi > lo:
             return np.empty(0), np.empty(0)
         edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
-        quarter = 0.25 * self.sigma
+        quarter = self.panel_width * self.sigma
         while x < hi:
             edges.append(x)
             width = min(1.5 * width, max(quarter, 0.5 * (floor - x)))
             x += width
         edges.append(hi)
         d_y = self.law.yield_approach
-        edges = np.unique(np.concatenate([edges, [d_y] if lo < d_y < hi else []]))
+        edges = np.unique(np.concatenate([edges, [b for b in (d_y, *breaks) if lo < b < hi]]))
         if self._root_at_top:
             # the last panel at least as wide as its neighbour: the plain panels keep their distance from the
             # square-root end, so the sums change smoothly when an edge appears as hi grows
@@ -357,6 +364,23 @@ class PlasticGWSurface:
         lo = max(u_met, 0.0)
         u, w = self._nodes(*self._span(lo, d_p, max(u_held, lo)))
         return float(self._weight(u, w, d_p) @ self.law.loop_energy(u)) if u.size else 0.0
+
+    def jumps(self, d, d_c, d_p, d_0):
+        """Losses (J/m^2) booked at the summits' jumps in this contact: the loops of those that let go (a JKR summit
+        jumps in at no cost; d_0, the deepest separation before the contact, does not enter)."""
+        return self.released(d, d_c, d_p)
+
+    def release_separation(self, d_c, d_p):
+        """d - d_p (m) beyond which no summit holds: the tallest's fold, or (d_c = inf, none met) its surface."""
+        u_top = self.z_top - d_p
+        return float((self.hold if math.isfinite(d_c) else self.recovery)(u_top))
+
+    def touch_separation(self, d_p):
+        """None: a JKR summit exerts nothing before it touches (the contact starts at the tallest summit)."""
+        return None
+
+    def check_depth(self, d_p):
+        """The closed forms hold at any depth: nothing to refuse."""
 
     def plasticity_index(self, hardness: float) -> float:
         """Greenwood-Williamson psi = (E*/H) sqrt(sigma/beta) of these summits (hardness H in Pa)."""
