@@ -122,9 +122,9 @@ class PlasticGWRoller(PlasticGWPunch):
     def describe(self):
         s = self.surface
         return {**super().describe(), "name": self.name, "roller_radius": s.roller_radius, "length": s.length,
-                "source": f"Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) {s.law.describe()['name']} "
-                          "summits under a rigid "
-                          "roller over a rigid substrate, history (h, h_c, h_p) on its axis"}
+                "source": f"Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) "
+                          f"{s.law.describe()['name']} summits under a rigid roller over a rigid substrate, history "
+                          "(h, h_c, h_p) on its axis"}
 
 
 class PlasticSummitsPunch(ContactLaw):

@@ -114,10 +114,23 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             if u.size == 0:
                 continue
             q = weight(self, u, w, d_p)
-            f, en = self.law.state(u - (d - d_p), np.clip(u, 0.0, self.u_table), attached)
+            f, en = self._summits(u - (d - d_p), np.clip(u, 0.0, self.u_table), attached)
             p, energy = p + float(q @ f), energy + float(q @ en)
             count += float(q.sum()) if attached else 0.0
         return p, energy, count
+
+    def _summits(self, delta, delta_max, attached: bool):
+        """(force N, stored energy J) of summits at approach delta (m), deepest approach delta_max (m), all on the
+        retreat branch (`attached`) or all on the approach branch: `PlasticBranchSummitLaw.state` for one branch."""
+        law = self.law
+        r_p, d_p = law.flattening(delta_max)
+        branch = "retreat" if attached else "approach"
+        eps = delta - d_p
+        f, en = law.branch_force(eps, r_p, branch), law.branch_energy(eps, r_p, branch)
+        if attached and math.isfinite(law.yield_approach):
+            line = (delta >= delta_max) & (delta_max > law.yield_approach)
+            f = np.where(line, law.yield_force + law.plastic_slope * (delta - law.yield_approach), f)
+        return f, en
 
     def state(self, d, d_c, d_p):
         """(pressure Pa (+ compressive), stored energy J/m^2, attached summits 1/m^2) at separation d (m)."""

@@ -285,6 +285,20 @@ class PlasticGWSurface:
     #: keeps them: its axis height is not a summit's height)
     _clip_floor = True
 
+    def _offsets(self):
+        """Edges of the panels above the floor relative to their start (m): 0, then widths growing by 1.5 from
+        `_first` to sigma/4 (`panel_width`), over (z_max + K) sigma."""
+        if getattr(self, "_offsets_cache", None) is None:
+            span, quarter = self.z_top - self.z_floor, self.panel_width * self.sigma
+            out, x, width = [0.0], self._first, self._first
+            while x < span:
+                out.append(x)
+                width = min(1.5 * width, quarter)
+                x += width
+            out.append(x)
+            self._offsets_cache = np.array(out)
+        return self._offsets_cache
+
     def _span(self, lo, d_p, hi=math.inf):
         """(lo, hi, floor) (m, in u = z - d_p) for `_nodes`: hi <= z_top - d_p, and lo >= floor = z_floor - d_p
         where `_clip_floor`."""
@@ -298,20 +312,28 @@ class PlasticGWSurface:
         most `node_bound(hi - lo)` nodes (plus one panel per point of `breaks`, where the integrand has a kink)."""
         if not hi > lo:
             return np.empty(0), np.empty(0)
-        edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
         quarter = self.panel_width * self.sigma
-        while x < hi:
-            edges.append(x)
-            width = min(1.5 * width, max(quarter, 0.5 * (floor - x)))
-            x += width
-        edges.append(hi)
+        offsets = self._offsets()
+        if floor <= lo and hi - lo < offsets[-1]:
+            # the panels' edges from lo do not depend on lo above the floor: the template's
+            edges = [*(lo + offsets[offsets < hi - lo]), hi]
+        else:
+            edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
+            while x < hi:
+                edges.append(x)
+                width = min(1.5 * width, max(quarter, 0.5 * (floor - x)))
+                x += width
+            edges.append(hi)
         d_y = self.law.yield_approach
         edges = np.unique(np.concatenate([edges, [b for b in (d_y, *breaks) if lo < b < hi]]))
         if self._root_at_top:
             # the last panel at least as wide as its neighbour: the plain panels keep their distance from the
             # square-root end, so the sums change smoothly when an edge appears as hi grows
-            while edges.size > 3 and hi - edges[-2] < edges[-2] - edges[-3]:
-                edges = np.delete(edges, -2)
+            # (drop the interior edges from the top down while the gap to hi is narrower than the panel below)
+            if edges.size > 3:
+                keep = np.flatnonzero(hi - edges[1:-1] >= edges[1:-1] - edges[:-2])
+                last = int(keep[-1]) + 1 if keep.size else 1
+                edges = np.append(edges[:last + 1], hi)
             if edges.size == 2:
                 edges = np.array([lo, 0.5 * (lo + hi), hi])
         xs, ws = [], []

@@ -140,7 +140,8 @@ def _table_integral(law, d, zeta_eff, top, what):
         lo, hi = e[:-1, None], e[1:, None]
         z = (0.5 * (lo + hi) + 0.5 * (hi - lo) * x).ravel()
         fn = law.force if what == "pressure" else law.energy
-        total += float((0.5 * (hi - lo) * wx).ravel() @ (np.asarray(fn(z - d, branch)) * np.exp(-0.5 * (z / SIGMA) ** 2)))
+        values = np.asarray(fn(z - d, branch)) * np.exp(-0.5 * (z / SIGMA) ** 2)
+        total += float((0.5 * (hi - lo) * wx).ravel() @ values)
     return DENSITY * total / (math.sqrt(2 * math.pi) * SIGMA)
 
 
@@ -206,11 +207,11 @@ def test_tabulated_jkr_summits_give_the_closed_form_plastic_mean_field():
 def test_plastic_roller_on_the_law_closes_its_energy_audit_and_remembers_the_spot(name):
     """A rigid roller on the mean field of the law's Thornton-Ning summits. p_y = inf: the impact of the project's
     elastic rigid roller on the GW mean field of the same law (`RigidRoughRoller` on `GWBranchSurface`): the same
-    restitution (1e-6, the runs' residuals) and booked loops (1e-5). p_y = 3 GPa, two impacts on the same spot: the driver's audit closes
-    as the elastic law's own does (its tables' F = dU/d delta holds to ~1e-5 of the turnover: both laws measure
-    1.3e-5 - 2e-5, so 1e-4), the loss equals what the law books (plastic work and jumps) to 1e-4 of the impact's
-    energy, the first impact loses more than on elastic summits, mostly as plastic work, the second less than
-    the first (the spot is flattened)."""
+    restitution (1e-6, the runs' residuals) and booked loops (1e-5). p_y = 3 GPa, two impacts on the same spot:
+    the driver's audit closes as the elastic law's own does (its tables' F = dU/d delta holds to ~1e-5 of the
+    turnover: both laws measure 1.3e-5 - 2e-5, so 1e-4), the loss equals what the law books (plastic work and
+    jumps) to 1e-4 of the impact's energy, the first impact loses more than on elastic summits, mostly as plastic
+    work, the second less than the first (the spot is flattened)."""
     from continuum.laws.rough_rigid import RigidRoughRoller
     from continuum.rough.gw_branches import GWBranchSurface
     from continuum.rough.summits import SummitStatistics
