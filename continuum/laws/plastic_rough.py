@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from ..rough.plastic_gw_branches import BranchRollerFootprint
 from ..rough.plastic_summits import PlasticGWSurface, PlasticSummitLaw, RollerFootprint
 from .base import ContactLaw
 
@@ -47,7 +48,15 @@ class PlasticGWPunch(ContactLaw):
 
     def reset(self) -> None:
         self._d_c = math.inf
+        self._d_0 = self._d_p                   # the deepest separation before this contact
         self._w0 = self.surface.plastic_work(self._d_p)
+
+    @property
+    def touch_gap(self) -> float:
+        """Gap (m) at which the contact starts: the tallest summit's reach (0 for JKR summits, which exert nothing
+        before they touch)."""
+        sep = self.surface.touch_separation(self._d_p)
+        return 0.0 if sep is None else self._d_p + sep - self.surface.z_top
 
     def _trial(self, gap):
         d = self.surface.z_top + gap
@@ -66,20 +75,19 @@ class PlasticGWPunch(ContactLaw):
     def dissipated(self, gap):
         d, d_c, d_p = self._trial(gap)
         s = self.surface
-        return self.area * (s.plastic_work(d_p) - self._w0 + s.released(d, d_c, d_p))
+        return self.area * (s.plastic_work(d_p) - self._w0 + s.jumps(d, d_c, d_p, self._d_0))
 
     def release_gap(self):
         s = self.surface
-        u_top = s.z_top - self._d_p
-        fn = s.hold if math.isfinite(self._d_c) else s.recovery
-        return self._d_p + float(fn(u_top)) - s.z_top
+        return self._d_p + s.release_separation(self._d_c, self._d_p) - s.z_top
 
     def on_release(self):
         s = self.surface
-        return self.area * (s.plastic_work(self._d_p) - self._w0 + s.released(math.inf, self._d_c, self._d_p))
+        return self.area * (s.plastic_work(self._d_p) - self._w0 + s.jumps(math.inf, self._d_c, self._d_p, self._d_0))
 
     def accept(self, gap):
         d, self._d_c, self._d_p = self._trial(gap)
+        self.surface.check_depth(self._d_p)
 
     def length_scale(self, mass, speed):
         return max(0.1 * self.surface.sigma, self.surface.delta_c)
@@ -101,19 +109,22 @@ class PlasticGWPunch(ContactLaw):
 
 class PlasticGWRoller(PlasticGWPunch):
     """Rigid roller of radius R and length l (m) on the mean field of plastic summits over a rigid substrate
-    (`RollerFootprint`); gap = d - z_max on the roller's axis. Same history and losses as `PlasticGWPunch`."""
+    (`RollerFootprint` for Thornton-Ning JKR summits, `BranchRollerFootprint` for Thornton-Ning's construction on
+    Maugis-Dugdale or DMT summits, `PlasticBranchSummitLaw`); gap = d - z_max on the roller's axis. Same history
+    and losses as `PlasticGWPunch`."""
 
     name = "rough_roller_gw_plastic_rigid"
 
-    def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float, radius: float,
-                 length: float):
-        super().__init__(RollerFootprint(law, sigma, density, z_max, radius, length), 1.0)
+    def __init__(self, law, sigma: float, density: float, z_max: float, radius: float, length: float):
+        footprint = RollerFootprint if isinstance(law, PlasticSummitLaw) else BranchRollerFootprint
+        super().__init__(footprint(law, sigma, density, z_max, radius, length), 1.0)
 
     def describe(self):
         s = self.surface
         return {**super().describe(), "name": self.name, "roller_radius": s.roller_radius, "length": s.length,
-                "source": "Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) summits under a rigid "
-                          "roller over a rigid substrate, history (h, h_c, h_p) on its axis"}
+                "source": f"Greenwood & Williamson (1966) mean field of Thornton & Ning (1998) "
+                          f"{s.law.describe()['name']} summits under a rigid roller over a rigid substrate, history "
+                          "(h, h_c, h_p) on its axis"}
 
 
 class PlasticSummitsPunch(ContactLaw):

@@ -446,8 +446,8 @@ def summit_plasticity(scene: Scene, regime: Regime, adhesion: str = "jkr", half_
     Where they yield, adhesive elastic-plastic summits under a rigid roller run (`continuum.laws.plastic_rough`):
     Thornton-Ning's construction on the summit law that runs (`adhesion`: JKR, Maugis-Dugdale or DMT,
     `continuum.rough.plastic_branches`), on each summit of the realisation (mode 'discrete', and every ensemble
-    member: `continuum.model.select.plastic_member`) or on the GW mean field (JKR summits; under another law the
-    mean-field trajectory keeps elastic summits and says so, while the ensemble members yield). They sit on a rigid
+    member: `continuum.model.select.plastic_member`) or on their GW mean field (`continuum.rough.plastic_summits`
+    for JKR, `continuum.rough.plastic_gw_branches` for Maugis-Dugdale and DMT). They sit on a rigid
     substrate without bridges, so under the half-space or menisci the summits stay elastic and the record says why.
     Plastic Maugis-Dugdale and DMT summits run compiled (`continuum.rough.plastic_kernel`; their cost against the
     elastic members: benchmarks/bench_plastic_summits.py, docs/benchmarks.md). `choice` is physics.plasticity
@@ -482,11 +482,8 @@ def summit_plasticity(scene: Scene, regime: Regime, adhesion: str = "jkr", half_
     if used:
         _check_summit_limit(scene, soft, e_s)
         why += (f": Thornton-Ning's construction on the {adhesion} summits under a rigid roller, "
-                + ("each summit of the realisation" if rough.mode == "discrete" else
-                   "their GW mean field" if adhesion == "jkr" else
-                   "each ensemble member's realisation (the mean field of plastic summits is summed for JKR summits "
-                   "only: the mean-field trajectory keeps elastic summits)"))
-        if rough.mode in ("auto", "ensemble") and adhesion == "jkr":
+                + ("each summit of the realisation" if rough.mode == "discrete" else "their GW mean field"))
+        if rough.mode in ("auto", "ensemble"):
             why += " (and each ensemble member's realisation, where an ensemble runs)"
     elif yields:
         why += "; " + "; ".join(blockers) + ": this run is elastic and overestimates the rebound"

@@ -87,12 +87,14 @@ def plastic_summit_law(scene: Scene, name: str, summit_e_star: float, limiting_p
                                limiting_pressure, surf.interface_interaction_range, 30.0 * surf.roughness.sigma)
 
 
-def plastic_rigid_roller(scene: Scene, summit_e_star: float, limiting_pressure: float, z_max: float) -> ContactLaw:
-    """Rigid roller on the GW mean field of Thornton-Ning JKR summits over a rigid substrate (summits of the scene's
-    roughness, the summits' E*, limiting contact pressure p_y in Pa, truncation z_max in units of sigma)."""
+def plastic_rigid_roller(scene: Scene, summit_e_star: float, limiting_pressure: float, z_max: float,
+                         summit_law: str = "jkr") -> ContactLaw:
+    """Rigid roller on the GW mean field of Thornton-Ning summits on `summit_law` (JKR closed forms, or the
+    construction on Maugis-Dugdale / DMT) over a rigid substrate (summits of the scene's roughness, the summits'
+    E*, limiting contact pressure p_y in Pa, truncation z_max in units of sigma)."""
     from ..laws.plastic_rough import PlasticGWRoller
     rough, body = scene.surfaces.roughness, scene.body
-    law = plastic_summit_law(scene, "jkr", summit_e_star, limiting_pressure)
+    law = plastic_summit_law(scene, summit_law, summit_e_star, limiting_pressure)
     return PlasticGWRoller(law, rough.sigma, rough.summit_density, z_max, body.radius, body.length)
 
 

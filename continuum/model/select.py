@@ -256,9 +256,9 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         if plastic.used and scene.surfaces.roughness.mode == "discrete":
             law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure,
                                                   plastic.summit_law)
-        elif plastic.used and plastic.summit_law == "jkr":
+        elif plastic.used:
             law = factory.plastic_rigid_roller(scene, regime.e_star, plastic.limiting_pressure,
-                                               record["datum"]["z_max"])
+                                               record["datum"]["z_max"], plastic.summit_law)
             record["table"] = {"used": False, "why": "plastic summits: the mean field is summed state by state "
                                "(continuum.rough.plastic_summits), no footprint tables"}
         models["estimate"] = rec.estimate_record(estimate)

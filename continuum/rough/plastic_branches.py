@@ -216,6 +216,16 @@ class PlasticBranchSummitLaw:
         return self._scaled(lambda law, d, s: np.cbrt(s) * law.delta_out, np.zeros_like(np.asarray(r_p, float)),
                             r_p)
 
+    def reach_of(self, r_p):
+        """Stretch (m) below delta_p beyond which a summit flattened to R_p exerts nothing on approach: exact for
+        the self-similar laws (JKR, DMT: 0), and for Maugis-Dugdale the bound cbrt(R_p) max_k reach_k/cbrt(R_k)
+        over the tabulation radii (a node's curve scaled to R_p reaches cbrt(R_p/R_k) reach_k, and the mean curve
+        pulls where either bracketing node does), which grows with R_p, so the attracting summits of a mean field
+        are those above one edge."""
+        r_p = np.asarray(r_p, float)
+        ratio = max(law.reach / np.cbrt(law.radius_tip) for law in self._laws)
+        return np.cbrt(r_p) * ratio
+
     def in_switch(self, r_p):
         """U_A - U_R (J) at delta_in: booked when a summit jumps in (0 at a tabulation radius)."""
         e = self.jump_in(r_p)

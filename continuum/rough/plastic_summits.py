@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import brentq
+from scipy.special import ndtri
 
 from ..reference import jkr
 from ..reference import thornton_ning as tn
@@ -67,6 +68,10 @@ __all__ = ["PlasticSummitLaw", "PlasticGWSurface", "RollerFootprint"]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _SQRT2PI = math.sqrt(2.0 * math.pi)
+#: Lowest summit height kept, in units of sigma: the fraction Phi(-K) of the Gaussian's summits below it is half
+#: the double-precision epsilon (K = 8.21), so it stays below the round-off of the quadrature sums (see
+#: `PlasticGWSurface`: the lower truncation and the bound it puts on the quadrature nodes).
+LOWER_TAIL = float(-ndtri(np.finfo(float).eps / 2.0))
 
 
 @dataclass(frozen=True)
@@ -166,6 +171,10 @@ class PlasticSummitLaw:
         """Stretch (m) below delta_p at which a virgin summit still pulls: its fold delta_c(beta)."""
         return float(self.release_stretch(self.radius))
 
+    def reach_of(self, r_p):
+        """Stretch (m) below delta_p at which the approach branch starts to pull: 0 (zero-range adhesion)."""
+        return np.zeros_like(np.asarray(r_p, float))
+
     def jump_in(self, r_p):
         """delta_in (m, relative to delta_p): a JKR summit snaps in on touching (zero-range adhesion)."""
         return np.zeros_like(np.asarray(r_p, float))
@@ -205,15 +214,39 @@ class PlasticSummitLaw:
 class PlasticGWSurface:
     """GW mean field of `PlasticSummitLaw` summits: Gaussian heights of rms sigma (m), density n (1/m^2), truncated
     at z_max sigma (the tallest summit, the datum of `PlasticGWPunch`). Values per unit nominal area, functions of
-    the separation d, this contact's deepest separation d_c and the deepest ever d_p (m; d_p <= d_c)."""
+    the separation d, this contact's deepest separation d_c and the deepest ever d_p (m; d_p <= d_c).
+
+    Lower truncation and the node bound: the summits below z = -K sigma (K = `LOWER_TAIL`, Phi(-K) = eps/2) are not
+    kept. They are a fraction eps/2 of the summits and the least compressed ones (u = z - d_p is smallest there), so
+    each carries no more than the loading force of the summits at the cut, and the values they leave out are
+    below the round-off of the sums over the kept summits. Every value (force, stored energy, plastic work, loops)
+    drops the same summits, so the law is exactly that of GW truncated at both ends and the energy audit holds
+    unchanged. What it buys: the integrals in u run over at most (z_max + K) sigma whatever the separation, so
+    the quadrature has at most `node_bound((z_max + K) sigma)` nodes (a footprint's, `RollerFootprint`, grow with
+    the log of its depth). Without it a trial step of the integrator deep below the surface (a 1 TPa summit
+    modulus gives forces that send DOP853's stages kilometres down) spanned its whole range in sigma/4 panels:
+    1e11 nodes, tens of GB."""
 
     def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float):
         if not math.isfinite(z_max):
             raise ValueError("PlasticGWSurface needs a finite truncation z_max (units of sigma): the tallest summit")
         self.law, self.sigma, self.density = law, float(sigma), float(density)
         self.z_top = float(z_max) * self.sigma
-        self.delta_c = float(law.release_stretch(law.radius))
+        # the adhesive length scale of a virgin summit: its release stretch (JKR's delta_c) or its reach
+        self.delta_c = max(-float(np.asarray(law.jump_out(np.array([law.radius])), float)[0]), law.approach_reach)
         self._first = 0.1 * max(self.delta_c, 1e-3 * self.sigma)
+        self.z_floor = -LOWER_TAIL * self.sigma
+
+    def node_bound(self, span: float) -> int:
+        """Most quadrature nodes of an integral over `span` = hi - lo (m) in u (this surface's: span <= (z_max + K)
+        sigma; a footprint's: up to the depth of its axis below z_top): 8 per panel; panels grow by 1.5 from the
+        first (`_first`) to their cap, then (below the floor) halve the distance left until sigma/4, then sigma/4
+        over (z_max + K) sigma, plus the split at delta_y and the end panels."""
+        q = self.panel_width * self.sigma
+        below = max(span - (self.z_top - self.z_floor), 0.0)
+        ramp = math.ceil(math.log(max(max(q, 0.5 * below) / self._first, 1.0)) / math.log(1.5)) + 1
+        descent = math.ceil(math.log2(max(below / q, 1.0))) + 1
+        return 8 * (ramp + descent + math.ceil((self.z_top - self.z_floor) / q) + 4)
 
     # ------------------------------------------------------------------ summit sets
     def recovery(self, u):
@@ -246,24 +279,61 @@ class PlasticGWSurface:
     #: the weight has a square-root end at the top of the summits (a footprint's edge): last panel in u = hi - t^2
     _root_at_top = False
 
-    def _nodes(self, lo, hi):
+    #: widest panel (units of sigma): the JKR closed forms and the Gaussian are smooth on sigma/4
+    panel_width = 0.25
+    #: the weight is the Gaussian's, negligible below z_floor: the summits there are dropped (`RollerFootprint`
+    #: keeps them: its axis height is not a summit's height)
+    _clip_floor = True
+
+    def _offsets(self):
+        """Edges of the panels above the floor relative to their start (m): 0, then widths growing by 1.5 from
+        `_first` to sigma/4 (`panel_width`), over (z_max + K) sigma."""
+        if getattr(self, "_offsets_cache", None) is None:
+            span, quarter = self.z_top - self.z_floor, self.panel_width * self.sigma
+            out, x, width = [0.0], self._first, self._first
+            while x < span:
+                out.append(x)
+                width = min(1.5 * width, quarter)
+                x += width
+            out.append(x)
+            self._offsets_cache = np.array(out)
+        return self._offsets_cache
+
+    def _span(self, lo, d_p, hi=math.inf):
+        """(lo, hi, floor) (m, in u = z - d_p) for `_nodes`: hi <= z_top - d_p, and lo >= floor = z_floor - d_p
+        where `_clip_floor`."""
+        floor = self.z_floor - d_p
+        return (max(lo, floor) if self._clip_floor else lo), min(hi, self.z_top - d_p), floor
+
+    def _nodes(self, lo, hi, floor=-math.inf, breaks=()):
         """Gauss-Legendre nodes and weights on [lo, hi] (m): geometric panels from lo (split at delta_y), the first in
-        u = lo + t^2 (and with `_root_at_top` the last in u = hi - t^2)."""
+        u = lo + t^2 (and with `_root_at_top` the last in u = hi - t^2), at most sigma/4 wide above `floor` and at
+        most half their distance from it below (where the weight is smooth on that scale, `RollerFootprint`), so at
+        most `node_bound(hi - lo)` nodes (plus one panel per point of `breaks`, where the integrand has a kink)."""
         if not hi > lo:
             return np.empty(0), np.empty(0)
-        edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
-        while x < hi:
-            edges.append(x)
-            width = min(1.5 * width, 0.25 * self.sigma)
-            x += width
-        edges.append(hi)
+        quarter = self.panel_width * self.sigma
+        offsets = self._offsets()
+        if floor <= lo and hi - lo < offsets[-1]:
+            # the panels' edges from lo do not depend on lo above the floor: the template's
+            edges = [*(lo + offsets[offsets < hi - lo]), hi]
+        else:
+            edges, x, width = [lo], lo + min(self._first, hi - lo), self._first
+            while x < hi:
+                edges.append(x)
+                width = min(1.5 * width, max(quarter, 0.5 * (floor - x)))
+                x += width
+            edges.append(hi)
         d_y = self.law.yield_approach
-        edges = np.unique(np.concatenate([edges, [d_y] if lo < d_y < hi else []]))
+        edges = np.unique(np.concatenate([edges, [b for b in (d_y, *breaks) if lo < b < hi]]))
         if self._root_at_top:
             # the last panel at least as wide as its neighbour: the plain panels keep their distance from the
             # square-root end, so the sums change smoothly when an edge appears as hi grows
-            while edges.size > 3 and hi - edges[-2] < edges[-2] - edges[-3]:
-                edges = np.delete(edges, -2)
+            # (drop the interior edges from the top down while the gap to hi is narrower than the panel below)
+            if edges.size > 3:
+                keep = np.flatnonzero(hi - edges[1:-1] >= edges[1:-1] - edges[:-2])
+                last = int(keep[-1]) + 1 if keep.size else 1
+                edges = np.append(edges[:last + 1], hi)
             if edges.size == 2:
                 edges = np.array([lo, 0.5 * (lo + hi), hi])
         xs, ws = [], []
@@ -288,7 +358,7 @@ class PlasticGWSurface:
     def state(self, d, d_c, d_p):
         """(pressure Pa (+ compressive), stored energy J/m^2, contact density 1/m^2) at separation d (m)."""
         u_met, u_held = self.bounds(d, d_c, d_p)
-        u, w = self._nodes(max(u_met, u_held, 0.0), self.z_top - d_p)
+        u, w = self._nodes(*self._span(max(u_met, u_held, 0.0), d_p))
         if u.size == 0:
             return 0.0, 0.0, 0.0
         f, en = self.law.branch(u - (d - d_p), u)
@@ -299,7 +369,7 @@ class PlasticGWSurface:
         """(pressure Pa, contacts 1/m^2) per unit nominal area at separation d (m): `state` with the Gaussian density
         whatever this surface's weight (a footprint's: its nominal pressure on the axis)."""
         u_met, u_held = self.bounds(d, d_c, d_p)
-        u, w = self._nodes(max(u_met, u_held, 0.0), self.z_top - d_p)
+        u, w = self._nodes(*self._span(max(u_met, u_held, 0.0), d_p))
         if u.size == 0:
             return 0.0, 0.0
         q = PlasticGWSurface._weight(self, u, w, d_p)
@@ -307,15 +377,32 @@ class PlasticGWSurface:
 
     def plastic_work(self, d_p):
         """Plastic work (J/m^2) of all summits after the deepest separation d_p (m)."""
-        u, w = self._nodes(max(self.law.yield_approach, 0.0), self.z_top - d_p)
+        u, w = self._nodes(*self._span(max(self.law.yield_approach, 0.0), d_p))
         return float(self._weight(u, w, d_p) @ self.law.plastic_work(u)) if u.size else 0.0
 
     def released(self, d, d_c, d_p):
         """Hysteresis (J/m^2) of the summits met in this contact that have let go at separation d (m)."""
         u_met, u_held = self.bounds(d, d_c, d_p)
         lo = max(u_met, 0.0)
-        u, w = self._nodes(lo, min(max(u_held, lo), self.z_top - d_p))
+        u, w = self._nodes(*self._span(lo, d_p, max(u_held, lo)))
         return float(self._weight(u, w, d_p) @ self.law.loop_energy(u)) if u.size else 0.0
+
+    def jumps(self, d, d_c, d_p, d_0):
+        """Losses (J/m^2) booked at the summits' jumps in this contact: the loops of those that let go (a JKR summit
+        jumps in at no cost; d_0, the deepest separation before the contact, does not enter)."""
+        return self.released(d, d_c, d_p)
+
+    def release_separation(self, d_c, d_p):
+        """d - d_p (m) beyond which no summit holds: the tallest's fold, or (d_c = inf, none met) its surface."""
+        u_top = self.z_top - d_p
+        return float((self.hold if math.isfinite(d_c) else self.recovery)(u_top))
+
+    def touch_separation(self, d_p):
+        """None: a JKR summit exerts nothing before it touches (the contact starts at the tallest summit)."""
+        return None
+
+    def check_depth(self, d_p):
+        """The closed forms hold at any depth: nothing to refuse."""
 
     def plasticity_index(self, hardness: float) -> float:
         """Greenwood-Williamson psi = (E*/H) sqrt(sigma/beta) of these summits (hardness H in Pa)."""
@@ -344,6 +431,10 @@ class RollerFootprint(PlasticGWSurface):
         self._tx, self._tw = np.polynomial.legendre.leggauss(24)
 
     _root_at_top = True
+    #: summits far below the axis height still touch the roller away from its axis (K(z) falls only as
+    #: |z|^(-1/2)): none is dropped; below z_floor K is smooth on the scale of the distance to the heights' range
+    #: (K(z) = l sqrt(2R) int phi(y) (y - z)^(-1/2) dy), where the panels grow with that distance
+    _clip_floor = False
 
     def _weight(self, u, w, d_p):
         z = d_p + u

@@ -65,19 +65,19 @@ def audit_tolerance(sigma, release, work, modulus):
     return 1e-4 if sigma < 1e-9 else 1e-5
 
 
-def overrides(sigma, release, work, modulus, max_bounces=3):
+def overrides(sigma, release, work, modulus, max_bounces=3, plasticity="off"):
     return {"surfaces.roughness.sigma": sigma, "release_height": release,
             "surfaces.work_of_adhesion": work, "surfaces.roughness.summit_modulus": modulus,
             "physics.adhesion_law": "jkr" if work > 0 else "none", "physics.half_space": "off",
-            # the elastic JKR mean field is what this grid sweeps; the sets now give a hardness, and plastic summits
-            # (tests/continuum/test_plastic_summits.py, test_plastic_branches.py) would switch on at stiff points
-            "physics.plasticity": "off",
+            # the grid sweeps the elastic JKR mean field; where the set's hardness yields the summits (stiff points)
+            # the plastic mean field runs in `test_a_point_with_yielding_summits_...` below
+            "physics.plasticity": plasticity,
             "surfaces.roughness.mode": "mean_field",
             "numerics.fidelity": "standard", "numerics.max_bounces": max_bounces, "numerics.max_time": 1.0}
 
 
-def run_point(point, max_bounces=3):
-    return run_impact(resolve_scene(SCENE, overrides=overrides(*point, max_bounces=max_bounces),
+def run_point(point, max_bounces=3, plasticity="off"):
+    return run_impact(resolve_scene(SCENE, overrides=overrides(*point, max_bounces=max_bounces, plasticity=plasticity),
                                     override_label="stability sweep"))
 
 
@@ -103,6 +103,31 @@ def test_a_point_inside_the_model_runs_to_the_codes_accuracy(point):
     for key in ("t", "gap", "velocity", "force", "energy"):
         assert np.all(np.isfinite(trace[key])), key
     assert result["n_bounces"] >= 1
+    audit = result["energy_audit"]["max_error_over_turnover"]
+    assert math.isfinite(audit) and audit < audit_tolerance(*point)
+
+
+#: stiff summits (1 TPa) whose set's hardness makes them yield: the plastic JKR mean field (Thornton-Ning summits,
+#: `continuum.rough.plastic_summits`) at the thinnest and the roughest sigma; the last drop sent DOP853's trial
+#: stages kilometres below the surface, where the quadrature once grew without bound (tens of GB)
+PLASTIC = ((0.1e-9, 1e-9, 0.1, 1e12), (5e-9, 1e-9, 1.0, 1e12), (100e-9, 100e-9, 1.0, 1e12))
+
+
+@pytest.mark.parametrize("point", PLASTIC)
+def test_a_point_with_yielding_summits_runs_the_plastic_mean_field_with_a_bounded_quadrature(point, monkeypatch):
+    from continuum.rough import plastic_summits as ps
+    nodes, counts = ps.PlasticGWSurface._nodes, []
+
+    def counted(self, lo, hi, floor=-math.inf):
+        x, w = nodes(self, lo, hi, floor)
+        counts.append(x.size <= (self.node_bound(hi - lo) if hi > lo else 0))
+        return x, w
+    monkeypatch.setattr(ps.PlasticGWSurface, "_nodes", counted)
+    result, trace = run_point(point, plasticity="auto")
+    assert result["models"]["contact_law"]["name"] == "rough_roller_gw_plastic_rigid"
+    assert counts and all(counts)
+    for key in ("t", "gap", "velocity", "force", "energy"):
+        assert np.all(np.isfinite(trace[key])), key
     audit = result["energy_audit"]["max_error_over_turnover"]
     assert math.isfinite(audit) and audit < audit_tolerance(*point)
 
