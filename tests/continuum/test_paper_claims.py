@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from continuum.paper import checks, wet_checks
+from continuum.paper import checks, single_surfaces, wet_checks
 from continuum.paper import sampled_claims as sc
 from continuum.paper.verdict import FAIL, NOT_EVALUABLE, PASS, entry, judge, over_samples
 
@@ -95,7 +95,9 @@ def test_seeds_decide_nothing_and_are_reported_beside_the_claim_with_their_inter
     seeds = [dict(_bundle(sigma3=dict(_seq([0.2 * i], stuck=False) if i else _seq([]), max_contacts=5 + i,
                                       loop_per_summit_over_drop=0.0886)), label=f"seed {k}", seed=True)
              for k, i in ((1, 1), (2, 0), (3, 2), (4, 0))]
-    claims = {c["name"]: c for c in sc.judged_over_samples("t", nominal, seeds)}
+    judged = sc.judged_over_samples("t", nominal, [])
+    single_surfaces.attach("t", judged, seeds, nominal)
+    claims = {c["name"]: c for c in judged}
     c = claims["fig7_sigma3_sticks_at_first_impact"]
     assert c["state"] == PASS and c["samples"] == 1 and c["sampled"]["uncertainty"] == 0
     ss = c["single_surfaces"]
@@ -104,7 +106,52 @@ def test_seeds_decide_nothing_and_are_reported_beside_the_claim_with_their_inter
     assert "0.0886 of the drop energy" in ss["mechanism"] and ">= 12 of them" in ss["mechanism"]
     assert "5-7 summits" in ss["mechanism"]
     assert "mechanism" not in claims["fig5a_ots_outbounces_silica"]["single_surfaces"]     # holds on every seed
-    assert claims["fig4_ots_loop_smaller_than_silica"]["single_surfaces"]["n"] == 0        # needs the averaged law
+    # Fig 4's loop on a single surface: the per-summit loops of the paired seed (the same summits)
+    assert claims["fig4_ots_loop_smaller_than_silica"]["single_surfaces"]["holds"] == 4
+
+
+def _seed_runs(esc=(6e-4, 5e-4, 4e-4, 3e-4), durations=(9e-6, 7e-6, 5e-6), first=(0.0, 0.2, 0.4, 0.5, 0.6, 0.7, 0.8),
+               t_a=None):
+    """A seed's single-surface runs (`seed_runs.single_surface_runs`' keys) on which every sweep claim holds."""
+    sig = (3e-9, 6e-9, 10e-9, 30e-9)
+    drops = (3e-9, 4.5e-9, 6e-9, 10e-9, 15e-9, 20e-9, 30e-9)
+    return {"escape_sigma": {x: {"escape_velocity": v, "rel_tol": 1e-2} for x, v in zip(sig, esc)},
+            "sweep_sigma": {x: [{"v_impact": 1e-3 * (i + 1), "stuck": False, "duration": d}
+                                for i, d in enumerate(durations)] for x in sig},
+            "drops_sigma": {x: _seq([f] if f else []) for x, f in zip(drops, first)},
+            "t_a": t_a or {"holds": True, "t_a_s": 25e-6}, "mass_kg": 1e-9}
+
+
+def _seed_claims(**kw):
+    return {n: c["state"] for n, c in single_surfaces.seed_claims("t", _bundle(**_seed_runs(**kw))).items()}
+
+
+def test_every_claim_judged_on_whole_sweeps_holds_on_a_good_single_surface_and_fails_on_a_broken_one():
+    """The claims the averaged law judges on its sweeps are judged on a seed's own runs by the same functions:
+    each holds on a good seed and fails when its sweep is broken that way."""
+    good = _seed_claims()
+    assert set(good.values()) == {PASS} and set(single_surfaces.SWEEP_CLAIMS) <= set(good)
+    assert _seed_claims(esc=(6e-4, 5e-4, 5.5e-4, 3e-4))[checks.ESCAPE_TREND] == FAIL
+    assert _seed_claims(durations=(9e-6, 5e-6, 7e-6))[checks.TIME_RISES] == FAIL
+    assert _seed_claims(first=(0.0, 0.4, 0.2, 0.5, 0.6, 0.7, 0.8))[checks.FIG7] == FAIL
+    assert _seed_claims(t_a={"holds": False, "t_a_s": 25e-6})[wet_checks.T_A_CLAIM] == FAIL
+
+
+def test_undecided_single_surfaces_carry_their_own_interval_and_the_one_summit_escape_velocity():
+    """Escape velocities that tie between neighbouring sigmas (one summit decides them) leave the trend undecided
+    on every seed: the block counts them apart with the Wilson interval of 4 of 4 (0.510-1.000) and names
+    v1 = sqrt(2 W_loop / m), here sqrt(2 * 1.8e-16 / 1e-9) = 6.0e-4 m/s."""
+    nominal = _bundle()
+    seeds = [dict(_bundle(**_seed_runs(esc=(6e-4, 6e-4, 6e-4, 6e-4)),
+                          silica=dict(_seq([0.5]), max_contacts=2, loop_per_summit_over_drop=0.09)),
+                  loop={"silica": 1.8e-16, "ots": 1e-16}, label=f"seed {k}", seed=True) for k in range(1, 5)]
+    trend = checks.escape_trend("t", [(x, {"escape_velocity": v, "rel_tol": 1e-3})
+                                      for x, v in ((3e-9, 6e-4), (6e-9, 5e-4), (10e-9, 4e-4), (30e-9, 3e-4))])
+    single_surfaces.attach("t", [trend], seeds, nominal)
+    ss = trend["single_surfaces"]
+    assert ss["decided"] == 0 and ss["wilson95"] is None
+    assert ss["undecided"]["k"] == 4 and ss["undecided"]["wilson95"] == pytest.approx([0.5101, 1.0], abs=1e-4)
+    assert "sqrt(2 W_loop / m) = 0.0006 m/s" in ss["mechanism"], ss["mechanism"]
 
 
 def test_a_claim_is_judged_over_its_uncertainty_rows_on_the_averaged_law_and_names_the_failing_rows():
