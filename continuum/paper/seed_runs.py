@@ -2,17 +2,19 @@
 
 A seed's bundle (``samples.bundle``) holds its drops; the claims judged on whole sweeps need, per surface, the
 same questions the nominal runs ask of the averaged law (``run``), asked of this realisation's discrete law:
-- Fig 8a: single impacts over ``FIG8_SPEED_FACTORS`` times the drop speed at each of ``FIG8_SIGMAS_NM`` and the
-  escape velocity there, bracketed by those outcomes (no speed run twice) and bisected to ``ESCAPE_REL_TOL``;
+- Fig 8a: single impacts over ``FIG8_SPEED_FACTORS`` times the drop speed at each of ``FIG8_SIGMAS_NM`` (at
+  ``SWEEP_RTOL``) and the escape velocity there (adaptive bracket from the drop speed, bisected to
+  ``SEED_ESCAPE_REL_TOL``);
 - Fig 8b: OTS's escape velocity, and both impacts at 1.2 times silica's;
 - Fig 7: the drop (at most ``SAMPLE_MAX_BOUNCES`` impacts) at each of ``SIGMAS_NM`` (6 nm is the bundle's own);
 - Fig 4: the adhesive loop per summit of each surface (from the drops' law records; a seed's silica and OTS share
   their summits, so at one depth both reach the same summits and the loop ratio is the per-summit one);
-- Fig 8a's t_a line: the dry escape velocity to ``WET_DRY_REL_TOL``, the band edge v_ta where the dry impact
+- Fig 8a's t_a line: the 6 nm escape bracket bisected on to ``WET_DRY_REL_TOL``, the band edge v_ta where the dry impact
   time falls through t_a (``speeds.t_a_band_edge``), and the one wet impact at v* that decides it
   (``wet_flips``: the claim holds exactly when that impact sticks).
-A discrete impact costs milliseconds (the summits' JKR laws in closed form, no tables), so these ~300 impacts
-cost about a second per seed.
+A discrete impact costs milliseconds to a tenth of a second (the summits' laws in closed form or their own
+tables, no footprint tables), so these ~300 impacts cost one to a few seconds of CPU per seed; the sample cache
+(`seed_cache`) keeps them for the next run with the same inputs and code.
 """
 from __future__ import annotations
 
