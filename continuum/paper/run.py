@@ -287,20 +287,21 @@ def fig8_cases() -> list[Case]:
     return [Case("hertz", "hertz_roller.toml", {"numerics.max_bounces": 1}, ("8a",))] + rough
 
 
-def _bundle_task(params: str, label: str, overrides: dict, fidelity: str | None, cases: dict, full: bool) -> dict:
+def _bundle_task(params: str, label: str, overrides: dict, fidelity: str | None, cases: dict, full: bool,
+                 single: bool = True) -> dict:
     """One sample's bundle of runs (continuum.paper.samples.bundle); a discrete seed's also carries its
     single-surface runs (`seed_runs`), which answer the claims judged on whole sweeps. Bundles are kept in the
     sample cache (`seed_cache`: the same inputs and code give the same runs)."""
     def runs() -> dict:
         b = bundle(params, label, overrides, fidelity, cases, full)
-        if b.get("seed") and "error" not in b:
+        if single and b.get("seed") and "error" not in b:
             try:
                 b.update(single_surface_runs(params, overrides, fidelity, cases, b))
             except (SceneError, ValueError, RuntimeError) as exc:     # as `bundle`: the sample counted undecided
                 b["single_surface_error"] = f"{type(exc).__name__}: {exc}"
         return b
 
-    key = seed_cache.bundle_key(params, overrides, fidelity, [*cases.values(), wet_cases()[0]], full)
+    key = seed_cache.bundle_key(params, overrides, fidelity, [*cases.values(), wet_cases()[0]], [full, single])
     b = seed_cache.cached(key, runs)
     return {"kind": "bundle", "case": label, "set": Path(params).stem, "bundle": b}
 
@@ -312,7 +313,9 @@ def sample_tasks(s: str, fidelity: str | None, seeds: int, uncertainty: list[dic
     cases = bundle_cases(dry_cases())
     if cases is None:
         return []
-    tasks = [("bundle", (s, label, o, fidelity, cases, False)) for label, o in seed_overrides(seeds)]
+    # a seed's single-surface runs mirror the Fig 8a sweeps and the wet sweep: only when this run makes them
+    single = bool(wet_cases()) and {sigma_case(x).name for x in FIG8_SIGMAS_NM} <= {c.name for c in fig8_cases()}
+    tasks = [("bundle", (s, label, o, fidelity, cases, False, single)) for label, o in seed_overrides(seeds)]
     tasks += [("bundle", (s, f"uncertainty {i + 1}", o, fidelity, cases, True)) for i, o in enumerate(uncertainty)]
     return tasks
 

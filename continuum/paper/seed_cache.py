@@ -47,15 +47,16 @@ def cache_dir() -> Path | None:
     return (Path(env).expanduser() if env else Path("~/.cache/nanoimpact").expanduser()) / "paper"
 
 
-def bundle_key(params: str, overrides: dict, fidelity: str | None, cases: list[Case], full: bool) -> str:
-    """The cache key of one sample's bundle: a seed's or an uncertainty row's (`overrides`), on `cases`."""
+def bundle_key(params: str, overrides: dict, fidelity: str | None, cases: list[Case], kind) -> str:
+    """The cache key of one sample's bundle: a seed's or an uncertainty row's (`overrides`), on `cases`; `kind`:
+    what the bundle holds (JSON-able: whether it is a full one, whether it has the single-surface runs)."""
     inputs = []
     for c in cases:
         row, _ = row_for_scene(c.path, params, c.overrides, overrides)
         inputs.append(resolve_scene(c.path, params=params, overrides={**c.overrides, **row},
                                     override_label="sample cache key").input_hash)
     blob = json.dumps({"version": CACHE_VERSION, "code": code_hash(), "inputs": inputs, "overrides": overrides,
-                       "fidelity": fidelity, "full": full}, sort_keys=True, default=repr)
+                       "fidelity": fidelity, "kind": kind}, sort_keys=True, default=repr)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 

@@ -229,10 +229,11 @@ def test_a_sample_bundle_is_cached_by_its_inputs_and_code_and_run_again_when_eit
 
     cases = list(bundle_cases(dry_cases()).values())
     seed = {"surfaces.roughness.mode": "discrete", "surfaces.roughness.seed": 1}
-    key = seed_cache.bundle_key("paper", seed, None, cases, False)
-    assert key == seed_cache.bundle_key("paper", dict(seed), None, cases, False)
-    assert key != seed_cache.bundle_key("paper", {**seed, "surfaces.roughness.seed": 2}, None, cases, False)
-    assert key != seed_cache.bundle_key("silicon", seed, None, cases, False)
+    key = seed_cache.bundle_key("paper", seed, None, cases, [False, True])
+    assert key == seed_cache.bundle_key("paper", dict(seed), None, cases, [False, True])
+    assert key != seed_cache.bundle_key("paper", {**seed, "surfaces.roughness.seed": 2}, None, cases, [False, True])
+    assert key != seed_cache.bundle_key("silicon", seed, None, cases, [False, True])
+    assert key != seed_cache.bundle_key("paper", seed, None, cases, [False, False])     # without its single-surface runs
     calls = []
     monkeypatch.setenv("NANOIMPACT_CACHE", str(tmp_path))
     first = seed_cache.cached(key, lambda: calls.append(1) or {"x": 1.0})
@@ -242,4 +243,4 @@ def test_a_sample_bundle_is_cached_by_its_inputs_and_code_and_run_again_when_eit
     assert seed_cache.cached(key, lambda: {"x": 3.0}) == {"x": 3.0}
     seed_cache.code_hash.cache_clear()
     monkeypatch.setattr(seed_cache, "code_hash", lambda: "another code")
-    assert seed_cache.bundle_key("paper", seed, None, cases, False) != key
+    assert seed_cache.bundle_key("paper", seed, None, cases, [False, True]) != key
