@@ -39,7 +39,8 @@ def loop_claim(s: str, b: dict) -> dict:
     name, units = NAMES[0], "1 (1 - loop ratio)"
     thr = "OTS's adhesive loop area < bare silica's (the loop ratio's size is a band)"
     if "loop" not in b:
-        return not_evaluable(name, s, REPRODUCTION, thr, units, "no averaged law in this sample (discrete seed)")
+        return not_evaluable(name, s, REPRODUCTION, thr, units,
+                             b.get("loop_missing", "no averaged law in this sample (discrete seed)"))
     ratio = b["loop"]["ots"] / b["loop"]["silica"] if b["loop"]["silica"] > 0 else math.inf
     return entry(name, s, REPRODUCTION, {"loop_ratio": ratio, "loop_area_J_per_m": b["loop"]}, thr, 1.0 - ratio,
                  RUN_RTOL, units)

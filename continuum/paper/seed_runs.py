@@ -89,7 +89,12 @@ def single_surface_runs(params: str, overrides: dict, fidelity: str | None, case
                 "ots": single_impact(ots, sc.body.mass, sc.environment.gravity, v, sc.numerics.rtol)}
         out["low_speed"] = {"v_impact": v, **{k: {"stuck": r.stuck, "duration": r.bounces[0].duration}
                                               for k, r in runs.items()}}
-    out["loop"] = {k: drops[k].get("loop_energy_per_summit") for k in ("silica", "ots")}
+    loops = {k: drops[k].get("loop_energy_per_summit") for k in ("silica", "ots")}
+    if all(loops.values()):
+        out["loop"] = loops
+    else:       # the summit law records no closed-form loop (plastic or tabulated summits): the claim says so
+        out["loop_missing"] = "the summit law of this seed records no loop per summit (" + ", ".join(
+            k for k, v in loops.items() if not v) + ")"
     out["mass_kg"] = sc.body.mass
     out["drops_sigma"] = {6e-9: drops["silica"]}
     for s in SIGMAS_NM:

@@ -435,3 +435,12 @@ def test_the_wet_sweep_runs_dry_and_wet_on_one_dry_law_so_impacts_shorter_than_t
     assert b["restitution"] == a["restitution"] and b["duration"] == a["duration"]
     other = select_law(resolve_case(case, "silicon", None).scene, v0, menisci=False)[0]
     assert sharing_tables(select_law(scene, v0, menisci=True)[0], other).dry is not other
+
+
+def test_a_seed_whose_summit_law_records_no_loop_leaves_the_loop_claim_undecided_with_the_reason():
+    """Plastic or tabulated summits (silicon, calibrated) record no closed-form loop per summit: the seed's Fig 4
+    claim is not evaluable and says why, instead of comparing None."""
+    b = {k: v for k, v in _bundle(**_seed_runs()).items() if k != "loop"}
+    b["loop_missing"] = "the summit law of this seed records no loop per summit (silica)"
+    c = single_surfaces.seed_claims("t", b)["fig4_ots_loop_smaller_than_silica"]
+    assert c["state"] == NOT_EVALUABLE and "no loop per summit" in c["reason"]
