@@ -474,15 +474,13 @@ def calibrate(recipe_path: str | Path, out: str | Path, *, md_fidelity: str = "q
         # 2. the set
         machine = {"cores": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}
         md_compute = {r: _md_wall(res) for r, res in results.items()}
-        table, rows, set_path = _write_set(cal, results, md_fidelity, machine, timings["md_s"], md_compute,
-                                           params_out, progress)
+        table, rows, set_path, keys, samples = _write_set(cal, results, md_fidelity, machine, timings["md_s"],
+                                                          md_compute, params_out, progress)
         # 3. the paper's cases
         t = time.perf_counter()
         from continuum.api import DEFAULT_SEEDS, make_paper
 
         sets = [cal.base, *[s for s in paper_sets if s != cal.base], str(set_path)]
-        keys, samples = sample_inputs(table["meta"].get("calibration", {}), cal.uncertainty.ranges,
-                                      cal.uncertainty.samples, cal.uncertainty.seed)
         # the new set's claims judged over the calibration's own Latin-hypercube rows; the seeds reported beside them
         rows_paper = paper_uncertainty(cal.uncertainty, samples, set_path)
         paper = make_paper(sets, out / "paper", executor=ex, progress=lambda m: None,   # the user's executor
@@ -546,20 +544,33 @@ def _run_md_jobs(ex, name: str, md_fidelity: str, executor_name: str, md_cache, 
 
 
 def _write_set(cal: CalibrationRecipe, results: dict, md_fidelity: str, machine: dict, md_s: float,
-               md_compute: dict, params_out, progress) -> tuple[dict, list, Path]:
-    """The calibrated parameter set built from the MD results and written; returns (table, rows, its path)."""
-    table, rows = build_parameter_set(results, cal.base, cal.name, description=cal.description,
-                                      extra_meta={"md_fidelity": md_fidelity, "machine": machine,
-                                                  "pipeline_md_wall_s": md_s, "md_compute_wall_s": md_compute,
-                                                  "md_compute_total_s": sum(md_compute.values()),
-                                                  "created_by": f"nanoimpact calibrate {cal.path}"})
+               md_compute: dict, params_out, progress) -> tuple[dict, list, Path, list, list]:
+    """The calibrated parameter set built from the MD results and written, with its Latin-hypercube rows beside it
+    (`<name>.uncertainty.csv`, the inputs of each row; `[meta] uncertainty_rows` points to it, so `nanoimpact paper`
+    judges the set's claims over them by default, `continuum.paper.samples.set_uncertainty_rows`); the rows are
+    written first, so the set never points to a missing file. Returns (table, rows, its path, the sampled keys, the
+    samples)."""
     set_path = Path(params_out) if params_out else data.writable_root() / "params" / f"{cal.name}.toml"
+    rows_name = f"{set_path.stem}.uncertainty.csv"
+    meta = {"md_fidelity": md_fidelity, "machine": machine, "pipeline_md_wall_s": md_s,
+            "md_compute_wall_s": md_compute, "md_compute_total_s": sum(md_compute.values()),
+            "created_by": f"nanoimpact calibrate {cal.path}"}
+    table, rows = build_parameter_set(results, cal.base, cal.name, description=cal.description, extra_meta=meta)
+    keys, samples = sample_inputs(table["meta"].get("calibration", {}), cal.uncertainty.ranges,
+                                  cal.uncertainty.samples, cal.uncertainty.seed)
+    if samples:
+        fh = io.StringIO(newline="")
+        w = csv.DictWriter(fh, fieldnames=keys)
+        w.writeheader()
+        w.writerows({k: s.get(k) for k in keys} for s in samples)
+        atomic_write_text(set_path.parent / rows_name, fh.getvalue())
+        table["meta"]["uncertainty_rows"] = rows_name
     write_parameter_set(table, set_path, header=(
         f"The `{cal.name}` parameter set, written by `nanoimpact calibrate {cal.path} --md-fidelity "
         f"{md_fidelity}`: MD-measured values on the `{cal.base}` base set; [meta.calibration] gives each "
         "value's stderr and MD run hash, [meta.rejected] what was not used and why."))
-    progress(f"  wrote {set_path}")
-    return table, rows, set_path
+    progress(f"  wrote {set_path}" + (f" and its {len(samples)} uncertainty rows ({rows_name})" if samples else ""))
+    return table, rows, set_path, keys, samples
 
 
 def paper_uncertainty(unc: Uncertainty, samples: list[dict], set_path: Path) -> dict[str, list[dict]]:

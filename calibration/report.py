@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any, Mapping
 
+from continuum.api import single_text
 from nanoimpact import __version__
 from nanoimpact.fileio import atomic_write_text
 
@@ -278,19 +279,18 @@ def report_markdown(rec: CalibrationReport) -> str:
               "A rejected or missing value keeps the base set's value (with the base set's [meta.origin] entry).",
               _work_sentence(rec.rows),
               "", "## The paper's claims per set", "",
-              "Each cell: the verdict on the paper's model (the averaged GW surface), then, for a reproduction claim "
-              "judged on single discrete-summit surfaces, on how many of them it holds (Wilson 95 %): the project's "
-              "finding beyond the paper, which decides nothing.", "",
-              "| claim | " + " | ".join(sets) + " |", "|---|" + "---|" * len(sets)]
+              "Two columns per set: the verdict on the paper's model (the averaged GW surface), and for a reproduction "
+              "claim on how many single discrete-summit surfaces it holds (Wilson 95 %; undecided surfaces counted "
+              "apart with theirs): the project's finding beyond the paper, which decides nothing.", "",
+              "| claim | " + " | ".join(f"{s} (paper's model) | {s} (single surfaces)" for s in sets) + " |",
+              "|---|" + "---|---|" * len(sets)]
     by: dict[str, dict] = {}
     for c in rec.paper_checks:
-        single = c.get("single_surfaces") or {}
-        beside = (f"; single surfaces {single['holds']} of {single['decided']} ({single['wilson95'][0]:.2f}-"
-                  f"{single['wilson95'][1]:.2f})" if single.get("decided") else "")
-        by.setdefault(c["name"], {})[c["set"]] = ("pass" if c["pass"] else "**fail**"
-                                                  if c.get("state", "fail") == "fail" else c["state"]) + beside
+        by.setdefault(c["name"], {})[c["set"]] = (("pass" if c["pass"] else "**fail**"
+                                                   if c.get("state", "fail") == "fail" else c["state"]),
+                                                  single_text(c) if c.get("kind") == "reproduction" else "-")
     for name, res in by.items():
-        lines.append(f"| `{name}` | " + " | ".join(res.get(s, "-") for s in sets) + " |")
+        lines.append(f"| `{name}` | " + " | ".join(" | ".join(res.get(s, ("-", "-"))) for s in sets) + " |")
     name = Path(rec.set_path).stem
     mine = rec.claims()
     agree = [c["name"] for c in mine if c["pass"]]

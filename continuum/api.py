@@ -37,6 +37,7 @@ from .paper import loop_probe
 from .paper import report as paper_report
 from .paper.samples import DEFAULT_SEEDS as DEFAULT_SEEDS
 from .paper.samples import row_for_scene as row_for_scene
+from .paper.verdict import single_text as single_text
 from .rough.ensemble import EnsembleResult
 from .scene import ResolvedScene, resolve_scene
 from .scene import SceneError as SceneError

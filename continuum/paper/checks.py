@@ -16,13 +16,11 @@ from .samples import ESCAPE_REL_TOL
 from .verdict import FAIL, REPRODUCTION, VERIFICATION, band, entry, not_evaluable, over_samples
 
 ESCAPE_TREND = "fig8a_escape_velocity_falls_as_sigma_rises"
+FIG7 = "fig7_rebounds_rise_with_sigma"
+TIME_RISES = "fig8a_rough_impact_time_rises_as_velocity_falls"
 #: What the sweep claims were sampled over (recorded in each entry's `sampled`).
 NOMINAL_ONLY = {"nominal": 1, "uncertainty": 0,
                 "note": "judged on the nominal set only: sampling it reruns whole velocity or sigma sweeps"}
-#: Why a claim judged on whole sweeps has no single-surface column (checks.json -> single_surfaces.note).
-NO_SINGLE_SURFACES = ("not evaluated on single surfaces: it needs whole sweeps or escape searches per surface "
-                      "(~15 discrete impacts per escape velocity); the gap between the averaged and single "
-                      "surfaces is measured on the sampled claims (fig7_sigma3_sticks_at_first_impact shows it)")
 #: Why each claim judged on the nominal set alone is not judged on the samples (checks.json -> sampled.note).
 NOT_SAMPLED = {
     "fig7_rebounds_rise_with_sigma": "the full drop (up to 100 impacts) at seven sigmas per sample; a discrete seed "
@@ -121,8 +119,7 @@ def _fig6(s: str, run: dict | None) -> list[dict]:
 
 
 def _nominal(e: dict, bands: dict | None = None) -> dict:
-    return dict(over_samples(e, [], nominal_only(e["name"]), bands),
-                single_surfaces={"n": 0, "note": NO_SINGLE_SURFACES})
+    return over_samples(e, [], nominal_only(e["name"]), bands)
 
 
 def reproduce_dry(s: str, impacts: dict, sweeps: dict, samples: list[dict] = ()) -> list[dict]:
@@ -143,34 +140,44 @@ def reproduce_dry(s: str, impacts: dict, sweeps: dict, samples: list[dict] = ())
 def _fig7(s: str, sig: list) -> dict:
     h0 = sig[0][1]["scene"]["si"]["release_height"]
     first = [(rebounds(c)[0] / h0 if rebounds(c) else 0.0) for _, c in sig]
-    counts = [len(rebounds(c)) for _, c in sig]
-    capped = [c["status"] == "max_bounces" for _, c in sig]
+    e = fig7_entry(s, [x for x, _ in sig], first, [len(rebounds(c)) for _, c in sig],
+                   [c["status"] == "max_bounces" for _, c in sig])
+    return _nominal(e, {"first_rebound_over_h0_at_largest_sigma": band([first[-1]])})
+
+
+def fig7_entry(s: str, sigmas: list[float], first: list[float], counts: list[int], capped: list[bool]) -> dict:
+    """Fig 7: the first rebound (/ h0, 0 where it sticks) rises with sigma and the rebounds before sticking do not
+    decrease (a capped drop, still rebounding at its last impact, bounds its count from below)."""
     steps = [b - a for a, b in zip(first, first[1:]) if a > 0.0 or b > 0.0]
-    values = {"sigma_m": [x for x, _ in sig], "first_rebound_over_h0": first, "rebounds_before_sticking": counts,
+    values = {"sigma_m": list(sigmas), "first_rebound_over_h0": first, "rebounds_before_sticking": counts,
               "capped": capped}
     thr = ("first rebound height rises with sigma (ties only where both stick at once), bounces before sticking "
            "do not decrease; sigma = 30 nm's first rebound is a band")
-    e = entry("fig7_rebounds_rise_with_sigma", s, REPRODUCTION, values, thr, min(steps, default=None), RUN_RTOL,
+    e = entry(FIG7, s, REPRODUCTION, values, thr, min(steps, default=None), RUN_RTOL,
               "h0 (smallest rise of the first rebound)",
               None if steps else "every sigma sticks at the first impact")
     fell = [i for i in range(len(counts) - 1) if counts[i + 1] < counts[i] and not capped[i + 1]]
     if fell:
-        e.update(state=FAIL, reason=f"fewer bounces at sigma = {sig[fell[0] + 1][0] * 1e9:g} nm", **{"pass": False})
-    return _nominal(e, {"first_rebound_over_h0_at_largest_sigma": band([first[-1]])})
+        e.update(state=FAIL, reason=f"fewer bounces at sigma = {sigmas[fell[0] + 1] * 1e9:g} nm", **{"pass": False})
+    return e
 
 
 def _time_rises(s: str, rough: dict) -> dict:
+    return _nominal(time_rises_entry(s, rough, RUN_RTOL))
+
+
+def time_rises_entry(s: str, rough: dict, tolerance: float) -> dict:
+    """Fig 8a: the impact time strictly rises as the velocity falls, at every sigma; `rough` = {case: sweep with
+    'points' ascending in speed}; `tolerance`: the durations' relative accuracy."""
     steps, values = [], {}
     for k, sw in rough.items():
         d = [p["duration"] for p in sw["points"] if not p["stuck"]]
         values[k] = d
         steps += [d[i] / d[i + 1] - 1.0 for i in range(len(d) - 1)]
     left_out = {k: [p["v_impact"] for p in sw.get("skipped", [])] for k, sw in rough.items() if sw.get("skipped")}
-    e = entry("fig8a_rough_impact_time_rises_as_velocity_falls", s, REPRODUCTION,
-              {"durations_s": values, "speeds_left_out_m_per_s": left_out},
-              "impact duration strictly falls with impact velocity, every sigma", min(steps, default=None),
-              RUN_RTOL, "1 (smallest relative rise as v falls)")
-    return _nominal(e)
+    return entry(TIME_RISES, s, REPRODUCTION, {"durations_s": values, "speeds_left_out_m_per_s": left_out},
+                 "impact duration strictly falls with impact velocity, every sigma", min(steps, default=None),
+                 tolerance, "1 (smallest relative rise as v falls)")
 
 
 def escape_trend(s: str, esc: list[tuple[float, dict]]) -> dict:
@@ -191,10 +198,10 @@ def _escape_falls(s: str, rough: dict, samples: list[dict]) -> dict:
     """The trend on the Fig 8a sweeps, judged also on every sample bundle that searched each sigma's escape
     velocity (the averaged law's: the nominal bundle and the uncertainty rows; a discrete seed searches none)."""
     nominal = escape_trend(s, [(sw["sigma"], sw["escape"]) for sw in rough.values()])
-    used = [b for b in samples if "escape_sigma" in b]
+    used = [b for b in samples if "escape_sigma" in b and not b.get("seed")]
     states = [escape_trend(s, list(b["escape_sigma"].items()))["state"] for b in used]
     sources = {"nominal": 1, "uncertainty": len(used)}
     sigmas = sorted(used[0]["escape_sigma"]) if used else []
     bands = {f"escape_velocity_m_per_s_at_{x * 1e9:g}nm": band(b["escape_sigma"][x].get("escape_velocity")
                                                               for b in used) for x in sigmas}
-    return dict(over_samples(nominal, states, sources, bands), single_surfaces={"n": 0, "note": NO_SINGLE_SURFACES})
+    return over_samples(nominal, states, sources, bands)

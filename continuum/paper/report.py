@@ -13,8 +13,9 @@ from . import checks, figures
 from .checks import NOMINAL_ONLY
 from .run import fig4_curves, run_paper
 from .sampled_claims import judged_over_samples, loop_claim
-from .samples import nominal_bundle
-from .verdict import REPRODUCTION, VERIFICATION, over_samples
+from .samples import nominal_bundle, set_uncertainty_rows
+from .single_surfaces import attach as attach_single_surfaces
+from .verdict import REPRODUCTION, VERIFICATION, over_samples, single_text
 from .wet_checks import evaluate_wet
 
 
@@ -155,14 +156,17 @@ def set_claims(set_name: str, collected: dict) -> list[dict]:
     curves = collected["curves"][set_name]
     out = checks.verify_dry(set_name, results, sweeps, {k: {"loop_area": v["loop_area"]} for k, v in curves.items()})
     bundles = {c: v["bundle"] for (c, s), v in collected.get("bundles", {}).items() if s == set_name}
-    out += checks.reproduce_dry(set_name, results, sweeps, [b for b in bundles.values() if "error" not in b])
+    rows = [b for b in bundles.values() if not b.get("seed")]
+    seeds = [b for b in bundles.values() if b.get("seed")]
+    out += checks.reproduce_dry(set_name, results, sweeps, [b for b in rows if "error" not in b])
     out += evaluate_wet(set_name, wet, results)
     nominal = nominal_bundle(results, sweeps, wet, curves)
     if nominal is not None:
-        out += judged_over_samples(set_name, nominal, list(bundles.values()))
+        out += judged_over_samples(set_name, nominal, rows)
     elif curves:                    # a run cut to Fig 4: its loop claim from the curves, on the nominal set alone
         loops = {"loop": {k: v["loop_area"] for k, v in curves.items()}}
         out.append(over_samples(loop_claim(set_name, loops), [], NOMINAL_ONLY))
+    attach_single_surfaces(set_name, out, seeds if nominal is not None else [], nominal)
     return sorted(out, key=lambda c: c["kind"] != VERIFICATION)
 
 
@@ -172,15 +176,6 @@ def _band_text(key: str, b: dict) -> str:
         lo, hi = b["wilson95"]
         return f"{key} {b['k']} of {b['n']} (95 % {lo:.2f}-{hi:.2f})"
     return f"{key} {_fmt(b['min'])}-{_fmt(b['max'])} (median {_fmt(b['median'])}, n {b['n']})"
-
-
-def _single_text(c: dict) -> str:
-    """The single-surfaces cell: holds on k of n (Wilson 95 %), or why none were judged."""
-    ss = c.get("single_surfaces") or {}
-    if not ss.get("decided"):
-        return "-" if not ss.get("n") else f"0 of {ss['n']} decided"
-    lo, hi = ss["wilson95"]
-    return f"{ss['holds']} of {ss['decided']} ({lo:.2f}-{hi:.2f})"
 
 
 def _source_text(c: dict) -> str:
@@ -203,12 +198,13 @@ def claim_tables(set_checks: list[dict]) -> list[str]:
                                               "uncertainty rows" if rows else "; no uncertainty rows were used: each "
                                               "claim is judged on the set's nominal runs") + "). Beside it, the "
               "project's finding beyond the paper: on how many single discrete-summit surfaces the claim holds "
-              "(Wilson 95 % interval):", "",
+              "(Wilson 95 % interval; undecided surfaces, with no subject or a margin inside its tolerance, counted "
+              "apart with theirs):", "",
               "| claim | paper's model | single surfaces: holds (95 %) | holds_fraction | uncertainty rows | margin "
               "| tolerance | units | threshold | reason | bands |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in rep:
         bands = "; ".join(_band_text(k, b) for k, b in (c.get("bands") or {}).items() if b)
-        lines.append(f"| `{c['name']}` | {c['state']} | {_single_text(c)} | {_fmt(c.get('holds_fraction'), '.3g')} | "
+        lines.append(f"| `{c['name']}` | {c['state']} | {single_text(c)} | {_fmt(c.get('holds_fraction'), '.3g')} | "
                      f"{c.get('sampled', {}).get('uncertainty', 0)} | {_fmt(c['margin'])} | {_fmt(c['tolerance'])} | "
                      f"{c['units']} | {_source_text(c)} | {c.get('reason', '')} | {bands} |")
     departs = [f"- `{c['name']}`: {c['single_surfaces']['mechanism']}." for c in rep
@@ -228,7 +224,9 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
     The sampled reproduction claims run on the nominal set, on `seeds` discrete-summit seeds per set (the command
     line's default is samples.DEFAULT_SEEDS; callers that only need pass/fail of the nominal runs, such as the
     calibration's reverts, leave 0) and on the `uncertainty` rows ({set name: [scene overrides, ...]}, e.g.
-    `samples.read_uncertainty_csv` of a calibration's uncertainty.csv, or the calibration's own draws).
+    `samples.read_uncertainty_csv` of a calibration's uncertainty.csv, or the calibration's own draws); a set that
+    points to its rows (`[meta] uncertainty_rows`, `samples.set_uncertainty_rows`) is judged over them unless
+    `uncertainty` names it.
 
     `draw_figures=False` draws none of Figs 4-8b (the claims, summary.md and checks.json are the same): for callers
     that want the claims alone, such as the calibration's claim attribution. `case_figures=True` also draws each
@@ -238,6 +236,7 @@ def make_paper(sets: list[str], out: str | Path, *, fidelity: str | None = None,
     `executor_name` executor with `workers` and `scheduler` (default: a local pool of CPU-count processes)."""
     out = Path(out)
     start = time.perf_counter()
+    uncertainty = {**set_uncertainty_rows(sets), **(uncertainty or {})}
 
     def draw(set_name: str, collected: dict) -> None:
         """A set's figures, drawn here while the pool runs the next set (~5 s of matplotlib per set)."""

@@ -23,46 +23,31 @@ import numpy as np
 
 from nanoimpact.executors import executor as make_executor
 
-from ..dynamics.escape import single_impact
 from ..dynamics.impact import first_impact_speed, run_impact
-from ..model import menisci_decision, regime_of, select_law
+from ..model import factory, menisci_decision, regime_of, select_law
 from ..numerics.compiled_contact import warm_up
 from ..output.impact_result import write_impact
 from ..output.results import write_run
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from ..wet import menisci as men
+from . import seed_cache
 from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, low_speed_runs, seed_overrides
+from .seed_runs import single_surface_runs
+from .speeds import (
+    BAND_POINTS,
+    FIG8_SPEED_FACTORS,
+    MAX_BAND_EPS,
+    STUDY_BAND_FACTOR,
+    STUDY_LN_WIDTH,
+    WET_DRY_REL_TOL,
+    WET_EPS,
+    WET_REL_TOL,
+    fastest_first,
+    t_a_band_edge,
+)
+from .speeds import outcome as _outcome
 from .wet_flips import BAND_EDGE, BEYOND_SCAN, FAILS, HOLDS, NO_SUBJECT, REFUSED, at_condensation_time, t_a_flips
-
-#: Fig 8a velocity sweep: impact speeds as multiples of the 100 nm drop speed.
-FIG8_SPEED_FACTORS = tuple(np.geomspace(0.05, 20.0, 10))
-#: Relative bracket of the dry and the wet escape velocity in the wet sweep: the runs' own accuracy (an impact's
-#: duration and rebound to ~1e-6 relative, `sampled_claims.RUN_RTOL`), never finer; far below the band of speeds
-#: where dry impacts outlast t_a (0.02 to 11 of v_esc wide in the shipped sets), so the band is resolved.
-WET_DRY_REL_TOL = 1e-6
-WET_REL_TOL = 1e-6
-#: Wet sweeps: impact speeds just above the dry escape velocity, v = v_esc (1 + eps), where the impact time grows
-#: and may outlast t_a; from the escape bracket's own width up (closer speeds cannot be told from it).
-WET_EPS = tuple(np.geomspace(WET_DRY_REL_TOL, 2.0, 10))
-#: Largest v / v_esc - 1 the t_a band's scan is extended to when every scanned impact outlasts t_a (for a set
-#: whose escape velocity is tens of um/s, impacts at several times it still last longer than t_a = 25 us).
-MAX_BAND_EPS = 1e3
-#: The t_a study scans bands up to this many times the declared t_a's band (`_t_a_study`), and bisects each band
-#: edge to this width in ln eps: v_ta to ~1e-4 of the band, against the claim's 1 % band edge.
-STUDY_BAND_FACTOR = 4.0
-STUDY_LN_WIDTH = 1e-4
-#: Speeds sampled inside the band where dry impacts outlast t_a.
-BAND_POINTS = 6
-
-
-def fastest_first(speeds):
-    """Sweep speeds in the order they run: the fastest first. The rigid rough law sizes its footprint tables
-    for the deepest impact it has seen and keeps them for impacts down to 1/20 of that depth
-    (`RigidRoughRoller.prepare`), so a descending sweep builds them once (~1 s) instead of at every speed of
-    an ascending one; the points move by the tables' and the integration's tolerance (< 1e-7 relative,
-    docs/benchmarks.md). The results are reported in ascending order."""
-    return sorted(speeds, reverse=True)
 
 
 def resolve_case(case: Case, params: str, fidelity: str | None) -> ResolvedScene:
@@ -113,12 +98,6 @@ def _sweep_task(case: Case, params: str, fidelity: str | None) -> dict:
     return out
 
 
-def _outcome(law, mass, g, v, rtol) -> dict:
-    run = single_impact(law, mass, g, v, rtol)
-    b = run.bounces[0]
-    return {"stuck": run.stuck, "duration": b.duration, "v_rebound": b.v_rebound, "restitution": b.restitution}
-
-
 def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     """Near-escape sweep of a wet case: each speed run without and (if bridges can pull) with menisci.
 
@@ -139,6 +118,7 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     menisci = menisci_decision(scene, regime)
     wet_possible = menisci.choice != "off"
     wet = select_law(scene, v0, menisci=True, regime=regime)[0] if wet_possible else None
+    wet = factory.wet_sharing_dry_tables(wet, dry) if wet is not None else None
     m = dict(regime.meniscus_parameters()) if wet is not None else {}
     t_a = m.get("condensation_time")
     grid, dry_runs, skipped = [], {}, []
@@ -162,12 +142,16 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
             band, edge = [], {"eps": None, "reason": f"a speed in the band's scan is refused: {exc}"}
         speeds |= {up * (1.0 + e) for e in WET_EPS} | set(band)
     speeds = sorted(speeds)
-    for v in fastest_first(speeds):
-        if v not in dry_runs:
-            dry_runs[v] = _outcome(dry, mass, g, v, rtol)
     wet_runs = {}
-    for v in fastest_first(speeds) if wet is not None else []:
+    for v in fastest_first(speeds):
+        if wet is None:
+            if v not in dry_runs:
+                dry_runs[v] = _outcome(dry, mass, g, v, rtol)
+            continue
+        # the pair back to back: on the shared tables (`continuum.model.factory.wet_sharing_dry_tables`) both see
+        # the same table sizes
         try:
+            dry_runs[v] = _outcome(dry, mass, g, v, rtol)
             wet_runs[v] = _outcome(wet, mass, g, v, rtol)
         except SceneError as exc:
             skipped.append({"v_impact": v, "reason": f"with menisci: {exc}"})
@@ -253,42 +237,6 @@ def _t_a_band(dry, mass, g, rtol, upper: float, t_a: float | None, runs: dict,
     return [upper * (1.0 + e) for e in np.geomspace(WET_DRY_REL_TOL, edge["eps"], BAND_POINTS)], edge
 
 
-def t_a_band_edge(duration: Callable[[float], float], t_a: float, scan: tuple, eps_floor: float,
-                  ln_width: float = 2e-8, max_eps: float = MAX_BAND_EPS) -> dict:
-    """Where the dry impact time falls through t_a above the escape velocity: eps of v = v_esc (1 + eps).
-
-    `duration(eps)` is the dry impact time (inf where it sticks), known to be >= t_a at eps = 0. The scan speeds
-    (eps values `scan`, extended by factors of 4 up to `max_eps` while every impact outlasts t_a) bracket the
-    crossing first; only a scan whose impacts outlast t_a up to one point and no further (one crossing, from long
-    to short) is bisected, in ln eps, to `ln_width` (below the scan's first point the bracket's lower end is
-    `eps_floor`, the escape velocity's own relative bracket). A scan that crosses t_a more than once (the impact
-    time is not monotone in the speed there), that starts short and turns long, or that outlasts t_a up to
-    `max_eps` gives no edge: {'eps': None, 'reason': ...}. Returns {'eps', 'rel_tol' (the bracket's width in
-    eps plus eps_floor), 'scan': [[eps, outlasts], ...]}."""
-    grid = sorted(scan)
-    long = [duration(e) >= t_a for e in grid]
-    while all(long) and grid[-1] < max_eps:               # the band reaches past the scan: extend it upwards
-        grid.append(4.0 * grid[-1])
-        long.append(duration(grid[-1]) >= t_a)
-    record = [[e, bool(x)] for e, x in zip(grid, long)]
-    crossings = sum(a != b for a, b in zip(long, long[1:]))
-    if crossings > 1 or (crossings == 1 and not long[0]):
-        where = ", ".join(f"{e:.3g}" for (e, a), (_, b) in zip(record, record[1:]) if a != b)
-        return {"eps": None, "scan": record,
-                "reason": f"the dry impact time crosses t_a {crossings} times in the scan (near eps = {where}): "
-                          "not monotone in the speed, so no single band edge"}
-    if all(long):
-        return {"eps": None, "scan": record,
-                "reason": f"dry impacts outlast t_a up to the scan's fastest speed, v_esc (1 + {grid[-1]:.3g})"}
-    n_long = sum(long)
-    lo = math.log(grid[n_long - 1]) if n_long else math.log(eps_floor)        # long at lo, short at hi
-    hi = math.log(grid[n_long])
-    while hi - lo > ln_width:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if duration(math.exp(mid)) >= t_a else (lo, mid)
-    return {"eps": math.exp(lo), "rel_tol": math.exp(hi) - math.exp(lo) + eps_floor, "scan": record}
-
-
 def fig4_curves(set_name: str, fidelity: str | None) -> dict:
     """Pressure-gap characteristics of rough silica and OTS-covered silica for one set (Fig 4)."""
     from .figures import characteristic
@@ -325,10 +273,23 @@ def fig8_cases() -> list[Case]:
     return [Case("hertz", "hertz_roller.toml", {"numerics.max_bounces": 1}, ("8a",))] + rough
 
 
-def _bundle_task(params: str, label: str, overrides: dict, fidelity: str | None, cases: dict, full: bool) -> dict:
-    """One sample's bundle of runs (continuum.paper.samples.bundle)."""
-    return {"kind": "bundle", "case": label, "set": Path(params).stem,
-            "bundle": bundle(params, label, overrides, fidelity, cases, full)}
+def _bundle_task(params: str, label: str, overrides: dict, fidelity: str | None, cases: dict, full: bool,
+                 single: bool = True) -> dict:
+    """One sample's bundle of runs (continuum.paper.samples.bundle); a discrete seed's also carries its
+    single-surface runs (`seed_runs`), which answer the claims judged on whole sweeps. Bundles are kept in the
+    sample cache (`seed_cache`: the same inputs and code give the same runs)."""
+    def runs() -> dict:
+        b = bundle(params, label, overrides, fidelity, cases, full)
+        if single and b.get("seed") and "error" not in b:
+            try:
+                b.update(single_surface_runs(params, overrides, fidelity, cases, b))
+            except (SceneError, ValueError, RuntimeError) as exc:     # as `bundle`: the sample counted undecided
+                b["single_surface_error"] = f"{type(exc).__name__}: {exc}"
+        return b
+
+    key = seed_cache.bundle_key(params, overrides, fidelity, [*cases.values(), wet_cases()[0]], [full, single])
+    b = seed_cache.cached(key, runs)
+    return {"kind": "bundle", "case": label, "set": Path(params).stem, "bundle": b}
 
 
 def sample_tasks(s: str, fidelity: str | None, seeds: int, uncertainty: list[dict]) -> list[tuple[str, tuple]]:
@@ -338,7 +299,9 @@ def sample_tasks(s: str, fidelity: str | None, seeds: int, uncertainty: list[dic
     cases = bundle_cases(dry_cases())
     if cases is None:
         return []
-    tasks = [("bundle", (s, label, o, fidelity, cases, False)) for label, o in seed_overrides(seeds)]
+    # a seed's single-surface runs mirror the Fig 8a sweeps and the wet sweep: only when this run makes them
+    single = bool(wet_cases()) and {sigma_case(x).name for x in FIG8_SIGMAS_NM} <= {c.name for c in fig8_cases()}
+    tasks = [("bundle", (s, label, o, fidelity, cases, False, single)) for label, o in seed_overrides(seeds)]
     tasks += [("bundle", (s, f"uncertainty {i + 1}", o, fidelity, cases, True)) for i, o in enumerate(uncertainty)]
     return tasks
 

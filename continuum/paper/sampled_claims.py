@@ -22,9 +22,6 @@ NAMES = ("fig4_ots_loop_smaller_than_silica", "fig5a_ots_outbounces_silica",
          "fig8b_ots_lower_escape_velocity", "fig8b_ots_impact_shorter_at_the_same_low_velocity")
 #: Failing samples a claim's reason names (checks.json -> failing_samples lists them all).
 NAMED_FAILURES = 8
-#: Claims that need the averaged-law runs of a bundle (escape velocities, loops): not judged on seeds.
-FULL_ONLY = {"fig4_ots_loop_smaller_than_silica", "fig8b_ots_lower_escape_velocity",
-             "fig8b_ots_impact_shorter_at_the_same_low_velocity"}
 
 
 def rebounds(seq: dict) -> list[float]:
@@ -42,7 +39,8 @@ def loop_claim(s: str, b: dict) -> dict:
     name, units = NAMES[0], "1 (1 - loop ratio)"
     thr = "OTS's adhesive loop area < bare silica's (the loop ratio's size is a band)"
     if "loop" not in b:
-        return not_evaluable(name, s, REPRODUCTION, thr, units, "no averaged law in this sample (discrete seed)")
+        return not_evaluable(name, s, REPRODUCTION, thr, units,
+                             b.get("loop_missing", "no averaged law in this sample (discrete seed)"))
     ratio = b["loop"]["ots"] / b["loop"]["silica"] if b["loop"]["silica"] > 0 else math.inf
     return entry(name, s, REPRODUCTION, {"loop_ratio": ratio, "loop_area_J_per_m": b["loop"]}, thr, 1.0 - ratio,
                  RUN_RTOL, units)
@@ -162,13 +160,10 @@ def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> li
     """The nominal bundle's claims judged on the paper's model (the averaged GW surface): the nominal set and its
     uncertainty rows (`samples` without 'seed', each its own averaged-law bundle), holds_fraction over them
     (`verdict.over_samples`), with the bands of their threshold shapes. The discrete-summit seeds (`samples` with
-    'seed') judge nothing: each claim carries them as its `single_surfaces` block, the project's finding beyond
-    the paper."""
+    'seed') judge nothing here: `single_surfaces.attach` reports them beside every claim."""
     nom = {c["name"]: c for c in bundle_claims(set_name, nominal)}
     rows = [b for b in samples if not b.get("seed")]
-    seeds = [b for b in samples if b.get("seed")]
     per = [{c["name"]: c for c in bundle_claims(set_name, b)} for b in rows]
-    per_seed = [{c["name"]: c for c in bundle_claims(set_name, b)} for b in seeds]
     out = []
     for name in NAMES:
         e = over_samples(nom[name], [p[name]["state"] for p in per], {"nominal": 1, "uncertainty": len(rows)},
@@ -185,51 +180,8 @@ def judged_over_samples(set_name: str, nominal: dict, samples: list[dict]) -> li
                     f["label"] + (f" (margin {f['margin']:.3g})" if f["margin"] is not None else "")
                     for f in failing[:NAMED_FAILURES]) + (f" and {len(failing) - NAMED_FAILURES} more (failing_samples)"
                                                           if len(failing) > NAMED_FAILURES else "")
-        e["single_surfaces"] = single_surfaces(name, e["state"], [p[name] for p in per_seed], seeds, nominal)
         out.append(e)
     return out
-
-
-def single_surfaces(name: str, state: str, claims: list[dict], seeds: list[dict], nominal: dict) -> dict:
-    """How the claim fares on single discrete-summit realisations (`seeds`: their bundles, `claims`: the claim on
-    each): the fraction of the decided ones on which it holds, their count, the Wilson 95 % interval, and where
-    that departs from the paper's model's verdict `state`, the mechanism with its numbers (`_mechanism`)."""
-    if name in FULL_ONLY:
-        return {"n": 0, "note": "not evaluated on single surfaces: it needs the averaged law's escape search or "
-                "adhesive loop (a discrete escape search is ~15 discrete impacts per surface)"}
-    if not seeds:
-        return {"n": 0, "note": "no discrete-summit seeds were run (--seeds 0)"}
-    decided = [c for c in claims if c["state"] in (PASS, FAIL)]
-    p = proportion(c["state"] == PASS for c in decided)
-    out = {"n": len(claims), "decided": len(decided), "holds": p["k"] if p else 0,
-           "holds_fraction": p["fraction"] if p else None, "wilson95": p["wilson95"] if p else None,
-           "failing": [b["label"] for c, b in zip(claims, seeds) if c["state"] == FAIL]}
-    departs = p is not None and ((state == PASS and p["fraction"] < 1.0) or (state == FAIL and p["fraction"] > 0.0))
-    if departs:
-        out["mechanism"] = _mechanism(name, seeds, nominal)
-    return out
-
-
-def _mechanism(name: str, seeds: list[dict], nominal: dict) -> str:
-    """Why single surfaces depart from the averaged one, in a sentence with its numbers: a JKR impact loses a fixed
-    loop per summit it reaches, so what a drop keeps is set by how many summits one realisation puts in reach,
-    where the averaged law spreads a fractional number of them."""
-    key = "sigma3" if name == NAMES[3] else "silica"
-    q = [b[key].get("loop_per_summit_over_drop") for b in seeds if b[key].get("loop_per_summit_over_drop")]
-    n = [b[key].get("max_contacts") for b in seeds if b[key].get("max_contacts") is not None]
-    if not q or not n:
-        return ("single realisations carry few summits, so the number one realisation puts in reach, not the "
-                "averaged law's fractional count, sets each rebound")
-    share = sorted(q)[len(q) // 2]
-    where = "at sigma = 3 nm" if key == "sigma3" else "at sigma = 6 nm (bare silica)"
-    text = (f"every summit a JKR impact reaches takes {share:.3g} of the drop energy {where} (the loop of one summit "
-            f"over m g h0), and single realisations put {min(n):g}-{max(n):g} summits in contact at once")
-    if name == NAMES[3]:
-        text += f", so sticking at the first impact needs >= {math.ceil(1.0 / share):d} of them"
-    nom = nominal.get(key, {}).get("max_contacts")
-    if nom is not None:
-        text += f"; the averaged law spreads {nom:.3g}"
-    return text
 
 
 def _bands(name: str, bundles: list[dict]) -> dict | None:

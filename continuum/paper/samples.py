@@ -24,7 +24,7 @@ from pathlib import Path
 from ..dynamics.escape import escape_velocity, single_impact
 from ..dynamics.impact import first_impact_speed, run_impact
 from ..model import select_law
-from ..scene import SceneError, resolve_scene
+from ..scene import SceneError, find_params, read_toml, resolve_scene
 from .cases import FIG8_SIGMAS_NM, RIGID, Case, sigma_case
 
 #: Impacts per sampled drop: the sampled claims read at most this many ("sticks within 20 impacts").
@@ -56,6 +56,23 @@ def read_uncertainty_csv(path: str | Path) -> list[dict]:
                 continue
             rows.append({k: float(v) for k, v in row.items() if k not in RESULT_COLUMNS and v not in ("", None)})
     return rows
+
+
+def set_uncertainty_rows(sets: list[str]) -> dict[str, list[dict]]:
+    """The uncertainty rows each parameter set points to: `[meta] uncertainty_rows`, a calibration's uncertainty.csv
+    (its Latin hypercube; a path relative to the set's file), read with `read_uncertainty_csv`; {set name: rows} for
+    the sets that point to rows. A pointer to a missing file is an input error naming the key."""
+    out = {}
+    for spec in sets:
+        path = find_params(spec)
+        rel = (read_toml(path, "params").get("meta") or {}).get("uncertainty_rows")
+        if rel is None:
+            continue
+        csv_path = path.parent / rel
+        if not csv_path.is_file():
+            raise SceneError("meta.uncertainty_rows", rel, f"a CSV file relative to {path} (not found)")
+        out[Path(spec).stem] = read_uncertainty_csv(csv_path)
+    return out
 
 
 def escape_search(law, mass: float, gravity: float, v_start: float, rtol: float,
@@ -115,7 +132,7 @@ def _sequence(result: dict) -> dict:
             "peak_force_N": [x["peak_force"] for x in b], "status": result["status"], "impacts": len(b),
             "v_impact": b[0]["v_impact"] if b else None,
             "max_contacts": result["models"].get("diagnostics", {}).get("max_contacts"),
-            "loop_per_summit_over_drop": loop / ref if loop and ref else None}
+            "loop_per_summit_over_drop": loop / ref if loop and ref else None, "loop_energy_per_summit": loop}
 
 
 #: Scene keys a case states its claim at, kept against a sample's row: Fig 7's sigma = 3 nm claim is made at

@@ -124,3 +124,20 @@ def proportion(flags) -> dict | None:
     if n == 0:
         return None
     return {"fraction": k / n, "k": k, "n": n, "wilson95": list(wilson_interval(k, n))}
+
+
+def single_text(c: dict) -> str:
+    """The single-surfaces cell: holds on k of the decided surfaces (Wilson 95 %), and how many are undecided (with
+    the interval of that fraction), or why none were judged."""
+    ss = c.get("single_surfaces") or {}
+    if not ss.get("n"):
+        return "-"
+    parts = []
+    if ss.get("decided"):
+        lo, hi = ss["wilson95"]
+        parts.append(f"{ss['holds']} of {ss['decided']} ({lo:.2f}-{hi:.2f})")
+    und = ss.get("undecided")
+    if und:
+        lo, hi = und["wilson95"]
+        parts.append(f"undecided on {und['k']} of {und['n']} ({lo:.2f}-{hi:.2f})")
+    return "; ".join(parts)

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 
-from .checks import NO_SINGLE_SURFACES, nominal_only, rebounds
-from .run import WET_DRY_REL_TOL, WET_REL_TOL
+from .checks import nominal_only, rebounds
 from .sampled_claims import RUN_RTOL
+from .speeds import WET_DRY_REL_TOL, WET_REL_TOL
 from .verdict import FAIL, REPRODUCTION, VERIFICATION, entry, not_evaluable, over_samples
 from .wet_flips import BAND_EDGE
 
@@ -68,7 +68,7 @@ def _end_rebounds(s: str, si: dict) -> dict:
         captured = (v_wet - v_dry) / (edge["speed"] - v_dry)
         values.update(captured_fraction_of_band=captured, band_width_relative=width)
         e = entry(name, s, REPRODUCTION, values, thr, captured - (1.0 - BAND_EDGE), rel / width, units)
-    return dict(over_samples(e, [], nominal_only(name)), single_surfaces={"n": 0, "note": NO_SINGLE_SURFACES})
+    return over_samples(e, [], nominal_only(name))
 
 
 def _unchanged(s: str, si: dict) -> dict:

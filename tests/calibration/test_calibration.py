@@ -497,6 +497,12 @@ def test_smoke_pipeline_on_two_dask_workers(md_smoke, tmp_path, monkeypatch):
     saved = json.loads((out / "calibration.json").read_text())
     assert saved["bands"]["samples"] == 2 and saved == json.loads(json.dumps(report.to_dict(), default=str))
     assert saved["versions"]["nanoimpact"] and saved["rows"][0]["key"] == report.rows[0].key
+    # the set points to its Latin-hypercube rows, written beside it, so `nanoimpact paper --params` judges the set's
+    # claims over them by default
+    written = tomllib.loads((tmp_path / "calibrated_smoke.toml").read_text())
+    assert written["meta"]["uncertainty_rows"] == "calibrated_smoke.uncertainty.csv"
+    rows = samples.set_uncertainty_rows([str(tmp_path / "calibrated_smoke.toml")])["calibrated_smoke"]
+    assert len(rows) == 2 and all(set(r) == set(saved["bands"]["covers"]) for r in rows)
 
 
 def test_uncertainty_samples_stay_inside_each_keys_allowed_range():

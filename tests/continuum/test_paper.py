@@ -23,7 +23,12 @@ SEEDS = 2
 @pytest.fixture(scope="module")
 def paper_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("paper")
-    record = make_paper(["paper"], out, progress=lambda msg: None, seeds=SEEDS)
+    mp = pytest.MonkeyPatch()
+    mp.setenv("NANOIMPACT_CACHE", str(tmp_path_factory.mktemp("cache")))     # the bundles run here, not read back
+    try:
+        record = make_paper(["paper"], out, progress=lambda msg: None, seeds=SEEDS)
+    finally:
+        mp.undo()
     return out, record
 
 
@@ -54,9 +59,17 @@ def test_the_paper_set_passes_its_verification_and_every_reproduction_claim_on_t
         assert c["state"] == "pass", (c["name"], c["margin"], c["tolerance"], c.get("reason"))
         assert c["margin"] > c["tolerance"] and c["threshold_source"]["source"] in ("paper", "project"), c["name"]
         assert "single_surfaces" in c and c["sampled"].get("uncertainty") == 0, c["name"]
-    # the seeds decide nothing: they are the single-surface column, with an interval
+    # the seeds decide nothing: every claim has its single-surface column, with a Wilson interval on the surfaces
+    # where it holds (of the decided ones) or on those where it is undecided, and a mechanism where it departs
+    for c in rep.values():
+        ss = c["single_surfaces"]
+        assert ss["n"] == SEEDS and "note" not in ss, (c["name"], ss)
+        intervals = [x for x in (ss.get("wilson95"), (ss.get("undecided") or {}).get("wilson95")) if x]
+        assert intervals and all(0.0 <= lo <= hi <= 1.0 for lo, hi in intervals), (c["name"], ss)
+        departs = ss["decided"] == 0 or ss["holds"] < ss["decided"]
+        assert departs == bool(ss.get("mechanism")), (c["name"], ss)
     s3 = rep["fig7_sigma3_sticks_at_first_impact"]
-    assert s3["single_surfaces"]["n"] == SEEDS and len(s3["single_surfaces"]["wilson95"]) == 2
+    assert len(s3["single_surfaces"]["wilson95"]) == 2
     assert s3["units"].startswith("1 (1 - (v0 / v_esc,3nm)^2)") and s3["margin"] > 0.1     # 0.43 on the paper set
     # the t_a claim holds in a window around the declared 25 us, both flips found
     t_a = rep["fig8a_menisci_end_rebounds_of_impacts_longer_than_t_a"]["values"]
@@ -186,3 +199,49 @@ def test_an_incomplete_user_set_is_refused_in_one_line_with_exit_2_on_every_exec
     lines = proc.stderr.strip().splitlines()
     assert proc.returncode == 2 and len(lines) == 1, proc.stderr[-3000:]
     assert lines[0].startswith("nanoimpact paper: ") and "is required" in lines[0], lines
+
+
+def test_the_calibrated_set_points_to_its_latin_hypercube_rows_and_the_paper_takes_them_by_default(tmp_path):
+    """`calibrated` names its rows ([meta] uncertainty_rows, the calibration's uncertainty.csv): every row that ran
+    without error becomes one set of scene overrides (the input columns); `paper` and `silicon` name none. A set
+    that points to a missing file is refused naming the key."""
+    import csv
+
+    from continuum.paper.samples import RESULT_COLUMNS, set_uncertainty_rows
+    from continuum.scene import SceneError
+    from nanoimpact import data
+
+    rows = set_uncertainty_rows(["paper", "silicon", "calibrated"])
+    with open(data.shipped_root() / "params" / "calibrated.uncertainty.csv", newline="") as fh:
+        table = [r for r in csv.DictReader(fh) if not r["error"]]
+    assert list(rows) == ["calibrated"] and len(rows["calibrated"]) == len(table) >= 10
+    assert rows["calibrated"][0] == {k: float(v) for k, v in table[0].items() if k not in RESULT_COLUMNS and v}
+    bad = tmp_path / "lost.toml"
+    bad.write_text('[meta]\ndescription = "x"\nuncertainty_rows = "nowhere.csv"\n')
+    with pytest.raises(SceneError, match="meta.uncertainty_rows"):
+        set_uncertainty_rows([str(bad)])
+
+
+def test_a_sample_bundle_is_cached_by_its_inputs_and_code_and_run_again_when_either_changes(tmp_path, monkeypatch):
+    from continuum.paper import seed_cache
+    from continuum.paper.cases import dry_cases
+    from continuum.paper.samples import bundle_cases
+
+    cases = list(bundle_cases(dry_cases()).values())
+    seed = {"surfaces.roughness.mode": "discrete", "surfaces.roughness.seed": 1}
+    key = seed_cache.bundle_key("paper", seed, None, cases, [False, True])
+    assert key == seed_cache.bundle_key("paper", dict(seed), None, cases, [False, True])
+    assert key != seed_cache.bundle_key("paper", {**seed, "surfaces.roughness.seed": 2}, None, cases, [False, True])
+    assert key != seed_cache.bundle_key("silicon", seed, None, cases, [False, True])
+    # without its single-surface runs
+    assert key != seed_cache.bundle_key("paper", seed, None, cases, [False, False])
+    calls = []
+    monkeypatch.setenv("NANOIMPACT_CACHE", str(tmp_path))
+    first = seed_cache.cached(key, lambda: calls.append(1) or {"x": 1.0})
+    again = seed_cache.cached(key, lambda: calls.append(1) or {"x": 2.0})
+    assert first == {"x": 1.0} and again == {"x": 1.0, "cached": True} and len(calls) == 1
+    monkeypatch.setenv("NANOIMPACT_CACHE", "off")
+    assert seed_cache.cached(key, lambda: {"x": 3.0}) == {"x": 3.0}
+    seed_cache.code_hash.cache_clear()
+    monkeypatch.setattr(seed_cache, "code_hash", lambda: "another code")
+    assert seed_cache.bundle_key("paper", seed, None, cases, [False, True]) != key

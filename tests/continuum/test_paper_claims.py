@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from continuum.paper import checks, wet_checks
+from continuum.paper import checks, single_surfaces, wet_checks
 from continuum.paper import sampled_claims as sc
 from continuum.paper.verdict import FAIL, NOT_EVALUABLE, PASS, entry, judge, over_samples
 
@@ -95,7 +95,9 @@ def test_seeds_decide_nothing_and_are_reported_beside_the_claim_with_their_inter
     seeds = [dict(_bundle(sigma3=dict(_seq([0.2 * i], stuck=False) if i else _seq([]), max_contacts=5 + i,
                                       loop_per_summit_over_drop=0.0886)), label=f"seed {k}", seed=True)
              for k, i in ((1, 1), (2, 0), (3, 2), (4, 0))]
-    claims = {c["name"]: c for c in sc.judged_over_samples("t", nominal, seeds)}
+    judged = sc.judged_over_samples("t", nominal, [])
+    single_surfaces.attach("t", judged, seeds, nominal)
+    claims = {c["name"]: c for c in judged}
     c = claims["fig7_sigma3_sticks_at_first_impact"]
     assert c["state"] == PASS and c["samples"] == 1 and c["sampled"]["uncertainty"] == 0
     ss = c["single_surfaces"]
@@ -104,7 +106,52 @@ def test_seeds_decide_nothing_and_are_reported_beside_the_claim_with_their_inter
     assert "0.0886 of the drop energy" in ss["mechanism"] and ">= 12 of them" in ss["mechanism"]
     assert "5-7 summits" in ss["mechanism"]
     assert "mechanism" not in claims["fig5a_ots_outbounces_silica"]["single_surfaces"]     # holds on every seed
-    assert claims["fig4_ots_loop_smaller_than_silica"]["single_surfaces"]["n"] == 0        # needs the averaged law
+    # Fig 4's loop on a single surface: the per-summit loops of the paired seed (the same summits)
+    assert claims["fig4_ots_loop_smaller_than_silica"]["single_surfaces"]["holds"] == 4
+
+
+def _seed_runs(esc=(6e-4, 5e-4, 4e-4, 3e-4), durations=(9e-6, 7e-6, 5e-6), first=(0.0, 0.2, 0.4, 0.5, 0.6, 0.7, 0.8),
+               t_a=None):
+    """A seed's single-surface runs (`seed_runs.single_surface_runs`' keys) on which every sweep claim holds."""
+    sig = (3e-9, 6e-9, 10e-9, 30e-9)
+    drops = (3e-9, 4.5e-9, 6e-9, 10e-9, 15e-9, 20e-9, 30e-9)
+    return {"escape_sigma": {x: {"escape_velocity": v, "rel_tol": 1e-2} for x, v in zip(sig, esc)},
+            "sweep_sigma": {x: [{"v_impact": 1e-3 * (i + 1), "stuck": False, "duration": d}
+                                for i, d in enumerate(durations)] for x in sig},
+            "drops_sigma": {x: _seq([f] if f else []) for x, f in zip(drops, first)},
+            "t_a": t_a or {"holds": True, "t_a_s": 25e-6}, "mass_kg": 1e-9}
+
+
+def _seed_claims(**kw):
+    return {n: c["state"] for n, c in single_surfaces.seed_claims("t", _bundle(**_seed_runs(**kw))).items()}
+
+
+def test_every_claim_judged_on_whole_sweeps_holds_on_a_good_single_surface_and_fails_on_a_broken_one():
+    """The claims the averaged law judges on its sweeps are judged on a seed's own runs by the same functions:
+    each holds on a good seed and fails when its sweep is broken that way."""
+    good = _seed_claims()
+    assert set(good.values()) == {PASS} and set(single_surfaces.SWEEP_CLAIMS) <= set(good)
+    assert _seed_claims(esc=(6e-4, 5e-4, 5.5e-4, 3e-4))[checks.ESCAPE_TREND] == FAIL
+    assert _seed_claims(durations=(9e-6, 5e-6, 7e-6))[checks.TIME_RISES] == FAIL
+    assert _seed_claims(first=(0.0, 0.4, 0.2, 0.5, 0.6, 0.7, 0.8))[checks.FIG7] == FAIL
+    assert _seed_claims(t_a={"holds": False, "t_a_s": 25e-6})[wet_checks.T_A_CLAIM] == FAIL
+
+
+def test_undecided_single_surfaces_carry_their_own_interval_and_the_one_summit_escape_velocity():
+    """Escape velocities that tie between neighbouring sigmas (one summit decides them) leave the trend undecided
+    on every seed: the block counts them apart with the Wilson interval of 4 of 4 (0.510-1.000) and names
+    v1 = sqrt(2 W_loop / m), here sqrt(2 * 1.8e-16 / 1e-9) = 6.0e-4 m/s."""
+    nominal = _bundle()
+    seeds = [dict(_bundle(**_seed_runs(esc=(6e-4, 6e-4, 6e-4, 6e-4)),
+                          silica=dict(_seq([0.5]), max_contacts=2, loop_per_summit_over_drop=0.09)),
+                  loop={"silica": 1.8e-16, "ots": 1e-16}, label=f"seed {k}", seed=True) for k in range(1, 5)]
+    trend = checks.escape_trend("t", [(x, {"escape_velocity": v, "rel_tol": 1e-3})
+                                      for x, v in ((3e-9, 6e-4), (6e-9, 5e-4), (10e-9, 4e-4), (30e-9, 3e-4))])
+    single_surfaces.attach("t", [trend], seeds, nominal)
+    ss = trend["single_surfaces"]
+    assert ss["decided"] == 0 and ss["wilson95"] is None
+    assert ss["undecided"]["k"] == 4 and ss["undecided"]["wilson95"] == pytest.approx([0.5101, 1.0], abs=1e-4)
+    assert "sqrt(2 W_loop / m) = 0.0006 m/s" in ss["mechanism"], ss["mechanism"]
 
 
 def test_a_claim_is_judged_over_its_uncertainty_rows_on_the_averaged_law_and_names_the_failing_rows():
@@ -262,7 +309,7 @@ def test_the_t_a_study_bisects_both_flips_of_a_claim_that_holds_in_a_window():
 # ------------------------------------------------------------------------------ the t_a band's edge
 def test_the_t_a_band_edge_is_bisected_to_the_closed_form_crossing_of_a_monotone_impact_time():
     """t(eps) = t_a (eps_c / eps)^0.1 falls through t_a at eps_c exactly."""
-    from continuum.paper.run import WET_DRY_REL_TOL, WET_EPS, t_a_band_edge
+    from continuum.paper.speeds import WET_DRY_REL_TOL, WET_EPS, t_a_band_edge
 
     t_a, eps_c = 25e-6, 3.7e-4
     edge = t_a_band_edge(lambda e: t_a * (eps_c / e) ** 0.1, t_a, WET_EPS, WET_DRY_REL_TOL)
@@ -277,7 +324,7 @@ def test_an_impact_time_that_crosses_t_a_twice_gives_no_band_edge_and_the_wet_cl
     """Dry impacts long near the escape velocity, short, long again around eps = 0.1 (a second band: the
     impact time not monotone in the speed), then short: a bisection between the scan's ends would pick either
     crossing, so no edge is reported and the claim is not evaluable with the reason."""
-    from continuum.paper.run import WET_DRY_REL_TOL, WET_EPS, t_a_band_edge
+    from continuum.paper.speeds import WET_DRY_REL_TOL, WET_EPS, t_a_band_edge
 
     t_a = 25e-6
 
@@ -358,3 +405,43 @@ def test_a_sam_that_adheres_more_than_bare_silica_fails_the_sam_claims():
     states = _states(b)
     assert states["fig4_ots_loop_smaller_than_silica"] == FAIL
     assert states["fig5a_ots_outbounces_silica"] == FAIL
+
+
+def test_the_wet_sweep_runs_dry_and_wet_on_one_dry_law_so_impacts_shorter_than_t_a_are_the_same_computation():
+    """The rigid rough law sizes its footprint tables for the deepest impact it has seen, so two instances that ran
+    different speeds interpolate different tables (|e_wet^2 - e_dry^2| reached 2e-5 near escape, `calibrated` with
+    the nucleation t_a). `sharing_tables` rebuilds the averaged wet roller on the dry law itself: after a deeper
+    impact, the dry and the wet run at one speed (both ending long before t_a = 1 s) are the same computation. The
+    pair that first reaches a depth differs by the tables' own accuracy (RUN_RTOL): its dry run deepens the tables
+    while it runs, and the wet run starts on the deeper ones. A dry law of other physics is not shared."""
+    from continuum.dynamics.impact import first_impact_speed
+    from continuum.model import select_law
+    from continuum.model.factory import wet_sharing_dry_tables as sharing_tables
+    from continuum.paper.cases import wet_cases
+    from continuum.paper.run import resolve_case
+    from continuum.paper.speeds import outcome
+    from continuum.scene import resolve_scene
+
+    case = wet_cases()[0]
+    resolved = resolve_scene(case.path, params="paper", overrides={**case.overrides, "menisci.condensation_time": 1.0})
+    scene, v0 = resolved.scene, first_impact_speed(resolved)
+    dry = select_law(scene, v0, menisci=False)[0]
+    wet = sharing_tables(select_law(scene, v0, menisci=True)[0], dry)
+    assert wet.dry is dry
+    m, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
+    deep = outcome(dry, m, g, 4.0 * v0, rtol), outcome(wet, m, g, 4.0 * v0, rtol)     # the sweep's order
+    assert deep[1]["restitution"] ** 2 == pytest.approx(deep[0]["restitution"] ** 2, rel=sc.RUN_RTOL)
+    a, b = outcome(dry, m, g, 0.5 * v0, rtol), outcome(wet, m, g, 0.5 * v0, rtol)
+    assert not a["stuck"] and a["duration"] < 1.0
+    assert b["restitution"] == a["restitution"] and b["duration"] == a["duration"]
+    other = select_law(resolve_case(case, "silicon", None).scene, v0, menisci=False)[0]
+    assert sharing_tables(select_law(scene, v0, menisci=True)[0], other).dry is not other
+
+
+def test_a_seed_whose_summit_law_records_no_loop_leaves_the_loop_claim_undecided_with_the_reason():
+    """Plastic or tabulated summits (silicon, calibrated) record no closed-form loop per summit: the seed's Fig 4
+    claim is not evaluable and says why, instead of comparing None."""
+    b = {k: v for k, v in _bundle(**_seed_runs()).items() if k != "loop"}
+    b["loop_missing"] = "the summit law of this seed records no loop per summit (silica)"
+    c = single_surfaces.seed_claims("t", b)["fig4_ots_loop_smaller_than_silica"]
+    assert c["state"] == NOT_EVALUABLE and "no loop per summit" in c["reason"]
