@@ -112,7 +112,7 @@ def _sweep_task(case: Case, params: str, fidelity: str | None) -> dict:
 
 
 def _outcome(law, mass, g, v, rtol) -> dict:
-    run = single_impact(law, mass, g, v, rtol)
+    run = single_impact(law, mass, g, v, rtol, series=False)
     b = run.bounces[0]
     return {"stuck": run.stuck, "duration": b.duration, "v_rebound": b.v_rebound, "restitution": b.restitution}
 
