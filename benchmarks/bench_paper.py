@@ -1,6 +1,6 @@
 """What `nanoimpact paper` costs against the previous cycle's code, per set and per impact, against a floor.
 
-    python benchmarks/bench_paper.py --side-by-side 5 [--baseline REV]      # the budget check (docs/benchmarks.md)
+    python benchmarks/bench_paper.py --side-by-side 5 [--baseline REV] [--keep-checks DIR]  # the budget check
     python benchmarks/bench_paper.py [--sets paper,silicon,calibrated] [--workers 2]
                                      [--baseline REV] [--skip-paper] [--whole] [--breakdown] [--repeat 5]
 
@@ -94,9 +94,11 @@ sys.exit(main(["paper", "--out", sys.argv[1], "--params", sys.argv[2], "--worker
 """
 
 
-def whole_command(code_root: Path, sets: list[str], workers: int, warm: bool = True) -> tuple[float, float]:
+def whole_command(code_root: Path, sets: list[str], workers: int, warm: bool = True,
+                  keep: Path | None = None) -> tuple[float, float]:
     """(wall s, CPU s) of `nanoimpact paper` for all `sets` in one process, run from `code_root` (its numba
-    kernels loaded or compiled first, untimed, unless `warm` is False)."""
+    kernels loaded or compiled first, untimed, unless `warm` is False); with `keep`, the run's checks.json is
+    copied there (the claims' verdicts and margins, to compare two trees' numbers)."""
     import resource
 
     env = {**os.environ, "PYTHONPATH": str(code_root)}
@@ -111,6 +113,9 @@ def whole_command(code_root: Path, sets: list[str], workers: int, warm: bool = T
             raise RuntimeError(f"nanoimpact paper in {code_root} failed: {proc.stderr[-2000:]}")
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        if keep is not None and (Path(folder) / "checks.json").is_file():
+            keep.parent.mkdir(parents=True, exist_ok=True)
+            keep.write_bytes((Path(folder) / "checks.json").read_bytes())
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
@@ -209,9 +214,10 @@ def machine() -> str:
     return f"{model}, {os.cpu_count()} CPUs, Python {sys.version.split()[0]}"
 
 
-def side_by_side(rev: str, repeat: int, workers: int, sets: list[str]) -> list[dict]:
+def side_by_side(rev: str, repeat: int, workers: int, sets: list[str], keep: Path | None = None) -> list[dict]:
     """`nanoimpact paper --params SETS` of revision `rev` and of this tree, alternately `repeat` times each (module
-    docstring); [{'baseline': (wall, CPU), 'this tree': (wall, CPU), 'load': ...}, ...] per pair."""
+    docstring); [{'baseline': (wall, CPU), 'this tree': (wall, CPU), 'load': ...}, ...] per pair. With `keep`, each
+    run's checks.json is kept as keep/<baseline|this-tree>-<pair>.json."""
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         base = worktree(rev, Path(tmp) / "baseline")
@@ -224,7 +230,8 @@ def side_by_side(rev: str, repeat: int, workers: int, sets: list[str]) -> list[d
                 order = ((("baseline", base), ("this tree", ROOT)) if i % 2 == 0 else
                          (("this tree", ROOT), ("baseline", base)))
                 for name, root in order:
-                    pair[name] = whole_command(root, sets, workers, warm=False)
+                    kept = keep / f"{name.replace(' ', '-')}-{i + 1}.json" if keep is not None else None
+                    pair[name] = whole_command(root, sets, workers, warm=False, keep=kept)
                 rows.append(pair)
                 b, n = pair["baseline"], pair["this tree"]
                 print(f"pair {i + 1} (load {pair['load']}): baseline {b[0]:6.1f} s wall {b[1]:6.1f} s CPU; "
@@ -342,6 +349,8 @@ def main(argv=None):
     parser.add_argument("--side-by-side", type=int, default=0, metavar="N",
                         help="only the budget check: this tree and --baseline (default PREVIOUS_CYCLE) alternately, "
                         "N times each")
+    parser.add_argument("--keep-checks", type=Path, default=None, metavar="DIR",
+                        help="with --side-by-side: keep each run's checks.json in DIR")
     args = parser.parse_args(argv)
     sets = args.sets.split(",")
     print(f"load average at start: {load()}  ({machine()})")
@@ -351,7 +360,7 @@ def main(argv=None):
                               text=True).stdout.strip() + (" + uncommitted changes" if _dirty() else "")
         print(f"\n## nanoimpact paper --params {args.sets} --workers {args.workers}: {rev} against this tree "
               f"({head}), alternately")
-        rows = side_by_side(rev, args.side_by_side, args.workers, sets)
+        rows = side_by_side(rev, args.side_by_side, args.workers, sets, args.keep_checks)
         for what, k in (("wall", 0), ("CPU", 1)):
             r = sorted(p["baseline"][k] / p["this tree"][k] for p in rows)
             t = sorted(p["this tree"][k] for p in rows)

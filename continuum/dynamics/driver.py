@@ -92,6 +92,10 @@ class DriverSettings:
     #: integrate contacts of laws with a compiled form (`ContactLaw.compiled`) with the compiled kernel
     #: (`continuum.numerics.contact_kernel`, the same DOP853 algorithm); False: always the Python stepper
     compiled: bool = True
+    #: take the law's profiles (`ContactLaw.snapshot`) at maximum approach and at pull-off into
+    #: `Bounce.profiles`; False: none (a run read for its outcome only: the motion is the same, and a rough law's
+    #: snapshot is a footprint quadrature that costs about as much as the contact itself)
+    profiles: bool = True
 
 
 def flight_time_to(gap0: float, v0: float, gravity: float, target: float) -> float:
@@ -289,7 +293,7 @@ class _ContactRun:
         self.at(s)
         f = law.force(gap_)
         self.record(s, gap_, v_, f, self.index, law.stored_energy(gap_), law.dissipated(gap_))
-        if self.after_max and f < self.pull_force:
+        if self.after_max and f < self.pull_force and self.settings.profiles:
             snap = law.snapshot(gap_)
             if snap is not None:
                 self.pull_force = f
@@ -365,11 +369,11 @@ class _ContactRun:
         if kernel.max_approach is not None and "max_approach" not in profiles:
             te, ge = kernel.max_approach
             self.at(te)
-            snap = law.snapshot(ge)
+            snap = law.snapshot(ge) if self.settings.profiles else None
             if snap is not None:
                 profiles["max_approach"] = {"t": te, "gap": ge, "force": law.force(ge), **snap}
             self.after_max = True
-        if kernel.pull_off is not None and kernel.pull_off[2] < self.pull_force:
+        if kernel.pull_off is not None and self.settings.profiles and kernel.pull_off[2] < self.pull_force:
             te, ge, fe = kernel.pull_off
             self.at(te)
             snap = law.snapshot(ge)
@@ -461,7 +465,7 @@ class _ContactRun:
                 self.max_pen = max(self.max_pen, -ye[0])
                 self.peak_force = max(self.peak_force, law.force(ye[0]))
                 self.sample(te, ye[0], 0.0)
-                if kind == "max_approach" and "max_approach" not in profiles:
+                if kind == "max_approach" and "max_approach" not in profiles and self.settings.profiles:
                     snap = law.snapshot(ye[0])
                     if snap is not None:
                         profiles["max_approach"] = {"t": te, "gap": ye[0], "force": law.force(ye[0]), **snap}

@@ -131,7 +131,7 @@ def member_escape(law, member: Scene, speed: float, rel_tol: float) -> dict:
     mass, g, rtol = member.body.mass, member.environment.gravity, member.numerics.rtol
     v, lo, hi = speed, None, None
     for _ in range(MAX_ESCAPE_BRACKET_STEPS):
-        if single_impact(law, mass, g, v, rtol).stuck:
+        if single_impact(law, mass, g, v, rtol, series=False).stuck:
             lo, v = v, 2.0 * v
         else:
             hi, v = v, 0.5 * v
@@ -150,9 +150,11 @@ def run_member(scene: Scene, seed: int, plan: MemberPlan, escape_rel_tol: float 
     release = _release(member, float(law.z_top))
     if release is not None and release <= 0.0:
         raise ValueError(f"member seed {seed}: the release height lies below the realisation's tallest summit")
-    # a member keeps its rebounds, not its time series: no samples inside steps (the steps are the same)
+    # a member keeps its rebounds, not its time series or profiles: no samples inside steps, no snapshots (the
+    # steps and events are the same)
     settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
-                              rest_fraction=n.rest_fraction, samples_per_flight=2, samples_per_step=0)
+                              rest_fraction=n.rest_fraction, samples_per_flight=2, samples_per_step=0,
+                              profiles=False)
     run = simulate(law, member.body.mass, member.environment.gravity, release_height=release,
                    impact_velocity=member.impact_velocity, settings=settings)
     heights = tuple(float(b.rebound_height) for b in run.bounces if b.rebound_height is not None)

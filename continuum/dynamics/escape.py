@@ -12,12 +12,19 @@ from ..laws.base import ContactLaw
 from .driver import DriverSettings, ImpactRun, simulate
 
 
-def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rtol: float = 1e-9) -> ImpactRun:
+def single_impact(law: ContactLaw, mass: float, gravity: float, speed: float, rtol: float = 1e-9, *,
+                  series: bool = True) -> ImpactRun:
     """One impact at `speed` (m/s) from the datum on virgin surfaces (`ContactLaw.forget_history`); the run
-    ends at release or when stuck."""
+    ends at release or when stuck. `series=False`, for a caller that reads the outcome (stuck, duration, rebound,
+    peak force): no samples inside the integrator's steps (the trace holds the step ends and events only) and no
+    profiles (`DriverSettings.profiles`); the steps, the events and so the outcome are the same, while the
+    samples' law evaluations (a fifth of a Python-stepped contact) and a rough law's snapshots (footprint
+    quadratures, a fifth of a wet sweep's CPU) are not made."""
     law.forget_history()
     return simulate(law, mass, gravity, impact_velocity=speed,
-                    settings=DriverSettings(rtol=rtol, max_bounces=1, max_time=1.0, samples_per_flight=2))
+                    settings=DriverSettings(rtol=rtol, max_bounces=1, max_time=1.0, samples_per_flight=2,
+                                            samples_per_step=DriverSettings.samples_per_step if series else 0,
+                                            profiles=series))
 
 
 def escape_velocity(law: ContactLaw, mass: float, gravity: float, v_low: float, v_high: float, *,
@@ -31,7 +38,7 @@ def escape_velocity(law: ContactLaw, mass: float, gravity: float, v_low: float, 
     order (a law whose tables were sized by deeper impacts in between) is not contradicted by its own rerun.
     """
     def escapes(v):
-        run = single_impact(law, mass, gravity, v, rtol)
+        run = single_impact(law, mass, gravity, v, rtol, series=on_run is not None)
         if on_run:
             on_run(v, run)
         return not run.stuck

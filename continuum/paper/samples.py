@@ -91,7 +91,7 @@ def escape_search(law, mass: float, gravity: float, v_start: float, rtol: float,
 def _escape_search(law, mass, gravity, v_start, rtol, rel_tol, known) -> dict:
     def stuck(v):
         if v not in known:
-            known[v] = single_impact(law, mass, gravity, v, rtol).stuck
+            known[v] = single_impact(law, mass, gravity, v, rtol, series=False).stuck
         return known[v]
 
     lo = max((v for v, s in known.items() if s), default=None)
@@ -216,7 +216,7 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
     v_si = out["escape"]["silica"].get("escape_velocity")
     if v_si:
         v = 1.2 * v_si
-        runs = {k: single_impact(law, m, g, v, rtol) for k, (law, m, g, rtol, _) in laws.items()}
+        runs = {k: single_impact(law, m, g, v, rtol, series=False) for k, (law, m, g, rtol, _) in laws.items()}
         out["low_speed"] = {"v_impact": v, **{k: {"stuck": r.stuck, "duration": r.bounces[0].duration}
                                               for k, r in runs.items()}}
     from .figures import characteristic
@@ -266,8 +266,9 @@ def low_speed_runs(params: str, fidelity: str | None, silica_law, mass: float, g
         return None
     ots = _resolved(Case("rough_ots", "rough_ots.toml"), params, {}, fidelity, 1).scene
     v = 1.2 * v_esc
-    runs = {"silica": single_impact(silica_law, mass, g, v, rtol),
-            "ots": single_impact(select_law(ots, v)[0], ots.body.mass, ots.environment.gravity, v, ots.numerics.rtol)}
+    runs = {"silica": single_impact(silica_law, mass, g, v, rtol, series=False),
+            "ots": single_impact(select_law(ots, v)[0], ots.body.mass, ots.environment.gravity, v, ots.numerics.rtol,
+                                 series=False)}
     return {"v_impact": v, **{k: {"stuck": r.stuck, "duration": r.bounces[0].duration} for k, r in runs.items()}}
 
 

@@ -85,8 +85,8 @@ def single_surface_runs(params: str, overrides: dict, fidelity: str | None, case
     if v_si:
         v = 1.2 * v_si
         law, m, g, rtol = laws[6e-9]
-        runs = {"silica": single_impact(law, m, g, v, rtol),
-                "ots": single_impact(ots, sc.body.mass, sc.environment.gravity, v, sc.numerics.rtol)}
+        runs = {"silica": single_impact(law, m, g, v, rtol, series=False),
+                "ots": single_impact(ots, sc.body.mass, sc.environment.gravity, v, sc.numerics.rtol, series=False)}
         out["low_speed"] = {"v_impact": v, **{k: {"stuck": r.stuck, "duration": r.bounces[0].duration}
                                               for k, r in runs.items()}}
     loops = {k: drops[k].get("loop_energy_per_summit") for k in ("silica", "ots")}
@@ -99,7 +99,7 @@ def single_surface_runs(params: str, overrides: dict, fidelity: str | None, case
     out["drops_sigma"] = {6e-9: drops["silica"]}
     for s in SIGMAS_NM:
         if s != 6.0:
-            r = run_impact(_resolved(sigma_case(s), params, overrides, fidelity, SAMPLE_MAX_BOUNCES))[0]
+            r = run_impact(_resolved(sigma_case(s), params, overrides, fidelity, SAMPLE_MAX_BOUNCES)).to_dict()
             out["drops_sigma"][s * 1e-9] = _sequence(r)
     out["t_a"] = _t_a_claim(params, overrides, fidelity, laws.get(6e-9), out["escape"]["silica"])
     return out
@@ -143,7 +143,7 @@ def _t_a_claim(params: str, overrides: dict, fidelity: str | None, dry_law, esc_
             return {"holds": None, "t_a_s": t_a, "reason": f"no band edge: {edge['reason']}"}
         v_dry, v_ta = esc["escape_velocity"], up * (1.0 + edge["eps"])
         v_star = v_dry + (1.0 - BAND_EDGE) * (v_ta - v_dry)
-        stuck = single_impact(wet, m, g, v_star, rtol).stuck
+        stuck = single_impact(wet, m, g, v_star, rtol, series=False).stuck
         return {"holds": bool(stuck), "t_a_s": t_a, "escape_velocity_dry_m_per_s": v_dry, "v_ta_m_per_s": v_ta,
                 "v_star_m_per_s": v_star, "band_width_relative": v_ta / v_dry - 1.0}
     except SceneError as exc:

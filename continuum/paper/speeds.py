@@ -77,7 +77,8 @@ def t_a_band_edge(duration: Callable[[float], float], t_a: float, scan: tuple, e
 
 
 def outcome(law, mass, g, v, rtol) -> dict:
-    """One impact at `v` on virgin surfaces: stuck, duration, rebound speed and restitution."""
-    run = single_impact(law, mass, g, v, rtol)
+    """One impact at `v` on virgin surfaces: stuck, duration, rebound speed and restitution (read for its outcome
+    only: no in-step samples, no profiles, `single_impact(series=False)`)."""
+    run = single_impact(law, mass, g, v, rtol, series=False)
     b = run.bounces[0]
     return {"stuck": run.stuck, "duration": b.duration, "v_rebound": b.v_rebound, "restitution": b.restitution}

