@@ -57,7 +57,7 @@ def _mean_field(params: str, plasticity: str, bounces: int, release_height: floa
     start, cpu = time.perf_counter(), time.process_time()
     try:
         resolved = _resolved(params, plasticity, bounces, release_height, **{"surfaces.roughness.mode": "mean_field"})
-        result, _ = run_impact(resolved, condensation_sweep=False)
+        result = run_impact(resolved, condensation_sweep=False).record
     except SceneError as err:       # e.g. the elastic footprint tables' cost bound: what a run would say
         return {"refused": str(err), "wall_s": None, "cpu_s": None}
     return {"wall_s": time.perf_counter() - start, "cpu_s": time.process_time() - cpu,

@@ -32,6 +32,11 @@ PlasticSummitsPunch`), so the driver's energy audit tests the motion against the
 the elastic law's and the sums are the elastic GW mean field of that law (`continuum.rough.gw_branches`, threshold
 zeta = d_c + delta_in; tested to 1e-7).
 
+Speed: a law with a compiled form (`compiled_form`, `continuum.rough.plastic_kernel`'s tables) has its edges and
+its sums over each summit set evaluated by `continuum.rough.plastic_gw_kernel` (one compiled call per set, the
+same nodes, weights and summit states); `compiled = False` on an instance keeps the NumPy form, the reference the
+compiled one is tested against.
+
 Quadrature: the same geometric Gauss-Legendre panels in u as the JKR surface, from each set's lower edge, with its
 lower truncation and node bound (`PlasticGWSurface`). The summit law is tabulated to its `delta_max`; a trial stage
 of the integrator deeper than that evaluates the summits with the flattening at the table's end, and an accepted
@@ -47,7 +52,9 @@ import math
 
 import numpy as np
 
-from .plastic_summits import PlasticGWSurface, RollerFootprint
+from . import plastic_gw_kernel as kernel
+from .plastic_kernel import _law_tables
+from .plastic_summits import _GL_W, _GL_X, PlasticGWSurface, RollerFootprint
 
 __all__ = ["PlasticBranchGWSurface", "BranchRollerFootprint"]
 
@@ -71,6 +78,21 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         self._reach0 = _at(law.reach_of, beta)
         #: deepest approach the summit law is tabulated to (m)
         self.u_table = float(getattr(law, "delta_max", math.inf))
+        #: sums and edges by the compiled kernel (`plastic_gw_kernel`); False: the NumPy form (the reference)
+        self.compiled = bool(getattr(law, "compiled_form", False)) and math.isfinite(self.u_table)
+        if self.compiled:
+            self._P, tables = _law_tables(law)
+            none = np.zeros(1)              # the kernel's tables, without the discrete summits' own rows
+            self._T = (none, none, *tables[:3], none, *tables[3:])
+            self._reach_ratio = _at(law.reach_of, 1.0)          # reach(R_p) = cbrt(R_p) * ratio
+            self._tx_tw = (getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0)))
+
+    def _edge(self, kind: int, method):
+        """Edge function `kind` (0 recovery, 1 met_edge, 2 hold, 3 reach_edge) as a scalar callable."""
+        if not self.compiled:
+            return method
+        args = (kind, self.u_table, self._reach_ratio, self._P, self._T)
+        return lambda u: kernel.edge(float(u), *args)
 
     # ------------------------------------------------------------------ summit sets
     def _flat(self, u):
@@ -98,16 +120,19 @@ class PlasticBranchGWSurface(PlasticGWSurface):
 
     def sets(self, d, d_c, d_p):
         """(u_att, u_r) (m): summits u >= u_att are attached, u_r < u < u_att on the approach branch."""
-        u_met = self._inverse(self.met_edge, d_c - d_p, -self._in0) if math.isfinite(d_c) else math.inf
+        u_met = (self._inverse(self._edge(1, self.met_edge), d_c - d_p, -self._in0) if math.isfinite(d_c)
+                 else math.inf)
         if not math.isfinite(d):
             return math.inf, math.inf
-        u_held = self._inverse(self.hold, d - d_p, -self._out0)
-        return max(u_met, u_held), self._inverse(self.reach_edge, d - d_p, self._reach0)
+        u_held = self._inverse(self._edge(2, self.hold), d - d_p, -self._out0)
+        return max(u_met, u_held), self._inverse(self._edge(3, self.reach_edge), d - d_p, self._reach0)
 
     # ------------------------------------------------------------------ values
     def _values(self, d, d_c, d_p, weight):
         u_att, u_r = self.sets(d, d_c, d_p)
-        touch = (self._inverse(self.recovery, d - d_p, 0.0),)     # the summits at eps = 0: the curves' kink
+        touch = (self._inverse(self._edge(0, self.recovery), d - d_p, 0.0),)   # summits at eps = 0: the kink
+        if self.compiled:
+            return self._compiled_values(d, d_p, u_att, u_r, touch, weight is not PlasticGWSurface._weight)
         p = energy = count = 0.0
         for lo, hi, attached in ((u_att, math.inf, True), (u_r, u_att, False)):
             u, w = self._nodes(*self._span(lo, d_p, hi), breaks=touch)
@@ -117,6 +142,25 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             f, en = self._summits(u - (d - d_p), np.clip(u, 0.0, self.u_table), attached)
             p, energy = p + float(q @ f), energy + float(q @ en)
             count += float(q.sum()) if attached else 0.0
+        return p, energy, count
+
+    def _compiled_values(self, d, d_p, u_att, u_r, touch, footprint: bool):
+        """`_values` by `plastic_gw_kernel.set_sums`: the same nodes (`gl_nodes`), weights and summit states."""
+        roller = footprint and isinstance(self, RollerFootprint)
+        geometry = np.array([self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
+                             getattr(self, "roller_radius", 0.0)])
+        breaks = np.array([self.law.yield_approach, *touch])
+        p = energy = count = 0.0
+        for lo, hi, attached in ((u_att, math.inf, True), (u_r, u_att, False)):
+            lo, hi, floor = self._span(lo, d_p, hi)
+            u, w = kernel.gl_nodes(lo, hi, floor, self._offsets(), self._first, self.panel_width * self.sigma,
+                                   breaks, self._root_at_top, _GL_X, _GL_W)
+            if u.size == 0:
+                continue
+            f, en, q = kernel.set_sums(u, w, d - d_p, d_p, attached, self.u_table, roller, geometry,
+                                       *self._tx_tw, self._P, self._T)
+            p, energy = p + f, energy + en
+            count += q if attached else 0.0
         return p, energy, count
 
     def _summits(self, delta, delta_max, attached: bool):

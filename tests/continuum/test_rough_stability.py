@@ -123,7 +123,8 @@ def test_a_point_with_yielding_summits_runs_the_plastic_mean_field_with_a_bounde
         counts.append(x.size <= (self.node_bound(hi - lo) if hi > lo else 0))
         return x, w
     monkeypatch.setattr(ps.PlasticGWSurface, "_nodes", counted)
-    result, trace = run_point(point, plasticity="auto")
+    run = run_point(point, plasticity="auto")
+    result, trace = run.to_dict(), run.trace
     assert result["models"]["contact_law"]["name"] == "rough_roller_gw_plastic_rigid"
     assert counts and all(counts)
     for key in ("t", "gap", "velocity", "force", "energy"):
