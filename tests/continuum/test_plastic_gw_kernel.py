@@ -62,7 +62,9 @@ def test_compiled_nodes_are_the_numpy_quadratures(roller):
     surf = (BranchRollerFootprint(law, SIGMA, DENSITY, ZMAX, R_ROLLER, L_ROLLER) if roller
             else PlasticBranchGWSurface(law, SIGMA, DENSITY, ZMAX))
     for lo, hi, floor, brk in ((0.1 * SIGMA, 2 * SIGMA, -10 * SIGMA, ()),
-                               (-SIGMA, 3 * SIGMA, -9 * SIGMA, (0.7 * SIGMA,)), (-1e-3, 2 * SIGMA, -8 * SIGMA, (1e-12,)), (0.0, 1e-3 * SIGMA, -8 * SIGMA, ()),
+                               (-SIGMA, 3 * SIGMA, -9 * SIGMA, (0.7 * SIGMA,)),
+                               (-1e-3, 2 * SIGMA, -8 * SIGMA, (1e-12,)),
+                               (0.0, 1e-3 * SIGMA, -8 * SIGMA, ()),
                                (-20 * SIGMA, 30 * SIGMA, -8 * SIGMA, (0.0, 5 * SIGMA))):
         x, w = surf._nodes(lo, hi, floor, breaks=brk)
         breaks = np.array([law.yield_approach, *brk])
