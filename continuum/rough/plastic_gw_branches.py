@@ -86,6 +86,10 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             self._T = (none, none, *tables[:3], none, *tables[3:])
             self._reach_ratio = _at(law.reach_of, 1.0)          # reach(R_p) = cbrt(R_p) * ratio
             self._tx_tw = (getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0)))
+            self._footprint = isinstance(self, RollerFootprint)
+            self._C = np.array([self._first, self.panel_width * self.sigma, float(self._root_at_top), self.u_table,
+                                self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
+                                getattr(self, "roller_radius", 0.0), self._reach_ratio])
 
     def _edge(self, kind: int, method):
         """Edge function `kind` (0 recovery, 1 met_edge, 2 hold, 3 reach_edge) as a scalar callable."""
@@ -145,23 +149,20 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         return p, energy, count
 
     def _compiled_values(self, d, d_p, u_att, u_r, touch, footprint: bool):
-        """`_values` by `plastic_gw_kernel.set_sums`: the same nodes (`gl_nodes`), weights and summit states."""
-        roller = footprint and isinstance(self, RollerFootprint)
-        geometry = np.array([self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
-                             getattr(self, "roller_radius", 0.0)])
-        breaks = np.array([self.law.yield_approach, *touch])
+        """`_values` by `plastic_gw_kernel.set_sum`: the same nodes, weights and summit states."""
         p = energy = count = 0.0
-        for lo, hi, attached in ((u_att, math.inf, True), (u_r, u_att, False)):
-            lo, hi, floor = self._span(lo, d_p, hi)
-            u, w = kernel.gl_nodes(lo, hi, floor, self._offsets(), self._first, self.panel_width * self.sigma,
-                                   breaks, self._root_at_top, _GL_X, _GL_W)
-            if u.size == 0:
-                continue
-            f, en, q = kernel.set_sums(u, w, d - d_p, d_p, attached, self.u_table, roller, geometry,
-                                       *self._tx_tw, self._P, self._T)
+        for lo, hi, what in ((u_att, math.inf, kernel.RETREAT), (u_r, u_att, kernel.APPROACH)):
+            f, en, q = self._set_sum(what, lo, hi, d_p, d - d_p, touch[0], footprint)
             p, energy = p + f, energy + en
-            count += q if attached else 0.0
+            count += q if what == kernel.RETREAT else 0.0
         return p, energy, count
+
+    def _set_sum(self, what, lo, hi, d_p, shift, touch=math.nan, footprint=True):
+        lo, hi, floor = self._span(lo, d_p, hi)
+        if not hi > lo:
+            return 0.0, 0.0, 0.0
+        return kernel.set_sum(what, lo, hi, floor, touch, d_p, shift, footprint and self._footprint, self._C,
+                              self._offsets(), _GL_X, _GL_W, *self._tx_tw, self._P, self._T)
 
     def _summits(self, delta, delta_max, attached: bool):
         """(force N, stored energy J) of summits at approach delta (m), deepest approach delta_max (m), all on the
@@ -186,6 +187,8 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         return p, count
 
     def plastic_work(self, d_p):
+        if self.compiled:
+            return self._set_sum(kernel.PLASTIC_WORK, max(self.law.yield_approach, 0.0), math.inf, d_p, 0.0)[0]
         u, w = self._nodes(*self._span(max(self.law.yield_approach, 0.0), d_p))
         return float(self._weight(u, w, d_p) @ self.law.plastic_work(np.minimum(u, self.u_table))) if u.size else 0.0
 
@@ -195,7 +198,11 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         let go."""
         if not math.isfinite(d_c):
             return 0.0
-        u_met = self._inverse(self.met_edge, d_c - d_p, -self._in0)
+        u_met = self._inverse(self._edge(1, self.met_edge), d_c - d_p, -self._in0)
+        if self.compiled:
+            u_held = self._inverse(self._edge(2, self.hold), d - d_p, -self._out0) if math.isfinite(d) else math.inf
+            return (self._set_sum(kernel.IN_SWITCH, u_met, math.inf, d_p, d_0 - d_p)[0]
+                    + self._set_sum(kernel.OUT_SWITCH, u_met, max(u_held, u_met), d_p, 0.0)[0])
         u, w = self._nodes(*self._span(u_met, d_p))
         if u.size == 0:
             return 0.0

@@ -18,9 +18,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .plastic_kernel import P_P_D_Y, P_P_F_Y, P_P_SLOPE, _blend, _flattening
+from .plastic_kernel import P_P_D_Y, P_P_F_Y, P_P_SLOPE, _blend, _flattening, _plastic_work
 
-__all__ = ["edge", "set_sums", "gl_nodes"]
+__all__ = ["edge", "set_sum", "gl_nodes"]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 
@@ -105,44 +105,75 @@ def gl_nodes(lo, hi, floor, offsets, first, quarter, breaks, root_at_top, gl_x, 
     return xs, ws
 
 
+#: C slots (the surface's constants, `PlasticBranchGWSurface._kernel_constants`)
+(C_FIRST, C_QUARTER, C_ROOT_AT_TOP, C_U_TABLE, C_DENSITY, C_SIGMA, C_Z_TOP, C_LENGTH, C_ROLLER_RADIUS,
+ C_REACH_RATIO) = range(10)
+#: what `set_sum` sums
+APPROACH, RETREAT, IN_SWITCH, OUT_SWITCH, PLASTIC_WORK = range(5)
+
+
 @njit(cache=True)
-def _weight(u, w, d_p, roller, G, tx, tw):
-    """Summits per unit height times the quadrature weight: n phi(z) (G: density, sigma) or the roller footprint's
-    K(z) (G: density, sigma, z_top, length, roller radius), z = d_p + u."""
-    density, sigma = G[0], G[1]
+def _weight(u, w, d_p, footprint, C, tx, tw):
+    """Summits per unit height times the quadrature weight at z = d_p + u: n phi(z) (`PlasticGWSurface._weight`)
+    or the roller footprint's kernel K(z) (`footprint`, `RollerFootprint._weight`, 24-node rule tx, tw)."""
+    density, sigma = C[C_DENSITY], C[C_SIGMA]
     z = d_p + u
-    if not roller:
+    if not footprint:
         y = z / sigma
         return density * w * math.exp(-0.5 * y * y) / (_SQRT2PI * sigma)
-    top = math.sqrt(max(G[2] - z, 0.0))
+    top = math.sqrt(max(C[C_Z_TOP] - z, 0.0))
     s = 0.0
     for j in range(tx.size):
         t = 0.5 * top * (tx[j] + 1.0)
         y = (z + t * t) / sigma
         s += math.exp(-0.5 * y * y) * tw[j]
     k = 0.5 * top * s * 2.0 / (_SQRT2PI * sigma)
-    return density * w * G[3] * math.sqrt(2.0 * G[4]) * k
+    return density * w * C[C_LENGTH] * math.sqrt(2.0 * C[C_ROLLER_RADIUS]) * k
 
 
 @njit(cache=True)
-def set_sums(u, w, shift, d_p, attached, u_table, roller, G, tx, tw, P, T):
-    """(sum q F, sum q U, sum q) over the nodes u (m) of one summit set: the summits at approach delta = u - shift
-    (shift = d - d_p), deepest approach clip(u, 0, u_table), all on the retreat branch (`attached`, with Thornton-
-    Ning's plastic line where delta >= delta_max > delta_y) or all on the approach branch."""
+def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+    """(sum q a, sum q b, sum q) over the quadrature of [lo, hi] (m, in u; `gl_nodes`, split at delta_y and
+    `touch`) of one summit set, q the weight (`_weight`) and, by `what`:
+
+    * APPROACH / RETREAT: a = force F, b = stored energy U of summits at approach delta = u - shift (shift =
+      d - d_p), deepest approach clip(u, 0, u_table), on that branch (the retreat branch with Thornton-Ning's
+      plastic line where delta >= delta_max > delta_y): `PlasticBranchGWSurface._summits`;
+    * IN_SWITCH: a = U_A - U_R at delta_in of the flattening of clip(u - shift, 0, u_table) (shift = d_0 - d_p:
+      the flattening a summit met this contact with); OUT_SWITCH: a = U_R - U_A at delta_out of clip(u, 0,
+      u_table)'s (`PlasticBranchSummitLaw.in_switch`, `out_switch`);
+    * PLASTIC_WORK: a = W_p(min(u, u_table)) (`PlasticBranchSummitLaw.plastic_work`)."""
+    u, w = gl_nodes(lo, hi, floor, offsets, C[C_FIRST], C[C_QUARTER], np.array([P[P_P_D_Y], touch]),
+                    C[C_ROOT_AT_TOP] != 0.0, gl_x, gl_w)
     flag = np.zeros(5)
-    fs = es = qs = 0.0
-    d_y = P[P_P_D_Y]
+    u_table, d_y = C[C_U_TABLE], P[P_P_D_Y]
+    sa = sb = sq = 0.0
     for i in range(u.size):
-        q = _weight(u[i], w[i], d_p, roller, G, tx, tw)
-        dm = min(max(u[i], 0.0), u_table)
-        r_p, dp = _flattening(dm, flag, P, T)
-        delta = u[i] - shift
-        eps = delta - dp
-        base = 2 if attached else 0
-        f = _blend(base, eps, r_p, P, T)
-        if attached and delta >= dm and dm > d_y:
-            f = P[P_P_F_Y] + P[P_P_SLOPE] * (delta - d_y)
-        fs += q * f
-        es += q * _blend(base + 1, eps, r_p, P, T)
-        qs += q
-    return fs, es, qs
+        q = _weight(u[i], w[i], d_p, footprint, C, tx, tw)
+        a = b = 0.0
+        if what == IN_SWITCH:
+            r_p, dp = _flattening(min(max(u[i] - shift, 0.0), u_table), flag, P, T)
+            e = _blend(4, 0.0, r_p, P, T)
+            a = _blend(1, e, r_p, P, T) - _blend(3, e, r_p, P, T)
+        elif what == OUT_SWITCH:
+            r_p, dp = _flattening(min(max(u[i], 0.0), u_table), flag, P, T)
+            e = _blend(5, 0.0, r_p, P, T)
+            a = _blend(3, e, r_p, P, T) - _blend(1, e, r_p, P, T)
+        elif what == PLASTIC_WORK:
+            dm = min(u[i], u_table)
+            r_p, dp = _flattening(max(dm, d_y), flag, P, T)
+            a = _plastic_work(dm, r_p, dp, P, T)
+        else:
+            dm = min(max(u[i], 0.0), u_table)
+            r_p, dp = _flattening(dm, flag, P, T)
+            delta = u[i] - shift
+            eps = delta - dp
+            base = 2 if what == RETREAT else 0
+            a = _blend(base, eps, r_p, P, T)
+            if what == RETREAT and delta >= dm and dm > d_y:
+                a = P[P_P_F_Y] + P[P_P_SLOPE] * (delta - d_y)
+            b = _blend(base + 1, eps, r_p, P, T)
+        sa += q * a
+        sb += q * b
+        sq += q
+    return sa, sb, sq

@@ -52,6 +52,11 @@ def test_compiled_sums_equal_the_numpy_form(name, p_y, roller):
             assert abs(a[-1] - b[-1]) <= TOL * max(abs(b[-1]), DENSITY * 1e-3), (what, d, d_c, d_p)
             if what == "state":
                 assert abs(a[1] - b[1]) <= TOL * max(abs(b[1]), scale * SIGMA * 1e-3), (d, d_c, d_p)
+        a, b = fast.plastic_work(d_p), slow.plastic_work(d_p)
+        assert abs(a - b) <= TOL * max(abs(b), scale * SIGMA * 1e-3), d_p
+        for d_0 in (d_p, d_p + 0.5 * SIGMA):
+            a, b = fast.jumps(d, d_c, d_p, d_0), slow.jumps(d, d_c, d_p, d_0)
+            assert abs(a - b) <= TOL * max(abs(b), scale * SIGMA * 1e-3), (d, d_c, d_p, d_0)
 
 
 @pytest.mark.parametrize("roller", [False, True])
