@@ -89,14 +89,14 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             self._footprint = isinstance(self, RollerFootprint)
             self._C = np.array([self._first, self.panel_width * self.sigma, float(self._root_at_top), self.u_table,
                                 self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
-                                getattr(self, "roller_radius", 0.0), self._reach_ratio])
+                                getattr(self, "roller_radius", 0.0), self._reach_ratio, self.z_floor,
+                                float(self._clip_floor), self._in0, self._out0, self._reach0])
 
-    def _edge(self, kind: int, method):
-        """Edge function `kind` (0 recovery, 1 met_edge, 2 hold, 3 reach_edge) as a scalar callable."""
-        if not self.compiled:
-            return method
-        args = (kind, self.u_table, self._reach_ratio, self._P, self._T)
-        return lambda u: kernel.edge(float(u), *args)
+    def _inverse_edge(self, kind: int, method, value, offset):
+        """`_inverse` of edge `kind` (`plastic_gw_kernel.edge`: 0 recovery, 1 met, 2 hold, 3 reach), compiled if so."""
+        if self.compiled:
+            return kernel.inverse(kind, value, offset, self._C, self._P, self._T)
+        return self._inverse(method, value, offset)
 
     # ------------------------------------------------------------------ summit sets
     def _flat(self, u):
@@ -124,19 +124,20 @@ class PlasticBranchGWSurface(PlasticGWSurface):
 
     def sets(self, d, d_c, d_p):
         """(u_att, u_r) (m): summits u >= u_att are attached, u_r < u < u_att on the approach branch."""
-        u_met = (self._inverse(self._edge(1, self.met_edge), d_c - d_p, -self._in0) if math.isfinite(d_c)
+        u_met = (self._inverse_edge(1, self.met_edge, d_c - d_p, -self._in0) if math.isfinite(d_c)
                  else math.inf)
         if not math.isfinite(d):
             return math.inf, math.inf
-        u_held = self._inverse(self._edge(2, self.hold), d - d_p, -self._out0)
-        return max(u_met, u_held), self._inverse(self._edge(3, self.reach_edge), d - d_p, self._reach0)
+        u_held = self._inverse_edge(2, self.hold, d - d_p, -self._out0)
+        return max(u_met, u_held), self._inverse_edge(3, self.reach_edge, d - d_p, self._reach0)
 
     # ------------------------------------------------------------------ values
     def _values(self, d, d_c, d_p, weight):
-        u_att, u_r = self.sets(d, d_c, d_p)
-        touch = (self._inverse(self._edge(0, self.recovery), d - d_p, 0.0),)   # summits at eps = 0: the kink
         if self.compiled:
-            return self._compiled_values(d, d_p, u_att, u_r, touch, weight is not PlasticGWSurface._weight)
+            return kernel.state_values(d, d_c, d_p, weight is not PlasticGWSurface._weight and self._footprint,
+                                       self._C, self._offsets(), _GL_X, _GL_W, *self._tx_tw, self._P, self._T)
+        u_att, u_r = self.sets(d, d_c, d_p)
+        touch = (self._inverse(self.recovery, d - d_p, 0.0),)     # the summits at eps = 0: the curves' kink
         p = energy = count = 0.0
         for lo, hi, attached in ((u_att, math.inf, True), (u_r, u_att, False)):
             u, w = self._nodes(*self._span(lo, d_p, hi), breaks=touch)
@@ -148,21 +149,10 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             count += float(q.sum()) if attached else 0.0
         return p, energy, count
 
-    def _compiled_values(self, d, d_p, u_att, u_r, touch, footprint: bool):
-        """`_values` by `plastic_gw_kernel.set_sum`: the same nodes, weights and summit states."""
-        p = energy = count = 0.0
-        for lo, hi, what in ((u_att, math.inf, kernel.RETREAT), (u_r, u_att, kernel.APPROACH)):
-            f, en, q = self._set_sum(what, lo, hi, d_p, d - d_p, touch[0], footprint)
-            p, energy = p + f, energy + en
-            count += q if what == kernel.RETREAT else 0.0
-        return p, energy, count
-
-    def _set_sum(self, what, lo, hi, d_p, shift, touch=math.nan, footprint=True):
-        lo, hi, floor = self._span(lo, d_p, hi)
-        if not hi > lo:
-            return 0.0, 0.0, 0.0
-        return kernel.set_sum(what, lo, hi, floor, touch, d_p, shift, footprint and self._footprint, self._C,
-                              self._offsets(), _GL_X, _GL_W, *self._tx_tw, self._P, self._T)
+    def _set_sum(self, what, lo, hi, d_p, shift):
+        """`plastic_gw_kernel.set_sum` of `what` over the summits lo < u < hi (m), this surface's weight."""
+        return kernel.span_sum(what, lo, hi, math.nan, d_p, shift, self._footprint, self._C, self._offsets(), _GL_X,
+                                _GL_W, *self._tx_tw, self._P, self._T)
 
     def _summits(self, delta, delta_max, attached: bool):
         """(force N, stored energy J) of summits at approach delta (m), deepest approach delta_max (m), all on the
@@ -198,9 +188,9 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         let go."""
         if not math.isfinite(d_c):
             return 0.0
-        u_met = self._inverse(self._edge(1, self.met_edge), d_c - d_p, -self._in0)
+        u_met = self._inverse_edge(1, self.met_edge, d_c - d_p, -self._in0)
         if self.compiled:
-            u_held = self._inverse(self._edge(2, self.hold), d - d_p, -self._out0) if math.isfinite(d) else math.inf
+            u_held = self._inverse_edge(2, self.hold, d - d_p, -self._out0) if math.isfinite(d) else math.inf
             return (self._set_sum(kernel.IN_SWITCH, u_met, math.inf, d_p, d_0 - d_p)[0]
                     + self._set_sum(kernel.OUT_SWITCH, u_met, max(u_held, u_met), d_p, 0.0)[0])
         u, w = self._nodes(*self._span(u_met, d_p))

@@ -20,7 +20,7 @@ from numba import njit
 
 from .plastic_kernel import P_P_D_Y, P_P_F_Y, P_P_SLOPE, _blend, _flattening, _plastic_work
 
-__all__ = ["edge", "set_sum", "gl_nodes"]
+__all__ = ["edge", "inverse", "set_sum", "span_sum", "state_values", "gl_nodes"]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 
@@ -107,7 +107,7 @@ def gl_nodes(lo, hi, floor, offsets, first, quarter, breaks, root_at_top, gl_x, 
 
 #: C slots (the surface's constants, `PlasticBranchGWSurface._kernel_constants`)
 (C_FIRST, C_QUARTER, C_ROOT_AT_TOP, C_U_TABLE, C_DENSITY, C_SIGMA, C_Z_TOP, C_LENGTH, C_ROLLER_RADIUS,
- C_REACH_RATIO) = range(10)
+ C_REACH_RATIO, C_Z_FLOOR, C_CLIP_FLOOR, C_IN0, C_OUT0, C_REACH0) = range(15)
 #: what `set_sum` sums
 APPROACH, RETREAT, IN_SWITCH, OUT_SWITCH, PLASTIC_WORK = range(5)
 
@@ -177,3 +177,91 @@ def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x,
         sb += q * b
         sq += q
     return sa, sb, sq
+
+
+@njit(cache=True)
+def _brentq(kind, value, xa, xb, xtol, rtol, C, P, T):
+    """The root of edge(u, kind) = value in [xa, xb]: scipy.optimize.brentq's algorithm (scipy's brentq.c, step for
+    step, maxiter 100), so the same root as `PlasticGWSurface._inverse` finds with it."""
+    u_table, ratio = C[C_U_TABLE], C[C_REACH_RATIO]
+    xpre, xcur = xa, xb
+    fpre = edge(xpre, kind, u_table, ratio, P, T) - value
+    fcur = edge(xcur, kind, u_table, ratio, P, T) - value
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    xblk = fblk = spre = scur = 0.0
+    for _ in range(100):
+        if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = 0.5 * (xtol + rtol * abs(xcur))
+        sbis = 0.5 * (xblk - xcur)
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre = scur = sbis
+        else:
+            spre = scur = sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0.0 else -delta
+        fcur = edge(xcur, kind, u_table, ratio, P, T) - value
+    return xcur
+
+
+@njit(cache=True)
+def inverse(kind, value, offset, C, P, T):
+    """`PlasticGWSurface._inverse` of edge `kind`: u with edge(u) = value, edge(u) = u + offset up to delta_y."""
+    d_y = P[P_P_D_Y]
+    if value - offset <= d_y:
+        return value - offset
+    hi = max(2.0 * (value - offset), d_y + C[C_SIGMA])
+    while edge(hi, kind, C[C_U_TABLE], C[C_REACH_RATIO], P, T) < value:
+        hi *= 2.0
+    return _brentq(kind, value, d_y, hi, 1e-15 * hi, 1e-14, C, P, T)
+
+
+@njit(cache=True)
+def span_sum(what, lo, hi, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+    """`set_sum` over `PlasticGWSurface._span(lo, d_p, hi)`."""
+    floor = C[C_Z_FLOOR] - d_p
+    if C[C_CLIP_FLOOR] != 0.0:
+        lo = max(lo, floor)
+    hi = min(hi, C[C_Z_TOP] - d_p)
+    if not hi > lo:
+        return 0.0, 0.0, 0.0
+    return set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T)
+
+
+@njit(cache=True)
+def state_values(d, d_c, d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+    """`PlasticBranchGWSurface._values` in one call: (pressure or force, stored energy, attached summits) at
+    (d, d_c, d_p), the sets' edges (`inverse`, as `sets`) and the touch break included."""
+    u_met = inverse(1, d_c - d_p, -C[C_IN0], C, P, T) if math.isfinite(d_c) else math.inf
+    if math.isfinite(d):
+        u_att = max(u_met, inverse(2, d - d_p, -C[C_OUT0], C, P, T))
+        u_r = inverse(3, d - d_p, C[C_REACH0], C, P, T)
+    else:
+        u_att = u_r = math.inf
+    touch = inverse(0, d - d_p, 0.0, C, P, T)
+    f, en, q = span_sum(RETREAT, u_att, math.inf, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
+                         P, T)
+    fa, ea, _ = span_sum(APPROACH, u_r, u_att, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
+                          P, T)
+    return f + fa, en + ea, q
