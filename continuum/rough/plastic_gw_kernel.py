@@ -18,7 +18,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .plastic_kernel import P_P_D_Y, P_P_F_Y, P_P_SLOPE, _blend, _flattening, _plastic_work
+from .plastic_kernel import (P_P_BETA, P_P_D_Y, P_P_F_Y, P_P_LOG_RATIO, P_P_NODES, P_P_SELF_SIMILAR, P_P_SLOPE,
+                             _blend, _flattening, _plastic_work)
 
 __all__ = ["edge", "inverse", "set_sum", "span_sum", "state_values", "gl_nodes"]
 
@@ -26,10 +27,78 @@ _SQRT2PI = math.sqrt(2.0 * math.pi)
 
 
 @njit(cache=True)
+def _lin2(x, xs, ya, yb, n):
+    """(`plastic_kernel._lin`(x, xs, ya), `_lin`(x, xs, yb)), the same arithmetic, one bisection for both."""
+    if x <= xs[0]:
+        return ya[0], yb[0]
+    if x >= xs[n - 1]:
+        return ya[n - 1], yb[n - 1]
+    lo, hi = 0, n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return (ya[lo] + (x - xs[lo]) / (xs[hi] - xs[lo]) * (ya[hi] - ya[lo]),
+            yb[lo] + (x - xs[lo]) / (xs[hi] - xs[lo]) * (yb[hi] - yb[lo]))
+
+
+@njit(cache=True)
+def _flat(dm, P, T):
+    """`plastic_kernel._flattening` for dm within the table: the same interval of its grid D_i = D_top (i/(n-1))^2
+    (the largest i <= n - 2 with D_i <= D), found from its square root instead of by bisection, the same
+    arithmetic."""
+    over = dm - P[P_P_D_Y]
+    if not over > 0.0:
+        return P[P_P_BETA], 0.0
+    xs, ys, zs = T[2], T[3], T[4]
+    n = xs.size
+    if over >= xs[n - 1]:
+        return ys[n - 1], zs[n - 1]
+    lo = min(int(math.sqrt(over / xs[n - 1]) * (n - 1)), n - 2)
+    while lo > 0 and xs[lo] > over:
+        lo -= 1
+    while lo < n - 2 and xs[lo + 1] <= over:
+        lo += 1
+    hi = lo + 1
+    return (ys[lo] + (over - xs[lo]) / (xs[hi] - xs[lo]) * (ys[hi] - ys[lo]),
+            zs[lo] + (over - xs[lo]) / (xs[hi] - xs[lo]) * (zs[hi] - zs[lo]))
+
+
+@njit(cache=True)
+def _branch_pair(retreat, eps, r, P, T):
+    """(force, energy) on the approach or the retreat branch: `plastic_kernel._blend`'s (0, 1) or (2, 3), the same
+    arithmetic, each node law's table searched once for both."""
+    info, tab = T[6], T[7]
+    nodes = int(P[P_P_NODES])
+    side = 1 if retreat else 0
+    if r == P[P_P_BETA]:            # an unflattened summit: node 0's own curve, no scaling
+        row = 3 * side
+        return _lin2(eps, tab[row], tab[row + 1], tab[row + 2], int(info[3 + side]))
+    k, t = 0, 0.0
+    if nodes > 1 and P[P_P_SELF_SIMILAR] == 0.0:
+        x = math.log(max(r / P[P_P_BETA], 1.0)) / P[P_P_LOG_RATIO]
+        k = min(int(math.floor(x)), nodes - 2)
+        t = min(max(x - k, 0.0), 1.0)
+    force = energy = 0.0
+    for j in range(k, k + 2):
+        wgt = 1.0 - t if j == k else t
+        if wgt == 0.0 or j >= nodes:
+            continue
+        s = r / info[5 * j]
+        c = s ** (1.0 / 3.0)
+        row = 6 * j + 3 * side
+        a, b = _lin2(eps / c, tab[row], tab[row + 1], tab[row + 2], int(info[5 * j + 3 + side]))
+        force += wgt * s * a
+        energy += wgt * s * c * b
+    return force, energy
+
+
+@njit(cache=True)
 def edge(u, kind, u_table, reach_ratio, P, T):
     """The summit-set edge functions of `PlasticBranchGWSurface` (see the module docstring) at u (m)."""
-    flag = np.zeros(5)
-    r_p, d_p = _flattening(min(max(u, 0.0), u_table), flag, P, T)
+    r_p, d_p = _flat(min(max(u, 0.0), u_table), P, T)
     g = u - d_p
     if kind == 0:
         return g
@@ -165,14 +234,11 @@ def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x,
             a = _plastic_work(dm, r_p, dp, P, T)
         else:
             dm = min(max(u[i], 0.0), u_table)
-            r_p, dp = _flattening(dm, flag, P, T)
+            r_p, dp = _flat(dm, P, T)
             delta = u[i] - shift
-            eps = delta - dp
-            base = 2 if what == RETREAT else 0
-            a = _blend(base, eps, r_p, P, T)
+            a, b = _branch_pair(what == RETREAT, delta - dp, r_p, P, T)
             if what == RETREAT and delta >= dm and dm > d_y:
                 a = P[P_P_F_Y] + P[P_P_SLOPE] * (delta - d_y)
-            b = _blend(base + 1, eps, r_p, P, T)
         sa += q * a
         sb += q * b
         sq += q
