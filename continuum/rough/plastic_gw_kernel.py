@@ -5,8 +5,9 @@ first in u = lo + t^2, with a square-root top the last in u = hi - t^2), the sam
 the roller footprint's kernel K(z), `RollerFootprint._weight`) and the same summit states as
 `PlasticBranchGWSurface._summits`, evaluated on the law's compiled tables (`continuum.rough.plastic_kernel`: the
 node laws' branches and the flattening table, blended over R_p as `PlasticBranchSummitLaw._scaled` does). One call
-per summit set instead of a few dozen NumPy calls: the values are those of the NumPy form up to the order of the
-sums (tests/continuum/test_plastic_gw_kernel.py compares both).
+per state (`state_values`: the sets' edges by scipy's brentq algorithm, `inverse`, then both sets' sums) instead of
+a few dozen NumPy calls and a Python root-finder's callbacks: the values are those of the NumPy form up to the
+order of the sums (tests/continuum/test_plastic_gw_kernel.py compares both).
 
 Edge functions (`edge`, kind): 0 g(u) = u - delta_p, 1 m(u) = g - delta_in(R_p), 2 h(u) = g - delta_out(R_p),
 3 r(u) = g + reach(R_p) (reach_ratio cbrt(R_p)), with u clipped to [0, u_table] for the flattening.
