@@ -103,6 +103,7 @@ class PlasticGWPunch(ContactLaw):
     def describe(self):
         s = self.surface
         return {"name": self.name, "area": self.area, "sigma": s.sigma, "density": s.density, "z_top": s.z_top,
+                "z_max": s.z_top,           # the tallest summit's height (m), as the elastic rough laws record it
                 "summit_law": s.law.describe(), "source": "Greenwood & Williamson (1966) mean field of Thornton & "
                 "Ning (1998) summits, history (d, d_c, d_p)"}
 

@@ -81,14 +81,16 @@ def _mean_field_cost(scene: Scene, adhesion: str, half_space: bool, w: float, e_
 
 
 def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None = None,
-              with_menisci: bool = False, regime: Regime | None = None) -> tuple[ContactLaw, dict]:
+              with_menisci: bool = False, regime: Regime | None = None,
+              tables: bool = True) -> tuple[ContactLaw | None, dict]:
     """GW rough roller for `scene` and the record of its datum and regime numbers.
 
     `regime` is the scene's (`regime_of`; derived here, at the scene's first impact, where not given).
     `adhesion` (a law name) and `half_space` default to the scene's choices; where the scene says
     'auto' they are decided as `select_law` does, on the regime's first-impact estimate. Before any table is
     built the tables' size is estimated and a scene beyond the bounds is refused with a `SceneError`
-    (`continuum.model.estimates.check_table_cost`).
+    (`continuum.model.estimates.check_table_cost`). `tables` False (mean field, no menisci): only the record, for a
+    law that replaces this one and needs no tables (plastic summits): nothing built or sized, the law is None.
     """
     from ..rough.datum import tallest_summit
     from ..rough.summits import SummitStatistics
@@ -114,7 +116,11 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
     table = scene.numerics.table
     generic = branch_summits(adhesion)
     cost = slaw = None
-    if rough.mode != "discrete":
+    if rough.mode != "discrete" and not tables:
+        if with_menisci:
+            raise ValueError("rough_law: tables=False builds no law to put menisci on")
+        slaw = summit_law(adhesion, scene, e_s) if generic else None
+    elif rough.mode != "discrete":
         table, slaw, cost = _mean_field_cost(scene, adhesion, half_space, w, e_s, stats, datum, table, est, speed)
     surface = None
     if rough.mode == "discrete":
@@ -122,6 +128,9 @@ def rough_law(scene: Scene, adhesion: str | None = None, half_space: bool | None
         slaw = summit_law(adhesion, scene, e_s) if generic else None
         law = factory.discrete_roller(scene, stats, w, e_s, half_space, datum["footprint_half_width"], slaw)
         delta_c = law.delta_c
+    elif not tables:
+        # the summits' JKR separation approach, as the averaged surfaces define it (`GWBranchSurface.delta_c`)
+        law, delta_c = None, float(jkr_ref.critical_approach(rough.summit_radius, w, e_s)) if w > 0 else 0.0
     else:
         surface = factory.averaged_surface(stats, summit_law=slaw, work_of_adhesion=w, summit_e_star=e_s,
                                            z_max=datum["z_max"], detachment=phys.detachment, resolution=table)
@@ -250,9 +259,11 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
     if scene.contact == "rough":
         estimate = regime.estimate
         hs = half_space_decision(scene, regime)
-        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, regime=regime)
         plastic = plasticity_decision(scene, regime, adhesion.law, half_space=hs.used, menisci=wet,
                                       depth=estimate.depth if estimate is not None else None)
+        # plastic summits in the mean field replace the elastic law, which is then neither built nor sized
+        tables = not (plastic.used and scene.surfaces.roughness.mode != "discrete" and not wet)
+        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, regime=regime, tables=tables)
         if plastic.used and scene.surfaces.roughness.mode == "discrete":
             law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure,
                                                   plastic.summit_law)

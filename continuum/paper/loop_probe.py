@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from ..model import select_law
-from .cases import MEAN_FIELD, RIGID, Case
+from .cases import FIG4_ELASTIC, MEAN_FIELD, RIGID, Case
 from .figures import characteristic
 from .run import resolve_case
 
@@ -28,7 +28,7 @@ PROBE_RADII = tuple(np.geomspace(0.05e-6, 2e-6, 9))
 def loop_area(scene: str, params: str, overrides: dict, fidelity: str | None = None) -> float:
     """Fig 4's loop area (J/m^2) of `scene` (rough_silica.toml or rough_ots.toml) with `params` and `overrides`,
     on the averaged summits of a rigid substrate (the paper's figure)."""
-    case = Case("probe", scene, {**MEAN_FIELD, "physics.half_space": RIGID, **overrides})
+    case = Case("probe", scene, {**MEAN_FIELD, "physics.half_space": RIGID, **FIG4_ELASTIC, **overrides})
     law, _ = select_law(resolve_case(case, params, fidelity).scene, 0.0)
     return characteristic(law.surface)["loop_area"]
 

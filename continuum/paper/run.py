@@ -31,7 +31,7 @@ from ..output.results import write_run
 from ..scene import ResolvedScene, SceneError, resolve_scene
 from ..wet import menisci as men
 from . import seed_cache
-from .cases import FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
+from .cases import FIG4_ELASTIC, FIG8_SIGMAS_NM, Case, dry_cases, sigma_case, wet_cases
 from .samples import ESCAPE_REL_TOL, bundle, bundle_cases, escape_search, low_speed_runs, seed_overrides
 from .seed_runs import single_surface_runs
 from .speeds import (
@@ -243,7 +243,7 @@ def fig4_curves(set_name: str, fidelity: str | None) -> dict:
 
     curves = {}
     for key, scene in (("silica", "rough_silica.toml"), ("ots", "rough_ots.toml")):
-        resolved = resolve_case(Case(key, scene), set_name, fidelity)
+        resolved = resolve_case(Case(key, scene, FIG4_ELASTIC), set_name, fidelity)
         law, _ = select_law(resolved.scene, 0.0)
         curves[key] = characteristic(law.surface)
     return curves

@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import csv
 import math
+from dataclasses import replace
 from pathlib import Path
 
 from ..dynamics.escape import escape_velocity, single_impact
 from ..dynamics.impact import first_impact_speed, run_impact
 from ..model import select_law
 from ..scene import SceneError, find_params, read_toml, resolve_scene
-from .cases import FIG8_SIGMAS_NM, RIGID, Case, sigma_case
+from .cases import FIG4_ELASTIC, FIG8_SIGMAS_NM, RIGID, Case, sigma_case
 
 #: Impacts per sampled drop: the sampled claims read at most this many ("sticks within 20 impacts").
 SAMPLE_MAX_BOUNCES = 20
@@ -221,7 +222,12 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
                                               for k, r in runs.items()}}
     from .figures import characteristic
 
-    out["loop"] = {k: characteristic(law.surface)["loop_area"] for k, (law, *_) in laws.items()}
+    out["loop"] = {}
+    for key in laws:        # Fig 4's loop: the paper's elastic characteristic (`cases.FIG4_ELASTIC`)
+        case = cases["rough_silica" if key == "silica" else "rough_ots"]
+        elastic = replace(case, overrides={**case.overrides, **FIG4_ELASTIC})
+        out["loop"][key] = characteristic(select_law(_resolved(elastic, params, overrides, fidelity, 1).scene,
+                                                     laws[key][4])[0].surface)["loop_area"]
     return out
 
 

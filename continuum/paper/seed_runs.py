@@ -22,7 +22,7 @@ import math
 
 from ..dynamics.escape import escape_velocity, single_impact
 from ..dynamics.impact import first_impact_speed, run_impact
-from ..model import menisci_decision, meniscus_parameters, select_law
+from ..model import menisci_decision, regime_of, select_law
 from ..scene import SceneError
 from .cases import FIG8_SIGMAS_NM, SIGMAS_NM, Case, sigma_case, wet_cases
 from .samples import SAMPLE_MAX_BOUNCES, _resolved, _sequence, escape_search
@@ -116,11 +116,13 @@ def _t_a_claim(params: str, overrides: dict, fidelity: str | None, dry_law, esc_
     try:
         resolved = _resolved(case, params, overrides, fidelity, 1)
         sc = resolved.scene
-        decision = menisci_decision(sc)
+        v0 = first_impact_speed(resolved)
+        regime = regime_of(sc, v0)
+        decision = menisci_decision(sc, regime)
         if decision.choice == "off":
             return {"holds": None, "reason": f"no menisci: {decision.why}"}
-        wet = select_law(sc, first_impact_speed(resolved), menisci=True)[0]
-        t_a = meniscus_parameters(sc)["condensation_time"]
+        wet = select_law(sc, v0, menisci=True, regime=regime)[0]
+        t_a = regime.meniscus_parameters()["condensation_time"]
         dry, m, g, rtol = dry_law
         esc = escape_velocity(dry, m, g, esc_6nm["lower"], esc_6nm["upper"], rel_tol=WET_DRY_REL_TOL, rtol=rtol,
                               ends_known=True)

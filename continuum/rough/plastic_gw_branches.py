@@ -32,6 +32,11 @@ PlasticSummitsPunch`), so the driver's energy audit tests the motion against the
 the elastic law's and the sums are the elastic GW mean field of that law (`continuum.rough.gw_branches`, threshold
 zeta = d_c + delta_in; tested to 1e-7).
 
+Speed: a law with a compiled form (`compiled_form`, `continuum.rough.plastic_kernel`'s tables) has its edges and
+its sums over each summit set evaluated by `continuum.rough.plastic_gw_kernel` (one compiled call per set, the
+same nodes, weights and summit states); `compiled = False` on an instance keeps the NumPy form, the reference the
+compiled one is tested against.
+
 Quadrature: the same geometric Gauss-Legendre panels in u as the JKR surface, from each set's lower edge, with its
 lower truncation and node bound (`PlasticGWSurface`). The summit law is tabulated to its `delta_max`; a trial stage
 of the integrator deeper than that evaluates the summits with the flattening at the table's end, and an accepted
@@ -47,7 +52,9 @@ import math
 
 import numpy as np
 
-from .plastic_summits import PlasticGWSurface, RollerFootprint
+from . import plastic_gw_kernel as kernel
+from .plastic_kernel import _law_tables
+from .plastic_summits import _GL_W, _GL_X, PlasticGWSurface, RollerFootprint
 
 __all__ = ["PlasticBranchGWSurface", "BranchRollerFootprint"]
 
@@ -71,6 +78,25 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         self._reach0 = _at(law.reach_of, beta)
         #: deepest approach the summit law is tabulated to (m)
         self.u_table = float(getattr(law, "delta_max", math.inf))
+        #: sums and edges by the compiled kernel (`plastic_gw_kernel`); False: the NumPy form (the reference)
+        self.compiled = bool(getattr(law, "compiled_form", False)) and math.isfinite(self.u_table)
+        if self.compiled:
+            self._P, tables = _law_tables(law)
+            none = np.zeros(1)              # the kernel's tables, without the discrete summits' own rows
+            self._T = (none, none, *tables[:3], none, *tables[3:])
+            self._reach_ratio = _at(law.reach_of, 1.0)          # reach(R_p) = cbrt(R_p) * ratio
+            self._tx_tw = (getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0)))
+            self._footprint = isinstance(self, RollerFootprint)
+            self._C = np.array([self._first, self.panel_width * self.sigma, float(self._root_at_top), self.u_table,
+                                self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
+                                getattr(self, "roller_radius", 0.0), self._reach_ratio, self.z_floor,
+                                float(self._clip_floor), self._in0, self._out0, self._reach0])
+
+    def _inverse_edge(self, kind: int, method, value, offset):
+        """`_inverse` of edge `kind` (`plastic_gw_kernel.edge`: 0 recovery, 1 met, 2 hold, 3 reach), compiled if so."""
+        if self.compiled:
+            return kernel.inverse(kind, value, offset, self._C, self._P, self._T)
+        return self._inverse(method, value, offset)
 
     # ------------------------------------------------------------------ summit sets
     def _flat(self, u):
@@ -98,14 +124,18 @@ class PlasticBranchGWSurface(PlasticGWSurface):
 
     def sets(self, d, d_c, d_p):
         """(u_att, u_r) (m): summits u >= u_att are attached, u_r < u < u_att on the approach branch."""
-        u_met = self._inverse(self.met_edge, d_c - d_p, -self._in0) if math.isfinite(d_c) else math.inf
+        u_met = (self._inverse_edge(1, self.met_edge, d_c - d_p, -self._in0) if math.isfinite(d_c)
+                 else math.inf)
         if not math.isfinite(d):
             return math.inf, math.inf
-        u_held = self._inverse(self.hold, d - d_p, -self._out0)
-        return max(u_met, u_held), self._inverse(self.reach_edge, d - d_p, self._reach0)
+        u_held = self._inverse_edge(2, self.hold, d - d_p, -self._out0)
+        return max(u_met, u_held), self._inverse_edge(3, self.reach_edge, d - d_p, self._reach0)
 
     # ------------------------------------------------------------------ values
     def _values(self, d, d_c, d_p, weight):
+        if self.compiled:
+            return kernel.state_values(d, d_c, d_p, weight is not PlasticGWSurface._weight and self._footprint,
+                                       self._C, self._offsets(), _GL_X, _GL_W, *self._tx_tw, self._P, self._T)
         u_att, u_r = self.sets(d, d_c, d_p)
         touch = (self._inverse(self.recovery, d - d_p, 0.0),)     # the summits at eps = 0: the curves' kink
         p = energy = count = 0.0
@@ -118,6 +148,11 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             p, energy = p + float(q @ f), energy + float(q @ en)
             count += float(q.sum()) if attached else 0.0
         return p, energy, count
+
+    def _set_sum(self, what, lo, hi, d_p, shift):
+        """`plastic_gw_kernel.set_sum` of `what` over the summits lo < u < hi (m), this surface's weight."""
+        return kernel.span_sum(what, lo, hi, math.nan, d_p, shift, self._footprint, self._C, self._offsets(), _GL_X,
+                                _GL_W, *self._tx_tw, self._P, self._T)
 
     def _summits(self, delta, delta_max, attached: bool):
         """(force N, stored energy J) of summits at approach delta (m), deepest approach delta_max (m), all on the
@@ -142,6 +177,8 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         return p, count
 
     def plastic_work(self, d_p):
+        if self.compiled:
+            return self._set_sum(kernel.PLASTIC_WORK, max(self.law.yield_approach, 0.0), math.inf, d_p, 0.0)[0]
         u, w = self._nodes(*self._span(max(self.law.yield_approach, 0.0), d_p))
         return float(self._weight(u, w, d_p) @ self.law.plastic_work(np.minimum(u, self.u_table))) if u.size else 0.0
 
@@ -151,7 +188,11 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         let go."""
         if not math.isfinite(d_c):
             return 0.0
-        u_met = self._inverse(self.met_edge, d_c - d_p, -self._in0)
+        u_met = self._inverse_edge(1, self.met_edge, d_c - d_p, -self._in0)
+        if self.compiled:
+            u_held = self._inverse_edge(2, self.hold, d - d_p, -self._out0) if math.isfinite(d) else math.inf
+            return (self._set_sum(kernel.IN_SWITCH, u_met, math.inf, d_p, d_0 - d_p)[0]
+                    + self._set_sum(kernel.OUT_SWITCH, u_met, max(u_held, u_met), d_p, 0.0)[0])
         u, w = self._nodes(*self._span(u_met, d_p))
         if u.size == 0:
             return 0.0

@@ -1,0 +1,344 @@
+"""Compiled sums of the GW mean field of plastic branch summits (`continuum.rough.plastic_gw_branches`).
+
+The same quadrature as `PlasticGWSurface._nodes` (geometric Gauss-Legendre panels from a set's lower edge, the
+first in u = lo + t^2, with a square-root top the last in u = hi - t^2), the same weights (the Gaussian density or
+the roller footprint's kernel K(z), `RollerFootprint._weight`) and the same summit states as
+`PlasticBranchGWSurface._summits`, evaluated on the law's compiled tables (`continuum.rough.plastic_kernel`: the
+node laws' branches and the flattening table, blended over R_p as `PlasticBranchSummitLaw._scaled` does). One call
+per state (`state_values`: the sets' edges by scipy's brentq algorithm, `inverse`, then both sets' sums) instead of
+a few dozen NumPy calls and a Python root-finder's callbacks: the values are those of the NumPy form up to the
+order of the sums (tests/continuum/test_plastic_gw_kernel.py compares both).
+
+Edge functions (`edge`, kind): 0 g(u) = u - delta_p, 1 m(u) = g - delta_in(R_p), 2 h(u) = g - delta_out(R_p),
+3 r(u) = g + reach(R_p) (reach_ratio cbrt(R_p)), with u clipped to [0, u_table] for the flattening.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .plastic_kernel import (
+    P_P_BETA,
+    P_P_D_Y,
+    P_P_F_Y,
+    P_P_LOG_RATIO,
+    P_P_NODES,
+    P_P_SELF_SIMILAR,
+    P_P_SLOPE,
+    _blend,
+    _flattening,
+    _plastic_work,
+)
+
+__all__ = ["edge", "inverse", "set_sum", "span_sum", "state_values", "gl_nodes"]
+
+_SQRT2PI = math.sqrt(2.0 * math.pi)
+
+
+@njit(cache=True)
+def _lin2(x, xs, ya, yb, n):
+    """(`plastic_kernel._lin`(x, xs, ya), `_lin`(x, xs, yb)), the same arithmetic, one bisection for both."""
+    if x <= xs[0]:
+        return ya[0], yb[0]
+    if x >= xs[n - 1]:
+        return ya[n - 1], yb[n - 1]
+    lo, hi = 0, n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return (ya[lo] + (x - xs[lo]) / (xs[hi] - xs[lo]) * (ya[hi] - ya[lo]),
+            yb[lo] + (x - xs[lo]) / (xs[hi] - xs[lo]) * (yb[hi] - yb[lo]))
+
+
+@njit(cache=True)
+def _flat(dm, P, T):
+    """`plastic_kernel._flattening` for dm within the table: the same interval of its grid D_i = D_top (i/(n-1))^2
+    (the largest i <= n - 2 with D_i <= D), found from its square root instead of by bisection, the same
+    arithmetic."""
+    over = dm - P[P_P_D_Y]
+    if not over > 0.0:
+        return P[P_P_BETA], 0.0
+    xs, ys, zs = T[2], T[3], T[4]
+    n = xs.size
+    if over >= xs[n - 1]:
+        return ys[n - 1], zs[n - 1]
+    lo = min(int(math.sqrt(over / xs[n - 1]) * (n - 1)), n - 2)
+    while lo > 0 and xs[lo] > over:
+        lo -= 1
+    while lo < n - 2 and xs[lo + 1] <= over:
+        lo += 1
+    hi = lo + 1
+    return (ys[lo] + (over - xs[lo]) / (xs[hi] - xs[lo]) * (ys[hi] - ys[lo]),
+            zs[lo] + (over - xs[lo]) / (xs[hi] - xs[lo]) * (zs[hi] - zs[lo]))
+
+
+@njit(cache=True)
+def _branch_pair(retreat, eps, r, P, T):
+    """(force, energy) on the approach or the retreat branch: `plastic_kernel._blend`'s (0, 1) or (2, 3), the same
+    arithmetic, each node law's table searched once for both."""
+    info, tab = T[6], T[7]
+    nodes = int(P[P_P_NODES])
+    side = 1 if retreat else 0
+    if r == P[P_P_BETA]:            # an unflattened summit: node 0's own curve, no scaling
+        row = 3 * side
+        return _lin2(eps, tab[row], tab[row + 1], tab[row + 2], int(info[3 + side]))
+    k, t = 0, 0.0
+    if nodes > 1 and P[P_P_SELF_SIMILAR] == 0.0:
+        x = math.log(max(r / P[P_P_BETA], 1.0)) / P[P_P_LOG_RATIO]
+        k = min(int(math.floor(x)), nodes - 2)
+        t = min(max(x - k, 0.0), 1.0)
+    force = energy = 0.0
+    for j in range(k, k + 2):
+        wgt = 1.0 - t if j == k else t
+        if wgt == 0.0 or j >= nodes:
+            continue
+        s = r / info[5 * j]
+        c = s ** (1.0 / 3.0)
+        row = 6 * j + 3 * side
+        a, b = _lin2(eps / c, tab[row], tab[row + 1], tab[row + 2], int(info[5 * j + 3 + side]))
+        force += wgt * s * a
+        energy += wgt * s * c * b
+    return force, energy
+
+
+@njit(cache=True)
+def edge(u, kind, u_table, reach_ratio, P, T):
+    """The summit-set edge functions of `PlasticBranchGWSurface` (see the module docstring) at u (m)."""
+    r_p, d_p = _flat(min(max(u, 0.0), u_table), P, T)
+    g = u - d_p
+    if kind == 0:
+        return g
+    if kind == 1:
+        return g - _blend(4, 0.0, r_p, P, T)
+    if kind == 2:
+        return g - _blend(5, 0.0, r_p, P, T)
+    return g + r_p ** (1.0 / 3.0) * reach_ratio
+
+
+@njit(cache=True)
+def gl_nodes(lo, hi, floor, offsets, first, quarter, breaks, root_at_top, gl_x, gl_w):
+    """`PlasticGWSurface._nodes` (same edges, same panels, same order of the nodes)."""
+    if not hi > lo:
+        return np.empty(0), np.empty(0)
+    raw = []
+    if floor <= lo and hi - lo < offsets[-1]:
+        for o in offsets:
+            if o < hi - lo:
+                raw.append(lo + o)
+        raw.append(hi)
+    else:
+        raw.append(lo)
+        x, width = lo + min(first, hi - lo), first
+        while x < hi:
+            raw.append(x)
+            width = min(1.5 * width, max(quarter, 0.5 * (floor - x)))
+            x += width
+        raw.append(hi)
+    for b in breaks:
+        if lo < b < hi:
+            raw.append(b)
+    srt = np.sort(np.array(raw))
+    edges = np.empty(srt.size)
+    m = 0
+    for v in srt:
+        if m == 0 or v != edges[m - 1]:
+            edges[m] = v
+            m += 1
+    edges = edges[:m]
+    if root_at_top:
+        if edges.size > 3:
+            last = 1
+            for i in range(1, edges.size - 1):
+                if hi - edges[i] >= edges[i] - edges[i - 1]:
+                    last = i
+            trimmed = np.empty(last + 2)
+            trimmed[:last + 1] = edges[:last + 1]
+            trimmed[last + 1] = hi
+            edges = trimmed
+        if edges.size == 2:
+            edges = np.array([lo, 0.5 * (lo + hi), hi])
+    top = root_at_top and edges.size > 2
+    first_inner = 1
+    last_inner = edges.size - 2 if top else edges.size - 1        # inner edges: edges[first_inner..last_inner]
+    plain = max(last_inner - first_inner, 0)
+    k = gl_x.size
+    ends = 2 if top else 1
+    xs, ws = np.empty(k * (ends + plain)), np.empty(k * (ends + plain))
+    n = 0
+    for end_panel in range(ends):
+        start, stop, sign = (edges[0], edges[1], 1.0) if end_panel == 0 else (hi, edges[-2], -1.0)
+        t1 = math.sqrt(abs(stop - start))
+        for j in range(k):
+            t = 0.5 * t1 * (gl_x[j] + 1.0)
+            xs[n], ws[n] = start + sign * t * t, 0.5 * t1 * gl_w[j] * 2.0 * t
+            n += 1
+    for i in range(first_inner, last_inner):
+        a, b = edges[i], edges[i + 1]
+        for j in range(k):
+            xs[n], ws[n] = 0.5 * (a + b) + 0.5 * (b - a) * gl_x[j], 0.5 * (b - a) * gl_w[j]
+            n += 1
+    return xs, ws
+
+
+#: C slots (the surface's constants, `PlasticBranchGWSurface._kernel_constants`)
+(C_FIRST, C_QUARTER, C_ROOT_AT_TOP, C_U_TABLE, C_DENSITY, C_SIGMA, C_Z_TOP, C_LENGTH, C_ROLLER_RADIUS,
+ C_REACH_RATIO, C_Z_FLOOR, C_CLIP_FLOOR, C_IN0, C_OUT0, C_REACH0) = range(15)
+#: what `set_sum` sums
+APPROACH, RETREAT, IN_SWITCH, OUT_SWITCH, PLASTIC_WORK = range(5)
+
+
+@njit(cache=True)
+def _weight(u, w, d_p, footprint, C, tx, tw):
+    """Summits per unit height times the quadrature weight at z = d_p + u: n phi(z) (`PlasticGWSurface._weight`)
+    or the roller footprint's kernel K(z) (`footprint`, `RollerFootprint._weight`, 24-node rule tx, tw)."""
+    density, sigma = C[C_DENSITY], C[C_SIGMA]
+    z = d_p + u
+    if not footprint:
+        y = z / sigma
+        return density * w * math.exp(-0.5 * y * y) / (_SQRT2PI * sigma)
+    top = math.sqrt(max(C[C_Z_TOP] - z, 0.0))
+    s = 0.0
+    for j in range(tx.size):
+        t = 0.5 * top * (tx[j] + 1.0)
+        y = (z + t * t) / sigma
+        s += math.exp(-0.5 * y * y) * tw[j]
+    k = 0.5 * top * s * 2.0 / (_SQRT2PI * sigma)
+    return density * w * C[C_LENGTH] * math.sqrt(2.0 * C[C_ROLLER_RADIUS]) * k
+
+
+@njit(cache=True)
+def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+    """(sum q a, sum q b, sum q) over the quadrature of [lo, hi] (m, in u; `gl_nodes`, split at delta_y and
+    `touch`) of one summit set, q the weight (`_weight`) and, by `what`:
+
+    * APPROACH / RETREAT: a = force F, b = stored energy U of summits at approach delta = u - shift (shift =
+      d - d_p), deepest approach clip(u, 0, u_table), on that branch (the retreat branch with Thornton-Ning's
+      plastic line where delta >= delta_max > delta_y): `PlasticBranchGWSurface._summits`;
+    * IN_SWITCH: a = U_A - U_R at delta_in of the flattening of clip(u - shift, 0, u_table) (shift = d_0 - d_p:
+      the flattening a summit met this contact with); OUT_SWITCH: a = U_R - U_A at delta_out of clip(u, 0,
+      u_table)'s (`PlasticBranchSummitLaw.in_switch`, `out_switch`);
+    * PLASTIC_WORK: a = W_p(min(u, u_table)) (`PlasticBranchSummitLaw.plastic_work`)."""
+    u, w = gl_nodes(lo, hi, floor, offsets, C[C_FIRST], C[C_QUARTER], np.array([P[P_P_D_Y], touch]),
+                    C[C_ROOT_AT_TOP] != 0.0, gl_x, gl_w)
+    flag = np.zeros(5)
+    u_table, d_y = C[C_U_TABLE], P[P_P_D_Y]
+    sa = sb = sq = 0.0
+    for i in range(u.size):
+        q = _weight(u[i], w[i], d_p, footprint, C, tx, tw)
+        a = b = 0.0
+        if what == IN_SWITCH:
+            r_p, dp = _flattening(min(max(u[i] - shift, 0.0), u_table), flag, P, T)
+            e = _blend(4, 0.0, r_p, P, T)
+            a = _blend(1, e, r_p, P, T) - _blend(3, e, r_p, P, T)
+        elif what == OUT_SWITCH:
+            r_p, dp = _flattening(min(max(u[i], 0.0), u_table), flag, P, T)
+            e = _blend(5, 0.0, r_p, P, T)
+            a = _blend(3, e, r_p, P, T) - _blend(1, e, r_p, P, T)
+        elif what == PLASTIC_WORK:
+            dm = min(u[i], u_table)
+            r_p, dp = _flattening(max(dm, d_y), flag, P, T)
+            a = _plastic_work(dm, r_p, dp, P, T)
+        else:
+            dm = min(max(u[i], 0.0), u_table)
+            r_p, dp = _flat(dm, P, T)
+            delta = u[i] - shift
+            a, b = _branch_pair(what == RETREAT, delta - dp, r_p, P, T)
+            if what == RETREAT and delta >= dm and dm > d_y:
+                a = P[P_P_F_Y] + P[P_P_SLOPE] * (delta - d_y)
+        sa += q * a
+        sb += q * b
+        sq += q
+    return sa, sb, sq
+
+
+@njit(cache=True)
+def _brentq(kind, value, xa, xb, xtol, rtol, C, P, T):
+    """The root of edge(u, kind) = value in [xa, xb]: scipy.optimize.brentq's algorithm (scipy's brentq.c, step for
+    step, maxiter 100), so the same root as `PlasticGWSurface._inverse` finds with it."""
+    u_table, ratio = C[C_U_TABLE], C[C_REACH_RATIO]
+    xpre, xcur = xa, xb
+    fpre = edge(xpre, kind, u_table, ratio, P, T) - value
+    fcur = edge(xcur, kind, u_table, ratio, P, T) - value
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    xblk = fblk = spre = scur = 0.0
+    for _ in range(100):
+        if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = 0.5 * (xtol + rtol * abs(xcur))
+        sbis = 0.5 * (xblk - xcur)
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre = scur = sbis
+        else:
+            spre = scur = sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0.0 else -delta
+        fcur = edge(xcur, kind, u_table, ratio, P, T) - value
+    return xcur
+
+
+@njit(cache=True)
+def inverse(kind, value, offset, C, P, T):
+    """`PlasticGWSurface._inverse` of edge `kind`: u with edge(u) = value, edge(u) = u + offset up to delta_y."""
+    d_y = P[P_P_D_Y]
+    if value - offset <= d_y:
+        return value - offset
+    hi = max(2.0 * (value - offset), d_y + C[C_SIGMA])
+    while edge(hi, kind, C[C_U_TABLE], C[C_REACH_RATIO], P, T) < value:
+        hi *= 2.0
+    return _brentq(kind, value, d_y, hi, 1e-15 * hi, 1e-14, C, P, T)
+
+
+@njit(cache=True)
+def span_sum(what, lo, hi, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+    """`set_sum` over `PlasticGWSurface._span(lo, d_p, hi)`."""
+    floor = C[C_Z_FLOOR] - d_p
+    if C[C_CLIP_FLOOR] != 0.0:
+        lo = max(lo, floor)
+    hi = min(hi, C[C_Z_TOP] - d_p)
+    if not hi > lo:
+        return 0.0, 0.0, 0.0
+    return set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T)
+
+
+@njit(cache=True)
+def state_values(d, d_c, d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+    """`PlasticBranchGWSurface._values` in one call: (pressure or force, stored energy, attached summits) at
+    (d, d_c, d_p), the sets' edges (`inverse`, as `sets`) and the touch break included."""
+    u_met = inverse(1, d_c - d_p, -C[C_IN0], C, P, T) if math.isfinite(d_c) else math.inf
+    if math.isfinite(d):
+        u_att = max(u_met, inverse(2, d - d_p, -C[C_OUT0], C, P, T))
+        u_r = inverse(3, d - d_p, C[C_REACH0], C, P, T)
+    else:
+        u_att = u_r = math.inf
+    touch = inverse(0, d - d_p, 0.0, C, P, T)
+    f, en, q = span_sum(RETREAT, u_att, math.inf, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
+                         P, T)
+    fa, ea, _ = span_sum(APPROACH, u_r, u_att, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
+                          P, T)
+    return f + fa, en + ea, q
