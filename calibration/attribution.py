@@ -131,6 +131,9 @@ def revert_table(table: Mapping[str, Any], revert: Revert) -> dict:
                            "set's values (claim attribution)")
     meta["reverted"] = {k: {"calibrated": c, "base": "scene default" if b is None else b}
                         for k, c, b in zip(revert.keys, revert.calibrated, revert.base)}
+    # the attribution passes the calibrated set's rows to each run itself (`attribute_claims`' uncertainty_rows);
+    # the set's relative pointer to them would not resolve from the attribution's folder
+    meta.pop("uncertainty_rows", None)
     base_origin = _base_origin(meta.get("base"))
     for key, base in zip(revert.keys, revert.base):
         (meta.get("calibration") or {}).pop(key, None)
