@@ -29,6 +29,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from typing import Any
 
+from ..model.regime import Regime
 from ..output.proportions import wilson_half_width
 from ..rough.ensemble import EnsembleResult, MemberOutcome, member_seeds
 from ..scene import ResolvedScene, Scene, SceneError
@@ -79,15 +80,20 @@ class MemberPlan:
     its numbers)."""
 
 
-def member_plan(scene: Scene, speed: float, heights=None) -> MemberPlan:
+def member_plan(scene: Scene, speed: float, heights=None, regime: Regime | None = None) -> MemberPlan:
     """The realisation-independent decisions of a discrete run of `scene` at first-impact `speed` (m/s), its
-    members drawing summit heights from `heights` (None: Gaussian)."""
+    members drawing summit heights from `heights` (None: Gaussian); `regime`: the scene's, derived once by the
+    caller (`continuum.dynamics.impact.run_impact`) at the same speed, else derived here."""
     from ..model import decisions
     from ..model.regime import regime_of
     from ..model.select import branch_summits
     from ..rough.tail import strip_half_width
 
-    regime = regime_of(scene, speed)
+    if regime is None:
+        regime = regime_of(scene, speed)
+    elif regime.speed != speed:
+        raise ValueError(f"member_plan: the regime was derived at {regime.speed!r} m/s, the plan asked for at "
+                         f"{speed!r} m/s")
     law = decisions.adhesion_decision(scene, regime).law
     rough, body = scene.surfaces.roughness, scene.body
     half = strip_half_width(heights, rough.sigma, rough.summit_density, body.radius, body.length)
@@ -248,7 +254,8 @@ def ensemble_source(heights, tail_model: str) -> dict:
 
 def run_ensemble(scene: Scene | ResolvedScene, members: int | str | None = None, seed: int | None = None,
                  executor: Any = None, workers: int | None = None, escape: bool | None = None,
-                 escape_rel_tol: float = ESCAPE_REL_TOL, heights=None, first_impact: bool = False) -> EnsembleResult:
+                 escape_rel_tol: float = ESCAPE_REL_TOL, heights=None, first_impact: bool = False,
+                 regime: Regime | None = None) -> EnsembleResult:
     """Run `members` discrete realisations (an int, or 'auto'; default surfaces.roughness.members) of the rough
     `scene` with seeds derived from `seed` (default surfaces.roughness.seed), their summit heights drawn from
     `heights` (None: Gaussian of surfaces.roughness.sigma; a ResolvedScene with a map and tail_model
@@ -256,7 +263,7 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | str | None = None,
     ('local', 'processes', 'dask'; None is 'local') opened and closed here with `workers`, or an open
     `nanoimpact.executors` executor. `escape` (default surfaces.roughness.escape_velocities): also bisect each
     member's escape velocity to `escape_rel_tol` (`member_escape`). `first_impact`: run each member to its first
-    rebound only."""
+    rebound only. `regime`: the scene's, derived once by the caller at its first-impact speed (`member_plan`)."""
     from ..model.regime import first_impact_speed
 
     sc = scene.scene if isinstance(scene, ResolvedScene) else scene
@@ -280,7 +287,7 @@ def run_ensemble(scene: Scene | ResolvedScene, members: int | str | None = None,
         if members < 1:
             raise ValueError(f"members = {members!r}: must be >= 1")
     master = rough.seed if seed is None else int(seed)
-    plan = member_plan(sc, first_impact_speed(sc), heights)
+    plan = member_plan(sc, first_impact_speed(sc), heights, regime)
     escape = bool(rough.escape_velocities) if escape is None else bool(escape)
     tol = float(escape_rel_tol) if escape else None
     start = time.perf_counter()

@@ -49,6 +49,8 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         verdict = dry_run_verdict(regime, [b.duration for b in run.bounces], run.status)
         if verdict.rerun:
             law, models = select_law(scene, regime.speed, menisci=True, regime=regime)
+            if realisation is not None:
+                models["realisation"] = realisation.record()
             run, release = _simulate(resolved, law, models, progress)
         models["menisci"].update(verdict.record())
     models["regimes"] = regime_numbers(scene, regime, models, run)
@@ -73,7 +75,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
         "timing": {"wall_s": wall},
     }
     if realisation is not None and realisation.mode == "ensemble":
-        result["ensemble"], extra = _ensemble_record(resolved, run, executor, workers)
+        result["ensemble"], extra = _ensemble_record(resolved, run, executor, workers, regime)
         if extra is not None:  # a height map: its cutoff band and the tail models (continuum.dynamics.map_ensembles)
             result["surface"] = {**result["surface"], "cutoff_band": extra["cutoff_band"]}
             result["warnings"] += extra["warnings"]
@@ -105,7 +107,8 @@ def _settle_realisation(resolved: ResolvedScene, regime: Regime):
     return resolved, decision
 
 
-def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> tuple[dict, dict | None]:
+def _ensemble_record(resolved: ResolvedScene, run, executor, workers,
+                     regime: Regime) -> tuple[dict, dict | None]:
     """(result.json -> ensemble: the members' distributions, with the mean-field run's numbers beside them; for a
     scene with a height map, what `continuum.dynamics.map_ensembles` adds: the tail models, the cutoff band,
     warnings)."""
@@ -113,7 +116,7 @@ def _ensemble_record(resolved: ResolvedScene, run, executor, workers) -> tuple[d
     from .map_ensembles import map_ensembles
 
     with open_executor(executor, workers) as ex:
-        ens = run_ensemble(resolved, executor=ex)
+        ens = run_ensemble(resolved, executor=ex, regime=regime)
         extra = map_ensembles(resolved, ens, executor=ex)
     heights = [b.rebound_height for b in run.bounces if b.rebound_height is not None]
     mean_field = {"rebounds": len(heights), "first_rebound_m": heights[0] if heights else 0.0,

@@ -48,6 +48,9 @@ def counted(monkeypatch):
     ("afm_tip_humidity", {"physics.menisci": "auto", "menisci.condensation_time": 1e-12}, False),
     ("rough_silica", {"surfaces.roughness.mode": "mean_field", "physics.half_space": "off",
                       "numerics.max_bounces": 1, "numerics.fidelity": "fast"}, True),
+    # an ensemble: its members' plan takes the run's regime (`member_plan`), the mean-field run beside it too
+    ("rough_silica", {"surfaces.roughness.mode": "ensemble", "surfaces.roughness.members": 2,
+                      "physics.half_space": "off", "numerics.max_bounces": 1, "numerics.fidelity": "fast"}, True),
 ])
 def test_run_impact_derives_the_regime_once(counted, scene, overrides, rough):
     run = run_impact(resolve_scene(scene, overrides=overrides, override_label="test"), condensation_sweep=False)
