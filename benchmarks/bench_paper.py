@@ -58,7 +58,15 @@ PREVIOUS_CYCLE = "4b7d0e0"
 #: numba's one-time compile of the contact kernel (cached beside the module) is not a run's cost; an exported
 #: baseline tree starts with an empty cache, so every tree is warmed first, untimed.
 # compile (or load) a tree's numba kernels untimed (whole_command skips it for a revision from before the kernels)
-WARM_SNIPPET = "from continuum.numerics.compiled_contact import warm_up; warm_up()"
+#: each tree's kernels compiled or loaded, untimed (a tree from before continuum's modules moved into folders keeps
+#: the compiled contact phase at the package root)
+WARM_SNIPPET = """
+try:
+    from continuum.numerics.compiled_contact import warm_up
+except ImportError:
+    from continuum.compiled_contact import warm_up
+warm_up()
+"""
 
 PAPER_SNIPPET = """
 import sys

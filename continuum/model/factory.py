@@ -178,6 +178,14 @@ def wet_sharing_dry_tables(wet: ContactLaw, dry: ContactLaw) -> ContactLaw:
     return wet
 
 
+def wet_dry_part(wet: ContactLaw) -> ContactLaw | None:
+    """The dry law inside the averaged wet roller `wet` (what it runs before t_a and outside its bridges); None where
+    `wet` is another law."""
+    from ..laws.wet import WetRoughRoller
+
+    return wet.dry if isinstance(wet, WetRoughRoller) else None
+
+
 def _same_law(a: ContactLaw, b: ContactLaw) -> bool:
     return type(a) is type(b) and json.dumps(a.describe(), sort_keys=True, default=repr) == \
         json.dumps(b.describe(), sort_keys=True, default=repr)

@@ -118,7 +118,15 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     menisci = menisci_decision(scene, regime)
     wet_possible = menisci.choice != "off"
     wet = select_law(scene, v0, menisci=True, regime=regime)[0] if wet_possible else None
-    wet = factory.wet_sharing_dry_tables(wet, dry) if wet is not None else None
+    dry_law = "the scene's dry law"
+    if wet is not None:
+        wet = factory.wet_sharing_dry_tables(wet, dry)
+        own = factory.wet_dry_part(wet)
+        if own is not None and own is not dry:
+            # other solids under the bridges (plastic summits yield dry, but the bridges' law wraps elastic
+            # summits: continuum.model.decisions.summit_plasticity): the humidity comparison runs both on the wet
+            # law's own dry part, so that before t_a the two runs are the same computation
+            dry, dry_law = own, "the wet law's own dry summits (elastic: the bridges' law wraps elastic summits)"
     m = dict(regime.meniscus_parameters()) if wet is not None else {}
     t_a = m.get("condensation_time")
     grid, dry_runs, skipped = [], {}, []
@@ -166,7 +174,7 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
     return {"kind": "wet", "case": case.name, "set": Path(params).stem, "points": points, "escape_dry": esc_dry,
             "escape_wet": esc_wet, "menisci_possible": wet_possible, "condensation_time": t_a,
             "condensation_time_nucleation": _nucleation_time(scene), "longest_dry_rebound_s": longest,
-            "t_a_band_edge": edge, "t_a_study": flips, "skipped": skipped,
+            "t_a_band_edge": edge, "t_a_study": flips, "skipped": skipped, "dry_law": dry_law,
             "menisci": {k: m[k] for k in ("kelvin_gap", "bridge_pull_off", "growth_length", "solid_adhesion",
                                           "solid_pull")} if m else None,
             "why_no_menisci": None if wet_possible else menisci.why,
