@@ -46,7 +46,9 @@ def _t_a_entry(set_name: str, t: dict) -> dict:
 
 
 def attach(set_name: str, claims: list[dict], seeds: list[dict], nominal: dict | None) -> None:
-    """Give every reproduction entry of `claims` its `single_surfaces` block from the discrete `seeds` (bundles)."""
+    """Give every reproduction entry of `claims` its `single_surfaces` block from the discrete `seeds` (bundles), in
+    label order (the pool returns them as its workers finish)."""
+    seeds = sorted(seeds, key=lambda b: (len(b["label"]), b["label"]))
     per_seed = [seed_claims(set_name, b) for b in seeds]
     for c in claims:
         if c["kind"] != REPRODUCTION:
