@@ -42,6 +42,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..physics.brent import brent_step
 from . import wet_discrete_kernel as wk
 from .dop853_tableau import E3, E5, A, B, C, D
 from .kernel_laws import (
@@ -227,43 +228,10 @@ def _brent(F, t_old, h, y_old, c, target, xa, xb):
     if fcur == 0.0:
         return xcur
     for _ in range(200):
-        if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
-            xblk = xpre
-            fblk = fpre
-            spre = scur = xcur - xpre
-        if abs(fblk) < abs(fcur):
-            xpre = xcur
-            xcur = xblk
-            xblk = xpre
-            fpre = fcur
-            fcur = fblk
-            fblk = fpre
-        delta = (xtol + rtol * abs(xcur)) / 2.0
-        sbis = (xblk - xcur) / 2.0
-        if fcur == 0.0 or abs(sbis) < delta:
+        done, xpre, xcur, xblk, fpre, fblk, spre, scur = brent_step(xpre, xcur, xblk, fpre, fcur, fblk, spre,
+                                                                    scur, xtol, rtol)
+        if done:
             return xcur
-        if abs(spre) > delta and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
-                spre = scur
-                scur = stry
-            else:
-                spre = sbis
-                scur = sbis
-        else:
-            spre = sbis
-            scur = sbis
-        xpre = xcur
-        fpre = fcur
-        if abs(scur) > delta:
-            xcur += scur
-        else:
-            xcur += delta if sbis > 0.0 else -delta
         fcur = _dense(F, t_old, h, y_old, xcur, c) - target
     return xcur
 
