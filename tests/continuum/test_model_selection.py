@@ -78,8 +78,9 @@ def test_every_choice_is_recorded_with_what_decided_it():
 
 
 def test_adhesion_left_out_for_stiff_weakly_adhesive_summits_is_safe():
+    # the mean field: the decision is the scene's whatever the mode ('auto' adds a 64-member ensemble to each run)
     stiff = {"surfaces.roughness.summit_modulus": 150e9, "surfaces.work_of_adhesion": 0.01,
-             "physics.half_space": "off", "numerics.max_bounces": 20}
+             "physics.half_space": "off", "numerics.max_bounces": 20, "surfaces.roughness.mode": "mean_field"}
     auto = run_impact(resolve_scene(SCENES / "rough_silica.toml",
                                        overrides={**stiff, "physics.adhesion_law": "auto"})).to_dict()
     rec = auto["models"]["adhesion"]
