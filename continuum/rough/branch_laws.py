@@ -185,9 +185,12 @@ def _concat(pieces):
     a = np.concatenate([p[2] for p in pieces])
     # a jump leaves two points at one delta: separate them by a rounding-level step so that
     # interpolation is one-sided (left value below the jump, right value above)
-    for i in range(1, d.size):
-        if d[i] <= d[i - 1]:
+    # (only where delta does not increase, and the points after one that a step pushes past: the left-to-right
+    # pass over every point, visiting only those that can change)
+    for i in np.flatnonzero(d[1:] <= d[:-1]) + 1:
+        while i < d.size and d[i] <= d[i - 1]:
             d[i] = np.nextafter(d[i - 1], np.inf) + 1e-15 * abs(d[i - 1])
+            i += 1
     return d, f, a
 
 

@@ -6,7 +6,7 @@ previous one solves F_L(a*; R_p) = F* (F_L falls with R), with delta_p = delta_y
 root is scipy's brentq algorithm step for step (`continuum.physics.brent.brent_step`; the bracket [R, 1.5 R]
 doubled until it holds the root, xtol 1e-14 hi, rtol 1e-13, maxiter 100) on the law's own contact: JKR's and DMT's
 closed forms, Maugis-Dugdale's compiled root (`continuum.reference.maugis_kernel`). One call builds the whole table
-instead of ~400 Python root finds with a few dozen NumPy calls each; tests/continuum/test_flattening_kernel.py
+instead of ~400 Python root finds with a few dozen NumPy calls each; tests/continuum/test_summit_law_build.py
 compares it with scipy's brentq on the same equation.
 """
 from __future__ import annotations

@@ -11,7 +11,6 @@ from scipy.optimize import brentq
 
 from continuum.reference import jkr as jkr_ref
 from continuum.reference import maugis as md_ref
-from continuum.rough import flattening_kernel as fk
 from continuum.rough.branch_laws import DUGDALE_FACTOR, make_summit_law
 from continuum.rough.plastic_branches import FLATTENING_POINTS, PlasticBranchSummitLaw
 
@@ -113,3 +112,30 @@ def test_the_factory_shares_a_plastic_summit_law_and_its_nodes():
     assert one is two
     for node in one._laws:
         assert node is make_summit_law("maugis_dugdale", node.radius_tip, W, E, z0=Z0, delta_max=30 * SIGMA)
+
+
+def test_joined_pieces_step_only_where_delta_does_not_increase():
+    """`_concat` separates equal (or falling) deltas at the joins by a rounding-level step: the result is strictly
+    increasing and is the left-to-right pass over every point (written out here), on pieces with repeated points,
+    runs of equal values and zero, tiny and large steps."""
+    from continuum.rough.branch_laws import _concat
+
+    def every_point(pieces):
+        d = np.concatenate([p[0] for p in pieces])
+        for i in range(1, d.size):
+            if d[i] <= d[i - 1]:
+                d[i] = np.nextafter(d[i - 1], np.inf) + 1e-15 * abs(d[i - 1])
+        return d
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        pieces = []
+        for _ in range(rng.integers(1, 6)):
+            m = rng.integers(1, 8)
+            d = rng.choice([0.0, 1e-9, -1e-9, 5.0]) + np.cumsum(rng.choice([0.0, 1e-30, 1e-24, 1e-9], m))
+            pieces.append((d, rng.normal(size=m), rng.normal(size=m)))
+        want = every_point([tuple(x.copy() for x in p) for p in pieces])
+        d, f, a = _concat(pieces)
+        np.testing.assert_array_equal(d, want)
+        assert np.all(np.diff(d) > 0.0)
+        np.testing.assert_array_equal(f, np.concatenate([p[1] for p in pieces]))
