@@ -71,6 +71,9 @@ def rigid_roller(surface, radius: float, length: float, resolution: str = "stand
 @functools.lru_cache(maxsize=16)
 def _plastic_summit_law(name: str, radius: float, work_of_adhesion: float, summit_e_star: float,
                         limiting_pressure: float, z0: float, delta_max: float):
+    """The plastic summit law of these values, built once per process (16 kept, least recently used dropped): a
+    pure function of them, and nothing writes into one after it is built (the compiled tables it derives,
+    `continuum.rough.plastic_kernel`, are a function of it too)."""
     from ..rough.plastic_branches import PlasticBranchSummitLaw
     from ..rough.plastic_summits import PlasticSummitLaw
     if name == "jkr":
@@ -82,10 +85,14 @@ def _plastic_summit_law(name: str, radius: float, work_of_adhesion: float, summi
 def plastic_summit_law(scene: Scene, name: str, summit_e_star: float, limiting_pressure: float):
     """One summit's adhesive elastic-plastic law on the summit law `name`: JKR's Thornton-Ning closed forms, or
     Thornton-Ning's construction on the tabulated Maugis-Dugdale / DMT law (tabulated to 30 sigma, as the elastic
-    summit law). Built once per process for a set of numbers (an ensemble's members share it)."""
+    summit law). Built once per process for a set of numbers (an ensemble's members share it): the cache is keyed
+    by the values as Python floats, and JKR's closed forms by the four that enter them."""
     surf = scene.surfaces
-    return _plastic_summit_law(name, surf.roughness.summit_radius, surf.interface_work_of_adhesion, summit_e_star,
-                               limiting_pressure, surf.interface_interaction_range, 30.0 * surf.roughness.sigma)
+    tabulated = name != "jkr"
+    return _plastic_summit_law(str(name), float(surf.roughness.summit_radius), float(surf.interface_work_of_adhesion),
+                               float(summit_e_star), float(limiting_pressure),
+                               float(surf.interface_interaction_range) if tabulated else 0.0,
+                               float(30.0 * surf.roughness.sigma) if tabulated else 0.0)
 
 
 def plastic_rigid_roller(scene: Scene, summit_e_star: float, limiting_pressure: float, z_max: float,

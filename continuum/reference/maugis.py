@@ -58,12 +58,17 @@ Pbar -> -(pi lambda/2) C^2, Dbar -> -(4/3) lambda C (-> -2 and 0 as lambda -> 0)
 load-controlled pull-off (minimum of Pbar) lies at A > 0, slightly below this end value.
 
 Root-finding is done in t = sqrt(m^2-1) >= 0, with t - arctan t by series for small t and
-1 - m = -t^2/(1 + m), so that the large-lambda (t -> 0) limit keeps full precision.
+1 - m = -t^2/(1 + m), so that the large-lambda (t -> 0) limit keeps full precision. The root is compiled
+(`continuum.reference.maugis_kernel`: scipy's brentq algorithm step for step, same bracket and tolerances); the scipy
+form stays here as its reference (`_t_of_A_scipy`, `_pdt_scipy`; the two agree to a few ulp, the difference of
+NumPy's and libm's arctan).
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
+
+from . import maugis_kernel as _k
 
 __all__ = [
     "dmt_force_from_approach",
@@ -159,15 +164,43 @@ def _energy_residual(t, A, lam):
     return 0.5 * lam * A * A * b1 + 4.0 / 3.0 * lam * lam * A * b2 - 1.0
 
 
-def _t_of_A(A, lam):
-    """Root t = sqrt(m^2-1) >= 0 of the Maugis energy equation (scalar A > 0, lam > 0)."""
-    if not (A > 0.0 and lam > 0.0 and np.isfinite(A) and np.isfinite(lam)):
-        raise ValueError(f"need A > 0 and lambda > 0 (got A={A!r}, lambda={lam!r})")
+def _check(A, lam):
+    if not (np.all(A > 0.0) and np.all(np.isfinite(A)) and lam > 0.0 and np.isfinite(lam)):
+        bad = A[~((A > 0.0) & np.isfinite(A))]
+        got = f"A={float(bad.flat[0])!r}" if bad.size else "every A valid"
+        raise ValueError(f"need finite A > 0 and lambda > 0 (got {got}, lambda={lam!r})")
+
+
+def _t_of_A_scipy(A, lam):
+    """Root t = sqrt(m^2-1) >= 0 of the Maugis energy equation (scalar A > 0, lam > 0) by scipy's brentq: the
+    reference form of the compiled root (`continuum.reference.maugis_kernel.t_of_A`), kept for its test."""
+    _check(np.asarray(A, float), lam)
     # residual(0) = -1 and it increases monotonically to +inf: expand the bracket.
     hi = 1.0
     while _energy_residual(hi, A, lam) < 0.0:
         hi *= 2.0
-    return brentq(_energy_residual, 0.0, hi, args=(A, lam), xtol=1e-300, rtol=1e-15, maxiter=500)
+    return brentq(_energy_residual, 0.0, hi, args=(A, lam), xtol=_k.T_XTOL, rtol=_k.T_RTOL, maxiter=_k.T_MAXITER)
+
+
+def _pdt_scipy(A, lam):
+    """(Pbar, Dbar, t) at scalar A from `_t_of_A_scipy`: the reference form of `maugis_kernel.pdt`."""
+    t = _t_of_A_scipy(A, lam)
+    _, _, _, _, b3 = _brackets(t)
+    return A**3 - lam * A * A * b3, A * A - 4.0 / 3.0 * lam * A * t, t
+
+
+def _solve(A, lam):
+    """(Pbar, Dbar, t) arrays shaped like A from the compiled root (`maugis_kernel.solution`)."""
+    A = np.asarray(A, float)
+    lam = float(lam)
+    _check(A, lam)
+    p, d, t = _k.solution(np.ascontiguousarray(A).ravel(), lam)
+    return p.reshape(A.shape), d.reshape(A.shape), t.reshape(A.shape)
+
+
+def _pd(A, lam):
+    p, d, _ = _k.pdt(float(A), float(lam))
+    return p, d
 
 
 def md_m_of_A(A, lam):
@@ -177,20 +210,8 @@ def md_m_of_A(A, lam):
     A: normalised contact radius (> 0), lam: Maugis parameter (> 0). Vectorised over A; by brentq
     in t (for large lambda m - 1 is small: use md_force_and_approach, which works in t).
     """
-    A = np.asarray(A, float)
-    t = np.vectorize(lambda x: _t_of_A(float(x), float(lam)), otypes=[float])(A)
+    _, _, t = _solve(A, lam)
     return _out(np.sqrt(1.0 + t * t))
-
-
-def _pdt(A, lam):
-    t = _t_of_A(A, lam)
-    _, _, _, _, b3 = _brackets(t)
-    return A**3 - lam * A * A * b3, A * A - 4.0 / 3.0 * lam * A * t, t
-
-
-def _pd(A, lam):
-    p, d, _ = _pdt(A, lam)
-    return p, d
 
 
 def md_force_and_approach(A, lam):
@@ -199,18 +220,14 @@ def md_force_and_approach(A, lam):
 
     Pbar = P/(pi dgamma beta), Dbar = delta/(9 pi^2 dgamma^2 beta/(16 E*^2))^{1/3} (see md_scales).
     """
-    A = np.asarray(A, float)
-    f = np.vectorize(lambda x: _pd(float(x), float(lam)), otypes=[float, float])
-    p, d = f(A)
+    p, d, _ = _solve(A, lam)
     return _out(p), _out(d)
 
 
 def md_solution(A, lam):
     """(Pbar, Dbar, m) at normalised contact radii A > 0: `md_force_and_approach` and `md_m_of_A` from one root of
     Maugis' equation per A (the same numbers; a tabulated summit law needs all three at ~2000 radii)."""
-    A = np.asarray(A, float)
-    f = np.vectorize(lambda x: _pdt(float(x), float(lam)), otypes=[float, float, float])
-    p, d, t = f(A)
+    p, d, t = _solve(A, lam)
     return _out(p), _out(d), _out(np.sqrt(1.0 + t * t))
 
 
@@ -233,7 +250,7 @@ def _pull_off_normalised(lam):
     """min over A > 0 of Pbar(A; lam) (negative); the end value at A -> 0 is -(pi lam/2) C^2."""
     # coarse scan then bounded refinement around the best grid point
     A = np.geomspace(1e-4, 3.0, 200)
-    p = np.array([_pd(x, lam)[0] for x in A])
+    p = _solve(A, lam)[0]
     i = int(np.argmin(p))
     if i == 0:  # not met for lam >= 1e-4 (checked); fall back to the A -> 0 end value
         q = 4.0 / 3.0 * lam * lam * (np.pi / 2.0 - 1.0)

@@ -43,9 +43,10 @@ Models (SI; E* Johnson's contact modulus, dgamma Dupre's work of adhesion)
 * A SAM as a compliant layer on each summit does not enter here: the laws take the coated summits' contact
   modulus E* (``continuum.physics.coated``, ``continuum.model.regime.coated_summits``).
 
-Cost: building a Maugis-Dugdale law solves Maugis' equation once at each of ~2000 contact radii (~0.1 s); JKR and
-DMT are closed form. Branches are tabulated on ~4000 points and evaluated by linear interpolation
-(measured error against the closed forms: tests/continuum/test_branch_laws.py).
+Cost: building a Maugis-Dugdale law solves Maugis' equation once at each of ~2000 contact radii (compiled,
+`continuum.reference.maugis_kernel`: a few ms); JKR and DMT are closed form. Branches are tabulated on ~4000
+points and evaluated by linear interpolation (measured error against the closed forms:
+tests/continuum/test_branch_laws.py).
 """
 from __future__ import annotations
 
@@ -184,9 +185,12 @@ def _concat(pieces):
     a = np.concatenate([p[2] for p in pieces])
     # a jump leaves two points at one delta: separate them by a rounding-level step so that
     # interpolation is one-sided (left value below the jump, right value above)
-    for i in range(1, d.size):
-        if d[i] <= d[i - 1]:
+    # (only where delta does not increase, and the points after one that a step pushes past: the left-to-right
+    # pass over every point, visiting only those that can change)
+    for i in np.flatnonzero(d[1:] <= d[:-1]) + 1:
+        while i < d.size and d[i] <= d[i - 1]:
             d[i] = np.nextafter(d[i - 1], np.inf) + 1e-15 * abs(d[i - 1])
+            i += 1
     return d, f, a
 
 
@@ -313,20 +317,9 @@ def maugis_dugdale_law(beta, w, e_star, z0, *, delta_max, n_contact=2000, n_free
                      extra={"maugis_lambda": lam, "dugdale_stress": sigma0, "dugdale_range_h0": h0, "z0": z0})
 
 
-@functools.lru_cache(maxsize=64)
-def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: float = 0.3e-9,
-                    detachment: str = "displacement", delta_max: float) -> SummitLaw:
-    """Law by name ('jkr', 'dmt', 'maugis_dugdale').
-
-    A law is a pure function of these arguments and nothing modifies one after it is built, so each
-    distinct set is built once per process and shared (callers must not write into its tables): a
-    Maugis-Dugdale law costs ~0.2 s and a scene asks for its summits' law several times (regime map,
-    estimates, the contact law). The tables stay writeable arrays so that compiled kernels receive the
-    array types they were compiled for.
-
-    Only displacement-controlled release exists here (summits under a roller are displacement
-    driven); detachment = 'load' is refused.
-    """
+def _build_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: float = 0.3e-9,
+                      detachment: str = "displacement", delta_max: float) -> SummitLaw:
+    """Law by name ('jkr', 'dmt', 'maugis_dugdale'), built afresh (`make_summit_law` shares them)."""
     if detachment != "displacement":
         raise ValueError(f"detachment = {detachment!r}: the branch laws release under displacement control only")
     if name == "jkr":
@@ -336,3 +329,34 @@ def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: floa
     if name == "maugis_dugdale":
         return maugis_dugdale_law(beta, w, e_star, z0, delta_max=delta_max)
     raise ValueError(f"summit law {name!r}: 'jkr', 'dmt' or 'maugis_dugdale'")
+
+
+@functools.lru_cache(maxsize=64)
+def _shared_summit_law(name: str, beta: float, w: float, e_star: float, z0: float, detachment: str,
+                       delta_max: float) -> SummitLaw:
+    return _build_summit_law(name, beta, w, e_star, z0=z0, detachment=detachment, delta_max=delta_max)
+
+
+def make_summit_law(name: str, beta: float, w: float, e_star: float, *, z0: float = 0.3e-9,
+                    detachment: str = "displacement", delta_max: float) -> SummitLaw:
+    """Law by name ('jkr', 'dmt', 'maugis_dugdale').
+
+    A law is a pure function of these arguments and nothing modifies one after it is built, so each
+    distinct set is built once per process and shared (callers must not write into its tables): a
+    Maugis-Dugdale law costs a few ms and a scene asks for its summits' law several times (regime map,
+    estimates, the contact law, each node of a plastic summit). The cache (64 laws, least recently used
+    dropped) is keyed by the values that define the law, however a caller spells them (keywords or
+    defaults, NumPy or Python floats; z0 only for Maugis-Dugdale, the one law it enters);
+    `make_summit_law.__wrapped__` builds afresh. The tables stay writeable arrays so that compiled kernels
+    receive the array types they were compiled for.
+
+    Only displacement-controlled release exists here (summits under a roller are displacement
+    driven); detachment = 'load' is refused.
+    """
+    return _shared_summit_law(str(name), float(beta), float(w), float(e_star),
+                              float(z0) if name == "maugis_dugdale" else 0.0, str(detachment), float(delta_max))
+
+
+make_summit_law.__wrapped__ = _build_summit_law
+make_summit_law.cache_info = _shared_summit_law.cache_info
+make_summit_law.cache_clear = _shared_summit_law.cache_clear

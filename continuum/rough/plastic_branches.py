@@ -58,8 +58,8 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from ..reference import jkr as jkr_ref
 from ..reference import maugis as md_ref
+from . import flattening_kernel as fk
 from .branch_laws import DUGDALE_FACTOR, make_summit_law
 
 __all__ = ["PlasticBranchSummitLaw", "NODE_RATIO"]
@@ -89,6 +89,7 @@ class PlasticBranchSummitLaw:
         self.self_similar = name in ("jkr", "dmt")
         self.node_ratio = NODE_RATIO
         self._laws = [self._law(self.radius)]
+        self._kind = fk.LAW_CODES[name]
         base = self._laws[0]
         #: stretch (m) at which the approach branch starts to pull (Maugis-Dugdale: h0; JKR, DMT: 0)
         self.approach_reach = float(base.reach)
@@ -107,13 +108,8 @@ class PlasticBranchSummitLaw:
         self._u_y = float(base.energy(d_y, "retreat"))
         d_top = max(self.delta_max - d_y, 0.0)
         self._d = d_top * np.linspace(0.0, 1.0, FLATTENING_POINTS) ** 2
-        r_p = np.empty_like(self._d)
-        d_p = np.zeros_like(self._d)
-        r_p[0] = self.radius
-        for i, dd in enumerate(self._d[1:], 1):
-            a, f = math.sqrt(a_y * a_y + self.radius * dd), f_y + self.plastic_slope * dd
-            r_p[i] = self._flattened_radius(a, f, r_p[i - 1])
-            d_p[i] = d_y + dd - self.force_approach(a, r_p[i])[1]
+        r_p, d_p = fk.flattening_table(self._kind, self.radius, a_y, f_y, d_y, self.plastic_slope, self._d,
+                                       self.work_of_adhesion, self.e_star, self.sigma0)
         self._r_p, self._d_p = r_p, d_p
         while not self.self_similar and self._laws[-1].radius_tip < r_p[-1]:
             self._laws.append(self._law(self.radius * NODE_RATIO ** len(self._laws)))
@@ -129,15 +125,9 @@ class PlasticBranchSummitLaw:
 
     def force_approach(self, a: float, radius: float) -> tuple[float, float]:
         """(F N, delta m) of L's contact of radius a (m) on a sphere of radius `radius` (m)."""
-        w, e = self.work_of_adhesion, self.e_star
-        if self.name == "jkr":
-            return float(jkr_ref.force_from_radius(a, radius, w, e)), float(jkr_ref.approach_from_radius(a, radius,
-                                                                                                         w, e))
-        if self.name == "dmt":
-            return 4.0 * e * a**3 / (3.0 * radius) - 2.0 * math.pi * w * radius, a * a / radius
-        a_s, p_s, d_s = (float(x) for x in md_ref.md_scales(radius, w, e))
-        p, d = md_ref.md_force_and_approach(a / a_s, self._lambda(radius))
-        return float(p) * p_s, float(d) * d_s
+        f, d = fk.force_approach(self._kind, float(a), float(radius), self.work_of_adhesion, self.e_star,
+                                 self.sigma0)
+        return float(f), float(d)
 
     def centre_pressure(self, a: float, radius: float) -> float:
         """Pressure (Pa, + compressive) at the centre of L's contact of radius a (m) on radius `radius` (m)."""
@@ -160,16 +150,6 @@ class PlasticBranchSummitLaw:
         if self.centre_pressure(lo, beta) >= p_y:
             raise ValueError(f"limiting pressure {p_y:.4g} Pa: below the summit's adhesive stress at first contact")
         return brentq(lambda a: self.centre_pressure(a, beta) - p_y, lo, hi, xtol=1e-16 * hi, rtol=1e-13)
-
-    def _flattened_radius(self, a: float, f: float, start: float) -> float:
-        """R_p >= start with F_L(a; R_p) = f (F_L falls with R)."""
-        g = lambda r: self.force_approach(a, r)[0] - f          # noqa: E731
-        lo, hi = start, 1.5 * start
-        if g(lo) <= 0.0:
-            return lo
-        while g(hi) > 0.0:
-            lo, hi = hi, 2.0 * hi
-        return brentq(g, lo, hi, xtol=1e-14 * hi, rtol=1e-13)
 
     # ------------------------------------------------------------------ the curve of radius R_p
     def _nodes(self, r_p):
