@@ -203,3 +203,20 @@ def wet_roller_with_condensation_time(wet: ContactLaw, t_a: float) -> ContactLaw
     bridges.t_a = t_a
     bridges.reset()
     return WetRoughRoller(wet.dry, bridges, dict(wet.record, condensation_time=t_a))
+
+
+def wet_plastic_summit_law(plastic: ContactLaw, wet_scene: Scene):
+    """The plastic summit law of the plastic discrete roller `plastic` rebuilt for `wet_scene` (the scene with the wet
+    work of adhesion W_wet > 0): the same summit law, E*, tip radius, limiting contact pressure and range z0."""
+    from ..rough.plastic_summits import PlasticSummitLaw
+    law = plastic.law
+    name = "jkr" if isinstance(law, PlasticSummitLaw) else law.name
+    return plastic_summit_law(wet_scene, name, law.e_star, law.limiting_pressure)
+
+
+def wet_plastic_summit_roller(plastic: ContactLaw, wet, elastic: ContactLaw, parameters: dict) -> ContactLaw:
+    """A plastic discrete roller whose summits inside a bridge run `wet` (its plastic summit law at W_wet) and outside
+    it their dry law, each summit carrying its deepest approach (`continuum.laws.wet_plastic_summits`); the bridges
+    on the summits of the elastic discrete roller `elastic` whose realisation `plastic` runs on."""
+    from ..laws.wet_plastic_summits import wet_plastic_summit_roller as build
+    return build(plastic, wet, elastic, parameters)
