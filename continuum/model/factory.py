@@ -205,11 +205,15 @@ def wet_roller_with_condensation_time(wet: ContactLaw, t_a: float) -> ContactLaw
     return WetRoughRoller(wet.dry, bridges, dict(wet.record, condensation_time=t_a))
 
 
-def wet_plastic_summit_law(plastic: ContactLaw, wet_scene: Scene):
+def wet_plastic_summit_law(plastic: ContactLaw, wet_scene: Scene, work_of_adhesion_wet: float):
     """The plastic summit law of the plastic discrete roller `plastic` rebuilt for `wet_scene` (the scene with the wet
-    work of adhesion W_wet > 0): the same summit law, E*, tip radius, limiting contact pressure and range z0."""
+    work of adhesion `work_of_adhesion_wet` = max(W_wet, 0), J/m^2): the same summit law, E*, tip radius, limiting
+    contact pressure and range z0; Thornton-Ning without adhesion (Hertz to yield) where it is 0."""
+    from ..rough.hertz_plastic import HertzPlasticSummitLaw
     from ..rough.plastic_summits import PlasticSummitLaw
     law = plastic.law
+    if not work_of_adhesion_wet > 0.0:
+        return HertzPlasticSummitLaw(law.radius, law.e_star, law.limiting_pressure)
     name = "jkr" if isinstance(law, PlasticSummitLaw) else law.name
     return plastic_summit_law(wet_scene, name, law.e_star, law.limiting_pressure)
 

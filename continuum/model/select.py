@@ -212,21 +212,19 @@ def discrete_menisci(scene: Scene, law: ContactLaw, elastic, regime: Regime) -> 
     menisci.solid_adhesion = 'wet' on a rigid substrate: the bridged summits adhere by their summit law rebuilt at
     the wet work of adhesion max(W_wet, 0), force and loop: elastic summits (`continuum.laws.wet_summits`; Hertz
     where W_wet <= 0) and Thornton-Ning plastic summits, each carrying its deepest approach across the class change
-    (`continuum.laws.wet_plastic_summits`, where W_wet > 0). Otherwise (the additive choice, the half-space, plastic
-    summits at W_wet <= 0) the bridges carry the mean field's DMT solid pull and the summits keep their dry loop
+    (`continuum.laws.wet_plastic_summits`; Thornton-Ning without adhesion where W_wet <= 0). Otherwise (the additive
+    choice, the half-space) the bridges carry the mean field's DMT solid pull and the summits keep their dry loop
     (`continuum.laws.discrete_bridges.wet_discrete`); the record says which."""
     params = dict(regime.meniscus_parameters())
     w_wet = max(params["work_of_adhesion_wet"], 0.0)
-    plastic = law is not elastic
-    if params["solid_adhesion"] != "wet" or elastic.use_half_space or (plastic and not w_wet > 0.0):
+    if params["solid_adhesion"] != "wet" or elastic.use_half_space:
         why = ("menisci.solid_adhesion = 'additive'" if params["solid_adhesion"] != "wet" else
-               "the half-space couples the summits" if elastic.use_half_space else
-               "plastic summits at W_wet <= 0: no Hertz-plastic summit law is built")
+               "the half-space couples the summits")
         inside = f"dry summit law, DMT solid pull (loop dry: {why})"
         return factory.bridged_discrete_roller(law, elastic, {**params, "solids_inside_bridges": inside})
     wet_scene = _with_work_of_adhesion(scene, w_wet)
-    if plastic:
-        wet = factory.wet_plastic_summit_law(law, wet_scene)
+    if law is not elastic:                      # plastic summits
+        wet = factory.wet_plastic_summit_law(law, wet_scene, w_wet)
         return factory.wet_plastic_summit_roller(law, wet, elastic, params)
     slaw = summit_law(elastic.slaw.name, wet_scene, regime.e_star) if elastic.slaw is not None and w_wet > 0 else None
     wet = factory.discrete_roller(wet_scene, elastic.stats, w_wet, elastic.summit_e_star, False,

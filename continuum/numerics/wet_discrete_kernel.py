@@ -26,9 +26,14 @@ approach, dry retreat, wet approach, wet retreat) one after another, located by 
 the rigid-table laws' first five slots (so the kernel's checks read the same places), the books (S_*), the bridges'
 block (SB_*), then one flag per kept summit.
 
+Plastic mode (P[C_MODE] of the dry block = MODE_PLASTIC): both classes are Thornton-Ning summits
+(`continuum.laws.wet_plastic_summits`); the summits are `continuum.numerics.wet_plastic_kernel`'s, with its own slots
+after PARAMS and in S, the bridges this module's.
+
 `LAW_BRIDGED` is the other discrete form of `continuum.laws.discrete_bridges` (`wet_discrete`: bridges with the
-mean field's DMT solid pull round summits that keep their own law, e.g. plastic summits): any compiled discrete law
-of `continuum.numerics.kernel_laws` with its P and S followed by the bridges' blocks.
+mean field's DMT solid pull round summits that keep their own law, e.g. plastic summits with menisci.solid_adhesion =
+'additive'): any compiled discrete law of `continuum.numerics.kernel_laws` with its P and S followed by the bridges'
+blocks.
 
 The contact time is t - P[pb + B_T0] (t: the kernel's absolute time; the laws' `set_time` in Python).
 """

@@ -21,6 +21,7 @@ from continuum.numerics import wet_discrete_kernel as wk
 from continuum.numerics.compiled_contact import STATS
 from continuum.reference import jkr as ref
 from continuum.rough.branch_laws import make_summit_law
+from continuum.rough.hertz_plastic import HertzPlasticSummitLaw
 from continuum.rough.plastic_branches import PlasticBranchSummitLaw
 from continuum.rough.plastic_summits import PlasticSummitLaw
 from continuum.rough.summits import SummitStatistics
@@ -130,14 +131,17 @@ class _ElasticWet(ContactLike):
         return getattr(self.law, name)
 
 
-def test_infinite_hardness_is_the_elastic_wet_class():
+@pytest.mark.parametrize("w_wet", [W_WET, 0.0])
+def test_infinite_hardness_is_the_elastic_wet_class(w_wet):
     """p_y = inf: no summit yields, and the plastic law with its wet class is the elastic discrete law of the same
-    Maugis-Dugdale summits with theirs (continuum.laws.wet_summits) to 1e-7 along a press, a hold past t_a and a
-    pull-off through both release points."""
+    Maugis-Dugdale summits with theirs (continuum.laws.wet_summits; Hertz at W_wet = 0, against the no-adhesion
+    plastic class) to 1e-7 along a press, a hold past t_a and a pull-off through both release points."""
     tables = {w: make_summit_law("maugis_dugdale", BETA, w, E, z0=Z0, delta_max=DMAX) for w in (W_DRY, W_WET)}
-    dry_el, wet_el = _elastic(W_DRY, summit_law=tables[W_DRY]), _elastic(W_WET, summit_law=tables[W_WET])
+    dry_el = _elastic(W_DRY, summit_law=tables[W_DRY])
+    wet_el = _elastic(w_wet, summit_law=tables[w_wet]) if w_wet > 0 else _elastic(0.0)
     elastic = wet_summit_roller(dry_el, wet_el, PARAMS)
-    plastic = _wet_plastic(_md(W_DRY, math.inf), _md(W_WET, math.inf), _elastic())
+    wet = _md(w_wet, math.inf) if w_wet > 0 else HertzPlasticSummitLaw(BETA, E, math.inf)
+    plastic = _wet_plastic(_md(W_DRY, math.inf), wet, _elastic())
     for law in (plastic, elastic):
         _press_and_hold(law, 3e-9, forms=False)
     rows = _along(plastic, _path(3e-9, 5e-9), _ElasticWet(elastic))
@@ -200,6 +204,40 @@ def test_one_bridged_plastic_summit_lets_go_at_the_wet_release_point_and_books_t
     assert abs(fold - (PlasticSummitLaw(BETA, W_DRY, E, p_y).flattening(dm)[1]
                        - PlasticSummitLaw(BETA, W_DRY, E, p_y).release_stretch(
                            PlasticSummitLaw(BETA, W_DRY, E, p_y).flattening(dm)[0]))) > 100 * step
+
+
+def test_one_bridged_plastic_summit_without_wet_adhesion_unloads_on_hertz_about_its_flattening():
+    """W_wet <= 0: inside its bridge a summit follows Thornton's construction without adhesion. Pressed past yield
+    and pulled off, it lets go at its residual approach delta_p with no loop, and books the plastic work, all from
+    the closed forms written here (yield at centre pressure 2E*a/(pi beta) = p_y, line pi p_y beta, R_p = 4E*a*^3
+    / 3F*); on the way out its force is Hertz about (R_p, delta_p)."""
+    p_y = 3e9
+    summits = PlasticDiscreteRoller(PlasticSummitLaw(BETA, W_DRY, E, p_y), np.array([0.0]), SIGMA, 1e-6)
+    law = WetPlasticSummits.from_dry(summits, HertzPlasticSummitLaw(BETA, E, p_y))
+    law.set_wet_prefix(1)
+    a_y = math.pi * BETA * p_y / (2 * E)
+    d_y, f_y = a_y**2 / BETA, 4 * E * a_y**3 / (3 * BETA)
+    dm = d_y + 4e-9
+    big_d = dm - d_y
+    a2 = a_y**2 + BETA * big_d
+    f_s = f_y + math.pi * p_y * BETA * big_d
+    r_p = 4 * E * a2**1.5 / (3 * f_s)
+    d_p = dm - a2 / r_p
+    work = (8 / 15 * E * math.sqrt(BETA) * d_y**2.5 + f_y * big_d + 0.5 * math.pi * p_y * BETA * big_d**2
+            - 8 / 15 * E * math.sqrt(r_p) * (dm - d_p)**2.5)
+    for g in np.linspace(1e-10, -dm, 400):
+        law.accept(g)
+    assert law.force(-dm) == pytest.approx(f_s, rel=1e-12)
+    half = -(d_p + 0.5 * (dm - d_p))
+    assert law.force(half) == pytest.approx(4 / 3 * E * math.sqrt(r_p) * (0.5 * (dm - d_p))**1.5, rel=1e-12)
+    step = 1e-13
+    for g in np.arange(-dm, 1e-9, step):
+        law.accept(g)
+        if not law._attached[0]:
+            break
+    assert -g == pytest.approx(d_p, abs=2 * step)
+    assert law.dissipated(g) == pytest.approx(work, rel=1e-9)
+    assert law.dissipated(g) == pytest.approx(law.wet.plastic_work(dm), rel=1e-12)
 
 
 @pytest.fixture(scope="module")
