@@ -263,13 +263,16 @@ def humid_member_runs():
 
 def test_a_humid_plastic_member_closes_its_energy_books(humid_member_runs):
     """The driver's audit (-int F dg against the change of stored + booked energy) over a humid member whose
-    bridged summits yield and change class: within 1e-4 of the impact energy, as the dry laws' audits."""
-    for run, _, law, _ in humid_member_runs:
+    bridged summits yield and change class: within 3e-5 of the impact energy (the switch work it books is a few
+    1e-4 of it, so leaving it out would fail)."""
+    for run, _, law, scene in humid_member_runs:
         s = law.dry
         assert isinstance(s, WetPlasticSummits)
         assert law.diagnostics()["menisci"]["contacts_with_bridges"] == 1
         assert np.sum(s.delta_max > s.wet.yield_approach) >= 1 and s._w_total > 0.0
-        assert run.audit["max_relative_error"] < 1e-4
+        impact = 0.5 * scene.body.mass * run.bounces[0].v_impact**2
+        assert abs(s.switched) > 1e-4 * impact
+        assert run.audit["max_relative_error"] < 3e-5
 
 
 def test_a_humid_plastic_member_gives_the_same_motion_compiled_and_in_python(humid_member_runs):
