@@ -10,8 +10,10 @@ time kept (on a shared machine the CPU time is the steadier of the two):
 - humid, nucleation t_a: the set's own t_a (ms), which no contact reaches: the wet law is its dry law up to t_a
   (compiled, stopped at t_a), so the cost is the dry cost plus the bridges' bookkeeping;
 - humid, short t_a (`--short-ta`, s, fixed): bridges form in most contacts; after t_a a contact goes on compiled
-  (`continuum.numerics.wet_discrete_kernel`): plastic summits with additive bridges (LAW_BRIDGED), and with
-  plasticity off elastic summits at W_wet inside their bridges (LAW_WET_DISCRETE).
+  (`continuum.numerics.wet_discrete_kernel`): the set's plastic summits at W_wet inside their bridges (its plastic
+  mode, `continuum.numerics.wet_plastic_kernel`), the same with menisci.solid_adhesion = 'additive' (the dry plastic
+  loop with additive bridges, LAW_BRIDGED), and with plasticity off elastic summits at W_wet inside their bridges
+  (LAW_WET_DISCRETE).
 
 Each row gives its ratio to the elastic dry ensemble and to the dry ensemble of the same summits, and how its
 contacts ran (compiled, handed over at t_a, on the Python stepper: `continuum.numerics.compiled_contact.STATS`).
@@ -50,7 +52,8 @@ def case(label: str, overrides: dict, members: int, repeat: int) -> dict:
 _LABELS = {"dry_elastic": "dry, elastic summits (plasticity off): the reference",
            "dry": "dry, the set's summits (silicon yields: plastic)",
            "humid_nucleation_t_a": "humid, the set's nucleation t_a",
-           "humid_short_t_a": "humid, short t_a: plastic summits, additive bridges (LAW_BRIDGED)",
+           "humid_short_t_a": "humid, short t_a: plastic summits at W_wet in bridges (LAW_WET_DISCRETE, plastic)",
+           "humid_short_t_a_additive": "humid, short t_a: plastic summits, dry loop, additive bridges (LAW_BRIDGED)",
            "humid_short_t_a_elastic": "humid, short t_a: elastic summits at W_wet in bridges (LAW_WET_DISCRETE)"}
 
 
@@ -90,6 +93,8 @@ def main() -> None:
             case("dry", {**base, **dry}, a.members, a.repeat),
             case("humid_nucleation_t_a", base, a.members, a.repeat),
             case("humid_short_t_a", {**base, **short}, a.members, a.repeat),
+            case("humid_short_t_a_additive", {**base, **short, "menisci.solid_adhesion": "additive"}, a.members,
+                 a.repeat),
             case("humid_short_t_a_elastic", {**base, **short, **elastic}, a.members, a.repeat)]
     ref = {r["case"]: r for r in rows}
     for r in rows:

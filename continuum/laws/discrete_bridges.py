@@ -127,6 +127,14 @@ class BridgedDiscreteRoller(WetRoughRoller):
         super().accept(gap)
         self._gap_acc = gap
 
+    def diagnostics(self):
+        """The wet law's, with what the solids inside a bridge follow (each member's record says it)."""
+        out = super().diagnostics()
+        inside = self.record.get("solids_inside_bridges")
+        if inside is not None:
+            out["menisci"] = {**out["menisci"], "solids_inside_bridges": inside}
+        return out
+
     def compiled(self, t0: float):
         if self.t == 0.0:                    # at touch: the dry form up to t_a
             form = super().compiled(t0)

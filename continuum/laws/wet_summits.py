@@ -248,6 +248,12 @@ class WetDiscreteRoller(WetRoughRoller):
         self._sync(gap)
         super().accept(gap)
 
+    def diagnostics(self):
+        """The wet law's, with what the solids inside a bridge follow (each member's record says it)."""
+        out = super().diagnostics()
+        out["menisci"] = {**out["menisci"], "solids_inside_bridges": self.record["solids_inside_bridges"]}
+        return out
+
     def compiled(self, t0: float):
         """At touch the dry kernel, stopped at t_a; from t_a on (the driver asks again once it has accepted the
         state at t_a) the summits with their bridges (`continuum.numerics.wet_discrete_kernel`)."""

@@ -210,3 +210,24 @@ def wet_roller_with_condensation_time(wet: ContactLaw, t_a: float) -> ContactLaw
     bridges.t_a = t_a
     bridges.reset()
     return WetRoughRoller(wet.dry, bridges, dict(wet.record, condensation_time=t_a))
+
+
+def wet_plastic_summit_law(plastic: ContactLaw, wet_scene: Scene, work_of_adhesion_wet: float):
+    """The plastic summit law of the plastic discrete roller `plastic` rebuilt for `wet_scene` (the scene with the wet
+    work of adhesion `work_of_adhesion_wet` = max(W_wet, 0), J/m^2): the same summit law, E*, tip radius, limiting
+    contact pressure and range z0; Thornton-Ning without adhesion (Hertz to yield) where it is 0."""
+    from ..rough.hertz_plastic import HertzPlasticSummitLaw
+    from ..rough.plastic_summits import PlasticSummitLaw
+    law = plastic.law
+    if not work_of_adhesion_wet > 0.0:
+        return HertzPlasticSummitLaw(law.radius, law.e_star, law.limiting_pressure)
+    name = "jkr" if isinstance(law, PlasticSummitLaw) else law.name
+    return plastic_summit_law(wet_scene, name, law.e_star, law.limiting_pressure)
+
+
+def wet_plastic_summit_roller(plastic: ContactLaw, wet, elastic: ContactLaw, parameters: dict) -> ContactLaw:
+    """A plastic discrete roller whose summits inside a bridge run `wet` (its plastic summit law at W_wet) and outside
+    it their dry law, each summit carrying its deepest approach (`continuum.laws.wet_plastic_summits`); the bridges
+    on the summits of the elastic discrete roller `elastic` whose realisation `plastic` runs on."""
+    from ..laws.wet_plastic_summits import wet_plastic_summit_roller as build
+    return build(plastic, wet, elastic, parameters)

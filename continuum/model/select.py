@@ -209,19 +209,23 @@ def discrete_menisci(scene: Scene, law: ContactLaw, elastic, regime: Regime) -> 
     """`law` (summits on the realisation of the elastic `DiscreteRoughRoller` `elastic`) with a bridge on each summit,
     of the meniscus parameters of the scene's `regime`.
 
-    menisci.solid_adhesion = 'wet' with elastic summits on a rigid substrate: the bridged summits adhere by their
-    summit law rebuilt at the wet work of adhesion max(W_wet, 0), force and loop (`continuum.laws.wet_summits`; Hertz
-    where W_wet <= 0). Otherwise (the additive choice, plastic summits, the half-space) the bridges carry the mean
-    field's DMT solid pull and the summits keep their dry loop (`continuum.laws.discrete_bridges.wet_discrete`);
-    the record says which."""
+    menisci.solid_adhesion = 'wet' on a rigid substrate: the bridged summits adhere by their summit law rebuilt at
+    the wet work of adhesion max(W_wet, 0), force and loop: elastic summits (`continuum.laws.wet_summits`; Hertz
+    where W_wet <= 0) and Thornton-Ning plastic summits, each carrying its deepest approach across the class change
+    (`continuum.laws.wet_plastic_summits`; Thornton-Ning without adhesion where W_wet <= 0). Otherwise (the additive
+    choice, the half-space) the bridges carry the mean field's DMT solid pull and the summits keep their dry loop
+    (`continuum.laws.discrete_bridges.wet_discrete`); the record says which."""
     params = dict(regime.meniscus_parameters())
-    if params["solid_adhesion"] != "wet" or law is not elastic or elastic.use_half_space:
+    w_wet = max(params["work_of_adhesion_wet"], 0.0)
+    if params["solid_adhesion"] != "wet" or elastic.use_half_space:
         why = ("menisci.solid_adhesion = 'additive'" if params["solid_adhesion"] != "wet" else
-               "plastic summits" if law is not elastic else "the half-space couples the summits")
+               "the half-space couples the summits")
         inside = f"dry summit law, DMT solid pull (loop dry: {why})"
         return factory.bridged_discrete_roller(law, elastic, {**params, "solids_inside_bridges": inside})
-    w_wet = max(params["work_of_adhesion_wet"], 0.0)
     wet_scene = _with_work_of_adhesion(scene, w_wet)
+    if law is not elastic:                      # plastic summits
+        wet = factory.wet_plastic_summit_law(law, wet_scene, w_wet)
+        return factory.wet_plastic_summit_roller(law, wet, elastic, params)
     slaw = summit_law(elastic.slaw.name, wet_scene, regime.e_star) if elastic.slaw is not None and w_wet > 0 else None
     wet = factory.discrete_roller(wet_scene, elastic.stats, w_wet, elastic.summit_e_star, False,
                                   elastic.footprint_half_width, slaw, (elastic.sx, elastic.sy, elastic.sz))

@@ -26,9 +26,14 @@ approach, dry retreat, wet approach, wet retreat) one after another, located by 
 the rigid-table laws' first five slots (so the kernel's checks read the same places), the books (S_*), the bridges'
 block (SB_*), then one flag per kept summit.
 
+Plastic mode (P[C_MODE] of the dry block = MODE_PLASTIC): both classes are Thornton-Ning summits
+(`continuum.laws.wet_plastic_summits`); the summits are `continuum.numerics.wet_plastic_kernel`'s, with its own slots
+after PARAMS and in S, the bridges this module's.
+
 `LAW_BRIDGED` is the other discrete form of `continuum.laws.discrete_bridges` (`wet_discrete`: bridges with the
-mean field's DMT solid pull round summits that keep their own law, e.g. plastic summits): any compiled discrete law
-of `continuum.numerics.kernel_laws` with its P and S followed by the bridges' blocks.
+mean field's DMT solid pull round summits that keep their own law, e.g. plastic summits with menisci.solid_adhesion =
+'additive'): any compiled discrete law of `continuum.numerics.kernel_laws` with its P and S followed by the bridges'
+blocks.
 
 The contact time is t - P[pb + B_T0] (t: the kernel's absolute time; the laws' `set_time` in Python).
 """
@@ -40,6 +45,7 @@ import numpy as np
 from numba import njit
 
 from ..rough.plastic_kernel import count_at_least
+from . import wet_plastic_kernel as wp
 from .kernel_laws import (
     _H_COEF,
     S_BEYOND_FLAG,
@@ -56,8 +62,9 @@ from .kernel_laws import (
 #: This law's kind, and the bridges round any other compiled discrete law (`continuum.numerics.kernel_laws` numbers
 #: the others 0-4).
 LAW_WET_DISCRETE, LAW_BRIDGED = 5, 6
-#: Summit-class modes.
-MODE_BRANCH, MODE_JKR, MODE_HERTZ = 0, 1, 2
+#: Summit-class modes (MODE_PLASTIC, set in the dry block: both classes are Thornton-Ning summits,
+#: `continuum.numerics.wet_plastic_kernel`, with its own slots after PARAMS).
+MODE_BRANCH, MODE_JKR, MODE_HERTZ, MODE_PLASTIC = 0, 1, 2, 3
 #: Slots of a class block.
 (C_MODE, C_IN, C_OUT, C_REACH, C_LOOP, C_INV_DELTA0, C_PSCALE, C_ESCALE, C_HERTZ_K, C_A_LO, C_A_HI, C_R_LO,
  C_R_HI) = range(13)
@@ -279,6 +286,11 @@ def wet_value(what, t, gap, S, P, T):
     pb, sb, u = G_BRIDGES, S_BRIDGES, T[0]
     tc = t - P[pb + B_T0]
     k_trial = _prefix(gap, tc, S, P, pb, sb, u)
+    if P[DRY + C_MODE] == MODE_PLASTIC:
+        own = wp.summits(what, gap, k_trial, S, P, T, PARAMS)
+        if what == 0:
+            return own - _bridges(0, gap, tc, S, P, pb, sb, u)
+        return own + _bridges(what, gap, tc, S, P, pb, sb, u)
     b = np.zeros(3)
     if what == 0:
         return _summits(_FORCE, gap, k_trial, S, P, T, b) - _bridges(0, gap, tc, S, P, pb, sb, u)
@@ -296,6 +308,10 @@ def wet_accept(t, gap, S, P, T):
     pb, sb, u = G_BRIDGES, S_BRIDGES, T[0]
     tc = t - P[pb + B_T0]
     k_trial = _prefix(gap, tc, S, P, pb, sb, u)
+    if P[DRY + C_MODE] == MODE_PLASTIC:
+        wp.summits(wp.ACCEPT, gap, k_trial, S, P, T, PARAMS)
+        _bridges_accept(gap, tc, S, P, pb, sb, u)
+        return
     b = np.zeros(3)
     _summits(_BOOKS, gap, k_trial, S, P, T, b)
     S[S_DET_DRY] += b[0]

@@ -224,17 +224,29 @@ def test_a_humid_member_runs_its_summits_at_the_wet_work_of_adhesion():
     assert law.bridges.solid_pull == 0.0 and "maugis_dugdale" in inside["summit_law"]
 
 
-def test_a_humid_plastic_member_keeps_its_bridges_with_the_dry_loop_and_says_so():
-    """Where the summits yield (calibrated silicon, psi > 0.6) a member carries its bridges on plastic summits; the
-    solids inside a bridge keep the dry summit law with the mean field's DMT correction, and the record says why."""
+def test_a_humid_plastic_member_runs_its_plastic_summits_at_the_wet_work_of_adhesion():
+    """Where the summits yield (calibrated silicon, psi > 0.6) a member carries its bridges on plastic summits whose
+    bridged ones follow the same Thornton-Ning law at W_wet (continuum.laws.wet_plastic_summits: same E*, radius,
+    limiting pressure, range); the bridges take no DMT pull. With menisci.solid_adhesion = 'additive' they keep the
+    dry law (the paper's additive bridges, no correction), and the record says why."""
     from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model.regime import first_impact_speed
 
     scene = resolve_scene("wet_silica", params="calibrated", overrides={"surfaces.roughness.mode": "ensemble"}).scene
     _, law = member_law(scene, 7, member_plan(scene, first_impact_speed(scene)))
-    text = str(law.describe())
-    assert "plastic summits" in text and "inside_bridges" not in law.describe()
-    assert law.bridges.solid_pull > 0.0
+    inside = law.describe()["inside_bridges"]
+    dry = law.describe()["summit_law"]
+    assert inside["work_of_adhesion"] == pytest.approx(meniscus_parameters(scene)["work_of_adhesion_wet"])
+    assert inside["summit_law"]["name"] == dry["name"] and "thornton_ning" in dry["name"]
+    for key in ("e_star", "radius", "limiting_pressure"):
+        assert inside["summit_law"][key] == dry[key]
+    assert law.bridges.solid_pull == 0.0 and "W_wet" in law.record["solids_inside_bridges"]
+
+    additive = resolve_scene("wet_silica", params="calibrated", overrides={
+        "surfaces.roughness.mode": "ensemble", "menisci.solid_adhesion": "additive"}).scene
+    _, law = member_law(additive, 7, member_plan(additive, first_impact_speed(additive)))
+    assert "inside_bridges" not in law.describe() and "additive" in law.record["solids_inside_bridges"]
+    assert law.bridges.solid_pull == 0.0
 
 
 def test_a_humid_scene_reports_its_sticking_against_t_a():
