@@ -10,7 +10,6 @@ else ~/.cache/nanoimpact/paper, written atomically; NANOIMPACT_CACHE=off runs ev
 """
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import logging
@@ -18,6 +17,8 @@ import os
 import pickle
 from pathlib import Path
 from typing import Callable
+
+from nanoimpact.compiled_cache import source_hash
 
 from ..scene import resolve_scene
 from .cases import Case
@@ -29,15 +30,10 @@ log = logging.getLogger(__name__)
 CACHE_VERSION = 1
 
 
-@functools.lru_cache(maxsize=1)
 def code_hash() -> str:
-    """SHA-256 over the `continuum` package's modules (path and bytes), computed once per process."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        h.update(str(path.relative_to(root)).encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()
+    """SHA-256 over the `continuum` package's modules (path and bytes), computed once per process: the key numba's
+    kernel cache also follows (`nanoimpact.compiled_cache.source_hash`)."""
+    return source_hash(Path(__file__).resolve().parents[1])
 
 
 def cache_dir() -> Path | None:

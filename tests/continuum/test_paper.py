@@ -242,6 +242,5 @@ def test_a_sample_bundle_is_cached_by_its_inputs_and_code_and_run_again_when_eit
     assert first == {"x": 1.0} and again == {"x": 1.0, "cached": True} and len(calls) == 1
     monkeypatch.setenv("NANOIMPACT_CACHE", "off")
     assert seed_cache.cached(key, lambda: {"x": 3.0}) == {"x": 3.0}
-    seed_cache.code_hash.cache_clear()
     monkeypatch.setattr(seed_cache, "code_hash", lambda: "another code")
     assert seed_cache.bundle_key("paper", seed, None, cases, [False, True]) != key

@@ -124,8 +124,9 @@ def test_one_bridged_summit_is_jkr_at_w_wet_minus_the_kelvin_laplace_bridge():
 @pytest.mark.parametrize("plasticity", ["off", "auto"])
 def test_a_humid_member_gives_the_same_motion_compiled_and_in_python(plasticity):
     """A wet_silica member (calibrated; t_a = 1 us, shorter than its contacts): elastic Maugis-Dugdale summits at
-    W_wet inside bridges (LAW_WET_DISCRETE) or yielding summits at W_wet inside bridges (its plastic mode). Compiled (the dry kernel to t_a, then the bridged kernel) and the Python stepper give the same
-    restitution and booked loss to the integrator's tolerance (rtol 1e-8 on a force with jumps: 1e-5)."""
+    W_wet inside bridges (LAW_WET_DISCRETE) or yielding summits at W_wet inside bridges (its plastic mode). Compiled
+    (the dry kernel to t_a, then the bridged kernel) and the Python stepper give the same restitution and booked
+    loss to the integrator's tolerance (rtol 1e-8 on a force with jumps: 1e-5)."""
     from continuum.dynamics.ensemble_run import member_law, member_plan
     from continuum.model.regime import first_impact_speed
     from continuum.scene import resolve_scene
