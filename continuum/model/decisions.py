@@ -447,8 +447,9 @@ def summit_plasticity(scene: Scene, regime: Regime, adhesion: str = "jkr", half_
     Thornton-Ning's construction on the summit law that runs (`adhesion`: JKR, Maugis-Dugdale or DMT,
     `continuum.rough.plastic_branches`), on each summit of the realisation (mode 'discrete', and every ensemble
     member: `continuum.model.select.plastic_member`) or on their GW mean field (`continuum.rough.plastic_summits`
-    for JKR, `continuum.rough.plastic_gw_branches` for Maugis-Dugdale and DMT). They sit on a rigid
-    substrate without bridges, so under the half-space or menisci the summits stay elastic and the record says why.
+    for JKR, `continuum.rough.plastic_gw_branches` for Maugis-Dugdale and DMT). They sit on a rigid substrate, so
+    under the half-space the summits stay elastic; a realisation's plastic summits carry bridges
+    (`continuum.laws.wet_plastic_summits`), the mean field's bridges wrap elastic summits; the record says why.
     Plastic Maugis-Dugdale and DMT summits run compiled (`continuum.rough.plastic_kernel`; their cost against the
     elastic members: benchmarks/bench_plastic_summits.py, docs/benchmarks.md). `choice` is physics.plasticity
     ('on' and 'auto' decide alike for rough contact; 'off' is handled by `plasticity_decision`).
@@ -477,7 +478,9 @@ def summit_plasticity(scene: Scene, regime: Regime, adhesion: str = "jkr", half_
         (adhesion == "none", "the summits are not adhesive (the plastic summit laws are adhesive)"),
         (half_space, "the half-space roller carries elastic summits only"),
 
-        (menisci, "the bridges' law wraps elastic summits")) if cond]
+        (menisci and rough.mode != "discrete", "the mean field's bridges wrap elastic summits (a discrete "
+                                               "realisation or an ensemble carries plastic summits in its bridges)"),
+    ) if cond]
     used = yields and not blockers
     if used:
         _check_summit_limit(scene, soft, e_s)

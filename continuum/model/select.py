@@ -265,12 +265,17 @@ def select_law(scene: Scene, first_impact_speed: float, menisci: bool | None = N
         hs = half_space_decision(scene, regime)
         plastic = plasticity_decision(scene, regime, adhesion.law, half_space=hs.used, menisci=wet,
                                       depth=estimate.depth if estimate is not None else None)
+        discrete = scene.surfaces.roughness.mode == "discrete"
         # plastic summits in the mean field replace the elastic law, which is then neither built nor sized
-        tables = not (plastic.used and scene.surfaces.roughness.mode != "discrete" and not wet)
-        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet, regime=regime, tables=tables)
-        if plastic.used and scene.surfaces.roughness.mode == "discrete":
-            law = factory.plastic_discrete_roller(law, scene, regime.e_star, plastic.limiting_pressure,
+        tables = not (plastic.used and not discrete and not wet)
+        law, record = rough_law(scene, adhesion.law, hs.used, with_menisci=wet and not (plastic.used and discrete),
+                                regime=regime, tables=tables)
+        if plastic.used and discrete:
+            elastic = law
+            law = factory.plastic_discrete_roller(elastic, scene, regime.e_star, plastic.limiting_pressure,
                                                   plastic.summit_law)
+            if wet:             # a bridge on each plastic summit, as on an ensemble member (`member_menisci`)
+                law = discrete_menisci(scene, law, elastic, regime)
         elif plastic.used:
             law = factory.plastic_rigid_roller(scene, regime.e_star, plastic.limiting_pressure,
                                                record["datum"]["z_max"], plastic.summit_law)

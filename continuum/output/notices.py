@@ -58,7 +58,8 @@ def result_warnings(scene, law, bounces) -> list[str]:
         if psi > 1.0:
             out.append(f"plasticity index psi = {psi:.3g} > 1: most summits yield (Greenwood & Williamson 1966); "
                        + ("they run the Thornton-Ning elastic-plastic law (models.plasticity)"
-                          if diag.get("plastic_summits") else "the elastic JKR summits overstate the rebound"))
+                          if diag.get("plastic_summits") else "this run's elastic summits overstate the rebound "
+                          "(models.plasticity says why; an ensemble's members record their own summits)"))
         elif psi > 0.6 and math.isfinite(psi):
             out.append(f"plasticity index psi = {psi:.3g} between 0.6 and 1: some summits yield")
     return out

@@ -123,10 +123,10 @@ def _wet_task(case: Case, params: str, fidelity: str | None) -> dict:
         wet = factory.wet_sharing_dry_tables(wet, dry)
         own = factory.wet_dry_part(wet)
         if own is not None and own is not dry:
-            # other solids under the bridges (plastic summits yield dry, but the bridges' law wraps elastic
+            # other solids under the bridges (plastic summits yield dry, but the mean field's bridges wrap elastic
             # summits: continuum.model.decisions.summit_plasticity): the humidity comparison runs both on the wet
             # law's own dry part, so that before t_a the two runs are the same computation
-            dry, dry_law = own, "the wet law's own dry summits (elastic: the bridges' law wraps elastic summits)"
+            dry, dry_law = own, "the wet law's own dry summits (elastic: the mean field's bridges wrap elastic summits)"
     m = dict(regime.meniscus_parameters()) if wet is not None else {}
     t_a = m.get("condensation_time")
     grid, dry_runs, skipped = [], {}, []

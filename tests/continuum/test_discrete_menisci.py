@@ -305,3 +305,22 @@ def test_the_t_a_sweep_runs_again_exactly_the_points_that_can_differ(monkeypatch
     member["menisci"]["contacts_with_bridges"] = 1    # a bridge formed: every other point can differ
     wet_sweep.condensation_sweep(resolved, {"ensemble": ens}, rerun=run_impact)
     assert len(asked) == len(wet_sweep.t_a_grid(25e-6, lo, hi)) - 1
+
+
+def test_a_humid_discrete_run_carries_its_bridges_on_plastic_summits_and_the_mean_field_says_why_not():
+    """A single realisation (mode 'discrete') of the yielding calibrated summits with menisci on runs the same law as
+    an ensemble member: plastic summits, bridged ones at W_wet. The mean field's bridges wrap elastic summits, so there
+    the summits stay elastic and the plasticity record names that reason."""
+    from continuum.model import select_law
+    from continuum.model.regime import first_impact_speed
+
+    wet = {"menisci.condensation_model": "fixed", "menisci.condensation_time": 1e-6}
+    one = resolve_scene("wet_silica", params="calibrated", overrides={**wet, "surfaces.roughness.mode": "discrete"})
+    law, models = select_law(one.scene, first_impact_speed(one.scene), menisci=True)
+    assert models["plasticity"]["used"] is True
+    assert law.describe()["inside_bridges"]["work_of_adhesion"] == pytest.approx(
+        meniscus_parameters(one.scene)["work_of_adhesion_wet"])
+    mean = resolve_scene("wet_silica", params="calibrated", overrides={**wet, "surfaces.roughness.mode": "mean_field"})
+    _, models = select_law(mean.scene, first_impact_speed(mean.scene), menisci=True)
+    assert models["plasticity"]["used"] is False and models["plasticity"]["summits_yield"] is True
+    assert "mean field's bridges wrap elastic summits" in models["plasticity"]["why"]
