@@ -35,7 +35,10 @@ zeta = d_c + delta_in; tested to 1e-7).
 Speed: a law with a compiled form (`compiled_form`, `continuum.rough.plastic_kernel`'s tables) has its edges and
 its sums over each summit set evaluated by `continuum.rough.plastic_gw_kernel` (one compiled call per set, the
 same nodes, weights and summit states); `compiled = False` on an instance keeps the NumPy form, the reference the
-compiled one is tested against.
+compiled one is tested against. With compiled sums the contact law (`continuum.laws.plastic_rough.PlasticGWPunch`)
+also runs whole contacts in the compiled contact phase (`plastic_gw_kernel.law_value`, kernel kind
+`LAW_PLASTIC_GW`); its edges at the top summit (`release_separation`, `touch_separation`) then use the compiled edge
+functions, so both paths find the same release gap.
 
 Quadrature: the same geometric Gauss-Legendre panels in u as the JKR surface, from each set's lower edge, with its
 lower truncation and node bound (`PlasticGWSurface`). The summit law is tabulated to its `delta_max`; a trial stage
@@ -207,15 +210,22 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         raise TypeError("PlasticBranchGWSurface books its jumps with `jumps(d, d_c, d_p, d_0)`")
 
     # ------------------------------------------------------------------ contact ends
+    def _edge(self, kind: int, method, u):
+        """Edge function `kind` (`plastic_gw_kernel.edge`) at u, compiled if so (the compiled contact phase then
+        finds the same release gap, `plastic_gw_kernel.law_release_gap`)."""
+        if self.compiled:
+            return kernel.edge(u, kind, self.u_table, self._reach_ratio, self._P, self._T)
+        return float(method(u))
+
     def release_separation(self, d_c, d_p):
         """d - d_p (m) beyond which no summit holds or attracts (d_c = inf: none met yet)."""
         u_top = self.z_top - d_p
-        edge = float(self.reach_edge(u_top))
-        return max(float(self.hold(u_top)), edge) if math.isfinite(d_c) else edge
+        edge = self._edge(3, self.reach_edge, u_top)
+        return max(self._edge(2, self.hold, u_top), edge) if math.isfinite(d_c) else edge
 
     def touch_separation(self, d_p):
         """d - d_p (m) at which the tallest summit starts to attract."""
-        return float(self.reach_edge(self.z_top - d_p))
+        return self._edge(3, self.reach_edge, self.z_top - d_p)
 
     def check_depth(self, d_p):
         if self.z_top - d_p > self.u_table * (1.0 + 1e-12):

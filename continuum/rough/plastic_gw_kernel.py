@@ -32,8 +32,10 @@ from .plastic_kernel import (
     _flattening,
     _plastic_work,
 )
+from .plastic_summits import _GL_W, _GL_X
 
-__all__ = ["edge", "inverse", "set_sum", "span_sum", "state_values", "gl_nodes"]
+__all__ = ["edge", "inverse", "set_sum", "span_sum", "state_values", "gl_nodes", "law_arrays", "law_value",
+           "law_accept", "law_release_gap"]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 
@@ -319,3 +321,127 @@ def state_values(d, d_c, d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
     fa, ea, _ = span_sum(APPROACH, u_r, u_att, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
                           P, T)
     return f + fa, en + ea, q
+
+
+# ----------------------------------------------------------------------------- the contact law, compiled
+# `continuum.laws.plastic_rough.PlasticGWPunch` (and its roller) as a law of the compiled contact phase
+# (`continuum.numerics.kernel_laws.LAW_PLASTIC_GW`): the same values as its Python methods, which call the sums
+# above once per state, here called from the kernel's stages and samples.
+#
+# P: the summit law's slots (`plastic_kernel.PLASTIC_PARAMS`), the surface's C from L_C, then the law's own slots.
+# T: (quadrature offsets `PlasticGWSurface._offsets`, Gauss-Legendre nodes then weights, the flattening table's three
+# rows, the footprint's 24-node rule's nodes then weights (empty for a flat punch), node-law info, node-law rows):
+# the summit law's tables keep the places `plastic_kernel` reads them from.
+# S: (d_c, d_p, unused, unused, beyond-the-table flag at the kernel's S_BEYOND_FLAG, then a memo of the last state
+# evaluated: d, d_c, d_p, force, stored energy, and of the plastic work W_p(d_p) and the jump-in sum at (d_c, d_p)).
+L_C = 12
+(L_AREA, L_D0, L_W0, L_FOOTPRINT, L_N_GL, L_N_TX) = range(L_C + 15, L_C + 21)
+GW_LAW_PARAMS = L_C + 21
+(S_D_C, S_D_P, S_FLAG) = 0, 1, 4
+(S_M_D, S_M_DC, S_M_DP, S_M_F, S_M_E, S_M_WDP, S_M_W, S_M_IDC, S_M_IDP, S_M_I) = range(5, 15)
+GW_LAW_STATE = 15
+#: what `law_value` returns
+LAW_FORCE, LAW_STORED, LAW_DISSIPATED, LAW_RELEASE_LOSS = range(4)
+
+
+def law_arrays(surface, area: float, d_c: float, d_p: float, d_0: float, w0: float):
+    """(P, T, S) of the compiled contact law on `surface` (a compiled `PlasticBranchGWSurface`, m and J/m^2):
+    nominal area (m^2; 1 for a roller, whose values are per roller), history (d_c, d_p), the deepest separation
+    before this contact d_0 and its plastic work w0 (per unit area)."""
+    tx, tw = surface._tx_tw
+    P = np.zeros(GW_LAW_PARAMS)
+    P[:L_C] = surface._P
+    P[L_C:L_C + 15] = surface._C
+    P[L_AREA], P[L_D0], P[L_W0] = area, d_0, w0
+    P[L_FOOTPRINT], P[L_N_GL], P[L_N_TX] = float(surface._footprint), _GL_X.size, tx.size
+    _, _, flat_d, flat_r, flat_p, _, info, tab = surface._T
+    T = (np.ascontiguousarray(surface._offsets(), float), np.concatenate((_GL_X, _GL_W)), flat_d, flat_r,
+         flat_p, np.concatenate((np.asarray(tx, float), np.asarray(tw, float))), info, tab)
+    S = np.full(GW_LAW_STATE, math.nan)
+    S[S_D_C], S[S_D_P], S[2], S[3], S[S_FLAG] = d_c, d_p, 0.0, 0.0, 0.0
+    return P, T, S
+
+
+@njit(cache=True)
+def _sum(what, lo, hi, touch, d_p, shift, P, T):
+    """`span_sum` with the quadrature rules and constants packed in (P, T) (`law_arrays`)."""
+    n, m = int(P[L_N_GL]), int(P[L_N_TX])
+    return span_sum(what, lo, hi, touch, d_p, shift, P[L_FOOTPRINT] != 0.0, P[L_C:L_C + 15], T[0], T[1][:n],
+                    T[1][n:], T[5][:m], T[5][m:], P, T)
+
+
+@njit(cache=True)
+def _pair(d, d_c, d_p, S, P, T):
+    """(force N, stored energy J) at (d, d_c, d_p): `state_values` times the area, remembered for the next call at
+    the same state (a sample asks for both)."""
+    if d == S[S_M_D] and d_c == S[S_M_DC] and d_p == S[S_M_DP]:
+        return S[S_M_F], S[S_M_E]
+    C = P[L_C:L_C + 15]
+    n, m = int(P[L_N_GL]), int(P[L_N_TX])
+    f, en, _ = state_values(d, d_c, d_p, P[L_FOOTPRINT] != 0.0, C, T[0], T[1][:n], T[1][n:], T[5][:m], T[5][m:],
+                            P, T)
+    S[S_M_D], S[S_M_DC], S[S_M_DP] = d, d_c, d_p
+    S[S_M_F], S[S_M_E] = P[L_AREA] * f, P[L_AREA] * en
+    return S[S_M_F], S[S_M_E]
+
+
+@njit(cache=True)
+def _plastic_work_at(d_p, S, P, T):
+    """W_p(d_p) (J/m^2): `PlasticBranchGWSurface.plastic_work`, remembered while d_p stays."""
+    if d_p != S[S_M_WDP]:
+        S[S_M_W] = _sum(PLASTIC_WORK, max(P[P_P_D_Y], 0.0), math.inf, math.nan, d_p, 0.0, P, T)[0]
+        S[S_M_WDP] = d_p
+    return S[S_M_W]
+
+
+@njit(cache=True)
+def _jumps(d, d_c, d_p, S, P, T):
+    """`PlasticBranchGWSurface.jumps` (J/m^2; d = inf: every summit met has let go), its jump-in sum remembered
+    while (d_c, d_p) stay."""
+    if not math.isfinite(d_c):
+        return 0.0
+    C = P[L_C:L_C + 15]
+    u_met = inverse(1, d_c - d_p, -C[C_IN0], C, P, T)
+    if d_c != S[S_M_IDC] or d_p != S[S_M_IDP]:
+        S[S_M_I] = _sum(IN_SWITCH, u_met, math.inf, math.nan, d_p, P[L_D0] - d_p, P, T)[0]
+        S[S_M_IDC], S[S_M_IDP] = d_c, d_p
+    u_held = inverse(2, d - d_p, -C[C_OUT0], C, P, T) if math.isfinite(d) else math.inf
+    return S[S_M_I] + _sum(OUT_SWITCH, u_met, max(u_held, u_met), math.nan, d_p, 0.0, P, T)[0]
+
+
+@njit(cache=True)
+def law_value(what, gap, S, P, T):
+    """`PlasticGWPunch`'s force (N), stored energy (J), loss booked so far (J) at `gap` (m) on the trial history
+    (d, min(d_c, d), min(d_p, d)), d = z_top + gap; LAW_RELEASE_LOSS: its `on_release` (every summit met lets go)."""
+    if what == LAW_RELEASE_LOSS:
+        d, d_c, d_p = math.inf, S[S_D_C], S[S_D_P]
+    else:
+        d = P[L_C + C_Z_TOP] + gap
+        d_c, d_p = min(S[S_D_C], d), min(S[S_D_P], d)
+    if what == LAW_FORCE:
+        return _pair(d, d_c, d_p, S, P, T)[0]
+    if what == LAW_STORED:
+        return _pair(d, d_c, d_p, S, P, T)[1]
+    return P[L_AREA] * (_plastic_work_at(d_p, S, P, T) - P[L_W0] + _jumps(d, d_c, d_p, S, P, T))
+
+
+@njit(cache=True)
+def law_accept(gap, S, P, T):
+    """`PlasticGWPunch.accept`: the history takes the state; one deeper than the summit law's table is flagged
+    (`check_depth` refuses it: the kernel hands the contact to the Python stepper, which raises there)."""
+    d = P[L_C + C_Z_TOP] + gap
+    S[S_D_C], S[S_D_P] = min(S[S_D_C], d), min(S[S_D_P], d)
+    if P[L_C + C_Z_TOP] - S[S_D_P] > P[L_C + C_U_TABLE] * (1.0 + 1e-12):
+        S[S_FLAG] = 1.0
+
+
+@njit(cache=True)
+def law_release_gap(S, P, T):
+    """`PlasticGWPunch.release_gap` on the accepted history (`PlasticBranchGWSurface.release_separation`)."""
+    C = P[L_C:L_C + 15]
+    d_p, z_top = S[S_D_P], C[C_Z_TOP]
+    u_top = z_top - d_p
+    sep = edge(u_top, 3, C[C_U_TABLE], C[C_REACH_RATIO], P, T)
+    if math.isfinite(S[S_D_C]):
+        sep = max(edge(u_top, 2, C[C_U_TABLE], C[C_REACH_RATIO], P, T), sep)
+    return d_p + sep - z_top

@@ -1,0 +1,94 @@
+"""The plastic GW mean field in the compiled contact phase against the Python stepper, measured in one run.
+
+    .venv/bin/python benchmarks/bench_plastic_gw_compiled.py [--params silicon] [--case sigma_10nm] [--repeat 1]
+                                                             [--json FILE]
+
+The paper's impact task (`continuum.paper.run._impact_task`: one dry case on one parameter set, `nanoimpact
+impact`'s run and its files) and the paper's escape-velocity search on its law
+(`continuum.paper.samples.escape_search`: bracketed from the drop speed, bisected to ESCAPE_REL_TOL), each run with
+the law's contacts in the compiled contact phase (`PlasticGWPunch.compiled_contact = True`, kernel kind
+LAW_PLASTIC_GW) and on the Python DOP853 stepper calling the same compiled sums (`False`), one after the other in
+this process (tables built and the kernel loaded first, untimed). Reports wall and CPU seconds of each, their
+ratios and the load average (the 2 cores are shared).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from continuum.dynamics.impact import first_impact_speed  # noqa: E402
+from continuum.laws.plastic_rough import PlasticGWPunch  # noqa: E402
+from continuum.model import select_law  # noqa: E402
+from continuum.paper import run as paper  # noqa: E402
+from continuum.paper.samples import ESCAPE_REL_TOL, escape_search  # noqa: E402
+
+log = logging.getLogger("bench_plastic_gw_compiled")
+
+
+def _timed(fn) -> tuple[float, float, object]:
+    start, cpu = time.perf_counter(), time.process_time()
+    out = fn()
+    return time.perf_counter() - start, time.process_time() - cpu, out
+
+
+def measure(params: str, case_name: str, repeat: int) -> dict:
+    case = {c.name: c for c in paper.dry_cases()}[case_name]
+    resolved = paper.resolve_case(case, params, None)
+    scene = resolved.scene
+    v0 = first_impact_speed(resolved)
+    law, _ = select_law(scene, v0)
+    mass, g, rtol = scene.body.mass, scene.environment.gravity, scene.numerics.rtol
+    out: dict = {"params": params, "case": case_name, "law": law.name, "repeat": repeat,
+                 "surface_compiled": bool(getattr(getattr(law, "surface", None), "compiled", False))}
+    folder = tempfile.mkdtemp(prefix="bench_plastic_gw_")
+    paper._impact_task(case, params, None, folder)          # tables and the kernel loaded, untimed
+    for label, flag in (("compiled", True), ("python", False)):
+        PlasticGWPunch.compiled_contact = flag
+        try:
+            wall = cpu = 0.0
+            for _ in range(repeat):
+                w, c, res = _timed(lambda: paper._impact_task(case, params, None, folder))
+                wall, cpu = wall + w, cpu + c
+            r = res["result"]
+            ew, ec, esc = _timed(lambda: escape_search(law, mass, g, v0, rtol, ESCAPE_REL_TOL))
+        finally:
+            PlasticGWPunch.compiled_contact = True
+        out[label] = {"impact_wall_s": wall / repeat, "impact_cpu_s": cpu / repeat, "n_bounces": r["n_bounces"],
+                      "energy_audit": r["energy_audit"]["max_error_over_turnover"],
+                      "escape_wall_s": ew, "escape_cpu_s": ec,
+                      "escape": {k: v for k, v in esc.items() if isinstance(v, (int, float, str, bool))}}
+        log.info("%s: impact %.2f s (%.2f s CPU), escape search %.2f s (%.2f s CPU)", label, wall / repeat,
+                 cpu / repeat, ew, ec)
+    for key in ("impact_wall_s", "impact_cpu_s", "escape_wall_s", "escape_cpu_s"):
+        out[f"ratio_python_over_compiled_{key}"] = out["python"][key] / out["compiled"][key]
+    out["load_average"] = os.getloadavg()
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--params", default="silicon")
+    ap.add_argument("--case", default="sigma_10nm")
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    res = measure(args.params, args.case, args.repeat)
+    text = json.dumps(res, indent=1, default=str)
+    if args.json:
+        args.json.write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
