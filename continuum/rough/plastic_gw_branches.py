@@ -73,6 +73,11 @@ class PlasticBranchGWSurface(PlasticGWSurface):
     #: the tabulated laws are piecewise linear between their table points: panels of sigma/8 keep the quadrature
     #: within 1e-7 of the exact integral of the table (tests/continuum/test_plastic_mean_field.py)
     panel_width = 0.125
+    #: the compiled sums interpolate the footprint kernel's 24-node sum in a table (`plastic_gw_kernel.
+    #: footprint_table`, within 1e-12 of the sum) over z_top - z up to FOOTPRINT_DEPTH u_table + FOOTPRINT_MARGIN
+    #: sigma; False (on the class, before a surface is built): they sum it at every node, as the NumPy form does
+    footprint_tabulated = True
+    FOOTPRINT_DEPTH, FOOTPRINT_MARGIN = 1.1, 10.0
 
     def __init__(self, law, sigma: float, density: float, z_max: float, *footprint):
         super().__init__(law, sigma, density, z_max, *footprint)      # (radius, length) of a `RollerFootprint`
@@ -88,8 +93,14 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             none = np.zeros(1)              # the kernel's tables, without the discrete summits' own rows
             self._T = (none, none, *tables[:3], none, *tables[3:])
             self._reach_ratio = _at(law.reach_of, 1.0)          # reach(R_p) = cbrt(R_p) * ratio
-            self._tx_tw = (getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0)))
             self._footprint = isinstance(self, RollerFootprint)
+            tx, tw = getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0))
+            # the footprint kernel's node sum tabulated over the depths a contact reaches (the summit law's table
+            # and the reach below it); deeper nodes sum it directly
+            kt = (kernel.footprint_table(self.z_top, self.sigma, self.FOOTPRINT_DEPTH * self.u_table
+                                         + self.FOOTPRINT_MARGIN * self.sigma, tx, tw)
+                  if self._footprint and self.footprint_tabulated else np.empty(0))
+            self._tx_tw = (tx, tw, kt)
             self._C = np.array([self._first, self.panel_width * self.sigma, float(self._root_at_top), self.u_table,
                                 self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
                                 getattr(self, "roller_radius", 0.0), self._reach_ratio, self.z_floor,

@@ -35,7 +35,7 @@ from .plastic_kernel import (
 from .plastic_summits import _GL_W, _GL_X
 
 __all__ = ["edge", "inverse", "set_sum", "span_sum", "state_values", "gl_nodes", "law_arrays", "law_value",
-           "law_accept", "law_release_gap"]
+           "law_accept", "law_release_gap", "footprint_table"]
 
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 
@@ -101,7 +101,7 @@ def _branch_pair(retreat, eps, r, P, T):
         if wgt == 0.0 or j >= nodes:
             continue
         s = r / info[5 * j]
-        c = s ** (1.0 / 3.0)
+        c = np.cbrt(s)                  # as `PlasticBranchSummitLaw._scaled` takes it
         row = 6 * j + 3 * side
         a, b = _lin2(eps / c, tab[row], tab[row + 1], tab[row + 2], int(info[5 * j + 3 + side]))
         force += wgt * s * a
@@ -120,7 +120,7 @@ def edge(u, kind, u_table, reach_ratio, P, T):
         return g - _blend(4, 0.0, r_p, P, T)
     if kind == 2:
         return g - _blend(5, 0.0, r_p, P, T)
-    return g + r_p ** (1.0 / 3.0) * reach_ratio
+    return g + np.cbrt(r_p) * reach_ratio
 
 
 @njit(cache=True)
@@ -195,10 +195,30 @@ def gl_nodes(lo, hi, floor, offsets, first, quarter, breaks, root_at_top, gl_x, 
 APPROACH, RETREAT, IN_SWITCH, OUT_SWITCH, PLASTIC_WORK = range(5)
 
 
+def footprint_table(z_top: float, sigma: float, depth: float, tx, tw, per_scale: float = 200.0) -> np.ndarray:
+    """The footprint kernel's node sum G(s) = sum_j tw_j exp(-y_j^2 / 2), y_j = (z + t_j^2) / sigma, t_j = s (tx_j + 1)
+    / 2, z = z_top - s^2 (`RollerFootprint._weight`: K(z) = s G(s) / (sqrt(2 pi) sigma)), and its derivative, on a
+    uniform grid in s from 0 to sqrt(depth) (z from z_top down to z_top - depth, m): [step, points, G..., G'...] for
+    `_weight`'s cubic Hermite interpolation. G is an entire function of s whose terms vary on the scale
+    sigma / (2 s); the step is that scale at the grid's end over `per_scale`, so the cubic's error, of order
+    (1/per_scale)^4 of G's size, stays below 1e-12 of it at 200 (tests/continuum/test_plastic_gw_compiled.py)."""
+    top_max = math.sqrt(depth)
+    step = sigma / (2.0 * top_max) / per_scale
+    n = int(math.ceil(top_max / step)) + 2
+    s = step * np.arange(n)
+    a = (0.5 * (np.asarray(tx, float) + 1.0)) ** 2           # t_j^2 = s^2 a_j
+    y = (z_top - np.outer(s * s, 1.0 - a)) / sigma
+    e = np.exp(-0.5 * y * y) * np.asarray(tw, float)
+    g = e.sum(axis=1)
+    dg = (e * y * (1.0 - a)).sum(axis=1) * 2.0 * s / sigma      # dy_j/ds = -2 s (1 - a_j) / sigma
+    return np.concatenate(([step, float(n)], g, dg))
+
+
 @njit(cache=True)
-def _weight(u, w, d_p, footprint, C, tx, tw):
+def _weight(u, w, d_p, footprint, C, tx, tw, kt):
     """Summits per unit height times the quadrature weight at z = d_p + u: n phi(z) (`PlasticGWSurface._weight`)
-    or the roller footprint's kernel K(z) (`footprint`, `RollerFootprint._weight`, 24-node rule tx, tw)."""
+    or the roller footprint's kernel K(z) (`footprint`, `RollerFootprint._weight`, 24-node rule tx, tw), its node sum
+    interpolated in the table `kt` (`footprint_table`) where it covers z, else summed."""
     density, sigma = C[C_DENSITY], C[C_SIGMA]
     z = d_p + u
     if not footprint:
@@ -206,16 +226,31 @@ def _weight(u, w, d_p, footprint, C, tx, tw):
         return density * w * math.exp(-0.5 * y * y) / (_SQRT2PI * sigma)
     top = math.sqrt(max(C[C_Z_TOP] - z, 0.0))
     s = 0.0
-    for j in range(tx.size):
-        t = 0.5 * top * (tx[j] + 1.0)
-        y = (z + t * t) / sigma
-        s += math.exp(-0.5 * y * y) * tw[j]
+    tabled = False
+    if kt.size > 0:
+        step = kt[0]
+        n = int(kt[1])
+        x = top / step
+        i = int(x)
+        if i < n - 1:
+            t = x - i
+            t2 = t * t
+            g0, g1 = kt[2 + i], kt[3 + i]
+            d0, d1 = kt[2 + n + i] * step, kt[3 + n + i] * step
+            s = (g0 + t2 * (3.0 * (g1 - g0) - 2.0 * d0 - d1) + t2 * t * (2.0 * (g0 - g1) + d0 + d1)
+                 + t * d0)
+            tabled = True
+    if not tabled:
+        for j in range(tx.size):
+            t = 0.5 * top * (tx[j] + 1.0)
+            y = (z + t * t) / sigma
+            s += math.exp(-0.5 * y * y) * tw[j]
     k = 0.5 * top * s * 2.0 / (_SQRT2PI * sigma)
     return density * w * C[C_LENGTH] * math.sqrt(2.0 * C[C_ROLLER_RADIUS]) * k
 
 
 @njit(cache=True)
-def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, kt, P, T):
     """(sum q a, sum q b, sum q) over the quadrature of [lo, hi] (m, in u; `gl_nodes`, split at delta_y and
     `touch`) of one summit set, q the weight (`_weight`) and, by `what`:
 
@@ -232,7 +267,7 @@ def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x,
     u_table, d_y = C[C_U_TABLE], P[P_P_D_Y]
     sa = sb = sq = 0.0
     for i in range(u.size):
-        q = _weight(u[i], w[i], d_p, footprint, C, tx, tw)
+        q = _weight(u[i], w[i], d_p, footprint, C, tx, tw, kt)
         a = b = 0.0
         if what == IN_SWITCH:
             r_p, dp = _flattening(min(max(u[i] - shift, 0.0), u_table), flag, P, T)
@@ -294,7 +329,7 @@ def inverse(kind, value, offset, C, P, T):
 
 
 @njit(cache=True)
-def span_sum(what, lo, hi, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+def span_sum(what, lo, hi, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, kt, P, T):
     """`set_sum` over `PlasticGWSurface._span(lo, d_p, hi)`."""
     floor = C[C_Z_FLOOR] - d_p
     if C[C_CLIP_FLOOR] != 0.0:
@@ -302,11 +337,11 @@ def span_sum(what, lo, hi, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w,
     hi = min(hi, C[C_Z_TOP] - d_p)
     if not hi > lo:
         return 0.0, 0.0, 0.0
-    return set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T)
+    return set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x, gl_w, tx, tw, kt, P, T)
 
 
 @njit(cache=True)
-def state_values(d, d_c, d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
+def state_values(d, d_c, d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, kt, P, T):
     """`PlasticBranchGWSurface._values` in one call: (pressure or force, stored energy, attached summits) at
     (d, d_c, d_p), the sets' edges (`inverse`, as `sets`) and the touch break included."""
     u_met = inverse(1, d_c - d_p, -C[C_IN0], C, P, T) if math.isfinite(d_c) else math.inf
@@ -316,9 +351,9 @@ def state_values(d, d_c, d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, P, T):
     else:
         u_att = u_r = math.inf
     touch = inverse(0, d - d_p, 0.0, C, P, T)
-    f, en, q = span_sum(RETREAT, u_att, math.inf, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
+    f, en, q = span_sum(RETREAT, u_att, math.inf, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, kt,
                          P, T)
-    fa, ea, _ = span_sum(APPROACH, u_r, u_att, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw,
+    fa, ea, _ = span_sum(APPROACH, u_r, u_att, touch, d_p, d - d_p, footprint, C, offsets, gl_x, gl_w, tx, tw, kt,
                           P, T)
     return f + fa, en + ea, q
 
@@ -348,7 +383,7 @@ def law_arrays(surface, area: float, d_c: float, d_p: float, d_0: float, w0: flo
     """(P, T, S) of the compiled contact law on `surface` (a compiled `PlasticBranchGWSurface`, m and J/m^2):
     nominal area (m^2; 1 for a roller, whose values are per roller), history (d_c, d_p), the deepest separation
     before this contact d_0 and its plastic work w0 (per unit area)."""
-    tx, tw = surface._tx_tw
+    tx, tw, kt = surface._tx_tw
     P = np.zeros(GW_LAW_PARAMS)
     P[:L_C] = surface._P
     P[L_C:L_C + 15] = surface._C
@@ -356,7 +391,7 @@ def law_arrays(surface, area: float, d_c: float, d_p: float, d_0: float, w0: flo
     P[L_FOOTPRINT], P[L_N_GL], P[L_N_TX] = float(surface._footprint), _GL_X.size, tx.size
     _, _, flat_d, flat_r, flat_p, _, info, tab = surface._T
     T = (np.ascontiguousarray(surface._offsets(), float), np.concatenate((_GL_X, _GL_W)), flat_d, flat_r,
-         flat_p, np.concatenate((np.asarray(tx, float), np.asarray(tw, float))), info, tab)
+         flat_p, np.concatenate((np.asarray(tx, float), np.asarray(tw, float), kt)), info, tab)
     S = np.full(GW_LAW_STATE, math.nan)
     S[S_D_C], S[S_D_P], S[2], S[3], S[S_FLAG] = d_c, d_p, 0.0, 0.0, 0.0
     return P, T, S
@@ -367,7 +402,7 @@ def _sum(what, lo, hi, touch, d_p, shift, P, T):
     """`span_sum` with the quadrature rules and constants packed in (P, T) (`law_arrays`)."""
     n, m = int(P[L_N_GL]), int(P[L_N_TX])
     return span_sum(what, lo, hi, touch, d_p, shift, P[L_FOOTPRINT] != 0.0, P[L_C:L_C + 15], T[0], T[1][:n],
-                    T[1][n:], T[5][:m], T[5][m:], P, T)
+                    T[1][n:], T[5][:m], T[5][m:2 * m], T[5][2 * m:], P, T)
 
 
 @njit(cache=True)
@@ -378,8 +413,8 @@ def _pair(d, d_c, d_p, S, P, T):
         return S[S_M_F], S[S_M_E]
     C = P[L_C:L_C + 15]
     n, m = int(P[L_N_GL]), int(P[L_N_TX])
-    f, en, _ = state_values(d, d_c, d_p, P[L_FOOTPRINT] != 0.0, C, T[0], T[1][:n], T[1][n:], T[5][:m], T[5][m:],
-                            P, T)
+    f, en, _ = state_values(d, d_c, d_p, P[L_FOOTPRINT] != 0.0, C, T[0], T[1][:n], T[1][n:], T[5][:m],
+                            T[5][m:2 * m], T[5][2 * m:], P, T)
     S[S_M_D], S[S_M_DC], S[S_M_DP] = d, d_c, d_p
     S[S_M_F], S[S_M_E] = P[L_AREA] * f, P[L_AREA] * en
     return S[S_M_F], S[S_M_E]

@@ -147,3 +147,26 @@ def test_compiled_impacts_match_the_python_stepper(roller):
         assert a.energy_booked == pytest.approx(b.energy_booked, rel=0, abs=tol * 0.5 * mass * b.v_impact ** 2)
     assert hist_fast == pytest.approx(hist_slow, rel=tol * 1e-2)
     assert diag_fast["plastic_work"] == pytest.approx(diag_slow["plastic_work"], rel=tol)
+
+
+@pytest.mark.parametrize("sigma,depth", [(5e-9, 30), (2e-9, 100)])
+def test_the_tabulated_footprint_kernel_is_its_node_sum(sigma, depth):
+    """The compiled sums interpolate the footprint kernel's 24-node sum (`plastic_gw_kernel.footprint_table`): within
+    1e-12 of the sum at every height the table covers, and summed beyond it; a table 8x coarser misses that bound
+    (the negative control: the bound resolves the interpolation's error)."""
+    law = PlasticBranchSummitLaw("maugis_dugdale", BETA, W, 1e11, 3e9, z0=Z0, delta_max=depth * sigma)
+    surf = _contact_law(True).surface.__class__(law, sigma, DENSITY, ZMAX, R_ROLLER, L_ROLLER)
+    tx, tw, kt = surf._tx_tw
+    assert kt.size > 0
+    reach = surf.FOOTPRINT_DEPTH * surf.u_table + surf.FOOTPRINT_MARGIN * sigma
+    z = surf.z_top - np.random.default_rng(1).uniform(0.0, 1.0, 4000) ** 2 * reach * 1.05
+    z = np.concatenate((z, [surf.z_top, surf.z_top - reach]))
+
+    def weights(table):
+        return np.array([pgk._weight(h, 1.0, 0.0, True, surf._C, tx, tw, table) for h in z])
+
+    summed = weights(np.empty(0))
+    assert summed[-2] == 0.0 and np.all(summed[:-2] > 0.0) and summed[-1] > 0.0     # K(z_top) = 0
+    assert np.all(np.abs(weights(kt) - summed) <= 1e-12 * summed)
+    coarse = pgk.footprint_table(surf.z_top, sigma, reach, tx, tw, per_scale=25.0)
+    assert not np.all(np.abs(weights(coarse) - summed) <= 1e-12 * summed)
