@@ -41,32 +41,35 @@ _SQRT2PI = math.sqrt(2.0 * math.pi)
 
 
 @njit(cache=True)
-def _lin2(x, xs, ya, yb, n):
-    """(`plastic_kernel._lin`(x, xs, ya), `_lin`(x, xs, yb)), the same arithmetic, one bisection for both."""
-    if x <= xs[0]:
-        return ya[0], yb[0]
-    if x >= xs[n - 1]:
-        return ya[n - 1], yb[n - 1]
+def _lin2(x, tab, row, n):
+    """(`plastic_kernel._lin`(x, xs, ya), `_lin`(x, xs, yb)) on the table rows xs, ya, yb = tab[row], tab[row + 1],
+    tab[row + 2], the same arithmetic, one bisection for both; the rows are read in place (a row view per call costs
+    more than the search)."""
+    ya, yb = row + 1, row + 2
+    if x <= tab[row, 0]:
+        return tab[ya, 0], tab[yb, 0]
+    if x >= tab[row, n - 1]:
+        return tab[ya, n - 1], tab[yb, n - 1]
     lo, hi = 0, n - 1
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if xs[mid] <= x:
+        if tab[row, mid] <= x:
             lo = mid
         else:
             hi = mid
-    return (ya[lo] + (x - xs[lo]) / (xs[hi] - xs[lo]) * (ya[hi] - ya[lo]),
-            yb[lo] + (x - xs[lo]) / (xs[hi] - xs[lo]) * (yb[hi] - yb[lo]))
+    x0, x1 = tab[row, lo], tab[row, hi]
+    return (tab[ya, lo] + (x - x0) / (x1 - x0) * (tab[ya, hi] - tab[ya, lo]),
+            tab[yb, lo] + (x - x0) / (x1 - x0) * (tab[yb, hi] - tab[yb, lo]))
 
 
 @njit(cache=True)
-def _flat(dm, P, T):
-    """`plastic_kernel._flattening` for dm within the table: the same interval of its grid D_i = D_top (i/(n-1))^2
-    (the largest i <= n - 2 with D_i <= D), found from its square root instead of by bisection, the same
-    arithmetic."""
+def _flat(dm, P, xs, ys, zs):
+    """`plastic_kernel._flattening` for dm within the table (xs, ys, zs = T[2], T[3], T[4], taken out of T once by
+    the caller): the same interval of its grid D_i = D_top (i/(n-1))^2 (the largest i <= n - 2 with D_i <= D), found
+    from its square root instead of by bisection, the same arithmetic."""
     over = dm - P[P_P_D_Y]
     if not over > 0.0:
         return P[P_P_BETA], 0.0
-    xs, ys, zs = T[2], T[3], T[4]
     n = xs.size
     if over >= xs[n - 1]:
         return ys[n - 1], zs[n - 1]
@@ -81,15 +84,13 @@ def _flat(dm, P, T):
 
 
 @njit(cache=True)
-def _branch_pair(retreat, eps, r, P, T):
+def _branch_pair(retreat, eps, r, P, info, tab):
     """(force, energy) on the approach or the retreat branch: `plastic_kernel._blend`'s (0, 1) or (2, 3), the same
-    arithmetic, each node law's table searched once for both."""
-    info, tab = T[6], T[7]
+    arithmetic, each node law's table searched once for both (info, tab = T[6], T[7], taken out once by the caller)."""
     nodes = int(P[P_P_NODES])
     side = 1 if retreat else 0
     if r == P[P_P_BETA]:            # an unflattened summit: node 0's own curve, no scaling
-        row = 3 * side
-        return _lin2(eps, tab[row], tab[row + 1], tab[row + 2], int(info[3 + side]))
+        return _lin2(eps, tab, 3 * side, int(info[3 + side]))
     k, t = 0, 0.0
     if nodes > 1 and P[P_P_SELF_SIMILAR] == 0.0:
         x = math.log(max(r / P[P_P_BETA], 1.0)) / P[P_P_LOG_RATIO]
@@ -102,8 +103,7 @@ def _branch_pair(retreat, eps, r, P, T):
             continue
         s = r / info[5 * j]
         c = np.cbrt(s)                  # as `PlasticBranchSummitLaw._scaled` takes it
-        row = 6 * j + 3 * side
-        a, b = _lin2(eps / c, tab[row], tab[row + 1], tab[row + 2], int(info[5 * j + 3 + side]))
+        a, b = _lin2(eps / c, tab, 6 * j + 3 * side, int(info[5 * j + 3 + side]))
         force += wgt * s * a
         energy += wgt * s * c * b
     return force, energy
@@ -112,7 +112,7 @@ def _branch_pair(retreat, eps, r, P, T):
 @njit(cache=True)
 def edge(u, kind, u_table, reach_ratio, P, T):
     """The summit-set edge functions of `PlasticBranchGWSurface` (see the module docstring) at u (m)."""
-    r_p, d_p = _flat(min(max(u, 0.0), u_table), P, T)
+    r_p, d_p = _flat(min(max(u, 0.0), u_table), P, T[2], T[3], T[4])
     g = u - d_p
     if kind == 0:
         return g
@@ -264,6 +264,7 @@ def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x,
     u, w = gl_nodes(lo, hi, floor, offsets, C[C_FIRST], C[C_QUARTER], np.array([P[P_P_D_Y], touch]),
                     C[C_ROOT_AT_TOP] != 0.0, gl_x, gl_w)
     flag = np.zeros(5)
+    fx, fr, fp, info, tab = T[2], T[3], T[4], T[6], T[7]
     u_table, d_y = C[C_U_TABLE], P[P_P_D_Y]
     sa = sb = sq = 0.0
     for i in range(u.size):
@@ -283,9 +284,9 @@ def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x,
             a = _plastic_work(dm, r_p, dp, P, T)
         else:
             dm = min(max(u[i], 0.0), u_table)
-            r_p, dp = _flat(dm, P, T)
+            r_p, dp = _flat(dm, P, fx, fr, fp)
             delta = u[i] - shift
-            a, b = _branch_pair(what == RETREAT, delta - dp, r_p, P, T)
+            a, b = _branch_pair(what == RETREAT, delta - dp, r_p, P, info, tab)
             if what == RETREAT and delta >= dm and dm > d_y:
                 a = P[P_P_F_Y] + P[P_P_SLOPE] * (delta - d_y)
         sa += q * a
