@@ -170,3 +170,20 @@ def test_the_tabulated_footprint_kernel_is_its_node_sum(sigma, depth):
     assert np.all(np.abs(weights(kt) - summed) <= 1e-12 * summed)
     coarse = pgk.footprint_table(surf.z_top, sigma, reach, tx, tw, per_scale=25.0)
     assert not np.all(np.abs(weights(coarse) - summed) <= 1e-12 * summed)
+
+
+def test_an_impact_beyond_the_summit_table_is_refused_on_both_paths():
+    """`check_depth`: an accepted state deeper than the summit law's table is refused. The compiled phase flags it
+    and hands the contact to the Python stepper, which raises there, as the Python stepper alone does."""
+    shallow = PlasticBranchSummitLaw("maugis_dugdale", BETA, W, 1e11, 3e9, z0=Z0, delta_max=2 * SIGMA)
+    law = PlasticGWRoller(shallow, SIGMA, DENSITY, ZMAX, R_ROLLER, L_ROLLER)
+    for flag in (True, False):
+        law.forget_history()
+        type(law).compiled_contact = flag
+        try:
+            before = cc.STATS.python
+            with pytest.raises(ValueError, match="beyond the summit law's table"):
+                simulate(law, 1e-6, 9.81, impact_velocity=0.05, settings=DriverSettings(rtol=1e-9, max_bounces=1))
+            assert cc.STATS.python - before == (1 if flag else 0)    # the kernel gave the contact back
+        finally:
+            type(law).compiled_contact = True
