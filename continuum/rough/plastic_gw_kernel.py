@@ -267,17 +267,23 @@ def set_sum(what, lo, hi, floor, touch, d_p, shift, footprint, C, offsets, gl_x,
     fx, fr, fp, info, tab = T[2], T[3], T[4], T[6], T[7]
     u_table, d_y = C[C_U_TABLE], P[P_P_D_Y]
     sa = sb = sq = 0.0
+    virgin = math.nan           # the switch term of an unflattened summit (R_p = beta): one value, computed once
     for i in range(u.size):
         q = _weight(u[i], w[i], d_p, footprint, C, tx, tw, kt)
         a = b = 0.0
-        if what == IN_SWITCH:
-            r_p, dp = _flattening(min(max(u[i] - shift, 0.0), u_table), flag, P, T)
-            e = _blend(4, 0.0, r_p, P, T)
-            a = _blend(1, e, r_p, P, T) - _blend(3, e, r_p, P, T)
-        elif what == OUT_SWITCH:
-            r_p, dp = _flattening(min(max(u[i], 0.0), u_table), flag, P, T)
-            e = _blend(5, 0.0, r_p, P, T)
-            a = _blend(3, e, r_p, P, T) - _blend(1, e, r_p, P, T)
+        if what == IN_SWITCH or what == OUT_SWITCH:
+            r_p, dp = _flattening(min(max(u[i] - shift if what == IN_SWITCH else u[i], 0.0), u_table), flag, P, T)
+            if r_p == P[P_P_BETA] and virgin == virgin:
+                a = virgin
+            else:
+                if what == IN_SWITCH:
+                    e = _blend(4, 0.0, r_p, P, T)
+                    a = _blend(1, e, r_p, P, T) - _blend(3, e, r_p, P, T)
+                else:
+                    e = _blend(5, 0.0, r_p, P, T)
+                    a = _blend(3, e, r_p, P, T) - _blend(1, e, r_p, P, T)
+                if r_p == P[P_P_BETA]:
+                    virgin = a
         elif what == PLASTIC_WORK:
             dm = min(u[i], u_table)
             r_p, dp = _flattening(max(dm, d_y), flag, P, T)
