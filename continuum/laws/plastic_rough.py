@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from ..rough.plastic_gw_branches import BranchRollerFootprint
+from ..rough.plastic_gw_kernel import S_D_C, S_D_P, law_arrays
 from ..rough.plastic_summits import PlasticGWSurface, PlasticSummitLaw, RollerFootprint
 from .base import ContactLaw
 
@@ -34,6 +35,9 @@ class PlasticGWPunch(ContactLaw):
     name = "plastic_gw_punch"
     has_history = True
     bound_is_final = True   # the driver ends a contact at its first turn while attached (one approach, one retreat)
+    #: run contacts in the compiled contact phase where the surface has compiled sums (`compiled`); False keeps them
+    #: on the driver's Python stepper calling the same sums (the reference the compiled phase is tested against)
+    compiled_contact = True
 
     def __init__(self, surface: PlasticGWSurface, area: float):
         self.surface, self.area = surface, float(area)
@@ -91,6 +95,21 @@ class PlasticGWPunch(ContactLaw):
 
     def length_scale(self, mass, speed):
         return max(0.1 * self.surface.sigma, self.surface.delta_c)
+
+    def compiled(self, t0: float):
+        """The contact's compiled form (`continuum.rough.plastic_gw_kernel.law_value`, kernel kind `LAW_PLASTIC_GW`)
+        on a surface whose sums are compiled (`PlasticBranchGWSurface.compiled`: Maugis-Dugdale or DMT summits with
+        tables); None for the closed-form JKR surface or with `compiled_contact` off (the Python stepper runs it)."""
+        if not (self.compiled_contact and getattr(self.surface, "compiled", False)):
+            return None
+        from ..numerics import kernel_laws as kl
+        from ..numerics.compiled_contact import CompiledLaw
+        P, T, S = law_arrays(self.surface, self.area, self._d_c, self._d_p, self._d_0, self._w0)
+        return CompiledLaw(kl.LAW_PLASTIC_GW, P, T, S)
+
+    def compiled_commit(self, state, last_accept: float) -> None:
+        """Take back a compiled contact's history (d_c, d_p): what `accept` left after its last accepted state."""
+        self._d_c, self._d_p = float(state[S_D_C]), float(state[S_D_P])
 
     def diagnostics(self):
         """The deepest state reached (first contact's maximum approach, where the most summits hold): its summits in

@@ -24,7 +24,9 @@ tolerance; `tests/continuum/test_contact_kernel.py` checks both):
 Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid rough roller's footprint tables, `continuum.laws.rough_rigid`;
 `LAW_DISCRETE`: a realisation of closed-form JKR or Hertz summits on a rigid base (`continuum.laws.discrete_roller`)
 or, `LAW_DISCRETE_BRANCH`, of tabulated branches of any summit law; `LAW_PLASTIC`: elastic-plastic summits,
-`continuum.rough.plastic_kernel`; `LAW_POWER`: F = k (-h)^n, Hertz, to validate the integrator against closed forms)
+`continuum.rough.plastic_kernel`; `LAW_PLASTIC_GW`: their GW mean field, `continuum.rough.plastic_gw_kernel`, whose
+release gap grows with the history, so the kernel takes it from the law before every step as the driver does;
+`LAW_POWER`: F = k (-h)^n, Hertz, to validate the integrator against closed forms)
 give parameters `P`, tables `T` (a tuple of arrays) and a history `S` that the kernel updates in place; their
 compiled force and energies live in `continuum.numerics.kernel_laws` (re-exported here). One law depends on time:
 `wet_discrete_kernel.LAW_WET_DISCRETE` (discrete summits with a capillary bridge each, after t_a), so the kernel
@@ -51,6 +53,8 @@ from .kernel_laws import (
     law_accept,
     law_dissipated,
     law_force,
+    law_release_gap,
+    law_release_loss,
     law_stored,
 )
 
@@ -329,7 +333,10 @@ def _release(kind, S, P, T, buf, n, te, release, v_e, pull, after_max, info):
     """The release event: a sample at the release gap, then the instant after (no force, nothing stored, the
     law's loss booked as dissipated); the end state and the loss go to `info`. Returns the sample count."""
     n = _sample(kind, S, P, T, buf, n, te, release, v_e, pull, after_max)
-    loss = _dissipated(kind, te, release, S, P, T)
+    if kind == wk.LAW_WET_DISCRETE or kind == wk.LAW_BRIDGED:
+        loss = _dissipated(kind, te, release, S, P, T)
+    else:
+        loss = law_release_loss(kind, release, S, P, T)
     if n < buf.shape[0]:
         buf[n, 0] = te
         buf[n, 1] = release
@@ -438,6 +445,7 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
         t_prev = t
         y_old[0] = y[0]
         y_old[1] = y[1]
+        release = law_release_gap(kind, S, P, T, release)     # on the history accepted so far, as the driver's
         if t == t_bound:
             end = END_MAX_TIME
             info[I_T], info[I_GAP], info[I_V] = t, y[0], y[1]

@@ -18,6 +18,7 @@ from numba import njit
 from numba.extending import overload
 
 from ..physics import jkr_kernel as jk
+from ..rough import plastic_gw_kernel as pgk
 from ..rough import plastic_kernel as pk
 
 #: Law kinds.
@@ -26,9 +27,9 @@ LAW_POWER = 1
 LAW_DISCRETE = 2
 LAW_DISCRETE_BRANCH = 3
 LAW_PLASTIC = 4
-
-
-
+#: (5 and 6: `continuum.numerics.wet_discrete_kernel`.) The GW mean field of plastic summits under a flat punch or a
+#: roller (`continuum.laws.plastic_rough.PlasticGWPunch`, `continuum.rough.plastic_gw_kernel.law_value`).
+LAW_PLASTIC_GW = 7
 
 #: Rigid-table law: P slots and S slots.
 (P_END_GAP, P_REACH, P_ATTACH, P_RELEASE, P_R_IN, P_H_LO, P_LOOP) = range(7)
@@ -302,6 +303,8 @@ def law_force(kind, gap, S, P, T):
         return _branch_sum(gap, S, P, T, False) if gap < P[P_B_END_GAP] else 0.0
     if kind == LAW_PLASTIC:
         return pk.plastic_value(gap, S, P, T, 0)
+    if kind == LAW_PLASTIC_GW:
+        return pgk.law_value(pgk.LAW_FORCE, gap, S, P, T)
     if gap >= P[P_END_GAP]:
         return 0.0
     if gap < P[P_H_LO]:
@@ -321,6 +324,8 @@ def law_stored(kind, gap, S, P, T):
         return _branch_sum(gap, S, P, T, True) if gap < P[P_B_END_GAP] else 0.0
     if kind == LAW_PLASTIC:
         return pk.plastic_value(gap, S, P, T, 1)
+    if kind == LAW_PLASTIC_GW:
+        return pgk.law_value(pgk.LAW_STORED, gap, S, P, T)
     if gap >= P[P_END_GAP] or (S[S_H_MIN] == math.inf and gap >= P[P_REACH]):
         return 0.0
     if gap < P[P_H_LO]:
@@ -338,6 +343,8 @@ def law_dissipated(kind, gap, S, P, T):
         return _branch_dissipated(gap, S, P, T)
     if kind == LAW_PLASTIC:
         return pk.plastic_value(gap, S, P, T, 2)
+    if kind == LAW_PLASTIC_GW:
+        return pgk.law_value(pgk.LAW_DISSIPATED, gap, S, P, T)
     if kind == LAW_POWER or S[S_H_MIN] == math.inf:
         return 0.0
     return P[P_LOOP] * max(S[S_COUNT_MIN] - _rigid_attached(gap, S, P, T), 0.0)
@@ -354,6 +361,9 @@ def law_accept(kind, gap, S, P, T):
     if kind == LAW_PLASTIC:
         pk.plastic_accept(gap, S, P, T)
         return
+    if kind == LAW_PLASTIC_GW:
+        pgk.law_accept(gap, S, P, T)
+        return
     if kind == LAW_DISCRETE_BRANCH:
         if gap < S[S_H_MIN]:
             S[S_H_MIN] = gap
@@ -367,3 +377,21 @@ def law_accept(kind, gap, S, P, T):
         S[S_H_MIN] = gap
         S[S_COUNT_MIN] = _rigid_count(gap, S, P, T) if gap < P[P_ATTACH] else 0.0
     S[S_MAX_CONTACTS] = max(S[S_MAX_CONTACTS], _rigid_attached(gap, S, P, T))
+
+
+@njit(cache=True)
+def law_release_gap(kind, S, P, T, release):
+    """The release gap (m) on the accepted history: the law's `release_gap`, which grows with the history for the
+    plastic mean field (the flattened summits hold longer); `release`, the one given at touch, for the others."""
+    if kind == LAW_PLASTIC_GW:
+        return pgk.law_release_gap(S, P, T)
+    return release
+
+
+@njit(cache=True)
+def law_release_loss(kind, gap, S, P, T):
+    """The loss (J) booked at release (the law's `on_release`): `law_dissipated` at the release gap, or, for the
+    plastic mean field, with every summit met let go."""
+    if kind == LAW_PLASTIC_GW:
+        return pgk.law_value(pgk.LAW_RELEASE_LOSS, gap, S, P, T)
+    return law_dissipated(kind, gap, S, P, T)

@@ -35,7 +35,10 @@ zeta = d_c + delta_in; tested to 1e-7).
 Speed: a law with a compiled form (`compiled_form`, `continuum.rough.plastic_kernel`'s tables) has its edges and
 its sums over each summit set evaluated by `continuum.rough.plastic_gw_kernel` (one compiled call per set, the
 same nodes, weights and summit states); `compiled = False` on an instance keeps the NumPy form, the reference the
-compiled one is tested against.
+compiled one is tested against. With compiled sums the contact law (`continuum.laws.plastic_rough.PlasticGWPunch`)
+also runs whole contacts in the compiled contact phase (`plastic_gw_kernel.law_value`, kernel kind
+`LAW_PLASTIC_GW`); its edges at the top summit (`release_separation`, `touch_separation`) then use the compiled edge
+functions, so both paths find the same release gap.
 
 Quadrature: the same geometric Gauss-Legendre panels in u as the JKR surface, from each set's lower edge, with its
 lower truncation and node bound (`PlasticGWSurface`). The summit law is tabulated to its `delta_max`; a trial stage
@@ -70,6 +73,11 @@ class PlasticBranchGWSurface(PlasticGWSurface):
     #: the tabulated laws are piecewise linear between their table points: panels of sigma/8 keep the quadrature
     #: within 1e-7 of the exact integral of the table (tests/continuum/test_plastic_mean_field.py)
     panel_width = 0.125
+    #: the compiled sums interpolate the footprint kernel's 24-node sum in a table (`plastic_gw_kernel.
+    #: footprint_table`, within 1e-12 of the sum) over z_top - z up to FOOTPRINT_DEPTH u_table + FOOTPRINT_MARGIN
+    #: sigma; False (on the class, before a surface is built): they sum it at every node, as the NumPy form does
+    footprint_tabulated = True
+    FOOTPRINT_DEPTH, FOOTPRINT_MARGIN = 1.1, 10.0
 
     def __init__(self, law, sigma: float, density: float, z_max: float, *footprint):
         super().__init__(law, sigma, density, z_max, *footprint)      # (radius, length) of a `RollerFootprint`
@@ -85,8 +93,14 @@ class PlasticBranchGWSurface(PlasticGWSurface):
             none = np.zeros(1)              # the kernel's tables, without the discrete summits' own rows
             self._T = (none, none, *tables[:3], none, *tables[3:])
             self._reach_ratio = _at(law.reach_of, 1.0)          # reach(R_p) = cbrt(R_p) * ratio
-            self._tx_tw = (getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0)))
             self._footprint = isinstance(self, RollerFootprint)
+            tx, tw = getattr(self, "_tx", np.empty(0)), getattr(self, "_tw", np.empty(0))
+            # the footprint kernel's node sum tabulated over the depths a contact reaches (the summit law's table
+            # and the reach below it); deeper nodes sum it directly
+            kt = (kernel.footprint_table(self.z_top, self.sigma, self.FOOTPRINT_DEPTH * self.u_table
+                                         + self.FOOTPRINT_MARGIN * self.sigma, tx, tw)
+                  if self._footprint and self.footprint_tabulated else np.empty(0))
+            self._tx_tw = (tx, tw, kt)
             self._C = np.array([self._first, self.panel_width * self.sigma, float(self._root_at_top), self.u_table,
                                 self.density, self.sigma, self.z_top, getattr(self, "length", 0.0),
                                 getattr(self, "roller_radius", 0.0), self._reach_ratio, self.z_floor,
@@ -207,15 +221,22 @@ class PlasticBranchGWSurface(PlasticGWSurface):
         raise TypeError("PlasticBranchGWSurface books its jumps with `jumps(d, d_c, d_p, d_0)`")
 
     # ------------------------------------------------------------------ contact ends
+    def _edge(self, kind: int, method, u):
+        """Edge function `kind` (`plastic_gw_kernel.edge`) at u, compiled if so (the compiled contact phase then
+        finds the same release gap, `plastic_gw_kernel.law_release_gap`)."""
+        if self.compiled:
+            return kernel.edge(u, kind, self.u_table, self._reach_ratio, self._P, self._T)
+        return float(method(u))
+
     def release_separation(self, d_c, d_p):
         """d - d_p (m) beyond which no summit holds or attracts (d_c = inf: none met yet)."""
         u_top = self.z_top - d_p
-        edge = float(self.reach_edge(u_top))
-        return max(float(self.hold(u_top)), edge) if math.isfinite(d_c) else edge
+        edge = self._edge(3, self.reach_edge, u_top)
+        return max(self._edge(2, self.hold, u_top), edge) if math.isfinite(d_c) else edge
 
     def touch_separation(self, d_p):
         """d - d_p (m) at which the tallest summit starts to attract."""
-        return float(self.reach_edge(self.z_top - d_p))
+        return self._edge(3, self.reach_edge, self.z_top - d_p)
 
     def check_depth(self, d_p):
         if self.z_top - d_p > self.u_table * (1.0 + 1e-12):
