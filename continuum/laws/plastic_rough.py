@@ -100,7 +100,7 @@ class PlasticGWPunch(ContactLaw):
         """The contact's compiled form (`continuum.rough.plastic_gw_kernel.law_value`, kernel kind `LAW_PLASTIC_GW`)
         on a surface whose sums are compiled (`PlasticBranchGWSurface.compiled`: Maugis-Dugdale or DMT summits with
         tables); None for the closed-form JKR surface or with `compiled_contact` off (the Python stepper runs it)."""
-        if not (self.compiled_contact and getattr(self.surface, "compiled", False)):
+        if not (self.compiled_contact and self.surface.compiled):
             return None
         from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import CompiledLaw

@@ -227,6 +227,9 @@ class PlasticGWSurface:
     modulus gives forces that send DOP853's stages kilometres down) spanned its whole range in sigma/4 panels:
     1e11 nodes, tens of GB."""
 
+    #: sums by a compiled kernel (`PlasticBranchGWSurface` where its summit law has tables); JKR's closed forms: NumPy
+    compiled = False
+
     def __init__(self, law: PlasticSummitLaw, sigma: float, density: float, z_max: float):
         if not math.isfinite(z_max):
             raise ValueError("PlasticGWSurface needs a finite truncation z_max (units of sigma): the tallest summit")
