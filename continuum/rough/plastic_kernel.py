@@ -174,23 +174,29 @@ def plastic_accept(gap, S, P, T):
     S[_S_MAX_CONTACTS] = max(S[_S_MAX_CONTACTS], plastic_value(gap, S, P, T, 3))
 
 
-def compiled_tables(law, heights_below_datum, delta_max, end_gap, reach, lowest):
+def compiled_tables(law, heights_below_datum, delta_max, end_gap, reach, lowest, rows=None):
     """(P, T) of `law` (a `PlasticBranchSummitLaw`) for summits at heights e_i - z_top (m, descending) with
     deepest approaches delta_max (m) before this contact; `end_gap` (m): where every summit has let go and is out
-    of reach; `reach` (m): the largest stretch at which a summit can pull; `lowest` (m): the kept summits' floor."""
+    of reach; `reach` (m): the largest stretch at which a summit can pull; `lowest` (m): the kept summits' floor.
+    `rows` (5, n): the summits' block 5 (R_p0, delta_p0, W_p(dm0), delta_in(R_p0), delta_out(R_p0)) where the
+    caller keeps it from contact to contact (`PlasticSummitsPunch._rows`); evaluated here otherwise."""
     e = np.ascontiguousarray(heights_below_datum, float)
     dm0 = np.ascontiguousarray(delta_max, float)
     n = e.size
-    per = np.empty(5 * n)
-    # unyielded summits share beta's values; only the yielded ones are evaluated one by one
-    base = np.array([law.radius])
-    per[:n], per[n:2 * n], per[2 * n:3 * n] = law.radius, 0.0, 0.0
-    per[3 * n:4 * n], per[4 * n:] = law.jump_in(base)[0], law.jump_out(base)[0]
-    yielded = np.flatnonzero(dm0 > law.yield_approach)
-    if yielded.size:
-        r0, dp0 = law.flattening(dm0[yielded])
-        for block, values in enumerate((r0, dp0, law.plastic_work(dm0[yielded]), law.jump_in(r0), law.jump_out(r0))):
-            per[block * n + yielded] = values
+    if rows is not None:
+        per = np.ascontiguousarray(rows, float).reshape(5 * n)     # a view: the kernel reads it only
+    else:
+        per = np.empty(5 * n)
+        # unyielded summits share beta's values; only the yielded ones are evaluated one by one
+        base = np.array([law.radius])
+        per[:n], per[n:2 * n], per[2 * n:3 * n] = law.radius, 0.0, 0.0
+        per[3 * n:4 * n], per[4 * n:] = law.jump_in(base)[0], law.jump_out(base)[0]
+        yielded = np.flatnonzero(dm0 > law.yield_approach)
+        if yielded.size:
+            r0, dp0 = law.flattening(dm0[yielded])
+            for block, values in enumerate((r0, dp0, law.plastic_work(dm0[yielded]), law.jump_in(r0),
+                                            law.jump_out(r0))):
+                per[block * n + yielded] = values
     P, T = _law_tables(law)
     P = P.copy()
     P[P_P_END_GAP], P[P_P_REACH], P[P_P_LOWEST] = end_gap, reach, lowest
