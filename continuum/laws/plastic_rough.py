@@ -223,15 +223,19 @@ class PlasticSummitsPunch(ContactLaw):
         (the compiled tables' block 5). Between contacts only the summits whose deepest approach changed are
         evaluated again (each row is elementwise in delta_max, so a summit's values do not depend on which others
         are evaluated with it); an unyielded summit takes beta's values."""
+        return self._row_cache(law)[2]
+
+    def _row_cache(self, law):
+        """(law, delta_max the rows were evaluated at, rows, beta's column, [index of max(z_i - delta_p0,i)])."""
         caches = self.__dict__.setdefault("_row_caches", {})
         cache = caches.get(id(law))
         if cache is None or cache[0] is not law or cache[1].shape != self.delta_max.shape:
             base = np.array([law.radius])
             virgin = np.array([law.radius, 0.0, 0.0, law.jump_in(base)[0], law.jump_out(base)[0]])
             n = self.delta_max.size
-            cache = (law, np.full(n, math.nan), np.empty((5, n)), virgin)     # every summit evaluated first
+            cache = (law, np.full(n, math.nan), np.empty((5, n)), virgin, [-1])     # every summit evaluated first
             caches[id(law)] = cache
-        _, seen, rows, virgin = cache
+        _, seen, rows, virgin, top = cache
         changed = np.flatnonzero(self.delta_max != seen)
         if changed.size:
             dm = self.delta_max[changed]
@@ -243,19 +247,28 @@ class PlasticSummitsPunch(ContactLaw):
                 rows[0, idx], rows[1, idx], rows[2, idx] = r0, dp0, law.plastic_work(dmy)
                 rows[3, idx], rows[4, idx] = law.jump_in(r0), law.jump_out(r0)
             seen[changed] = dm
-        return rows
+            # the highest flattened summit: kept by comparison with the changed ones unless it is one of them
+            i = top[0]
+            if i < 0 or np.any(changed == i):
+                top[0] = int(np.argmax(self.heights - rows[1]))
+            else:
+                j = int(np.argmax(self.heights[changed] - rows[1, changed]))
+                if self.heights[changed[j]] - rows[1, changed[j]] > self.heights[i] - rows[1, i]:
+                    top[0] = int(changed[j])
+        return cache
 
-    def _release_gap_of(self, law) -> float:
-        """`release_gap` with every summit on `law`."""
+    def _release_gap_of(self, law, cache=None) -> float:
+        """`release_gap` with every summit on `law` (`cache`: its `_row_cache`, where the caller has it)."""
         stretch = law.max_stretch
-        rows = self._rows(law)
-        if stretch is not None and not self._met.any():
+        _, _, rows, _, top = self._row_cache(law) if cache is None else cache
+        met = np.flatnonzero(self._met)
+        if stretch is not None and not met.size:
             # before any summit is met in this contact: a bound for the whole contact (R_p may still grow), where
             # every summit has let go and is out of reach (the compiled form runs to it)
-            return float(np.max(self.heights - rows[1])) - self.z_top + stretch
-        if self._met.any():
-            met = self._met
-            held = float(np.max(self.heights[met] - rows[1][met] - rows[4][met])) - self.z_top
+            i = top[0]
+            return float(self.heights[i] - rows[1, i]) - self.z_top + stretch
+        if met.size:
+            held = float(np.max(self.heights[met] - rows[1, met] - rows[4, met])) - self.z_top
         else:
             held = float(np.max(self.heights - rows[1] - rows[4])) - self.z_top
         return max(held, self._approach_reach) if self._approach_reach > 0.0 else held
@@ -293,8 +306,9 @@ class PlasticSummitsPunch(ContactLaw):
         from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import CompiledLaw
         from ..rough.plastic_kernel import compiled_tables
-        P, T = compiled_tables(self.law, self._below, self.delta_max, self._release_gap_of(self.law),
-                               self.law.max_stretch, self._lowest, rows=self._rows(self.law))
+        cache = self._row_cache(self.law)
+        P, T = compiled_tables(self.law, self._below, self.delta_max, self._release_gap_of(self.law, cache),
+                               self.law.max_stretch, self._lowest, rows=cache[2])
         return CompiledLaw(kl.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def compiled_commit(self, state, last_accept: float) -> None:
