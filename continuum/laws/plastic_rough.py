@@ -169,6 +169,7 @@ class PlasticSummitsPunch(ContactLaw):
         self.heights = np.sort(np.asarray(heights, float))[::-1].copy()      # descending
         self._neg = -self.heights                                            # ascending, for searchsorted
         self.z_top = float(self.heights[0])
+        self._below = self.heights - self.z_top                              # e_i - z_top (m), the kernel's T[0]
         self._approach_reach = float(law.approach_reach)
         self.touch_gap = self._approach_reach    # the tallest summit's attraction starts here
         self.forget_history()
@@ -236,17 +237,63 @@ class PlasticSummitsPunch(ContactLaw):
         _, _, jumps, dw = self._values(gap)
         return self._w_total + dw - self._w0 + self._loops + jumps
 
-    def release_gap(self):
-        stretch = self.law.max_stretch
-        if stretch is not None and not self._met.any():
+    def _rows(self, law):
+        """Each summit's accepted state on `law`, (5, n): R_p0, delta_p0, W_p(dm0), delta_in(R_p0), delta_out(R_p0)
+        (the compiled tables' block 5). Between contacts only the summits whose deepest approach changed are
+        evaluated again (each row is elementwise in delta_max, so a summit's values do not depend on which others
+        are evaluated with it); an unyielded summit takes beta's values."""
+        return self._row_cache(law)[2]
+
+    def _row_cache(self, law):
+        """(law, delta_max the rows were evaluated at, rows, beta's column, [index of max(z_i - delta_p0,i)])."""
+        caches = self.__dict__.setdefault("_row_caches", {})
+        cache = caches.get(id(law))
+        if cache is None or cache[0] is not law or cache[1].shape != self.delta_max.shape:
+            base = np.array([law.radius])
+            virgin = np.array([law.radius, 0.0, 0.0, law.jump_in(base)[0], law.jump_out(base)[0]])
+            n = self.delta_max.size
+            cache = (law, np.full(n, math.nan), np.empty((5, n)), virgin, [-1])     # every summit evaluated first
+            caches[id(law)] = cache
+        _, seen, rows, virgin, top = cache
+        changed = np.flatnonzero(self.delta_max != seen)
+        if changed.size:
+            dm = self.delta_max[changed]
+            yielded = dm > law.yield_approach
+            rows[:, changed] = virgin[:, None]
+            if yielded.any():
+                idx, dmy = changed[yielded], dm[yielded]
+                r0, dp0 = law.flattening(dmy)
+                rows[0, idx], rows[1, idx], rows[2, idx] = r0, dp0, law.plastic_work(dmy)
+                rows[3, idx], rows[4, idx] = law.jump_in(r0), law.jump_out(r0)
+            seen[changed] = dm
+            # the highest flattened summit: kept by comparison with the changed ones unless it is one of them
+            i = top[0]
+            if i < 0 or np.any(changed == i):
+                top[0] = int(np.argmax(self.heights - rows[1]))
+            else:
+                j = int(np.argmax(self.heights[changed] - rows[1, changed]))
+                if self.heights[changed[j]] - rows[1, changed[j]] > self.heights[i] - rows[1, i]:
+                    top[0] = int(changed[j])
+        return cache
+
+    def _release_gap_of(self, law, cache=None) -> float:
+        """`release_gap` with every summit on `law` (`cache`: its `_row_cache`, where the caller has it)."""
+        stretch = law.max_stretch
+        _, _, rows, _, top = self._row_cache(law) if cache is None else cache
+        met = np.flatnonzero(self._met)
+        if stretch is not None and not met.size:
             # before any summit is met in this contact: a bound for the whole contact (R_p may still grow), where
             # every summit has let go and is out of reach (the compiled form runs to it)
-            r_p, d_p = self.law.flattening(self.delta_max)
-            return float(np.max(self.heights - d_p)) - self.z_top + stretch
-        met = self._met if self._met.any() else np.ones_like(self._met)
-        r_p, d_p = self.law.flattening(self.delta_max[met])
-        held = float(np.max(self.heights[met] - d_p - self.law.jump_out(r_p))) - self.z_top
+            i = top[0]
+            return float(self.heights[i] - rows[1, i]) - self.z_top + stretch
+        if met.size:
+            held = float(np.max(self.heights[met] - rows[1, met] - rows[4, met])) - self.z_top
+        else:
+            held = float(np.max(self.heights - rows[1] - rows[4])) - self.z_top
         return max(held, self._approach_reach) if self._approach_reach > 0.0 else held
+
+    def release_gap(self):
+        return self._release_gap_of(self.law)
 
     def on_release(self):
         held = self._attached
@@ -278,8 +325,9 @@ class PlasticSummitsPunch(ContactLaw):
         from ..numerics import kernel_laws as kl
         from ..numerics.compiled_contact import CompiledLaw
         from ..rough.plastic_kernel import compiled_tables
-        P, T = compiled_tables(self.law, self.heights - self.z_top, self.delta_max, self.release_gap(),
-                               self.law.max_stretch, self._lowest)
+        cache = self._row_cache(self.law)
+        P, T = compiled_tables(self.law, self._below, self.delta_max, self._release_gap_of(self.law, cache),
+                               self.law.max_stretch, self._lowest, rows=cache[2])
         return CompiledLaw(kl.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
 
     def compiled_commit(self, state, last_accept: float) -> None:
@@ -290,16 +338,18 @@ class PlasticSummitsPunch(ContactLaw):
         if not math.isfinite(h_min):
             return
         law = self.law
+        rows = self._rows(law)
         # the summits the contact could reach (delta_p >= 0 and delta_in >= -reach): a prefix of the sorted heights
         k = int(np.searchsorted(self._neg, -(self.z_top + h_min - law.max_stretch), side="right"))
         dm0 = self.delta_max[:k]
-        deep = self.heights[:k] - self.z_top - h_min
-        r0, dp0 = law.flattening(dm0)
-        jumped = deep - dp0 >= law.jump_in(r0)
-        dm = np.where(jumped, np.maximum(dm0, deep), dm0)
-        self._w_total += float(np.sum(law.plastic_work(dm[jumped])) - np.sum(law.plastic_work(dm0[jumped])))
-        self._loops += float(np.sum(law.in_switch(r0[jumped])))
-        self.delta_max[:k] = dm
+        deep = self._below[:k] - h_min
+        jumped = deep - rows[1, :k] >= rows[3, :k]
+        grew = jumped & (deep > dm0)
+        if grew.any():
+            self._w_total += float(np.sum(law.plastic_work(deep[grew])) - np.sum(rows[2, :k][grew]))
+        if jumped.any():
+            self._loops += float(np.sum(law.in_switch(rows[0, :k][jumped])))
+            self.delta_max[:k][grew] = deep[grew]
         self._met[:k] |= jumped
         self._attached[:] = False
         self._attached[:k] = jumped

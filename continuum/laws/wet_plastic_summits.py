@@ -41,13 +41,8 @@ Rigid substrate only (the plastic discrete law and the bridges both see rigid ge
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ..numerics import kernel_laws as kl
-from ..numerics.compiled_contact import CompiledLaw
-from ..rough.plastic_kernel import compiled_tables
 from .discrete_bridges import DiscreteBridges
 from .plastic_rough import PlasticDiscreteRoller
 from .wet_plastic_compiled import take_back, wet_plastic_form
@@ -193,17 +188,6 @@ class WetPlasticSummits(PlasticDiscreteRoller):
                 total += float(np.sum(law.out_switch(law.flattening(self.delta_max[sl][held])[0])))
         return total
 
-    def _release_gap_of(self, law) -> float:
-        """`PlasticSummitsPunch.release_gap` with every summit on `law`."""
-        stretch = law.max_stretch
-        if stretch is not None and not self._met.any():
-            _, d_p = law.flattening(self.delta_max)
-            return float(np.max(self.heights - d_p)) - self.z_top + stretch
-        met = self._met if self._met.any() else np.ones_like(self._met)
-        r_p, d_p = law.flattening(self.delta_max[met])
-        held = float(np.max(self.heights[met] - d_p - law.jump_out(r_p))) - self.z_top
-        return max(held, self._approach_reach) if self._approach_reach > 0.0 else held
-
     def release_gap(self):
         """Beyond it no summit holds or pulls: the dry law's rule, and once summits have been bridged in this
         contact the wet one's too (before that the law is its dry law, release included)."""
@@ -213,11 +197,7 @@ class WetPlasticSummits(PlasticDiscreteRoller):
     def compiled(self, t0: float):
         """Before any summit is bridged: the dry plastic law's compiled form (`LAW_PLASTIC`), which the wrapper stops
         at t_a; None once summits are bridged (the wrapper issues the wet form) or for JKR Thornton-Ning summits."""
-        if self.k_wet or not self.law.compiled_form:
-            return None
-        P, T = compiled_tables(self.law, self.heights - self.z_top, self.delta_max, self._release_gap_of(self.law),
-                               self.law.max_stretch, self._lowest)
-        return CompiledLaw(kl.LAW_PLASTIC, P, T, np.array([math.inf, 0.0, 0.0, 0.0, 0.0]))
+        return None if self.k_wet else super().compiled(t0)
 
     def diagnostics(self):
         return {**super().diagnostics(), "wet_summits": {"work_of_adhesion_wet": self.wet.work_of_adhesion,

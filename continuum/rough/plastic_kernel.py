@@ -68,10 +68,12 @@ def _lin(x, xs, ys, n):
 
 
 @njit(cache=True)
-def _blend(what, eps, r, P, T):
+def _blend_a(what, eps, r, P, info, tab):
     """Node-blended value on the curve of radius r at eps (m): what 0/1 approach force/energy, 2/3 retreat
-    force/energy, 4/5 delta_in/delta_out."""
-    info, tab = T[6], T[7]
+    force/energy, 4/5 delta_in/delta_out. `info`, `tab`: T[6], T[7], passed as arrays: a call that takes the tables'
+    tuple costs more than a summit's evaluation, so the helpers take the arrays they read (and the summit sum, which
+    needs the tuple once, is inlined into the kernel's law calls; inlining these helpers too would save ~5 % of a
+    contact for ~50 % more compile time)."""
     nodes = int(P[P_P_NODES])
     k, t = 0, 0.0
     if r == P[P_P_BETA]:            # an unflattened summit: node 0's own curve, no scaling
@@ -105,40 +107,67 @@ def _blend(what, eps, r, P, T):
 
 
 @njit(cache=True)
-def _flattening(dm, S, P, T):
-    """(R_p, delta_p) after the deepest approach dm; flags dm beyond the table."""
+def _flattening_a(dm, S, P, d, flat_r, flat_p):
+    """(R_p, delta_p) after the deepest approach dm (d, flat_r, flat_p: T[2], T[3], T[4]); flags dm beyond the
+    table."""
     over = dm - P[P_P_D_Y]
     if not over > 0.0:
         return P[P_P_BETA], 0.0
     if over > P[P_P_D_TOP] * (1.0 + 1e-12):
         S[_S_BEYOND_FLAG] = 1.0
-    n = T[2].size
-    return _lin(over, T[2], T[3], n), _lin(over, T[2], T[4], n)
+    n = d.size
+    return _lin(over, d, flat_r, n), _lin(over, d, flat_p, n)
 
 
 @njit(cache=True)
-def _plastic_work(dm, r, dp, P, T):
+def _plastic_work_a(dm, r, dp, P, info, tab):
     over = dm - P[P_P_D_Y]
     if not over > 0.0:
         return 0.0
     w_in = P[P_P_U_Y] + P[P_P_F_Y] * over + 0.5 * P[P_P_SLOPE] * over * over
-    return w_in - _blend(3, dm - dp, r, P, T)
+    return w_in - _blend_a(3, dm - dp, r, P, info, tab)
 
 
 @njit(cache=True)
+def _blend(what, eps, r, P, T):
+    """`_blend_a` on the tables' tuple T (the mean-field kernel `plastic_gw_kernel` calls it so)."""
+    return _blend_a(what, eps, r, P, T[6], T[7])
+
+
+@njit(cache=True)
+def _flattening(dm, S, P, T):
+    """`_flattening_a` on the tables' tuple T."""
+    return _flattening_a(dm, S, P, T[2], T[3], T[4])
+
+
+@njit(cache=True)
+def _plastic_work(dm, r, dp, P, T):
+    """`_plastic_work_a` on the tables' tuple T."""
+    return _plastic_work_a(dm, r, dp, P, T[6], T[7])
+
+
+@njit(cache=True, inline="always")
 def plastic_value(gap, S, P, T, what):
     """Sum over the summits: what 0 force (N), 1 stored energy (J), 2 loss booked this contact (J), 3 summits on
     their retreat branch."""
-    e, dm0s, per = T[0], T[1], T[5]
-    n = e.size
     hm = min(gap, S[_S_H_MIN])
     end = gap >= P[P_P_END_GAP]
     if end and what < 2:
         return 0.0
     if hm - P[P_P_REACH] < P[P_P_LOWEST]:
         S[_S_BEYOND_FLAG] = 1.0
+    e = T[0]
     # force, energy and count: the summits within reach of gap; the loss: every summit reached this contact
     k = count_at_least(e, (hm if what == 2 else gap) - P[P_P_REACH])
+    if k == 0:
+        return 0.0
+    return _summit_sum(gap, hm, end, k, S, P, e, T[1], T[2], T[3], T[4], T[5], T[6], T[7], what)
+
+
+@njit(cache=True, inline="always")
+def _summit_sum(gap, hm, end, k, S, P, e, dm0s, d, flat_r, flat_p, per, info, tab, what):
+    """`plastic_value` over the first k summits (the tables' arrays passed one by one)."""
+    n = e.size
     total = 0.0
     for i in range(k):
         r0, dp0, wp0, din0, dout = per[i], per[n + i], per[2 * n + i], per[3 * n + i], per[4 * n + i]
@@ -148,22 +177,22 @@ def plastic_value(gap, S, P, T, what):
         r, dp = r0, dp0
         if jumped and deep > dm:
             dm = deep
-            r, dp = _flattening(dm, S, P, T)
+            r, dp = _flattening_a(dm, S, P, d, flat_r, flat_p)
             if r != r0:
-                dout = _blend(5, 0.0, r, P, T)
+                dout = _blend_a(5, 0.0, r, P, info, tab)
         on_r = jumped and not end and delta - dp > dout
         if what == 3:
             total += 1.0 if on_r else 0.0
         elif what == 2:
             if jumped:
-                total += _plastic_work(dm, r, dp, P, T) - wp0
-                total += _blend(1, din0, r0, P, T) - _blend(3, din0, r0, P, T)
+                total += _plastic_work_a(dm, r, dp, P, info, tab) - wp0
+                total += _blend_a(1, din0, r0, P, info, tab) - _blend_a(3, din0, r0, P, info, tab)
                 if not on_r:
-                    total += _blend(3, dout, r, P, T) - _blend(1, dout, r, P, T)
+                    total += _blend_a(3, dout, r, P, info, tab) - _blend_a(1, dout, r, P, info, tab)
         elif on_r and what == 0 and delta >= dm and dm > P[P_P_D_Y]:
             total += P[P_P_F_Y] + P[P_P_SLOPE] * (delta - P[P_P_D_Y])
         else:
-            total += _blend((2 if on_r else 0) + what, delta - dp, r, P, T)
+            total += _blend_a((2 if on_r else 0) + what, delta - dp, r, P, info, tab)
     return total
 
 
@@ -174,23 +203,29 @@ def plastic_accept(gap, S, P, T):
     S[_S_MAX_CONTACTS] = max(S[_S_MAX_CONTACTS], plastic_value(gap, S, P, T, 3))
 
 
-def compiled_tables(law, heights_below_datum, delta_max, end_gap, reach, lowest):
+def compiled_tables(law, heights_below_datum, delta_max, end_gap, reach, lowest, rows=None):
     """(P, T) of `law` (a `PlasticBranchSummitLaw`) for summits at heights e_i - z_top (m, descending) with
     deepest approaches delta_max (m) before this contact; `end_gap` (m): where every summit has let go and is out
-    of reach; `reach` (m): the largest stretch at which a summit can pull; `lowest` (m): the kept summits' floor."""
+    of reach; `reach` (m): the largest stretch at which a summit can pull; `lowest` (m): the kept summits' floor.
+    `rows` (5, n): the summits' block 5 (R_p0, delta_p0, W_p(dm0), delta_in(R_p0), delta_out(R_p0)) where the
+    caller keeps it from contact to contact (`PlasticSummitsPunch._rows`); evaluated here otherwise."""
     e = np.ascontiguousarray(heights_below_datum, float)
     dm0 = np.ascontiguousarray(delta_max, float)
     n = e.size
-    per = np.empty(5 * n)
-    # unyielded summits share beta's values; only the yielded ones are evaluated one by one
-    base = np.array([law.radius])
-    per[:n], per[n:2 * n], per[2 * n:3 * n] = law.radius, 0.0, 0.0
-    per[3 * n:4 * n], per[4 * n:] = law.jump_in(base)[0], law.jump_out(base)[0]
-    yielded = np.flatnonzero(dm0 > law.yield_approach)
-    if yielded.size:
-        r0, dp0 = law.flattening(dm0[yielded])
-        for block, values in enumerate((r0, dp0, law.plastic_work(dm0[yielded]), law.jump_in(r0), law.jump_out(r0))):
-            per[block * n + yielded] = values
+    if rows is not None:
+        per = np.ascontiguousarray(rows, float).reshape(5 * n)     # a view: the kernel reads it only
+    else:
+        per = np.empty(5 * n)
+        # unyielded summits share beta's values; only the yielded ones are evaluated one by one
+        base = np.array([law.radius])
+        per[:n], per[n:2 * n], per[2 * n:3 * n] = law.radius, 0.0, 0.0
+        per[3 * n:4 * n], per[4 * n:] = law.jump_in(base)[0], law.jump_out(base)[0]
+        yielded = np.flatnonzero(dm0 > law.yield_approach)
+        if yielded.size:
+            r0, dp0 = law.flattening(dm0[yielded])
+            for block, values in enumerate((r0, dp0, law.plastic_work(dm0[yielded]), law.jump_in(r0),
+                                            law.jump_out(r0))):
+                per[block * n + yielded] = values
     P, T = _law_tables(law)
     P = P.copy()
     P[P_P_END_GAP], P[P_P_REACH], P[P_P_LOWEST] = end_gap, reach, lowest
