@@ -180,3 +180,22 @@ def test_calibrated_rough_silica_members_run_plastic_maugis_dugdale_summits_and_
     psi = summit_e_star(off) / off.surfaces.substrate.hardness * math.sqrt(rough.sigma / rough.summit_radius)
     assert not rec["used"] and rec["decided_by"] == "scene"
     assert rec["plasticity_index"] == pytest.approx(psi, rel=1e-12) and rec["plasticity_index"] > 1.0
+
+
+def test_just_past_yield_the_construction_never_sharpens_a_summit_where_thornton_ning_does():
+    """Within 1 nm past yield (docs/model.md, 'Just past yield'): the construction holds R_p >= beta and growing,
+    delta_p >= 0 and the plastic work >= 0 and growing, on JKR and on Maugis-Dugdale. Thornton-Ning's closed forms
+    on adhesive JKR summits (the reference elsewhere) dip below beta there, with a negative plastic work: the two
+    forms differ by design in this band and agree from ~2 nm on (test_on_jkr_it_is_thornton_ning_closed_form)."""
+    beta, w, e, p_y = 1e-6, 0.1, 1e11, 3e9                  # a JKR summit whose plastic line is the stiffer at yield
+    tn = PlasticSummitLaw(beta, w, e, p_y)
+    d = np.array([1e-12, 1e-11, 1e-10, 3e-10, 1e-9])
+    r_c, dp_c = tn.flattening(tn.yield_approach + d)
+    assert r_c[2] < beta and dp_c[2] < 0.0 and tn.plastic_work(tn.yield_approach + d[2:3])[0] < 0.0
+    for law in (PlasticBranchSummitLaw("jkr", beta, w, e, p_y, delta_max=30 * SIGMA),
+                PlasticBranchSummitLaw("maugis_dugdale", BETA, W, E, P_Y, z0=Z0, delta_max=DMAX)):
+        dm = law.yield_approach + d
+        r_p, d_p = law.flattening(dm)
+        work = law.plastic_work(dm)
+        assert np.all(r_p >= law.radius) and np.all(np.diff(r_p) >= 0.0)
+        assert np.all(d_p >= 0.0) and np.all(work >= 0.0) and np.all(np.diff(work) > 0.0)
