@@ -139,12 +139,35 @@ def discrete_roller(scene: Scene, stats, work_of_adhesion: float, summit_e_star:
 
 
 def with_menisci(dry: ContactLaw, scene: Scene, stats, parameters: dict) -> ContactLaw:
-    """`dry` (an averaged rough roller) plus capillary bridges with the scene's meniscus `parameters`."""
+    """`dry` (an averaged rough roller) plus capillary bridges with the scene's meniscus `parameters`.
+
+    menisci.solid_adhesion = 'wet' on the rigid mean field of JKR (or Hertz) summits: the bridged summits adhere at
+    max(W_wet, 0), force and loop, on a second footprint table (`continuum.laws.wet_mean_field`). Otherwise the
+    summits keep their dry law inside the bridges, with the DMT solid pull ('wet') or without it ('additive'); the
+    record's `solids_inside_bridges` says which and why."""
+    from ..laws.rough_rigid import RigidRoughRoller
     from ..laws.wet import MeniscusBridges, WetRoughRoller
+    from ..laws.wet_mean_field import wet_mean_field_roller
     body, p = scene.body, parameters
     bridges = MeniscusBridges(stats, dry.z_top, body.radius, body.length, p["bridge_pull_off"], p["kelvin_gap"],
                               p["condensation_time"], p["growth_length"])
-    return WetRoughRoller(dry, bridges, p)
+    w_wet = max(p["work_of_adhesion_wet"], 0.0)
+    if p["solid_adhesion"] != "wet":
+        return WetRoughRoller(dry, bridges, {**p, "solids_inside_bridges": "dry summit law, dry loop "
+                                             "(menisci.solid_adhesion = 'additive': the paper's eq 14)"})
+    s = getattr(dry, "surface", None)
+    why = ("the elastic half-space couples the summits (the deflection breaks the split in h + delta)"
+           if not isinstance(dry, RigidRoughRoller) else
+           f"{s.law_name} summits on quadrature tables (jump-in and reach): the split is written for JKR/Hertz"
+           if s.kind != "tabulated" else
+           f"W_wet = {w_wet:.4g} > dgamma = {s.work_of_adhesion:.4g} J/m^2" if w_wet > s.work_of_adhesion else None)
+    if why is not None:
+        return WetRoughRoller(dry, bridges, {**p, "solids_inside_bridges": f"dry summit law, DMT solid pull "
+                                             f"2 pi beta (dgamma - max(W_wet, 0)) (loop dry: {why})"})
+    wet_surface = averaged_surface(stats, work_of_adhesion=w_wet, summit_e_star=s.e_star, z_max=s._tmax,
+                                   detachment=s.detachment, resolution=s.resolution)
+    wet = rigid_roller(wet_surface, body.radius, body.length, resolution=dry.resolution)
+    return wet_mean_field_roller(dry, wet, bridges, p)
 
 
 def with_sphere_meniscus(dry: ContactLaw, wet: ContactLaw, parameters: dict) -> ContactLaw:
@@ -209,7 +232,7 @@ def wet_roller_with_condensation_time(wet: ContactLaw, t_a: float) -> ContactLaw
     bridges = copy.copy(wet.bridges)
     bridges.t_a = t_a
     bridges.reset()
-    return WetRoughRoller(wet.dry, bridges, dict(wet.record, condensation_time=t_a))
+    return type(wet)(wet.dry, bridges, dict(wet.record, condensation_time=t_a))
 
 
 def wet_plastic_summit_law(plastic: ContactLaw, wet_scene: Scene, work_of_adhesion_wet: float):

@@ -1,0 +1,135 @@
+"""The rigid mean field with two classes of summits (continuum.laws.wet_mean_field): inside a bridge the JKR summits
+adhere at W_wet, force and loop; outside at dgamma. Checked against the dry law (W_wet = dgamma), against a
+brute-force quadrature of the split footprint integral written here from the GW density, and by the energy books of a
+humid impact."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from continuum.laws.rough_rigid import RigidRoughRoller
+from continuum.laws.wet import MeniscusBridges
+from continuum.laws.wet_mean_field import TwoClassRigidRoller, WetMeanFieldRoller
+from continuum.reference import jkr as ref
+from continuum.rough.datum import tallest_summit
+from continuum.rough.gw import GWJKRSurface
+from continuum.rough.summits import SummitStatistics
+from continuum.scene import resolve_scene
+
+SIGMA, DENSITY, BETA = 6e-9, 1.0e13, 0.5e-6      # paper-like summits (m, 1/m^2, m)
+E_STAR, W_DRY = 3.0e10, 0.042                   # Pa, J/m^2
+RADIUS, LENGTH = 2.0e-6, 1.0e-5                 # roller (m)
+D_K, F0, T_A, H1 = 1.08e-9, 1.6e-7, 1e-6, 0.34e-9
+
+
+def _stats():
+    return SummitStatistics(SIGMA, DENSITY, BETA)
+
+
+def _roller(w: float) -> RigidRoughRoller:
+    z = tallest_summit(SIGMA, DENSITY, RADIUS, LENGTH)["z_max"]
+    law = RigidRoughRoller(GWJKRSurface(_stats(), w, E_STAR, z_max=z), RADIUS, LENGTH)
+    law.size_for(2.0 * SIGMA, 1e-3)
+    return law
+
+
+def _two_class(w_wet: float) -> TwoClassRigidRoller:
+    law = TwoClassRigidRoller.from_dry(_roller(W_DRY), _roller(w_wet), D_K)
+    law.size_for(2.0 * SIGMA, 1e-3)
+    return law
+
+
+def _path(depth: float):
+    """(gap, contact time): approach to -depth, t_a passed on the way down, retreat to beyond the Kelvin gap."""
+    down = np.linspace(0.0, -depth, 120)
+    up = np.linspace(-depth, 1.3 * D_K, 300)
+    gaps = np.concatenate([down, up[1:]])
+    times = np.linspace(0.0, 6.0 * T_A, gaps.size)
+    return list(zip(gaps, times))
+
+
+def test_wet_equal_to_dry_work_is_the_dry_mean_field_to_round_off():
+    """W_wet = dgamma: whatever the class boundary does (bridges from t_a, growing, breaking on the way out), force,
+    stored energy and booked energy are the dry law's, to round-off of the force and energy scales."""
+    law, dry = _two_class(W_DRY), _roller(W_DRY)
+    bridges = MeniscusBridges(_stats(), law.z_top, RADIUS, LENGTH, F0, D_K, T_A, H1)
+    law.reset()
+    dry.reset()
+    f_scale = abs(dry.force(-2.0 * SIGMA))
+    e_scale = abs(dry.stored_energy(-2.0 * SIGMA))
+    crossed = 0
+    for g, t in _path(2.0 * SIGMA):
+        law.set_boundary(bridges.offset(g, t))
+        crossed += math.isfinite(law.s_trial)
+        assert law.force(g) == pytest.approx(dry.force(g), abs=1e-9 * f_scale)
+        assert law.stored_energy(g) == pytest.approx(dry.stored_energy(g), abs=1e-9 * e_scale)
+        assert law.dissipated(g) == pytest.approx(dry.dissipated(g), abs=1e-9 * e_scale)
+        law.accept(g)
+        dry.accept(g)
+        bridges.accept(g, t)
+    assert crossed > 100 and law.loops[1] > 0.0           # the two classes were both in play
+
+
+def _density(law, u: float) -> float:
+    """GW summits per unit u under the roller: 2 l n/sigma int_0^{x_m} phi((u + z_top + x^2/2R)/sigma) dx, truncated
+    at the tallest summit (x_m^2 = -2 R u); Greenwood & Williamson (1966) with the roller's parabola."""
+    if u >= 0.0:
+        return 0.0
+    xm = math.sqrt(-2.0 * RADIUS * u)
+    inner = integrate.quad(lambda x: math.exp(-0.5 * ((u + law.z_top + x * x / (2.0 * RADIUS)) / SIGMA) ** 2),
+                           0.0, xm, epsabs=0.0, epsrel=1e-11)[0]
+    return 2.0 * LENGTH * DENSITY / SIGMA * inner / math.sqrt(2.0 * math.pi)
+
+
+def _brute(law, what: str, h: float, w_wet: float, a_w: float, a_d: float, b_d: float) -> float:
+    """int q rho over the wet summits u >= a_w (JKR at W_wet) and the dry ones a_d <= u < b_d (JKR at dgamma)."""
+    def q(delta, w):
+        return float(ref.force_from_approach(delta, BETA, w, E_STAR) if what == "force"
+                     else ref.energy_from_approach(delta, BETA, w, E_STAR))
+
+    def part(lo, hi, w):
+        if not hi > lo:
+            return 0.0
+        pts = [p for p in (0.0,) if lo < p < hi]
+        return integrate.quad(lambda d: q(d, w) * _density(law, h + d), lo, hi, points=pts or None, limit=200,
+                              epsabs=0.0, epsrel=1e-9)[0]
+
+    return part(a_w - h, -h, w_wet) + part(a_d - h, min(b_d - h, -h), W_DRY)
+
+
+@pytest.mark.parametrize("state", [
+    # (gap, deepest gap, offset s, lowest offset s_min) in units of the dry release stretch
+    (-3.0, -6.0, -3.4, -3.6),        # on the way out: wet down to its release, dry ones below the lowest offset
+    (-1.0, -6.0, -1.6, -1.8),        # the wet release cuts the wet class, the dry class cut by s_min
+    (-4.5, -5.0, -4.8, -4.9),        # just after the turn: a thin stretched band bridged
+    (-4.0, -5.0, -3.9, -4.2),        # boundary above the gap (class books after t_a): the band 0 < delta < s - h
+])
+def test_the_split_law_is_the_split_footprint_integral(state):
+    """At states of the two classes the tables' split (T_wet(h, h - a_w) + T_dry(h, h - a_d) - T_dry(h, h - b_d)) is
+    the footprint integral split at the bridges' boundary, done here by adaptive quadrature over the approach with the
+    GW density and the JKR closed forms, on the classes written here from the physics: wet and attached u >= max(s,
+    h - Delta_wet, h_min); dry and attached max(h - Delta_dry, h_min) <= u < s_min (D_K > Delta_wet: a summit that lost
+    its bridge at D_K had let go inside it). Tolerance: 1e-8 (the quadrature's) plus 5x the tables' own error at the
+    windows used, each table T(h, r) against the brute-force integral over delta >= -r (the GW tables' and the
+    footprint quadrature's error off the nodes, docs/rough-gw.md); a wrong split misses whole bands of summits."""
+    w_wet = 0.3 * W_DRY
+    law = _two_class(w_wet)
+    d = law.delta_dry
+    h, h_min, s, s_min = (x * d for x in state)
+    assert D_K > law.delta_wet
+    law.reset()
+    law.h_min, law.s, law.s_min, law.h_acc = h_min, s, s_min, h
+    law.set_boundary(s)
+    a_w = max(s, h - law.delta_wet, h_min)
+    a_d, b_d = max(h - d, h_min), s_min
+    assert a_d < b_d and a_w < 0.0                      # both classes hold attached summits here
+    for what, fun in (("force", law.force), ("energy", law.stored_energy)):
+        tables = sum(abs(law._above(x, what, h, a - h) - _brute(law, what, h, w_wet, *(
+            (a, 0.0, 0.0) if x is law.wet else (math.inf, a, math.inf))))
+            for x, a in ((law.wet, a_w), (law, a_d), (law, b_d)))
+        brute = _brute(law, what, h, w_wet, a_w, a_d, b_d)
+        assert tables < 1e-4 * abs(brute)
+        assert fun(h) == pytest.approx(brute, abs=1e-8 * abs(brute) + 5.0 * tables)
