@@ -133,3 +133,111 @@ def test_the_split_law_is_the_split_footprint_integral(state):
         brute = _brute(law, what, h, w_wet, a_w, a_d, b_d)
         assert tables < 1e-4 * abs(brute)
         assert fun(h) == pytest.approx(brute, abs=1e-8 * abs(brute) + 5.0 * tables)
+
+
+def _humid_mean_field(w_wet_over_dry: float):
+    """wet_silica (paper set) as a rigid mean field with bridges from t_a = 1 us and the 'wet' solid adhesion, its
+    faces' W_SL set so that W_wet = w_wet_over_dry x dgamma (Dupre in the liquid: W_wet = dgamma + 2 gamma - 2 W_SL)."""
+    from continuum.model.regime import first_impact_speed
+    from continuum.model.select import select_law
+
+    base = resolve_scene("wet_silica", params="paper").scene
+    w, gamma = base.surfaces.interface_work_of_adhesion, base.menisci.surface_tension
+    w_sl = 0.5 * (w + 2.0 * gamma - w_wet_over_dry * w)
+    scene = resolve_scene("wet_silica", params="paper", overrides={
+        "surfaces.roughness.mode": "mean_field", "menisci.condensation_time": 1e-6, "menisci.solid_adhesion": "wet",
+        "surfaces.body.work_of_adhesion_sl": w_sl, "surfaces.substrate.work_of_adhesion_sl": w_sl}).scene
+    v = first_impact_speed(scene)
+    law, _ = select_law(scene, v, menisci=True)
+    return scene, law
+
+
+def test_a_humid_mean_field_impact_keeps_its_books_and_needs_the_class_change_work(monkeypatch):
+    """One impact of the humid mean field whose bridged summits adhere at 0.3 dgamma: E_kin + E_pot + stored + booked
+    constant to the driver's tolerance (1e-4 of the turnover at rtol 1e-8, as the discrete law's test); without the
+    work booked when summits change class (the jump of their stored energy) the audit fails."""
+    from continuum.dynamics.driver import DriverSettings, simulate
+
+    scene, law = _humid_mean_field(0.3)
+    assert isinstance(law, WetMeanFieldRoller)
+    assert law.dry.wet.surface.work_of_adhesion == pytest.approx(0.3 * scene.surfaces.interface_work_of_adhesion)
+    settings = DriverSettings(rtol=1e-8, max_bounces=1)
+    run = simulate(law, scene.body.mass, 9.81, release_height=scene.release_height, settings=settings)
+    assert law.diagnostics()["menisci"]["contacts_with_bridges"] >= 1
+    assert law.dry.loops[1] > 0.0 and law.dry.switched != 0.0
+    assert run.audit["max_relative_error"] < 1e-4
+
+    pending = TwoClassRigidRoller._pending
+    monkeypatch.setattr(TwoClassRigidRoller, "_pending", lambda self, gap: (*pending(self, gap)[:2], 0.0))
+    scene, law = _humid_mean_field(0.3)
+    run = simulate(law, scene.body.mass, 9.81, release_height=scene.release_height, settings=settings)
+    assert run.audit["max_relative_error"] > 1e-3
+
+
+def test_dense_discrete_realisations_of_the_wet_law_average_to_the_mean_field():
+    """The same humid contact on discrete GW realisations (each summit its own bridge and class,
+    continuum.laws.wet_summits) and on the mean field, along one quasi-static path of the roller's height above the
+    summits' mean plane (approach past t_a, then retreat; each holds ~10^3 summits in contact). What humidity does
+    to the force, F_humid - F_dry on the same summits (the realisation's scatter cancels in it), averages over the
+    realisations to the mean field's within 4 standard errors of their mean, and that change is resolved (> 10 of
+    them); the mean field that kept the dry law and the DMT pull inside its bridges misses it by more than 4."""
+    from continuum.laws.discrete_roller import DiscreteRoughRoller
+    from continuum.laws.wet_mean_field import wet_mean_field_roller
+    from continuum.laws.wet_summits import wet_summit_roller
+
+    w_wet, length = 0.3 * W_DRY, 1e-3
+    params = {"bridge_pull_off": F0, "kelvin_gap": D_K, "condensation_time": T_A, "growth_length": H1}
+    datum = tallest_summit(SIGMA, DENSITY, RADIUS, length)
+    z = datum["z_max"]
+
+    def mean_field(w):
+        law = RigidRoughRoller(GWJKRSurface(_stats(), w, E_STAR, z_max=z), RADIUS, length)
+        law.size_for(4.5 * SIGMA, 1e-3)
+        return law
+
+    dry_mf = mean_field(W_DRY)
+    bridges = MeniscusBridges(_stats(), dry_mf.z_top, RADIUS, length, F0, D_K, T_A, H1)
+    mf = wet_mean_field_roller(mean_field(W_DRY), mean_field(w_wet), bridges, params)
+    mf.dry.size_for(4.5 * SIGMA, 1e-3)
+    depth = 3.0 * SIGMA
+    down = np.linspace(0.0, -depth, 40)
+    up = np.linspace(-depth, -depth + 6.0 * mf.dry.delta_dry, 80)
+    gaps = np.concatenate([down, up[1:]])
+    times = np.linspace(0.0, 4.0 * T_A, gaps.size)
+    check = np.arange(gaps.size)[30::8]
+
+    def forces(law, offset):
+        law.reset()
+        out = []
+        for k, (g, t) in enumerate(zip(gaps + offset, times)):
+            law.set_time(t)
+            if k in check:
+                out.append(law.force(g))
+            law.accept(g)
+        return np.array(out)
+
+    change_mf = forces(mf, 0.0) - forces(dry_mf, 0.0)
+    runs = []
+    for seed in range(6):
+        kw = dict(seed=seed, half_space=False, footprint_half_width=datum["footprint_half_width"])
+        dry = DiscreteRoughRoller(_stats(), W_DRY, E_STAR, RADIUS, length, 1e11, **kw)
+        summits = dict(kw, summits=(dry.sx, dry.sy, dry.sz))
+        wet = DiscreteRoughRoller(_stats(), w_wet, E_STAR, RADIUS, length, 1e11, **summits)
+        alone = DiscreteRoughRoller(_stats(), W_DRY, E_STAR, RADIUS, length, 1e11, **summits)
+        humid = wet_summit_roller(dry, wet, params)
+        # the same height above the mean plane: each law's gap is measured from its own tallest summit
+        offset = dry_mf.z_top - dry.z_top
+        runs.append(forces(humid, offset) - forces(alone, offset))
+    runs = np.array(runs)
+    mean, sem = runs.mean(axis=0), runs.std(axis=0, ddof=1) / math.sqrt(len(runs))
+    assert np.all(np.abs(mean - change_mf) <= 4.0 * sem)
+    assert np.all(np.abs(change_mf) > 10.0 * sem)
+    # the mean field as it was: dry summits inside the bridges, the DMT solid pull taken from the compressed ones
+    from continuum.laws.wet import WetRoughRoller
+
+    pull = 2.0 * math.pi * BETA * (W_DRY - w_wet)            # continuum.wet.menisci.solid_pull_inside_bridge
+    old = WetRoughRoller(mean_field(W_DRY), MeniscusBridges(_stats(), dry_mf.z_top, RADIUS, length, F0, D_K, T_A, H1,
+                                                           solid_pull=pull), params)
+    old.dry.size_for(4.5 * SIGMA, 1e-3)
+    change_old = forces(old, 0.0) - forces(dry_mf, 0.0)
+    assert np.max(np.abs(mean - change_old) / sem) > 4.0
