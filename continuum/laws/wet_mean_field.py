@@ -105,6 +105,7 @@ class TwoClassRigidRoller(RigidRoughRoller):
         self.books = 0.0                        # loops and class-change work booked since the first bridge (J)
         self.loops = [0.0, 0.0]                 # summits let go (dry, wet) since the first bridge
         self.switched = 0.0                     # class-change work booked (J)
+        self.s_trial = math.inf                 # no bridge until the wrapper says so (run bare, this is the dry law)
         self._trial = None
 
     def set_boundary(self, s: float) -> None:
@@ -237,11 +238,13 @@ class TwoClassRigidRoller(RigidRoughRoller):
     def accept(self, gap):
         if gap < self._h_lo:
             self.beyond_tables += 1
-        n_dry, n_wet, switch = self._pending(gap)
-        self.books += n_dry * self.loop_dry + n_wet * self.loop_wet + switch
-        self.loops[0] += n_dry
-        self.loops[1] += n_wet
-        self.switched += switch
+        if math.isfinite(self.s_trial):
+            # from the first bridged state on the books accumulate (until then they are the dry closed form)
+            n_dry, n_wet, switch = self._pending(gap)
+            self.books += n_dry * self.loop_dry + n_wet * self.loop_wet + switch
+            self.loops[0] += n_dry
+            self.loops[1] += n_wet
+            self.switched += switch
         if gap < self.h_min:
             self.h_min = gap
             self.count_min = self._n_above(gap)

@@ -71,6 +71,17 @@ def test_wet_equal_to_dry_work_is_the_dry_mean_field_to_round_off():
         dry.accept(g)
         bridges.accept(g, t)
     assert crossed > 100 and law.loops[1] > 0.0           # the two classes were both in play
+    # run bare after a humid contact (the paper's humidity comparison runs the wet law's own dry part), it is dry
+    wet_only = _two_class(0.3 * W_DRY)
+    wet_only.reset()
+    wet_only.set_boundary(-SIGMA)
+    wet_only.reset()
+    dry.reset()
+    for g, _ in _path(2.0 * SIGMA):
+        assert wet_only.force(g) == pytest.approx(dry.force(g), abs=1e-9 * f_scale)
+        assert wet_only.dissipated(g) == pytest.approx(dry.dissipated(g), abs=1e-9 * e_scale)
+        wet_only.accept(g)
+        dry.accept(g)
 
 
 def _density(law, u: float) -> float:
