@@ -49,7 +49,9 @@ adhesion is left. For a summit in contact the DMT solid pull is 2 pi beta W, so 
 max(W_wet, 0) inside a bridge takes 2 pi beta (dgamma - max(W_wet, 0)) from each compressed bridged
 summit; where W_wet >= 0 that is exactly F0, so the sphere-flat wet pull-off is the dry one,
 2 pi beta dgamma (Israelachvili 2011 eq 17.25 for r_K << beta), not dry + F0 (the paper's additive
-eq 14). The summits' JKR hysteresis loop keeps its dry dgamma: the correction is DMT's force, stated.
+eq 14). That DMT force correction keeps the summits' dry loop; where the summit law itself can be rebuilt at
+W_wet (discrete summits, `continuum.laws.wet_summits`; the rigid mean field of JKR summits,
+`continuum.laws.wet_mean_field`) it is, force and loop, and the bridges take no solid pull.
 
 When bridges form (paper eq 12, corrected; Riedo et al. PRL 88 (2002) 185505)
 -----------------------------------------------------------------------------
