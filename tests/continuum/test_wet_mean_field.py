@@ -98,6 +98,10 @@ def _density(law, u: float) -> float:
 def _brute(law, what: str, h: float, w_wet: float, a_w: float, a_d: float, b_d: float) -> float:
     """int q rho over the wet summits u >= a_w (JKR at W_wet) and the dry ones a_d <= u < b_d (JKR at dgamma)."""
     def q(delta, w):
+        if w == 0.0:                                   # Hertz (Johnson 1985 eq 4.23) and its work
+            d = max(delta, 0.0)
+            return (4.0 / 3.0 * E_STAR * math.sqrt(BETA) * d ** 1.5 if what == "force"
+                    else 8.0 / 15.0 * E_STAR * math.sqrt(BETA) * d ** 2.5)
         return float(ref.force_from_approach(delta, BETA, w, E_STAR) if what == "force"
                      else ref.energy_from_approach(delta, BETA, w, E_STAR))
 
@@ -111,6 +115,7 @@ def _brute(law, what: str, h: float, w_wet: float, a_w: float, a_d: float, b_d: 
     return part(a_w - h, -h, w_wet) + part(a_d - h, min(b_d - h, -h), W_DRY)
 
 
+@pytest.mark.parametrize("ratio", [0.3, 0.0])
 @pytest.mark.parametrize("state", [
     # (gap, deepest gap, offset s, lowest offset s_min) in units of the dry release stretch
     (-3.0, -6.0, -3.4, -3.6),        # on the way out: wet down to its release, dry ones below the lowest offset
@@ -118,15 +123,16 @@ def _brute(law, what: str, h: float, w_wet: float, a_w: float, a_d: float, b_d: 
     (-4.5, -5.0, -4.8, -4.9),        # just after the turn: a thin stretched band bridged
     (-4.0, -5.0, -3.9, -4.2),        # boundary above the gap (class books after t_a): the band 0 < delta < s - h
 ])
-def test_the_split_law_is_the_split_footprint_integral(state):
+def test_the_split_law_is_the_split_footprint_integral(state, ratio):
     """At states of the two classes the tables' split (T_wet(h, h - a_w) + T_dry(h, h - a_d) - T_dry(h, h - b_d)) is
     the footprint integral split at the bridges' boundary, done here by adaptive quadrature over the approach with the
     GW density and the JKR closed forms, on the classes written here from the physics: wet and attached u >= max(s,
     h - Delta_wet, h_min); dry and attached max(h - Delta_dry, h_min) <= u < s_min (D_K > Delta_wet: a summit that lost
     its bridge at D_K had let go inside it). Tolerance: 1e-8 (the quadrature's) plus 5x the tables' own error at the
     windows used, each table T(h, r) against the brute-force integral over delta >= -r (the GW tables' and the
-    footprint quadrature's error off the nodes, docs/rough-gw.md); a wrong split misses whole bands of summits."""
-    w_wet = 0.3 * W_DRY
+    footprint quadrature's error off the nodes, docs/rough-gw.md); a wrong split misses whole bands of summits.
+    W_wet = 0 (a liquid that wets between the solids): Hertz summits inside the bridges, released at delta = 0."""
+    w_wet = ratio * W_DRY
     law = _two_class(w_wet)
     d = law.delta_dry
     h, h_min, s, s_min = (x * d for x in state)
