@@ -155,7 +155,7 @@ def with_menisci(dry: ContactLaw, scene: Scene, stats, parameters: dict) -> Cont
     if p["solid_adhesion"] != "wet":
         return WetRoughRoller(dry, bridges, {**p, "solids_inside_bridges": "dry summit law, dry loop "
                                              "(menisci.solid_adhesion = 'additive': the paper's eq 14)"})
-    s = getattr(dry, "surface", None)
+    s = dry.surface if isinstance(dry, RigidRoughRoller) else None
     why = ("the elastic half-space couples the summits (the deflection breaks the split in h + delta)"
            if not isinstance(dry, RigidRoughRoller) else
            f"{s.law_name} summits on quadrature tables (jump-in and reach): the split is written for JKR/Hertz"
