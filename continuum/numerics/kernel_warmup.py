@@ -135,16 +135,23 @@ def run_part(name: str) -> None:
 
 def warm(timeout: float = 600.0) -> float:
     """Compile the contact kernel into the cache with the two parts in two processes at once (nothing where the cache
-    already holds it); returns the seconds it took. Raises CalledProcessError where a part failed."""
+    already holds it); returns the seconds it took. Raises CalledProcessError where a part failed, TimeoutExpired
+    after `timeout` s (the parts killed)."""
     if fcntl is None or is_warm():
         return 0.0
     start = time.monotonic()
     cmd = [sys.executable, "-m", "continuum.numerics.kernel_warmup", "--part"]
     procs = [subprocess.Popen([*cmd, name]) for name in PARTS]
-    for name, proc in zip(PARTS, procs):
-        rc = proc.wait(timeout=max(timeout - (time.monotonic() - start), 1.0))
-        if rc != 0:
-            raise subprocess.CalledProcessError(rc, [*cmd, name])
+    try:
+        for name, proc in zip(PARTS, procs):
+            rc = proc.wait(timeout=max(timeout - (time.monotonic() - start), 1.0))
+            if rc != 0:
+                raise subprocess.CalledProcessError(rc, [*cmd, name])
+    finally:                            # a failed or timed-out warm-up leaves no part running
+        for proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
     return time.monotonic() - start
 
 
