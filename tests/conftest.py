@@ -4,9 +4,16 @@ CI (environment variable CI=true) installs every extra, so a missing backend the
 install is broken and must fail, never silently skip (ASE's conftest is the model; our CI is stricter).
 
 md_smoke: each shipped MD recipe run at smoke once per session, shared by the md tests that read its result.
+
+Kernel warm-up: a parallel run of the whole suite (the README's `-n 2`) compiles the contact kernel into numba's
+cache first, in two processes at once (`continuum.numerics.kernel_warmup`), so that the workers load it instead of
+each compiling all of it side by side on a cold cache (a fresh clone, or after any edit of the sources).
 """
 import importlib.util
 import os
+import subprocess
+import sys
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -22,6 +29,19 @@ def require_backend(module: str, what: str) -> None:
     if os.environ.get("CI", "").strip().lower() == "true":
         pytest.fail(f"CI=true but {reason}; CI must install the md extra", pytrace=False)
     pytest.skip(reason)
+
+
+def pytest_configure(config):
+    """In the controller of a parallel run of the whole suite, before the workers start: the kernel warm-up."""
+    if os.environ.get("PYTEST_XDIST_WORKER") or not getattr(config.option, "numprocesses", None):
+        return
+    if config.args_source != pytest.Config.ArgsSource.TESTPATHS:
+        return                          # a chosen set of tests may need no kernel: they compile what they use
+    try:
+        subprocess.run([sys.executable, "-m", "continuum.numerics.kernel_warmup"], check=True, timeout=900)
+    except (OSError, subprocess.SubprocessError) as exc:
+        # only the time changes: each worker then compiles the kernels it uses itself
+        warnings.warn(f"kernel warm-up failed ({exc}); the workers compile the kernels themselves", stacklevel=1)
 
 
 @pytest.fixture

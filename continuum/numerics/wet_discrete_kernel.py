@@ -36,6 +36,10 @@ mean field's DMT solid pull round summits that keep their own law, e.g. plastic 
 blocks.
 
 The contact time is t - P[pb + B_T0] (t: the kernel's absolute time; the laws' `set_time` in Python).
+
+Selectors passed from one compiled function to another are NumPy scalars (`np.int64(k)`, `np.bool_(b)`), not
+Python constants: numba compiles the callee once for every literal constant a compiled caller passes
+(`Literal[int](k)`), so constant selectors multiplied the kernels' cold compile (docs/benchmarks.md).
 """
 from __future__ import annotations
 
@@ -131,9 +135,9 @@ def _attached(c, was, dl, P):
 def _energy_in(c, was, dl, P, T):
     """Stored energy (J) of one summit under class c's rule (0 beyond its release and reach)."""
     if _attached(c, was, dl, P):
-        return _value(c, dl, True, True, P, T)
+        return _value(c, dl, np.bool_(True), np.bool_(True), P, T)
     if P[c + C_MODE] == MODE_BRANCH and dl >= -P[c + C_REACH]:
-        return _value(c, dl, False, True, P, T)
+        return _value(c, dl, np.bool_(False), np.bool_(True), P, T)
     return 0.0
 
 
@@ -192,15 +196,17 @@ def _bridges(what, gap, tc, S, P, pb, sb, u):
     state's pending part (J, 2) (`MeniscusBridges.force`, `energy`, `formed + pending_formation`)."""
     s = _offset(gap, tc, S, P, pb, sb)
     if what < 2:
-        return _bridge_sum(what, gap, s, math.inf, False, 0.0, 0.0, P, pb, u) if math.isfinite(s) else 0.0
+        if not math.isfinite(s):
+            return 0.0
+        return _bridge_sum(np.int64(what), gap, s, math.inf, np.bool_(False), 0.0, 0.0, P, pb, u)
     s_acc = S[sb + SB_S]
     pending = 0.0
     if s < s_acc:
         if s_acc == math.inf:
-            pending = -_bridge_sum(1, gap, s, math.inf, False, 0.0, 0.0, P, pb, u)
+            pending = -_bridge_sum(np.int64(1), gap, s, math.inf, np.bool_(False), 0.0, 0.0, P, pb, u)
         else:
             g_acc = min(S[sb + SB_G_ACC], _h_mw(max(S[sb + SB_T_ACC], P[pb + B_TA]), P, pb))
-            pending = -_bridge_sum(1, gap, s, s_acc, True, g_acc, gap - s, P, pb, u)
+            pending = -_bridge_sum(np.int64(1), gap, s, s_acc, np.bool_(True), g_acc, gap - s, P, pb, u)
     return S[sb + SB_FORMED] + pending
 
 
@@ -209,7 +215,7 @@ def _bridges_accept(gap, tc, S, P, pb, sb, u):
     """`MeniscusBridges.accept`; flags an abort where the first bridge forms in a contact that began without."""
     s = _offset(gap, tc, S, P, pb, sb)
     if s < S[sb + SB_S]:
-        S[sb + SB_FORMED] = _bridges(2, gap, tc, S, P, pb, sb, u)
+        S[sb + SB_FORMED] = _bridges(np.int64(2), gap, tc, S, P, pb, sb, u)
         if P[pb + B_ABORT_ON_FORM] != 0.0 and S[sb + SB_EVER] == 0.0:
             S[S_BEYOND_FLAG] = 1.0               # the release gap grows to D_K: the Python stepper goes on
         S[sb + SB_EVER] = 1.0
@@ -217,7 +223,8 @@ def _bridges_accept(gap, tc, S, P, pb, sb, u):
     S[sb + SB_T_ACC] = tc
     S[sb + SB_G_ACC] = gap - s if math.isfinite(s) else 0.0
     if math.isfinite(s):
-        S[sb + SB_MAX] = max(S[sb + SB_MAX], _bridge_sum(2, gap, s, math.inf, False, 0.0, 0.0, P, pb, u))
+        bridged = _bridge_sum(np.int64(2), gap, s, math.inf, np.bool_(False), 0.0, 0.0, P, pb, u)
+        S[sb + SB_MAX] = max(S[sb + SB_MAX], bridged)
 
 
 @njit(cache=True)
@@ -252,9 +259,9 @@ def _summits(what, gap, k_trial, S, P, T, out):
         att = _attached(c, was, dl, P)
         if what == _FORCE:
             if att:
-                total += _value(c, dl, True, False, P, T)
+                total += _value(c, dl, np.bool_(True), np.bool_(False), P, T)
             elif P[c + C_MODE] == MODE_BRANCH and dl >= -P[c + C_REACH]:
-                total += _value(c, dl, False, False, P, T)
+                total += _value(c, dl, np.bool_(False), np.bool_(False), P, T)
             continue
         if what == _STORED:
             total += _energy_in(c, was, dl, P, T) if not final else 0.0
@@ -270,9 +277,9 @@ def _summits(what, gap, k_trial, S, P, T, out):
             out[0 if c_old == DRY else 1] += 1.0
         old = 0.0
         if held:
-            old = _value(c_old, dl, True, True, P, T)
+            old = _value(c_old, dl, np.bool_(True), np.bool_(True), P, T)
         elif not was and P[c_old + C_MODE] == MODE_BRANCH and dl >= -P[c_old + C_REACH]:
-            old = _value(c_old, dl, False, True, P, T)
+            old = _value(c_old, dl, np.bool_(False), np.bool_(True), P, T)
         new = _energy_in(c, was, dl, P, T) if not final else 0.0
         out[2] += old - new
     return total
@@ -283,37 +290,37 @@ def wet_value(what, t, gap, S, P, T):
     """Upward force (N, what 0), stored energy (J, 1) or energy booked as lost this contact (J, 2) at `gap` (m)
     and absolute time t (s): the summits' minus the bridges' pull, their sum, and loops + switch work + formation
     work (`WetRoughRoller.force`, `stored_energy`, `dissipated`)."""
-    pb, sb, u = G_BRIDGES, S_BRIDGES, T[0]
+    pb, sb, u = np.int64(G_BRIDGES), np.int64(S_BRIDGES), T[0]
     tc = t - P[pb + B_T0]
     k_trial = _prefix(gap, tc, S, P, pb, sb, u)
     if P[DRY + C_MODE] == MODE_PLASTIC:
-        own = wp.summits(what, gap, k_trial, S, P, T, PARAMS)
+        own = wp.summits(np.int64(what), gap, k_trial, S, P, T, PARAMS)
         if what == 0:
-            return own - _bridges(0, gap, tc, S, P, pb, sb, u)
-        return own + _bridges(what, gap, tc, S, P, pb, sb, u)
+            return own - _bridges(np.int64(0), gap, tc, S, P, pb, sb, u)
+        return own + _bridges(np.int64(what), gap, tc, S, P, pb, sb, u)
     b = np.zeros(3)
     if what == 0:
-        return _summits(_FORCE, gap, k_trial, S, P, T, b) - _bridges(0, gap, tc, S, P, pb, sb, u)
+        return _summits(np.int64(_FORCE), gap, k_trial, S, P, T, b) - _bridges(np.int64(0), gap, tc, S, P, pb, sb, u)
     if what == 1:
-        return _summits(_STORED, gap, k_trial, S, P, T, b) + _bridges(1, gap, tc, S, P, pb, sb, u)
-    _summits(_BOOKS, gap, k_trial, S, P, T, b)
+        return _summits(np.int64(_STORED), gap, k_trial, S, P, T, b) + _bridges(np.int64(1), gap, tc, S, P, pb, sb, u)
+    _summits(np.int64(_BOOKS), gap, k_trial, S, P, T, b)
     return ((S[S_DET_DRY] + b[0]) * P[DRY + C_LOOP] + (S[S_DET_WET] + b[1]) * P[WET + C_LOOP] + S[S_SWITCHED]
-            + b[2] + _bridges(2, gap, tc, S, P, pb, sb, u))
+            + b[2] + _bridges(np.int64(2), gap, tc, S, P, pb, sb, u))
 
 
 @njit(cache=True)
 def wet_accept(t, gap, S, P, T):
     """Commit a trial state (`WetDiscreteRoller.accept`: the summits with the bridged prefix the accepted bridges
     give, then the bridges)."""
-    pb, sb, u = G_BRIDGES, S_BRIDGES, T[0]
+    pb, sb, u = np.int64(G_BRIDGES), np.int64(S_BRIDGES), T[0]
     tc = t - P[pb + B_T0]
     k_trial = _prefix(gap, tc, S, P, pb, sb, u)
     if P[DRY + C_MODE] == MODE_PLASTIC:
-        wp.summits(wp.ACCEPT, gap, k_trial, S, P, T, PARAMS)
+        wp.summits(np.int64(wp.ACCEPT), gap, k_trial, S, P, T, PARAMS)
         _bridges_accept(gap, tc, S, P, pb, sb, u)
         return
     b = np.zeros(3)
-    _summits(_BOOKS, gap, k_trial, S, P, T, b)
+    _summits(np.int64(_BOOKS), gap, k_trial, S, P, T, b)
     S[S_DET_DRY] += b[0]
     S[S_DET_WET] += b[1]
     S[S_SWITCHED] += b[2]
@@ -346,10 +353,10 @@ def bridged_value(what, t, gap, S, P, T):
     tc = t - P[pb + B_T0]
     if what == 0:
         own = law_force(inner, gap, S, P, T)
-        return own - _bridges(0, gap, tc, S, P, pb, sb, T[0])
+        return own - _bridges(np.int64(0), gap, tc, S, P, pb, sb, T[0])
     if what == 1:
-        return law_stored(inner, gap, S, P, T) + _bridges(1, gap, tc, S, P, pb, sb, T[0])
-    return law_dissipated(inner, gap, S, P, T) + _bridges(2, gap, tc, S, P, pb, sb, T[0])
+        return law_stored(inner, gap, S, P, T) + _bridges(np.int64(1), gap, tc, S, P, pb, sb, T[0])
+    return law_dissipated(inner, gap, S, P, T) + _bridges(np.int64(2), gap, tc, S, P, pb, sb, T[0])
 
 
 @njit(cache=True)

@@ -19,6 +19,10 @@ the other, 4 both classes' node info, 5-6 unused, 7 both classes' node branch ro
 slots, committed bridged prefix, loops and jumps booked this contact (J), plastic work booked in total (J), switch
 work (J), 1 + last attached summit, the bridges' block, the largest stretch at which a summit can pull (m), then per
 summit the attached flags, the deepest approaches (m) and the met flags.
+
+Selectors passed from one compiled function to another are NumPy scalars (`np.int64(k)`, `np.bool_(b)`), not
+Python constants: numba compiles the callee once for every literal constant a compiled caller passes
+(`Literal[int](k)`), so constant selectors multiplied the kernels' cold compile (docs/benchmarks.md).
 """
 from __future__ import annotations
 
@@ -126,7 +130,7 @@ def _plastic_work(dm, r, dp, P, T, c):
     if not over > 0.0:
         return 0.0
     w_in = P[c + pk.P_P_U_Y] + P[c + pk.P_P_F_Y] * over + 0.5 * P[c + pk.P_P_SLOPE] * over * over
-    return w_in - _blend(3, dm - dp, r, P, T, c)
+    return w_in - _blend(np.int64(3), dm - dp, r, P, T, c)
 
 
 @njit(cache=True)
@@ -162,21 +166,21 @@ def _span(what, gap, lo, hi, wet, k_wet, S, P, T, c, co, acc):
         if changed and what != FORCE and what != STORED:
             # under the old class to the trial approach (let go there: the old loop), then the class change
             ro, dpo = _flattening(dm0, S, P, T, co)
-            douto = _blend(5, 0.0, ro, P, T, co)
+            douto = _blend(np.int64(5), 0.0, ro, P, T, co)
             h_o = held and delta - dpo > douto
             if held and not h_o:
-                acc[1] += _blend(3, douto, ro, P, T, co) - _blend(1, douto, ro, P, T, co)
+                acc[1] += _blend(np.int64(3), douto, ro, P, T, co) - _blend(np.int64(1), douto, ro, P, T, co)
             e_old = _blend(3 if h_o else 1, delta - dpo, ro, P, T, co)
             held = h_o
         elif changed:
             ro, dpo = _flattening(dm0, S, P, T, co)
-            held = held and delta - dpo > _blend(5, 0.0, ro, P, T, co)
+            held = held and delta - dpo > _blend(np.int64(5), 0.0, ro, P, T, co)
         r, dp = _flattening(dm0, S, P, T, c) if dm0 > d_y else (beta, 0.0)
         eps = delta - dp
         if r == beta:
             din, dout = din_b, dout_b
         else:
-            din, dout = _blend(4, 0.0, r, P, T, c), _blend(5, 0.0, r, P, T, c)
+            din, dout = _blend(np.int64(4), 0.0, r, P, T, c), _blend(np.int64(5), 0.0, r, P, T, c)
         att = eps >= din or (held and eps > dout)
         dm = max(dm0, delta) if att else dm0
         if dm != dm0 and dm > d_y:
@@ -187,11 +191,11 @@ def _span(what, gap, lo, hi, wet, k_wet, S, P, T, c, co, acc):
             total += _value(what == STORED, delta, dm, att, r2, dp2, P, T, c)
             continue
         if changed:
-            acc[4] += e_old - _value(True, delta, dm0, held, r, dp, P, T, c)
+            acc[4] += e_old - _value(np.bool_(True), delta, dm0, held, r, dp, P, T, c)
         if held and not att:
-            acc[1] += _blend(3, dout, r, P, T, c) - _blend(1, dout, r, P, T, c)
+            acc[1] += _blend(np.int64(3), dout, r, P, T, c) - _blend(np.int64(1), dout, r, P, T, c)
         elif att and not held:
-            acc[1] += _blend(1, din, r, P, T, c) - _blend(3, din, r, P, T, c)
+            acc[1] += _blend(np.int64(1), din, r, P, T, c) - _blend(np.int64(3), din, r, P, T, c)
         if dm > dm0:
             acc[2] += _plastic_work(dm, r2, dp2, P, T, c)
             acc[3] += _plastic_work(dm0, r, dp, P, T, c)
@@ -202,7 +206,7 @@ def _span(what, gap, lo, hi, wet, k_wet, S, P, T, c, co, acc):
                 S[met + i] = 1.0
                 acc[5] = i + 1
                 acc[6] += 1.0
-                acc[7] = max(acc[7], -(dout_b if r2 == beta else _blend(5, 0.0, r2, P, T, c)))
+                acc[7] = max(acc[7], -(dout_b if r2 == beta else _blend(np.int64(5), 0.0, r2, P, T, c)))
     acc[0] += total
 
 
@@ -222,8 +226,8 @@ def summits(what, gap, k_trial, S, P, T, base):
     kw = min(k_trial, k)
     acc = np.zeros(8)
     acc[7] = reach
-    _span(what, gap, 0, kw, True, k_wet, S, P, T, cw, cd, acc)
-    _span(what, gap, kw, k, False, k_wet, S, P, T, cd, cw, acc)
+    _span(np.int64(what), gap, np.int64(0), kw, np.bool_(True), k_wet, S, P, T, cw, cd, acc)
+    _span(np.int64(what), gap, kw, k, np.bool_(False), k_wet, S, P, T, cd, cw, acc)
     dw = acc[2] - acc[3]
     if what == BOOKED:
         return S[S_W_TOTAL] + dw - P[base + W0] + S[S_LOOPS] + acc[1] + S[S_SWITCHED] + acc[4]

@@ -21,6 +21,10 @@ Tables (T): 0 e_i - z_top (descending); 1 dm0_i; 2 the flattening's D grid; 3 R_
 delta_out, approach points, retreat points); 7 per node six rows (approach delta, force, energy, retreat delta,
 force, energy), padded. History S: the rigid
 laws' five slots (h_min, unused, most summits attached, unused, beyond-the-tables flag).
+
+Selectors passed from one compiled function to another are NumPy scalars (`np.int64(k)`, `np.bool_(b)`), not
+Python constants: numba compiles the callee once for every literal constant a compiled caller passes
+(`Literal[int](k)`), so constant selectors multiplied the kernels' cold compile (docs/benchmarks.md).
 """
 from __future__ import annotations
 
@@ -125,13 +129,13 @@ def _plastic_work_a(dm, r, dp, P, info, tab):
     if not over > 0.0:
         return 0.0
     w_in = P[P_P_U_Y] + P[P_P_F_Y] * over + 0.5 * P[P_P_SLOPE] * over * over
-    return w_in - _blend_a(3, dm - dp, r, P, info, tab)
+    return w_in - _blend_a(np.int64(3), dm - dp, r, P, info, tab)
 
 
 @njit(cache=True)
 def _blend(what, eps, r, P, T):
     """`_blend_a` on the tables' tuple T (the mean-field kernel `plastic_gw_kernel` calls it so)."""
-    return _blend_a(what, eps, r, P, T[6], T[7])
+    return _blend_a(np.int64(what), eps, r, P, T[6], T[7])
 
 
 @njit(cache=True)
@@ -179,16 +183,16 @@ def _summit_sum(gap, hm, end, k, S, P, e, dm0s, d, flat_r, flat_p, per, info, ta
             dm = deep
             r, dp = _flattening_a(dm, S, P, d, flat_r, flat_p)
             if r != r0:
-                dout = _blend_a(5, 0.0, r, P, info, tab)
+                dout = _blend_a(np.int64(5), 0.0, r, P, info, tab)
         on_r = jumped and not end and delta - dp > dout
         if what == 3:
             total += 1.0 if on_r else 0.0
         elif what == 2:
             if jumped:
                 total += _plastic_work_a(dm, r, dp, P, info, tab) - wp0
-                total += _blend_a(1, din0, r0, P, info, tab) - _blend_a(3, din0, r0, P, info, tab)
+                total += _blend_a(np.int64(1), din0, r0, P, info, tab) - _blend_a(np.int64(3), din0, r0, P, info, tab)
                 if not on_r:
-                    total += _blend_a(3, dout, r, P, info, tab) - _blend_a(1, dout, r, P, info, tab)
+                    total += _blend_a(np.int64(3), dout, r, P, info, tab) - _blend_a(np.int64(1), dout, r, P, info, tab)
         elif on_r and what == 0 and delta >= dm and dm > P[P_P_D_Y]:
             total += P[P_P_F_Y] + P[P_P_SLOPE] * (delta - P[P_P_D_Y])
         else:

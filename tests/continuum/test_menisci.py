@@ -81,16 +81,26 @@ def _bridges(t_a=25e-6):
 
 
 def _brute_force(fn, gap, s, *args):
-    """The footprint sum of fn(gap of each summit) by trapezoids over x (across the roller) and summit height z:
-    summits attached down to the threshold stretch s, Gaussian heights, the roller's parabola."""
+    """The footprint sum of fn(gap of each summit) by trapezoids over x (across the roller) and, at each x, over the
+    summit heights z from the attachment threshold (stretch u = s, summits below it hold no bridge) to the top, in two
+    pieces split where the summit touches (u = gap: the law's kink, a step with a solid pull): Gaussian heights, the
+    roller's parabola. With no step inside a piece the quadrature error falls as the square of the spacing (<= 3e-6 of
+    the sum on this grid, 4x less at twice it)."""
     xmax = math.sqrt(2 * R * -s)
-    x = np.linspace(-xmax, xmax, 2001)
-    z = np.linspace(Z_TOP - 12e-9, Z_TOP, 12001)
-    X, Z = np.meshgrid(x, z, indexing="ij")
-    u = Z - Z_TOP - X * X / (2 * R)
-    phi = np.exp(-0.5 * (Z / SIGMA) ** 2) / (SIGMA * math.sqrt(2 * math.pi))
-    values = np.where(u >= s, fn(gap - u, F0, DK, *args), 0)
-    return np.trapezoid(np.trapezoid(values * phi, z, axis=1), x) * L * DENSITY
+    x = np.linspace(-xmax, xmax, 1001)
+    lift = x * x / (2 * R)
+    z_lo = np.maximum(Z_TOP + s + lift, Z_TOP - 12e-9)
+    z_touch = np.clip(Z_TOP + gap + lift, z_lo, Z_TOP)
+    t = np.linspace(0.0, 1.0, 401)[None, :]
+    total = np.zeros_like(x)
+    # each piece evaluates its own side of the step at the touch point (stretched g > 0, compressed g <= 0)
+    for a, b, side in ((z_lo, z_touch, lambda g: np.maximum(g, 1e-30)), (z_touch, np.full_like(x, Z_TOP),
+                                                                          lambda g: np.minimum(g, 0.0))):
+        Z = a[:, None] + (b - a)[:, None] * t
+        u = Z - Z_TOP - lift[:, None]
+        phi = np.exp(-0.5 * (Z / SIGMA) ** 2) / (SIGMA * math.sqrt(2 * math.pi))
+        total += np.trapezoid(fn(side(gap - u), F0, DK, *args) * phi, Z, axis=1)
+    return np.trapezoid(total, x) * L * DENSITY
 
 
 @pytest.mark.parametrize("gap, s", [(-2e-9, -3e-9), (0.3e-9, -0.5e-9), (-5e-9, -5.5e-9), (-1e-9, -8e-9)])
@@ -98,8 +108,8 @@ def test_bridge_sum_matches_a_brute_force_grid_over_x_and_z(gap, s):
     b = _bridges()
     s = max(s, gap - DK)
     force, energy = _brute_force(men.bridge_force, gap, s), _brute_force(men.bridge_energy, gap, s)
-    assert b._integral("force", gap, s) == pytest.approx(force, rel=2e-4, abs=0)
-    assert b._integral("energy", gap, s) == pytest.approx(energy, rel=2e-4, abs=0)
+    assert b._integral("force", gap, s) == pytest.approx(force, rel=2e-5, abs=0)
+    assert b._integral("energy", gap, s) == pytest.approx(energy, rel=2e-5, abs=0)
 
 
 def test_compiled_bridge_sum_is_the_numpy_sum_to_the_formulas_conditioning():
@@ -286,8 +296,8 @@ def test_bridge_sum_with_solid_pull_matches_a_brute_force_grid(gap, s):
     s = max(s, gap - DK)
     for kind, fn in (("force", men.bridge_force), ("energy", men.bridge_energy)):
         want = _brute_force(fn, gap, s, solid)
-        assert b._integral(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
-        assert b._integral_numpy(kind, gap, s) == pytest.approx(want, rel=2e-4, abs=0)
+        assert b._integral(kind, gap, s) == pytest.approx(want, rel=2e-5, abs=0)
+        assert b._integral_numpy(kind, gap, s) == pytest.approx(want, rel=2e-5, abs=0)
 
 
 def test_a_set_that_declares_nothing_uses_the_wet_solid_adhesion_and_the_paper_set_declares_additive():
