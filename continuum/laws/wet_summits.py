@@ -4,8 +4,9 @@ Inside a capillary bridge the two solids touch under liquid, so a bridged summit
 with W_wet = gamma_1L + gamma_2L - gamma_12 in place of dgamma (Dupre in the liquid, `continuum.wet.menisci.
 wet_work_of_adhesion`; Israelachvili 2011 §17.7, Butt & Kappl 2009): its force, its jump-in and release points,
 and the loop it dissipates when it lets go (a JKR loop scales as W^(5/3): at W_wet / dgamma = 0.15 it is 0.04 of
-the dry one). The mean field corrects only the force (a DMT pull taken from compressed bridged summits,
-`continuum.laws.wet`); on a discrete realisation each summit can carry its own law, and this one does.
+the dry one). The rigid mean field of JKR/Hertz summits splits its footprint integral at the bridge boundary
+(`continuum.laws.wet_mean_field`); the other mean fields correct only the force (a DMT pull taken from compressed
+bridged summits, `continuum.laws.wet`). On a discrete realisation each summit carries its own law, and this one does.
 
 `WetSummitRoller` is a `DiscreteRoughRoller` (the dry law at dgamma, its realisation, its history flags) whose first
 `k_wet` summits (sorted by effective height) follow a second summit law at W_wet: the bridged summits are exactly
