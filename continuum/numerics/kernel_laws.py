@@ -313,6 +313,13 @@ def law_force(kind, gap, S, P, T):
     return bicubic(T[0], T[1], T[2], gap, _rigid_w(_rigid_window(gap, S, P), P))
 
 
+#: `law_force` inlined where the stepper evaluates its stages (`contact_kernel._rhs`: 12 to 15 evaluations a step):
+#: a compiled call that passes the tables' tuple costs ~0.1 us, as much as a summit's evaluation. One function, so
+#: one source of every law's force; the other call sites (samples, events) call `law_force` itself, so the law's
+#: code is compiled a few times, not at every site.
+law_force_inline = njit(inline="always")(law_force.py_func)
+
+
 @njit(cache=True)
 def law_stored(kind, gap, S, P, T):
     """Energy (J) stored in the contact relative to touch."""
