@@ -97,7 +97,7 @@ def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, wor
             if ens:
                 point = _ensemble_point(run_ensemble(other, executor=executor, workers=workers).to_record())
             else:
-                point = {"stick_probability_within_run": float(run_impact(other, condensation_sweep=False).stuck)}
+                point = {"stick_probability_within_run": float(run_impact(other, condensation_sweep=False, series=False).stuck)}
             rows.append({"condensation_time_s": t, **point, "how": "run again at this t_a"})
     values = [r["stick_probability_within_run"] for r in rows]
     lo, hi = rng["range_s"]
