@@ -8,9 +8,9 @@ With `--side-by-side N` it prints only the budget check: the whole command as a 
 (`nanoimpact paper` with its defaults: every set, the default discrete-summit seeds and the sampled claims, 2
 workers), for this tree and for git revision `--baseline` (default PREVIOUS_CYCLE, checked out into a temporary
 git worktree that is removed afterwards), run alternately N times each (baseline, this tree, baseline, ...), each
-tree's numba kernels loaded or compiled first, untimed, and each run with an empty sample cache (NANOIMPACT_CACHE:
-the seeds' and the sampled claims' bundles are run, as on a first run, never read back from an earlier one). Each
-pair's ratio (baseline / this tree, wall and CPU of the command and its pool) and their range are printed: on a
+tree's numba kernels loaded or compiled first by one untimed run of the command, and each run with an empty sample
+cache (NANOIMPACT_CACHE: the seeds' and the sampled claims' bundles are run, as on a first run, never read back from
+an earlier one). Each pair's ratio (baseline / this tree, wall and CPU of the command and its pool) and their range are printed: on a
 shared machine the load moves both runs of a pair alike, so the pair ratios scatter far less than the times.
 
 Otherwise it prints, from one run of this script (so the ratios are comparable on a shared machine):
@@ -241,6 +241,10 @@ def side_by_side(rev: str, repeat: int, workers: int, sets: list[str], keep: Pat
             for root in (base, ROOT):                # compile or load each tree's kernels once, untimed
                 subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=root,
                                env={**os.environ, "PYTHONPATH": str(root)}, check=True, capture_output=True)
+                # numba compiles a kernel the first time a process calls it: the kernels outside warm_up's set
+                # (footprint quadratures, summit laws) would compile inside the first timed run of a tree whose
+                # source-keyed cache is cold (a fresh baseline worktree, this tree after an edit)
+                whole_command(root, sets, workers, warm=False)
             for i in range(repeat):
                 pair = {"load": load()}
                 order = ((("baseline", base), ("this tree", ROOT)) if i % 2 == 0 else
