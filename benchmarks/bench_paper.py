@@ -10,8 +10,9 @@ workers), for this tree and for git revision `--baseline` (default PREVIOUS_CYCL
 git worktree that is removed afterwards), run alternately N times each (baseline, this tree, baseline, ...), each
 tree's numba kernels loaded or compiled first by one untimed run of the command, and each run with an empty sample
 cache (NANOIMPACT_CACHE: the seeds' and the sampled claims' bundles are run, as on a first run, never read back from
-an earlier one). Each pair's ratio (baseline / this tree, wall and CPU of the command and its pool) and their range are printed: on a
-shared machine the load moves both runs of a pair alike, so the pair ratios scatter far less than the times.
+an earlier one). Each pair's ratio (baseline / this tree, wall and CPU of the command and its pool) and their range
+are printed: on a shared machine the load moves both runs of a pair alike, so the pair ratios scatter far less than
+the times.
 
 Otherwise it prints, from one run of this script (so the ratios are comparable on a shared machine):
 
