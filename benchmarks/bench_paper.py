@@ -8,9 +8,11 @@ With `--side-by-side N` it prints only the budget check: the whole command as a 
 (`nanoimpact paper` with its defaults: every set, the default discrete-summit seeds and the sampled claims, 2
 workers), for this tree and for git revision `--baseline` (default PREVIOUS_CYCLE, checked out into a temporary
 git worktree that is removed afterwards), run alternately N times each (baseline, this tree, baseline, ...), each
-tree's numba kernels loaded or compiled first, untimed. Each pair's ratio (baseline / this tree, wall and CPU of
-the command and its pool) and their range are printed: on a shared machine the load moves both runs of a pair
-alike, so the pair ratios scatter far less than the times.
+tree's numba kernels loaded or compiled first by one untimed run of the command, and each run with an empty sample
+cache (NANOIMPACT_CACHE: the seeds' and the sampled claims' bundles are run, as on a first run, never read back from
+an earlier one). Each pair's ratio (baseline / this tree, wall and CPU of the command and its pool) and their range
+are printed: on a shared machine the load moves both runs of a pair alike, so the pair ratios scatter far less than
+the times.
 
 Otherwise it prints, from one run of this script (so the ratios are comparable on a shared machine):
 
@@ -29,7 +31,8 @@ Otherwise it prints, from one run of this script (so the ratios are comparable o
 With `--breakdown`, where the whole command's CPU goes (this tree only): the command process and its pool
 apart, the pool's CPU by kind of run, and two costs that cut across the runs, the rigid rough roller's
 footprint-table builds (`RigidRoughRoller._build`, per process: a table one worker built is built again
-in the other) and the figures' rendering (`atomic_save_figure`, in the runs and in the command process).
+in the other) and the figures' rendering (`atomic_save_figure`, in the runs and in the command process), and the
+costliest runs one by one.
 
 The load average is printed at the start and the end: absolute times move by +-30 % on the shared
 2-core machine, ratios much less.
@@ -112,7 +115,9 @@ def whole_command(code_root: Path, sets: list[str], workers: int, warm: bool = T
     env = {**os.environ, "PYTHONPATH": str(code_root)}
     if warm and (code_root / "continuum" / "compiled_contact.py").exists():
         subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=code_root, env=env, check=True, capture_output=True)
-    with tempfile.TemporaryDirectory() as folder:
+    with tempfile.TemporaryDirectory() as folder, tempfile.TemporaryDirectory() as cache:
+        # a fresh sample cache each run: the seeds' and sampled claims' bundles are run, never read back
+        env["NANOIMPACT_CACHE"] = cache
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         proc = subprocess.run([sys.executable, "-c", WHOLE_SNIPPET, folder, ",".join(sets), str(workers)],
@@ -156,7 +161,8 @@ figures.atomic_save_figure = timed("figure", figures.atomic_save_figure)
 _orig_run = run._run
 def _run(task):
     out = _orig_run(task)
-    log.write(json.dumps({"pid": os.getpid(), "what": "run: " + out["kind"], "cpu": out["cpu_s"]}) + "\\n")
+    log.write(json.dumps({"pid": os.getpid(), "what": "run: " + out["kind"], "cpu": out["cpu_s"],
+                          "task": f"{out['kind']} {out['case']} ({out['set']})"}) + "\\n")
     return out
 run._run = _run
 from calibration.cli import main
@@ -169,12 +175,14 @@ sys.exit(rc)
 
 def breakdown(sets: list[str], workers: int) -> dict:
     """(wall s, CPU s of the command and its pool, {what: (CPU s in the command process, CPU s in the pool,
-    calls)}) of `nanoimpact paper` for all `sets` in one process with BREAKDOWN_SNIPPET's counters."""
+    calls)}, [(task, CPU s), ...] costliest first) of `nanoimpact paper` for all `sets` in one process with
+    BREAKDOWN_SNIPPET's counters."""
     import json
     import resource
 
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
     with tempfile.TemporaryDirectory() as folder:
+        # a fresh sample cache: the seeds' and the sampled claims' bundles are run, as on a first run
+        env = {**os.environ, "PYTHONPATH": str(ROOT), "NANOIMPACT_CACHE": str(Path(folder) / "cache")}
         log = Path(folder) / "cpu.jsonl"
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
@@ -191,7 +199,8 @@ def breakdown(sets: list[str], workers: int) -> dict:
         here, pool, calls = out.get(r["what"], (0.0, 0.0, 0))
         out[r["what"]] = (here + r["cpu"] * (r["pid"] == main_pid), pool + r["cpu"] * (r["pid"] != main_pid), calls + 1)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return {"wall": wall, "cpu": cpu, "parts": out}
+    tasks = sorted(((r["task"], r["cpu"]) for r in rows if "task" in r), key=lambda t: -t[1])
+    return {"wall": wall, "cpu": cpu, "parts": out, "tasks": tasks}
 
 
 def worktree(rev: str, dest: Path) -> Path:
@@ -233,6 +242,10 @@ def side_by_side(rev: str, repeat: int, workers: int, sets: list[str], keep: Pat
             for root in (base, ROOT):                # compile or load each tree's kernels once, untimed
                 subprocess.run([sys.executable, "-c", WARM_SNIPPET], cwd=root,
                                env={**os.environ, "PYTHONPATH": str(root)}, check=True, capture_output=True)
+                # numba compiles a kernel the first time a process calls it: the kernels outside warm_up's set
+                # (footprint quadratures, summit laws) would compile inside the first timed run of a tree whose
+                # source-keyed cache is cold (a fresh baseline worktree, this tree after an edit)
+                whole_command(root, sets, workers, warm=False)
             for i in range(repeat):
                 pair = {"load": load()}
                 order = ((("baseline", base), ("this tree", ROOT)) if i % 2 == 0 else
@@ -334,6 +347,9 @@ def print_breakdown(sets: list[str], workers: int) -> None:
     for what, (here, pool, calls) in sorted(parts.items(), key=lambda kv: -(kv[1][0] + kv[1][1])):
         if what != "command process":
             print(f"{what:28s} {here:14.1f} {pool:11.1f} {calls:6d}")
+    print(f"\nthe costliest runs (CPU s; {len(b['tasks'])} runs):")
+    for task, cpu in b["tasks"][:12]:
+        print(f"  {cpu:7.1f}  {task}")
 
 
 def _dirty() -> bool:

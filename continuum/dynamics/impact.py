@@ -24,7 +24,8 @@ def first_impact_speed(resolved: ResolvedScene) -> float:
 
 
 def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | None = None,
-               executor=None, workers: int | None = None, condensation_sweep: bool = True) -> ImpactResult:
+               executor=None, workers: int | None = None, condensation_sweep: bool = True,
+               series: bool = True) -> ImpactResult:
     """Simulate a resolved scene; returns its typed result (`continuum.output.impact_result.ImpactResult`: the
     result.json record, its typed views, the time series and the scene's `Regime`).
 
@@ -35,7 +36,11 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     process) and adds result.json -> ensemble; the trajectory (bounces, time series) is then the mean-field law's,
     with the members' summit law, for comparison. A humid scene (menisci not 'off') adds result.json ->
     menisci_condensation_time, its sticking against t_a over the range the estimate allows
-    (`continuum.dynamics.wet_sweep`; `condensation_sweep` False leaves it out)."""
+    (`continuum.dynamics.wet_sweep`; `condensation_sweep` False leaves it out). `series=False`, for a caller that
+    reads the bounces and the verdict only (as `continuum.dynamics.escape.single_impact`): no samples inside the
+    integrator's steps, two per flight and no profiles, so the time series holds the step ends and events only; the
+    steps, the events and so every bounce are the same, while the samples' law evaluations (~40 % of a compiled
+    contact's) and a rough law's snapshots are not made."""
     start = time.perf_counter()
     regime = regime_of(resolved.scene, first_impact_speed(resolved))
     resolved, realisation = _settle_realisation(resolved, regime)
@@ -43,7 +48,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
     law, models = select_law(scene, regime.speed, regime=regime)
     if realisation is not None:
         models["realisation"] = realisation.record()
-    run, release = _simulate(resolved, law, models, progress)
+    run, release = _simulate(resolved, law, models, progress, series)
     if models["menisci"].get("decided_by") == "longest_contact_time" and "used" not in models["menisci"]:
         # auto menisci, pending: the dry run settles it (continuum.model.decisions.dry_run_verdict)
         verdict = dry_run_verdict(regime, [b.duration for b in run.bounces], run.status)
@@ -51,7 +56,7 @@ def run_impact(resolved: ResolvedScene, progress: Callable[[Bounce], None] | Non
             law, models = select_law(scene, regime.speed, menisci=True, regime=regime)
             if realisation is not None:
                 models["realisation"] = realisation.record()
-            run, release = _simulate(resolved, law, models, progress)
+            run, release = _simulate(resolved, law, models, progress, series)
         models["menisci"].update(verdict.record())
     models["regimes"] = regime_numbers(scene, regime, models, run)
     wall = time.perf_counter() - start
@@ -151,12 +156,15 @@ def regime_numbers(scene, regime: Regime, models: dict, run) -> dict:
     }
 
 
-def _simulate(resolved: ResolvedScene, law, models: dict, progress):
-    """Drive `law` through the scene's release; returns the run and the release height used (m)."""
+def _simulate(resolved: ResolvedScene, law, models: dict, progress, series: bool = True):
+    """Drive `law` through the scene's release; returns the run and the release height used (m). `series`: the
+    scene's samples and the law's profiles (`run_impact`)."""
     scene = resolved.scene
     n = scene.numerics
+    sampled = {} if series else {"samples_per_step": 0, "profiles": False}
     settings = DriverSettings(rtol=n.rtol, max_bounces=n.max_bounces, max_time=n.max_time,
-                              rest_fraction=n.rest_fraction, samples_per_flight=n.samples_per_flight)
+                              rest_fraction=n.rest_fraction,
+                              samples_per_flight=n.samples_per_flight if series else 2, **sampled)
     release = scene.release_height
     rough = scene.surfaces.roughness if scene.contact == "rough" else None
     if rough is not None and release is not None:

@@ -97,7 +97,8 @@ def condensation_sweep(resolved: ResolvedScene, result: dict, executor=None, wor
             if ens:
                 point = _ensemble_point(run_ensemble(other, executor=executor, workers=workers).to_record())
             else:
-                point = {"stick_probability_within_run": float(run_impact(other, condensation_sweep=False).stuck)}
+                rerun_ = run_impact(other, condensation_sweep=False, series=False)     # read for its verdict
+                point = {"stick_probability_within_run": float(rerun_.stuck)}
             rows.append({"condensation_time_s": t, **point, "how": "run again at this t_a"})
     values = [r["stick_probability_within_run"] for r in rows]
     lo, hi = rng["range_s"]

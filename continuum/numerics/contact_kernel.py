@@ -20,6 +20,10 @@ tolerance; `tests/continuum/test_contact_kernel.py` checks both):
   xtol 1e-30, rtol 4 eps).
 * History laws are restarted at every extremum of the motion, so no stage after it uses the
   history from before it (Hairer, Norsett & Wanner, section II.6 on discontinuities).
+* A step's dense output (three more stages) is built only where it is read: a step that holds an event or
+  samples inside it (SciPy builds it on request too); the force at a step's end is evaluated once for the peak
+  force and the sample; the thin dispatchers between the stepper and the laws are inlined (a compiled call that
+  passes the tables' tuple costs ~0.1 us, as much as a summit's evaluation). None of this changes a number.
 
 Laws with a compiled form (`LAW_RIGID_TABLE`: the rigid rough roller's footprint tables, `continuum.laws.rough_rigid`;
 `LAW_DISCRETE`: a realisation of closed-form JKR or Hertz summits on a rigid base (`continuum.laws.discrete_roller`)
@@ -53,6 +57,7 @@ from .kernel_laws import (
     law_accept,
     law_dissipated,
     law_force,
+    law_force_inline,
     law_release_gap,
     law_release_loss,
     law_stored,
@@ -75,7 +80,7 @@ _EPS = np.finfo(float).eps
 
 
 # ----------------------------------------------------------------------------- the law at time t
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _force(kind, t, gap, S, P, T):
     """`kernel_laws.law_force`, and the time-dependent law (`wet_discrete_kernel`) at absolute time t."""
     if kind == wk.LAW_WET_DISCRETE:
@@ -85,7 +90,17 @@ def _force(kind, t, gap, S, P, T):
     return law_force(kind, gap, S, P, T)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def _stage_force(kind, t, gap, S, P, T):
+    """`_force` with the law's force inlined (`kernel_laws.law_force_inline`): the stepper's stages only."""
+    if kind == wk.LAW_WET_DISCRETE:
+        return wk.wet_value(0, t, gap, S, P, T)
+    if kind == wk.LAW_BRIDGED:
+        return wk.bridged_value(0, t, gap, S, P, T)
+    return law_force_inline(kind, gap, S, P, T)
+
+
+@njit(cache=True, inline="always")
 def _stored(kind, t, gap, S, P, T):
     if kind == wk.LAW_WET_DISCRETE:
         return wk.wet_value(1, t, gap, S, P, T)
@@ -94,7 +109,7 @@ def _stored(kind, t, gap, S, P, T):
     return law_stored(kind, gap, S, P, T)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _dissipated(kind, t, gap, S, P, T):
     if kind == wk.LAW_WET_DISCRETE:
         return wk.wet_value(2, t, gap, S, P, T)
@@ -103,7 +118,7 @@ def _dissipated(kind, t, gap, S, P, T):
     return law_dissipated(kind, gap, S, P, T)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _accept(kind, t, gap, S, P, T):
     if kind == wk.LAW_WET_DISCRETE:
         wk.wet_accept(t, gap, S, P, T)
@@ -114,10 +129,19 @@ def _accept(kind, t, gap, S, P, T):
 
 
 # ----------------------------------------------------------------------------- DOP853
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rhs(kind, t, gap, v, S, P, T, mass, gravity, out, row):
+    """A stage's slope into out[row] (inlined into the stepper and the dense output's stages)."""
     out[row, 0] = v
-    out[row, 1] = _force(kind, t, gap, S, P, T) / mass - gravity
+    out[row, 1] = _stage_force(kind, t, gap, S, P, T) / mass - gravity
+
+
+@njit(cache=True)
+def _first_slope(kind, t, gap, v, S, P, T, mass, gravity, out):
+    """The slope at a step's start (a contact's touch, a restart), into out[0], through `_force` (the law called,
+    not a third inlined copy of it)."""
+    out[0, 0] = v
+    out[0, 1] = _force(kind, t, gap, S, P, T) / mass - gravity
 
 
 @njit(cache=True)
@@ -258,7 +282,15 @@ def _sample(kind, S, P, T, buf, n, t, gap, v, pull, after_max):
     """Record a sample (the driver's `sample`); track the lowest force after the maximum approach."""
     if n >= buf.shape[0]:
         return n + 1
-    f = _force(kind, t, gap, S, P, T)
+    return _sample_f(kind, S, P, T, buf, n, t, gap, v, _force(kind, t, gap, S, P, T), pull, after_max)
+
+
+@njit(cache=True)
+def _sample_f(kind, S, P, T, buf, n, t, gap, v, f, pull, after_max):
+    """`_sample` with the force at (t, gap) already evaluated (`f`, N): where the caller needs it too (the peak
+    force at a step's end or an extremum), the law is evaluated once."""
+    if n >= buf.shape[0]:
+        return n + 1
     buf[n, 0] = t
     buf[n, 1] = gap
     buf[n, 2] = v
@@ -272,6 +304,14 @@ def _sample(kind, S, P, T, buf, n, t, gap, v, pull, after_max):
         pull[2] = f
         pull[3] = 1.0
     return n + 1
+
+
+@njit(cache=True)
+def _needs_dense(y_old, y, release, t_prev, t1, t_stop):
+    """Whether the step t_prev -> t1 holds an event (`_events`' tests on the step's ends): only then, or to sample
+    inside the step, is its dense output (3 more stages) built; a step without either does not read it."""
+    return (y_old[1] < 0.0 <= y[1] or y_old[1] > 0.0 >= y[1] or y_old[0] < release <= y[0]
+            or t_prev < t_stop <= t1)
 
 
 @njit(cache=True)
@@ -372,8 +412,9 @@ def _on_events(kind, S, P, T, mass, gravity, F, t_prev, h, y_old, ne_, ev_t, ev_
             break
         if kind_e == 0 or kind_e == 3:
             max_pen = max(max_pen, -g_e)
-            peak = max(peak, _force(kind, te, g_e, S, P, T))
-            n = _sample(kind, S, P, T, buf, n, te, g_e, 0.0, pull, after_max)
+            f_e = _force(kind, te, g_e, S, P, T)
+            peak = max(peak, f_e)
+            n = _sample_f(kind, S, P, T, buf, n, te, g_e, 0.0, f_e, pull, after_max)
             if kind_e == 0 and info[I_HAS_MAX] == 0.0:
                 info[I_MAX_T] = te
                 info[I_MAX_GAP] = g_e
@@ -424,12 +465,12 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
     S[S_BEYOND_FLAG] = 0.0 if kind != LAW_POWER else S[S_BEYOND_FLAG]
     after_max = after_max0
     t = t0
-    _rhs(kind, t, y[0], y[1], S, P, T, mass, gravity, K, 0)
+    _first_slope(kind, t, y[0], y[1], S, P, T, mass, gravity, K)
     evals = 1
     h_abs = min(first_step, max_step)
     peak = _force(kind, t0, gap0, S, P, T)
     max_pen = -gap0
-    n = _sample(kind, S, P, T, buf, 0, t0, gap0, v0, pull, after_max)
+    n = _sample_f(kind, S, P, T, buf, 0, t0, gap0, v0, peak, pull, after_max)
     last_accept = t0
     steps = 0
     ev_t = np.empty(4)
@@ -462,8 +503,9 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
         t = t1
         y[0] = y_new[0]
         y[1] = y_new[1]
-        _dense_coefficients(kind, S, P, T, mass, gravity, t_prev, y_old, y, K, h, F)
-        evals += 3
+        if samples_per_step > 0 or _needs_dense(y_old, y, release, t_prev, t1, t_stop):
+            _dense_coefficients(kind, S, P, T, mass, gravity, t_prev, y_old, y, K, h, F)
+            evals += 3
         ne_, t_stop = _events(F, t_prev, h, y_old, y, t1, release, t_stop, ev_t, ev_k)
         n = _step_samples(kind, S, P, T, buf, n, F, t_prev, h, y_old, t1, samples_per_step, ne_, ev_t, pull,
                           after_max)
@@ -476,13 +518,14 @@ def integrate_contact(kind, S, P, T, mass, gravity, t0, gap0, v0, rtol, atol, fi
             t = rt
             y[0] = rg
             y[1] = 0.0
-            _rhs(kind, t, y[0], y[1], S, P, T, mass, gravity, K, 0)
+            _first_slope(kind, t, y[0], y[1], S, P, T, mass, gravity, K)
             evals += 1
             h_abs = min(first_step, max_step)
             continue
         max_pen = max(max_pen, -y[0])
-        peak = max(peak, _force(kind, t1, y[0], S, P, T))
-        n = _sample(kind, S, P, T, buf, n, t1, y[0], y[1], pull, after_max)
+        f1 = _force(kind, t1, y[0], S, P, T)
+        peak = max(peak, f1)
+        n = _sample_f(kind, S, P, T, buf, n, t1, y[0], y[1], f1, pull, after_max)
         _accept(kind, t1, y[0], S, P, T)
         last_accept = t1
         # FSAL: the next step starts from f(t1, y1)

@@ -69,24 +69,31 @@ def _span(t, k, x):
     return lo
 
 
-@njit(cache=True)
-def _basis3(t, l, x, h):
-    """The 4 non-zero cubic B-splines at x in knot interval l (de Boor-Cox recursion, FITPACK fpbspl)."""
-    hh = np.empty(3)
-    h[0] = 1.0
-    for j in range(1, 4):
-        for i in range(j):
-            hh[i] = h[i]
-        h[0] = 0.0
-        for i in range(1, j + 1):
-            li = l + i
-            lj = li - j
-            if t[li] == t[lj]:
-                h[i] = 0.0
-                continue
-            f = hh[i - 1] / (t[li] - t[lj])
-            h[i - 1] += f * (t[li] - x)
-            h[i] = f * (x - t[lj])
+@njit(cache=True, inline="always")
+def _dbc(t, l, i, j, hh, h_prev, x):
+    """One term of the de Boor-Cox recursion at order j: (h[i-1] after it, h[i]) from hh = h[i-1] of order j - 1."""
+    li = l + i
+    lj = li - j
+    if t[li] == t[lj]:
+        return h_prev, 0.0
+    f = hh / (t[li] - t[lj])
+    return h_prev + f * (t[li] - x), f * (x - t[lj])
+
+
+@njit(cache=True, inline="always")
+def _basis3(t, l, x):
+    """The 4 non-zero cubic B-splines at x in knot interval l (de Boor-Cox recursion, FITPACK fpbspl), as a tuple:
+    the recursion's operations in FITPACK's order on scalars (no arrays allocated per evaluation, which cost more
+    than the arithmetic)."""
+    h0, h1 = _dbc(t, l, 1, 1, 1.0, 0.0, x)
+    a0, a1 = h0, h1
+    h0, h1 = _dbc(t, l, 1, 2, a0, 0.0, x)
+    h1, h2 = _dbc(t, l, 2, 2, a1, h1, x)
+    a0, a1, a2 = h0, h1, h2
+    h0, h1 = _dbc(t, l, 1, 3, a0, 0.0, x)
+    h1, h2 = _dbc(t, l, 2, 3, a1, h1, x)
+    h2, h3 = _dbc(t, l, 3, 3, a2, h2, x)
+    return h0, h1, h2, h3
 
 
 @njit(cache=True)
@@ -95,9 +102,8 @@ def bicubic(tx, ty, c, x, y):
     x = min(max(x, tx[3]), tx[tx.size - 4])
     y = min(max(y, ty[3]), ty[ty.size - 4])
     lx, ly = _span(tx, 3, x), _span(ty, 3, y)
-    hx, hy = np.empty(4), np.empty(4)
-    _basis3(tx, lx, x, hx)
-    _basis3(ty, ly, y, hy)
+    hx = _basis3(tx, lx, x)
+    hy = _basis3(ty, ly, y)
     ny = ty.size - 4
     total = 0.0
     for i in range(4):
@@ -311,6 +317,13 @@ def law_force(kind, gap, S, P, T):
         S[S_BEYOND_FLAG] = 1.0
         return 0.0
     return bicubic(T[0], T[1], T[2], gap, _rigid_w(_rigid_window(gap, S, P), P))
+
+
+#: `law_force` inlined where the stepper evaluates its stages (`contact_kernel._rhs`: 12 to 15 evaluations a step):
+#: a compiled call that passes the tables' tuple costs ~0.1 us, as much as a summit's evaluation. One function, so
+#: one source of every law's force; the other call sites (samples, events) call `law_force` itself, so the law's
+#: code is compiled a few times, not at every site.
+law_force_inline = njit(inline="always")(law_force.py_func)
 
 
 @njit(cache=True)

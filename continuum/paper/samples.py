@@ -200,7 +200,7 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
     n_si = SAMPLE_MAX_BOUNCES
     for key, case in (("silica", cases["rough_silica"]), ("ots", cases["rough_ots"])):
         resolved = _resolved(case, params, overrides, fidelity, n_si)
-        run = run_impact(resolved)
+        run = run_impact(resolved, series=False)     # read for its bounces only (`_sequence`)
         out[key] = _sequence(run.to_dict())
         n_si = min(SAMPLE_MAX_BOUNCES, out[key]["impacts"] + 2)
         if full:
@@ -209,7 +209,7 @@ def _bundle(params, label, overrides, fidelity, cases, full) -> dict:
             laws[key] = (select_law(sc, v0, regime=run.regime)[0], sc.body.mass, sc.environment.gravity,
                          sc.numerics.rtol, v0)
     s3 = _resolved(sigma_case(3.0), params, overrides, fidelity, 1)
-    out["sigma3"] = _sequence(run_impact(s3).to_dict())
+    out["sigma3"] = _sequence(run_impact(s3, series=False).to_dict())
     if not full:
         return out
     out["escape"] = {k: escape_search(law, m, g, v0, rtol) for k, (law, m, g, rtol, v0) in laws.items()}

@@ -99,7 +99,8 @@ def single_surface_runs(params: str, overrides: dict, fidelity: str | None, case
     out["drops_sigma"] = {6e-9: drops["silica"]}
     for s in SIGMAS_NM:
         if s != 6.0:
-            r = run_impact(_resolved(sigma_case(s), params, overrides, fidelity, SAMPLE_MAX_BOUNCES)).to_dict()
+            r = run_impact(_resolved(sigma_case(s), params, overrides, fidelity, SAMPLE_MAX_BOUNCES),
+                           series=False).to_dict()
             out["drops_sigma"][s * 1e-9] = _sequence(r)
     out["t_a"] = _t_a_claim(params, overrides, fidelity, laws.get(6e-9), out["escape"]["silica"])
     return out
