@@ -31,7 +31,6 @@ from numba.core import dispatcher as _dispatcher
 from numba.core import sigutils
 
 from . import compiled_contact as cc
-from . import contact_kernel as ck
 from . import kernel_laws as kl
 
 try:
@@ -108,14 +107,15 @@ def _install_locks(locks: _FunctionLocks) -> None:
 
 
 def law_part() -> list[tuple[object, tuple]]:
-    """(dispatcher, argument types) of the contact kernel's energy, loss, accept and release dispatchers, in the
-    order the laws' part compiles them (bottom-up: the integrator's own branch, `compiled_contact.warm_up`, reaches
-    the force first), with the types `integrate_contact` calls them with."""
+    """(dispatcher, argument types) of the laws' energy, loss, accept and release dispatchers, in the order the
+    laws' part compiles them (bottom-up: the integrator's own branch, `compiled_contact.warm_up`, reaches the force
+    first), with the types the contact kernel calls them with. The kernel's own thin wrappers (`_stored`,
+    `_dissipated`, `_accept`) are inlined into their callers, so the dispatchers below them are what is compiled."""
     arr, f8, i8 = typeof(np.zeros(1)), types.float64, types.int64
     tables = typeof(cc.EMPTY_TABLES)
-    state = (i8, f8, f8, arr, arr, tables)         # kind, t, gap, S, P, T
-    return [(kl.law_release_loss, (i8, f8, arr, arr, tables)), (kl.law_release_gap, (i8, arr, arr, tables, f8)),
-            (ck._accept, state), (ck._dissipated, state), (ck._stored, state)]
+    state = (i8, f8, arr, arr, tables)             # kind, gap, S, P, T
+    return [(kl.law_release_loss, state), (kl.law_release_gap, (i8, arr, arr, tables, f8)),
+            (kl.law_accept, state), (kl.law_dissipated, state), (kl.law_stored, state)]
 
 
 def _part_laws() -> None:
